@@ -1,0 +1,852 @@
+//! Scenario configuration: the TOML a user writes (user units, every key documented in `assets/`),
+//! parsed strictly, validated once, and converted once into SI [`Params`].
+//!
+//! Every error names the key, the value and the unit (and the allowed range where there is one).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+use crate::euler::Attitude;
+use crate::gimbal::{AxisErrors, AxisGeometry, Chain, TableErrors};
+use crate::motion::{AngleKind, Ramp, VehicleMotion, Wobble};
+use crate::scheme::{IndexedStep, Scheme};
+use crate::units::{RAD_PER_ARCSEC, RAD_PER_DEG};
+
+/// A configuration problem a user can fix. Displayed as one line naming key, value and unit.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    /// The file could not be read.
+    #[error("cannot read config file {path}: {source}")]
+    Read {
+        /// The path as given.
+        path: String,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// TOML syntax, an unknown key or a wrong type (the toml crate's message shows the line).
+    #[error("{origin}: {message}")]
+    Parse {
+        /// The file or scenario name.
+        origin: String,
+        /// toml's message, with the offending line and key.
+        message: String,
+    },
+    /// A number that is not finite (nan, inf).
+    #[error("{origin}: `{key}` = {value} {unit} is not a finite number")]
+    NotFinite {
+        /// The file or scenario name.
+        origin: String,
+        /// Dotted key path.
+        key: String,
+        /// The value as read.
+        value: f64,
+        /// The unit of the key.
+        unit: &'static str,
+    },
+    /// A number outside its allowed range.
+    #[error("{origin}: `{key}` = {value} {unit} is out of range: {range}")]
+    OutOfRange {
+        /// The file or scenario name.
+        origin: String,
+        /// Dotted key path.
+        key: String,
+        /// The value as read.
+        value: f64,
+        /// The unit of the key.
+        unit: &'static str,
+        /// The allowed range and a hint.
+        range: String,
+    },
+    /// Any other inconsistency (duplicate axis names, an unknown axis referenced, ...).
+    #[error("{origin}: `{key}`: {message}")]
+    Invalid {
+        /// The file or scenario name.
+        origin: String,
+        /// Dotted key path.
+        key: String,
+        /// What is wrong and how to fix it.
+        message: String,
+    },
+}
+
+// ---------------------------------------------------------------------------------------------
+// The TOML as written (user units). Defaults live here, in one place, and in assets/ comments.
+// ---------------------------------------------------------------------------------------------
+
+/// The whole scenario file.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawConfig {
+    /// What the scenario is.
+    pub scenario: RawScenario,
+    /// Time span and step.
+    #[serde(default)]
+    pub simulation: RawSimulation,
+    /// Output rates and drawing.
+    #[serde(default)]
+    pub recording: RawRecording,
+    /// Where on Earth.
+    #[serde(default)]
+    pub site: RawSite,
+    /// Vehicle attitude profile.
+    #[serde(default)]
+    pub vehicle: RawVehicle,
+    /// The gimbal chain and its true errors.
+    pub turntable: RawTurntable,
+    /// How the gimbals move.
+    pub scheme: RawScheme,
+    /// Parameters the compensated demodulation assumes (each defaults to the true value).
+    #[serde(default)]
+    pub compensation: RawCompensation,
+}
+
+/// `[scenario]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawScenario {
+    /// Identifier, also the recording's file name.
+    pub name: String,
+    /// One line shown by `rinscope scenarios`.
+    pub title: String,
+    /// Markdown shown beside the scene in the viewer.
+    #[serde(default)]
+    pub description: String,
+    /// Seed of every random draw; stored in the recording.
+    #[serde(default)]
+    pub seed: u64,
+}
+
+/// `[simulation]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RawSimulation {
+    /// Simulated time, s.
+    pub duration_s: f64,
+    /// Simulation (IMU) rate, Hz.
+    pub step_hz: f64,
+}
+
+impl Default for RawSimulation {
+    fn default() -> Self {
+        Self { duration_s: 360.0, step_hz: 200.0 }
+    }
+}
+
+/// `[recording]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RawRecording {
+    /// Time-series output rate, Hz of simulated time.
+    pub series_hz: f64,
+    /// 3D scene output rate, Hz of simulated time.
+    pub scene_hz: f64,
+    /// Factor applied to every error angle when drawing the 3D scene.
+    pub exaggeration: f64,
+}
+
+impl Default for RawRecording {
+    fn default() -> Self {
+        Self { series_hz: 100.0, scene_hz: 25.0, exaggeration: 60.0 }
+    }
+}
+
+/// `[site]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RawSite {
+    /// Geodetic latitude, deg.
+    pub latitude_deg: f64,
+    /// Longitude, deg.
+    pub longitude_deg: f64,
+    /// Height above the ellipsoid, m.
+    pub height_m: f64,
+}
+
+impl Default for RawSite {
+    fn default() -> Self {
+        Self { latitude_deg: 0.0, longitude_deg: 0.0, height_m: 0.0 }
+    }
+}
+
+/// `[vehicle]`
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RawVehicle {
+    /// Initial pitch, deg.
+    pub pitch_deg: f64,
+    /// Initial roll, deg.
+    pub roll_deg: f64,
+    /// Initial heading (clockwise from North), deg.
+    pub heading_deg: f64,
+    /// Scripted ramps of one Euler angle to a target.
+    pub ramp: Vec<RawRamp>,
+    /// Sinusoidal wobble of one Euler angle.
+    pub wobble: Vec<RawWobble>,
+}
+
+/// `[[vehicle.ramp]]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawRamp {
+    /// Which Euler angle: "pitch", "roll" or "heading".
+    pub angle: String,
+    /// Start time, s.
+    pub start_s: f64,
+    /// Target value, deg.
+    pub target_deg: f64,
+    /// Rate magnitude, deg/s.
+    pub rate_deg_per_s: f64,
+}
+
+/// `[[vehicle.wobble]]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawWobble {
+    /// Which Euler angle: "pitch", "roll" or "heading".
+    pub angle: String,
+    /// Amplitude, deg.
+    pub amplitude_deg: f64,
+    /// Frequency, Hz.
+    pub frequency_hz: f64,
+    /// Phase at t = 0, deg.
+    #[serde(default)]
+    pub phase_deg: f64,
+}
+
+/// `[turntable]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawTurntable {
+    /// Installation error of the table base on the body: rotation about body x, arcsec.
+    #[serde(default)]
+    pub installation_x_arcsec: f64,
+    /// Installation error about body y, arcsec.
+    #[serde(default)]
+    pub installation_y_arcsec: f64,
+    /// Installation error about body z, arcsec.
+    #[serde(default)]
+    pub installation_z_arcsec: f64,
+    /// IMU mounting error on the last gimbal: rotation about its x, arcsec.
+    #[serde(default)]
+    pub imu_mount_x_arcsec: f64,
+    /// IMU mounting error about y, arcsec.
+    #[serde(default)]
+    pub imu_mount_y_arcsec: f64,
+    /// IMU mounting error about z, arcsec.
+    #[serde(default)]
+    pub imu_mount_z_arcsec: f64,
+    /// The gimbal axes from the body outward (outer first).
+    pub axis: Vec<RawAxis>,
+}
+
+/// `[[turntable.axis]]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawAxis {
+    /// Name used by the scheme, the compensation and the recording ("outer", "inner", ...).
+    pub name: String,
+    /// Nominal rotation axis in the parent frame: "x", "y" or "z".
+    pub axis: String,
+    /// Gimbal angle at t = 0, deg.
+    #[serde(default)]
+    pub initial_angle_deg: f64,
+    /// Swing-cone half-angle, arcsec.
+    #[serde(default)]
+    pub swing_half_angle_arcsec: f64,
+    /// Swing-cone initial phase, deg.
+    #[serde(default)]
+    pub swing_phase_deg: f64,
+    /// Tilt of this axis toward the previous axis (away from perpendicular), arcsec.
+    #[serde(default)]
+    pub non_orthogonality_arcsec: f64,
+    /// Encoder constant offset, arcsec.
+    #[serde(default)]
+    pub encoder_offset_arcsec: f64,
+    /// Encoder scale-factor error, ppm.
+    #[serde(default)]
+    pub encoder_scale_ppm: f64,
+    /// Encoder latch time minus IMU sample time, ms (positive: the angle is older than the IMU data).
+    #[serde(default)]
+    pub encoder_delay_ms: f64,
+}
+
+/// `[scheme]`: one of "static", "continuous", "indexed".
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawScheme {
+    /// "static", "continuous" or "indexed".
+    pub kind: String,
+    /// Continuous: one rate per axis.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub rate: Vec<RawRate>,
+    /// Indexed: dwell at the start, s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_dwell_s: Option<f64>,
+    /// Indexed: repeat the sequence until the end of the run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub repeat: Option<bool>,
+    /// Indexed: the sequence of moves.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub step: Vec<RawStep>,
+}
+
+/// `[[scheme.rate]]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawRate {
+    /// Axis name.
+    pub axis: String,
+    /// Rotation rate, deg/s (sign = direction).
+    pub rate_deg_per_s: f64,
+}
+
+/// `[[scheme.step]]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawStep {
+    /// Axis name.
+    pub axis: String,
+    /// Rotation of this move, deg (sign = direction).
+    pub angle_deg: f64,
+    /// Cruise rate magnitude, deg/s.
+    pub rate_deg_per_s: f64,
+    /// Dwell after the move, s.
+    #[serde(default)]
+    pub dwell_s: f64,
+    /// Angular acceleration magnitude, deg/s^2 (0: the rate steps instantly).
+    #[serde(default)]
+    pub accel_deg_per_s2: f64,
+}
+
+/// `[compensation]`: every key is optional and defaults to the true value of the same key.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawCompensation {
+    /// See `turntable.installation_x_arcsec`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub installation_x_arcsec: Option<f64>,
+    /// See `turntable.installation_y_arcsec`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub installation_y_arcsec: Option<f64>,
+    /// See `turntable.installation_z_arcsec`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub installation_z_arcsec: Option<f64>,
+    /// See `turntable.imu_mount_x_arcsec`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub imu_mount_x_arcsec: Option<f64>,
+    /// See `turntable.imu_mount_y_arcsec`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub imu_mount_y_arcsec: Option<f64>,
+    /// See `turntable.imu_mount_z_arcsec`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub imu_mount_z_arcsec: Option<f64>,
+    /// Per axis, by name.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub axis: BTreeMap<String, RawAxisCompensation>,
+}
+
+/// `[compensation.axis.NAME]`
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawAxisCompensation {
+    /// arcsec
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub swing_half_angle_arcsec: Option<f64>,
+    /// deg
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub swing_phase_deg: Option<f64>,
+    /// arcsec
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub non_orthogonality_arcsec: Option<f64>,
+    /// arcsec
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub encoder_offset_arcsec: Option<f64>,
+    /// ppm
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub encoder_scale_ppm: Option<f64>,
+    /// ms
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub encoder_delay_ms: Option<f64>,
+}
+
+// ---------------------------------------------------------------------------------------------
+// The validated, SI form.
+// ---------------------------------------------------------------------------------------------
+
+/// What the scenario is, for people.
+#[derive(Debug, Clone)]
+pub struct ScenarioMeta {
+    /// Identifier.
+    pub name: String,
+    /// One line.
+    pub title: String,
+    /// Markdown.
+    pub description: String,
+    /// Seed of every random draw.
+    pub seed: u64,
+}
+
+/// Output rates and drawing.
+#[derive(Debug, Clone, Copy)]
+pub struct RecordingParams {
+    /// Time-series output rate, Hz.
+    pub series_hz: f64,
+    /// Scene output rate, Hz.
+    pub scene_hz: f64,
+    /// Drawing factor for error angles.
+    pub exaggeration: f64,
+}
+
+/// Site on Earth.
+#[derive(Debug, Clone, Copy)]
+pub struct Site {
+    /// Geodetic latitude, rad.
+    pub latitude_rad: f64,
+    /// Longitude, rad.
+    pub longitude_rad: f64,
+    /// Height, m.
+    pub height_m: f64,
+}
+
+/// A validated scenario in SI units.
+#[derive(Debug, Clone)]
+pub struct Params {
+    /// Name, title, description, seed.
+    pub meta: ScenarioMeta,
+    /// Simulated time, s.
+    pub duration_s: f64,
+    /// Simulation rate, Hz.
+    pub step_hz: f64,
+    /// Output rates and drawing.
+    pub recording: RecordingParams,
+    /// Site.
+    pub site: Site,
+    /// Vehicle attitude over time.
+    pub vehicle: VehicleMotion,
+    /// Nominal gimbal geometry.
+    pub chain: Chain,
+    /// True turntable errors.
+    pub truth: TableErrors,
+    /// Errors assumed by the compensated demodulation.
+    pub compensation: TableErrors,
+    /// Gimbal angles over time.
+    pub scheme: Scheme,
+    /// The configuration as resolved (defaults and compensation filled in), as TOML.
+    pub resolved_toml: String,
+}
+
+impl Params {
+    /// Number of simulation steps (samples at t = k / step_hz, k = 0..steps).
+    #[must_use]
+    pub fn steps(&self) -> u64 {
+        // Validation bounds duration * rate, so the cast cannot overflow or go negative.
+        (self.duration_s * self.step_hz).round() as u64 + 1
+    }
+}
+
+/// Reads and validates a scenario file.
+pub fn load_file(path: &Path) -> Result<Params, ConfigError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+        path: path.display().to_string(),
+        source,
+    })?;
+    parse(&text, &path.display().to_string())
+}
+
+/// Parses and validates scenario text; `origin` names the file or the embedded scenario in errors.
+pub fn parse(text: &str, origin: &str) -> Result<Params, ConfigError> {
+    let raw: RawConfig = toml::from_str(text).map_err(|e| ConfigError::Parse {
+        origin: origin.to_owned(),
+        message: e.to_string().trim_end().to_owned(),
+    })?;
+    validate(raw, origin)
+}
+
+/// A helper that knows the file name and checks numbers with their keys and units.
+struct Checker<'a> {
+    origin: &'a str,
+}
+
+impl Checker<'_> {
+    fn finite(&self, key: &str, value: f64, unit: &'static str) -> Result<f64, ConfigError> {
+        if value.is_finite() {
+            Ok(value)
+        } else {
+            Err(ConfigError::NotFinite { origin: self.origin.to_owned(), key: key.to_owned(), value, unit })
+        }
+    }
+
+    /// Checks `lo <= value <= hi` (and finiteness).
+    fn range(&self, key: &str, value: f64, unit: &'static str, lo: f64, hi: f64, hint: &str) -> Result<f64, ConfigError> {
+        self.finite(key, value, unit)?;
+        if value < lo || value > hi {
+            let mut range = format!("allowed {lo} ..= {hi} {unit}");
+            if !hint.is_empty() {
+                range.push_str(" (");
+                range.push_str(hint);
+                range.push(')');
+            }
+            return Err(ConfigError::OutOfRange { origin: self.origin.to_owned(), key: key.to_owned(), value, unit, range });
+        }
+        Ok(value)
+    }
+
+    /// Checks `lo < value <= hi`.
+    fn positive(&self, key: &str, value: f64, unit: &'static str, hi: f64) -> Result<f64, ConfigError> {
+        self.finite(key, value, unit)?;
+        if value <= 0.0 || value > hi {
+            return Err(ConfigError::OutOfRange {
+                origin: self.origin.to_owned(),
+                key: key.to_owned(),
+                value,
+                unit,
+                range: format!("must be > 0 and <= {hi} {unit}"),
+            });
+        }
+        Ok(value)
+    }
+
+    fn invalid(&self, key: &str, message: impl Into<String>) -> ConfigError {
+        ConfigError::Invalid { origin: self.origin.to_owned(), key: key.to_owned(), message: message.into() }
+    }
+}
+
+/// Largest error angle accepted anywhere, arcsec: 10 deg. Turntable errors are arcseconds to
+/// arcminutes; a value this large is a typo (degrees typed into an arcsec key, say).
+pub const MAX_ERROR_ANGLE_ARCSEC: f64 = 36_000.0;
+const ERROR_HINT: &str = "turntable errors are arcsec to arcmin; over 10 deg is a typo";
+
+fn angle_kind(c: &Checker<'_>, key: &str, s: &str) -> Result<AngleKind, ConfigError> {
+    match s {
+        "pitch" => Ok(AngleKind::Pitch),
+        "roll" => Ok(AngleKind::Roll),
+        "heading" => Ok(AngleKind::Heading),
+        other => Err(c.invalid(key, format!("\"{other}\" is not an Euler angle; use \"pitch\", \"roll\" or \"heading\""))),
+    }
+}
+
+fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigError> {
+    let c = Checker { origin };
+
+    // [scenario]
+    if raw.scenario.name.trim().is_empty()
+        || !raw.scenario.name.chars().all(|ch| ch.is_ascii_alphanumeric() || ch == '-' || ch == '_')
+    {
+        return Err(c.invalid(
+            "scenario.name",
+            format!("\"{}\" must be non-empty and use only letters, digits, '-' and '_' (it names the recording file)", raw.scenario.name),
+        ));
+    }
+
+    // [simulation]
+    let step_hz = c.range("simulation.step_hz", raw.simulation.step_hz, "Hz", 1.0, 100_000.0, "")?;
+    let duration_s = c.positive("simulation.duration_s", raw.simulation.duration_s, "s", 30.0 * 86_400.0)?;
+    if duration_s * step_hz > 2.0e9 {
+        return Err(c.invalid(
+            "simulation.duration_s",
+            format!("{duration_s} s at {step_hz} Hz is {:.3e} steps; at most 2e9 are supported", duration_s * step_hz),
+        ));
+    }
+
+    // [recording]
+    let series_hz = c.positive("recording.series_hz", raw.recording.series_hz, "Hz", step_hz)?;
+    let scene_hz = c.positive("recording.scene_hz", raw.recording.scene_hz, "Hz", step_hz)?;
+    let exaggeration = c.range("recording.exaggeration", raw.recording.exaggeration, "x", 1.0, 100_000.0, "")?;
+
+    // [site]
+    let site = Site {
+        latitude_rad: c.range("site.latitude_deg", raw.site.latitude_deg, "deg", -90.0, 90.0, "")? * RAD_PER_DEG,
+        longitude_rad: c.range("site.longitude_deg", raw.site.longitude_deg, "deg", -180.0, 360.0, "")? * RAD_PER_DEG,
+        height_m: c.range("site.height_m", raw.site.height_m, "m", -1000.0, 100_000.0, "")?,
+    };
+
+    // [vehicle]
+    let pitch_hint = "Euler angles are singular at +-90 deg pitch";
+    let base = Attitude {
+        pitch_rad: c.range("vehicle.pitch_deg", raw.vehicle.pitch_deg, "deg", -85.0, 85.0, pitch_hint)? * RAD_PER_DEG,
+        roll_rad: c.range("vehicle.roll_deg", raw.vehicle.roll_deg, "deg", -180.0, 180.0, "")? * RAD_PER_DEG,
+        heading_rad: c.range("vehicle.heading_deg", raw.vehicle.heading_deg, "deg", -360.0, 360.0, "")? * RAD_PER_DEG,
+    };
+    let mut ramps = Vec::new();
+    for (i, r) in raw.vehicle.ramp.iter().enumerate() {
+        let k = |f: &str| format!("vehicle.ramp[{i}].{f}");
+        let kind = angle_kind(&c, &k("angle"), &r.angle)?;
+        let (lo, hi, hint) = match kind {
+            AngleKind::Pitch => (-85.0, 85.0, pitch_hint),
+            AngleKind::Roll => (-180.0, 180.0, ""),
+            AngleKind::Heading => (-3600.0, 3600.0, ""),
+        };
+        ramps.push(Ramp {
+            angle: kind,
+            start_s: c.range(&k("start_s"), r.start_s, "s", 0.0, duration_s, "within the run")?,
+            target_rad: c.range(&k("target_deg"), r.target_deg, "deg", lo, hi, hint)? * RAD_PER_DEG,
+            rate_rad_per_s: c.positive(&k("rate_deg_per_s"), r.rate_deg_per_s, "deg/s", 1000.0)? * RAD_PER_DEG,
+        });
+    }
+    let mut wobbles = Vec::new();
+    for (i, w) in raw.vehicle.wobble.iter().enumerate() {
+        let k = |f: &str| format!("vehicle.wobble[{i}].{f}");
+        wobbles.push(Wobble {
+            angle: angle_kind(&c, &k("angle"), &w.angle)?,
+            amplitude_rad: c.range(&k("amplitude_deg"), w.amplitude_deg, "deg", 0.0, 45.0, "")? * RAD_PER_DEG,
+            omega_rad_per_s: c.range(&k("frequency_hz"), w.frequency_hz, "Hz", 0.0, 0.25 * step_hz, "at most a quarter of simulation.step_hz")?
+                * std::f64::consts::TAU,
+            phase_rad: c.finite(&k("phase_deg"), w.phase_deg, "deg")? * RAD_PER_DEG,
+        });
+    }
+    let vehicle = VehicleMotion::new(base, ramps, wobbles).map_err(|m| c.invalid("vehicle.ramp", m))?;
+    // Pitch must stay clear of the Euler singularity over the whole profile (ramps + wobble).
+    let max_pitch = vehicle.max_abs_pitch_rad(duration_s);
+    if max_pitch > 85.0 * RAD_PER_DEG {
+        return Err(c.invalid(
+            "vehicle",
+            format!("the pitch profile reaches {:.2} deg; keep |pitch| <= 85 deg ({pitch_hint})", max_pitch / RAD_PER_DEG),
+        ));
+    }
+
+    // [turntable]
+    let t = &raw.turntable;
+    if t.axis.is_empty() || t.axis.len() > 3 {
+        return Err(c.invalid("turntable.axis", format!("{} axes given; a table has 1, 2 or 3", t.axis.len())));
+    }
+    let err_angle = |key: &str, v: f64| -> Result<f64, ConfigError> {
+        Ok(c.range(key, v, "arcsec", -MAX_ERROR_ANGLE_ARCSEC, MAX_ERROR_ANGLE_ARCSEC, ERROR_HINT)? * RAD_PER_ARCSEC)
+    };
+    let mut geometry = Vec::new();
+    let mut axis_errors = Vec::new();
+    for (i, a) in t.axis.iter().enumerate() {
+        let k = |f: &str| format!("turntable.axis[{i}].{f}");
+        if a.name.trim().is_empty() || geometry.iter().any(|g: &AxisGeometry| g.name == a.name) {
+            return Err(c.invalid(&k("name"), format!("\"{}\" must be non-empty and unique", a.name)));
+        }
+        let dir = match a.axis.as_str() {
+            "x" => Vector3::x(),
+            "y" => Vector3::y(),
+            "z" => Vector3::z(),
+            other => return Err(c.invalid(&k("axis"), format!("\"{other}\" is not an axis; use \"x\", \"y\" or \"z\""))),
+        };
+        if let Some(prev) = geometry.last() {
+            let prev: &AxisGeometry = prev;
+            if prev.axis.dot(&dir).abs() > 0.5 {
+                return Err(c.invalid(
+                    &k("axis"),
+                    format!("\"{}\" is parallel to the previous axis \"{}\"; consecutive gimbal axes must be perpendicular", a.axis, prev.name),
+                ));
+            }
+        }
+        let swing = c.range(&k("swing_half_angle_arcsec"), a.swing_half_angle_arcsec, "arcsec", 0.0, MAX_ERROR_ANGLE_ARCSEC, ERROR_HINT)?;
+        if i == 0 && a.non_orthogonality_arcsec != 0.0 {
+            return Err(c.invalid(
+                &k("non_orthogonality_arcsec"),
+                format!(
+                    "{} arcsec given on the first axis; its tilt against the body is the installation error (turntable.installation_*_arcsec)",
+                    a.non_orthogonality_arcsec
+                ),
+            ));
+        }
+        geometry.push(AxisGeometry::new(a.name.clone(), dir, c.finite(&k("initial_angle_deg"), a.initial_angle_deg, "deg")? * RAD_PER_DEG));
+        axis_errors.push(AxisErrors {
+            swing_half_angle_rad: swing * RAD_PER_ARCSEC,
+            swing_phase_rad: c.range(&k("swing_phase_deg"), a.swing_phase_deg, "deg", -360.0, 360.0, "")? * RAD_PER_DEG,
+            non_orthogonality_rad: err_angle(&k("non_orthogonality_arcsec"), a.non_orthogonality_arcsec)?,
+            encoder_offset_rad: err_angle(&k("encoder_offset_arcsec"), a.encoder_offset_arcsec)?,
+            encoder_scale: c.range(&k("encoder_scale_ppm"), a.encoder_scale_ppm, "ppm", -10_000.0, 10_000.0, "1% at most")? * 1e-6,
+            encoder_delay_s: c.range(&k("encoder_delay_ms"), a.encoder_delay_ms, "ms", -1000.0, 1000.0, "")? * 1e-3,
+        });
+    }
+    let chain = Chain::new(geometry);
+    let truth = TableErrors {
+        installation_rad: Vector3::new(
+            err_angle("turntable.installation_x_arcsec", t.installation_x_arcsec)?,
+            err_angle("turntable.installation_y_arcsec", t.installation_y_arcsec)?,
+            err_angle("turntable.installation_z_arcsec", t.installation_z_arcsec)?,
+        ),
+        imu_mount_rad: Vector3::new(
+            err_angle("turntable.imu_mount_x_arcsec", t.imu_mount_x_arcsec)?,
+            err_angle("turntable.imu_mount_y_arcsec", t.imu_mount_y_arcsec)?,
+            err_angle("turntable.imu_mount_z_arcsec", t.imu_mount_z_arcsec)?,
+        ),
+        axes: axis_errors,
+    };
+
+    // [scheme]
+    let scheme = validate_scheme(&c, &raw.scheme, &chain)?;
+
+    // [compensation]
+    let (compensation, resolved_comp) = validate_compensation(&c, &raw.compensation, &raw.turntable, &chain, &truth)?;
+
+    let meta = ScenarioMeta {
+        name: raw.scenario.name.clone(),
+        title: raw.scenario.title.clone(),
+        description: raw.scenario.description.clone(),
+        seed: raw.scenario.seed,
+    };
+    let mut resolved = raw;
+    resolved.compensation = resolved_comp;
+    let resolved_toml = toml::to_string_pretty(&resolved).unwrap_or_else(|e| format!("# could not serialise: {e}"));
+
+    Ok(Params {
+        meta,
+        duration_s,
+        step_hz,
+        recording: RecordingParams { series_hz, scene_hz, exaggeration },
+        site,
+        vehicle,
+        chain,
+        truth,
+        compensation,
+        scheme,
+        resolved_toml,
+    })
+}
+
+fn axis_index(c: &Checker<'_>, key: &str, chain: &Chain, name: &str) -> Result<usize, ConfigError> {
+    chain.index_of(name).ok_or_else(|| {
+        let names: Vec<&str> = chain.axes().iter().map(|a| a.name.as_str()).collect();
+        c.invalid(key, format!("no turntable axis is named \"{name}\"; the axes are {names:?}"))
+    })
+}
+
+fn validate_scheme(c: &Checker<'_>, s: &RawScheme, chain: &Chain) -> Result<Scheme, ConfigError> {
+    let n = chain.axes().len();
+    let only_for = |key: &str, kind: &str| c.invalid(key, format!("is only read when scheme.kind = \"{kind}\"; remove it or change the kind"));
+    match s.kind.as_str() {
+        "static" | "continuous" => {
+            if s.initial_dwell_s.is_some() {
+                return Err(only_for("scheme.initial_dwell_s", "indexed"));
+            }
+            if s.repeat.is_some() {
+                return Err(only_for("scheme.repeat", "indexed"));
+            }
+            if !s.step.is_empty() {
+                return Err(only_for("scheme.step", "indexed"));
+            }
+        }
+        "indexed" => {
+            if !s.rate.is_empty() {
+                return Err(only_for("scheme.rate", "continuous"));
+            }
+        }
+        other => {
+            return Err(c.invalid("scheme.kind", format!("\"{other}\" is not a scheme; use \"static\", \"continuous\" or \"indexed\"")));
+        }
+    }
+    let initial: Vec<f64> = chain.axes().iter().map(|a| a.initial_angle_rad).collect();
+    match s.kind.as_str() {
+        "static" => {
+            if !s.rate.is_empty() {
+                return Err(only_for("scheme.rate", "continuous"));
+            }
+            Ok(Scheme::continuous(initial, vec![0.0; n]))
+        }
+        "continuous" => {
+            if s.rate.is_empty() {
+                return Err(c.invalid("scheme.rate", "a continuous scheme needs at least one [[scheme.rate]] entry"));
+            }
+            let mut rates = vec![0.0; n];
+            for (i, r) in s.rate.iter().enumerate() {
+                let idx = axis_index(c, &format!("scheme.rate[{i}].axis"), chain, &r.axis)?;
+                rates[idx] = c.range(&format!("scheme.rate[{i}].rate_deg_per_s"), r.rate_deg_per_s, "deg/s", -1000.0, 1000.0, "")? * RAD_PER_DEG;
+            }
+            Ok(Scheme::continuous(initial, rates))
+        }
+        _ => {
+            if s.step.is_empty() {
+                return Err(c.invalid("scheme.step", "an indexed scheme needs at least one [[scheme.step]]"));
+            }
+            let dwell0 = c.range("scheme.initial_dwell_s", s.initial_dwell_s.unwrap_or(0.0), "s", 0.0, 1e7, "")?;
+            let mut steps = Vec::new();
+            for (i, st) in s.step.iter().enumerate() {
+                let k = |f: &str| format!("scheme.step[{i}].{f}");
+                steps.push(IndexedStep {
+                    axis: axis_index(c, &k("axis"), chain, &st.axis)?,
+                    angle_rad: c.range(&k("angle_deg"), st.angle_deg, "deg", -3600.0, 3600.0, "")? * RAD_PER_DEG,
+                    rate_rad_per_s: c.positive(&k("rate_deg_per_s"), st.rate_deg_per_s, "deg/s", 1000.0)? * RAD_PER_DEG,
+                    dwell_s: c.range(&k("dwell_s"), st.dwell_s, "s", 0.0, 1e7, "")?,
+                    accel_rad_per_s2: c.range(&k("accel_deg_per_s2"), st.accel_deg_per_s2, "deg/s^2", 0.0, 1e5, "0 means the rate steps instantly")?
+                        * RAD_PER_DEG,
+                });
+            }
+            let scheme = Scheme::indexed(initial, dwell0, steps, s.repeat.unwrap_or(true));
+            if scheme.period_s() <= 0.0 {
+                return Err(c.invalid("scheme.step", "the sequence takes no time (all moves and dwells are zero)"));
+            }
+            Ok(scheme)
+        }
+    }
+}
+
+fn validate_compensation(
+    c: &Checker<'_>,
+    comp: &RawCompensation,
+    table: &RawTurntable,
+    chain: &Chain,
+    truth: &TableErrors,
+) -> Result<(TableErrors, RawCompensation), ConfigError> {
+    let err_angle = |key: &str, v: f64| -> Result<f64, ConfigError> {
+        Ok(c.range(key, v, "arcsec", -MAX_ERROR_ANGLE_ARCSEC, MAX_ERROR_ANGLE_ARCSEC, ERROR_HINT)? * RAD_PER_ARCSEC)
+    };
+    for name in comp.axis.keys() {
+        axis_index(c, &format!("compensation.axis.{name}"), chain, name)?;
+    }
+    let pick = |v: Option<f64>, default: f64| v.unwrap_or(default);
+    let mut resolved = RawCompensation {
+        installation_x_arcsec: Some(pick(comp.installation_x_arcsec, table.installation_x_arcsec)),
+        installation_y_arcsec: Some(pick(comp.installation_y_arcsec, table.installation_y_arcsec)),
+        installation_z_arcsec: Some(pick(comp.installation_z_arcsec, table.installation_z_arcsec)),
+        imu_mount_x_arcsec: Some(pick(comp.imu_mount_x_arcsec, table.imu_mount_x_arcsec)),
+        imu_mount_y_arcsec: Some(pick(comp.imu_mount_y_arcsec, table.imu_mount_y_arcsec)),
+        imu_mount_z_arcsec: Some(pick(comp.imu_mount_z_arcsec, table.imu_mount_z_arcsec)),
+        axis: BTreeMap::new(),
+    };
+    let mut axes = Vec::new();
+    for (i, a) in table.axis.iter().enumerate() {
+        let given = comp.axis.get(&a.name).cloned().unwrap_or_default();
+        let k = |f: &str| format!("compensation.axis.{}.{f}", a.name);
+        let r = RawAxisCompensation {
+            swing_half_angle_arcsec: Some(pick(given.swing_half_angle_arcsec, a.swing_half_angle_arcsec)),
+            swing_phase_deg: Some(pick(given.swing_phase_deg, a.swing_phase_deg)),
+            non_orthogonality_arcsec: Some(pick(given.non_orthogonality_arcsec, a.non_orthogonality_arcsec)),
+            encoder_offset_arcsec: Some(pick(given.encoder_offset_arcsec, a.encoder_offset_arcsec)),
+            encoder_scale_ppm: Some(pick(given.encoder_scale_ppm, a.encoder_scale_ppm)),
+            encoder_delay_ms: Some(pick(given.encoder_delay_ms, a.encoder_delay_ms)),
+        };
+        if i == 0 && r.non_orthogonality_arcsec != Some(0.0) {
+            return Err(c.invalid(&k("non_orthogonality_arcsec"), "the first axis has no non-orthogonality; compensate installation_*_arcsec instead"));
+        }
+        axes.push(AxisErrors {
+            swing_half_angle_rad: c.range(
+                &k("swing_half_angle_arcsec"),
+                r.swing_half_angle_arcsec.unwrap_or_default(),
+                "arcsec",
+                0.0,
+                MAX_ERROR_ANGLE_ARCSEC,
+                ERROR_HINT,
+            )? * RAD_PER_ARCSEC,
+            swing_phase_rad: c.range(&k("swing_phase_deg"), r.swing_phase_deg.unwrap_or_default(), "deg", -360.0, 360.0, "")? * RAD_PER_DEG,
+            non_orthogonality_rad: err_angle(&k("non_orthogonality_arcsec"), r.non_orthogonality_arcsec.unwrap_or_default())?,
+            encoder_offset_rad: err_angle(&k("encoder_offset_arcsec"), r.encoder_offset_arcsec.unwrap_or_default())?,
+            encoder_scale: c.range(&k("encoder_scale_ppm"), r.encoder_scale_ppm.unwrap_or_default(), "ppm", -10_000.0, 10_000.0, "1% at most")? * 1e-6,
+            encoder_delay_s: c.range(&k("encoder_delay_ms"), r.encoder_delay_ms.unwrap_or_default(), "ms", -1000.0, 1000.0, "")? * 1e-3,
+        });
+        resolved.axis.insert(a.name.clone(), r);
+    }
+    let errors = TableErrors {
+        installation_rad: Vector3::new(
+            err_angle("compensation.installation_x_arcsec", resolved.installation_x_arcsec.unwrap_or_default())?,
+            err_angle("compensation.installation_y_arcsec", resolved.installation_y_arcsec.unwrap_or_default())?,
+            err_angle("compensation.installation_z_arcsec", resolved.installation_z_arcsec.unwrap_or_default())?,
+        ),
+        imu_mount_rad: Vector3::new(
+            err_angle("compensation.imu_mount_x_arcsec", resolved.imu_mount_x_arcsec.unwrap_or_default())?,
+            err_angle("compensation.imu_mount_y_arcsec", resolved.imu_mount_y_arcsec.unwrap_or_default())?,
+            err_angle("compensation.imu_mount_z_arcsec", resolved.imu_mount_z_arcsec.unwrap_or_default())?,
+        ),
+        axes,
+    };
+    debug_assert_eq!(errors.axes.len(), truth.axes.len());
+    Ok((errors, resolved))
+}

@@ -1,0 +1,366 @@
+//! One simulation step: truth, encoders, and the body attitude error of three demodulations.
+//!
+//! Pure: `step(&Model, &mut DemodState, t)` knows nothing of Rerun, files or threads.
+//! The IMU attitude is exact here (an ideal INS), so every error is the turntable's.
+
+use nalgebra::UnitQuaternion;
+
+use crate::config::Params;
+use crate::euler::{Attitude, AttitudeError};
+use crate::frames::{Rot, B, N, S};
+use crate::gimbal::{Chain, ErrorRotations, LinkRotations, TableErrors};
+use crate::motion::VehicleMotion;
+use crate::scheme::{AxisValues, Scheme, MAX_AXES};
+
+/// The three ways of computing the body attitude, in recording order.
+pub const VARIANTS: [&str; 3] = ["uncompensated", "compensated", "closed_form"];
+/// The three attitude-error axes, in recording order.
+pub const ERROR_AXES: [&str; 3] = ["pitch", "roll", "heading"];
+
+/// Everything a step needs, precomputed from [`Params`].
+#[derive(Debug, Clone)]
+pub struct Model {
+    /// Nominal chain.
+    pub chain: Chain,
+    /// Vehicle motion.
+    pub vehicle: VehicleMotion,
+    /// Gimbal angles over time.
+    pub scheme: Scheme,
+    /// True errors.
+    pub truth: TableErrors,
+    /// Errors assumed by the compensated demodulation.
+    pub compensation: TableErrors,
+    truth_rot: ErrorRotations,
+    compensation_rot: ErrorRotations,
+    /// Exaggerated truth, for drawing.
+    drawing_rot: ErrorRotations,
+}
+
+impl Model {
+    /// Precomputes the constant rotations of a scenario.
+    #[must_use]
+    pub fn new(p: &Params) -> Self {
+        Self::from_parts(p.chain.clone(), p.vehicle.clone(), p.scheme.clone(), p.truth.clone(), p.compensation.clone(), p.recording.exaggeration)
+    }
+
+    /// Builds a model from its parts (tests and benchmarks vary them independently).
+    #[must_use]
+    pub fn from_parts(chain: Chain, vehicle: VehicleMotion, scheme: Scheme, truth: TableErrors, compensation: TableErrors, exaggeration: f64) -> Self {
+        let truth_rot = chain.error_rotations(&truth);
+        let compensation_rot = chain.error_rotations(&compensation);
+        let drawing_rot = chain.error_rotations(&truth.exaggerated(exaggeration));
+        Self { chain, vehicle, scheme, truth, compensation, truth_rot, compensation_rot, drawing_rot }
+    }
+
+    /// Number of gimbal axes.
+    #[must_use]
+    pub fn n_axes(&self) -> usize {
+        self.chain.axes().len()
+    }
+
+    /// The exaggerated link rotations at gimbal angles `angles_rad`, for the 3D scene.
+    #[must_use]
+    pub fn drawing_links(&self, angles_rad: &AxisValues) -> LinkRotations {
+        self.chain.link_rotations(&self.drawing_rot, angles_rad)
+    }
+}
+
+/// What the compensated demodulation remembers between steps (to estimate the gimbal rate for the
+/// encoder-delay correction from its own readings, as a real system must).
+#[derive(Debug, Clone, Default)]
+pub struct DemodState {
+    previous: Option<(f64, AxisValues)>,
+}
+
+/// Everything one step produces.
+#[derive(Debug, Clone, Copy)]
+pub struct StepOutput {
+    /// Simulated time, s.
+    pub t_s: f64,
+    /// True vehicle attitude.
+    pub attitude: Attitude,
+    /// True C_b^n.
+    pub n_from_b: UnitQuaternion<f64>,
+    /// True gimbal angles, rad.
+    pub gimbal_rad: AxisValues,
+    /// Encoder readings, rad.
+    pub encoder_rad: AxisValues,
+    /// Attitude errors per variant (see [`VARIANTS`]).
+    pub errors: [AttitudeError; 3],
+}
+
+/// The body attitude a RINS computes from the IMU attitude and a model of the table.
+fn demodulate(n_from_s: Rot<N, S>, b_from_s: Rot<B, S>) -> Attitude {
+    Attitude::from_n_from_b(&(n_from_s * b_from_s.inverse()))
+}
+
+/// Advances the simulation to `t_s` (steps must come in increasing time).
+#[must_use]
+pub fn step(model: &Model, state: &mut DemodState, t_s: f64) -> StepOutput {
+    let attitude = model.vehicle.attitude(t_s);
+    let n_from_b = attitude.n_from_b();
+    let (gimbal_rad, rate_rad_per_s) = model.scheme.state(t_s);
+    let n = model.n_axes();
+
+    // Truth: the IMU attitude through the exact chain (an ideal INS reports it without error).
+    let n_from_s = n_from_b * model.chain.b_from_s(&model.truth_rot, &gimbal_rad);
+
+    // Encoders: latched `delay` before the IMU sample, then offset and scale applied.
+    let mut encoder_rad = [0.0; MAX_AXES];
+    for k in 0..n {
+        let e = &model.truth.axes[k];
+        let latched = if e.encoder_delay_s == 0.0 { gimbal_rad[k] } else { model.scheme.state(t_s - e.encoder_delay_s).0[k] };
+        encoder_rad[k] = e.encoder_reading(latched);
+    }
+
+    // 1. Uncompensated: the nominal table with the raw encoder angles.
+    let uncompensated = demodulate(n_from_s, model.chain.b_from_s_nominal(&encoder_rad));
+
+    // 2. Compensated: the exact chain with the assumed errors, encoder corrected and extrapolated
+    //    over the assumed delay with the rate seen in successive corrected readings.
+    let mut corrected = [0.0; MAX_AXES];
+    for k in 0..n {
+        corrected[k] = model.compensation.axes[k].encoder_correct(encoder_rad[k]);
+    }
+    let raw_corrected = corrected;
+    if let Some((t_prev, prev)) = state.previous {
+        let dt = t_s - t_prev;
+        if dt > 0.0 {
+            for k in 0..n {
+                corrected[k] += (raw_corrected[k] - prev[k]) / dt * model.compensation.axes[k].encoder_delay_s;
+            }
+        }
+    }
+    state.previous = Some((t_s, raw_corrected));
+    let compensated = demodulate(n_from_s, model.chain.b_from_s(&model.compensation_rot, &corrected));
+
+    // 3. Closed form: first-order error model (docs/closed-form.md).
+    let phi_b = model.chain.first_order_phi_b(&model.truth, &gimbal_rad, &rate_rad_per_s);
+    let closed_form = AttitudeError::first_order(&attitude, n_from_b.apply(phi_b));
+
+    StepOutput {
+        t_s,
+        attitude,
+        n_from_b: *n_from_b.quaternion(),
+        gimbal_rad,
+        encoder_rad,
+        errors: [uncompensated.error_from(&attitude), compensated.error_from(&attitude), closed_form],
+    }
+}
+
+/// Running RMS and peak of one error component.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Stat {
+    sum_sq: f64,
+    peak_abs: f64,
+    count: u64,
+}
+
+impl Stat {
+    /// Adds one sample.
+    pub fn add(&mut self, x: f64) {
+        self.sum_sq += x * x;
+        self.peak_abs = self.peak_abs.max(x.abs());
+        self.count += 1;
+    }
+
+    /// Root mean square of the samples.
+    #[must_use]
+    pub fn rms(&self) -> f64 {
+        if self.count == 0 { 0.0 } else { (self.sum_sq / self.count as f64).sqrt() }
+    }
+
+    /// Largest absolute sample.
+    #[must_use]
+    pub fn peak(&self) -> f64 {
+        self.peak_abs
+    }
+}
+
+/// RMS and peak of every variant and axis over a run.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ErrorStats {
+    /// `[variant][axis]`, radians.
+    pub stats: [[Stat; 3]; 3],
+}
+
+impl ErrorStats {
+    /// Adds one step's errors.
+    pub fn add(&mut self, out: &StepOutput) {
+        for (v, e) in out.errors.iter().enumerate() {
+            for (a, x) in e.as_array().into_iter().enumerate() {
+                self.stats[v][a].add(x);
+            }
+        }
+    }
+}
+
+/// Runs a model over `[0, duration]` at `step_hz` without recording; returns the statistics.
+#[must_use]
+pub fn run_stats(model: &Model, duration_s: f64, step_hz: f64) -> ErrorStats {
+    let mut state = DemodState::default();
+    let mut stats = ErrorStats::default();
+    let steps = (duration_s * step_hz).round() as u64 + 1;
+    for i in 0..steps {
+        let out = step(model, &mut state, i as f64 / step_hz);
+        stats.add(&out);
+    }
+    stats
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::Vector3;
+
+    use super::*;
+    use crate::gimbal::AxisGeometry;
+    use crate::scheme::IndexedStep;
+    use crate::units::{ARCSEC_PER_RAD, RAD_PER_ARCMIN, RAD_PER_ARCSEC, RAD_PER_DEG};
+
+    fn dual_axis_chain() -> Chain {
+        Chain::new(vec![
+            AxisGeometry::new("outer".into(), Vector3::y(), 0.0),
+            AxisGeometry::new("inner".into(), Vector3::z(), 0.0),
+        ])
+    }
+
+    /// A 16-step dual-axis sequence (docs/schemes.md) at 10 deg/s with 20 s dwells.
+    fn sixteen_position() -> Scheme {
+        let s = |axis, deg: f64| IndexedStep { axis, angle_rad: deg * RAD_PER_DEG, rate_rad_per_s: 10.0 * RAD_PER_DEG, dwell_s: 20.0, accel_rad_per_s2: 0.0 };
+        let first = [s(1, 180.0), s(0, 180.0), s(1, 180.0), s(0, 180.0), s(0, -180.0), s(1, -180.0), s(0, -180.0), s(1, -180.0)];
+        let second = [s(1, -180.0), s(0, -180.0), s(1, -180.0), s(0, -180.0), s(0, 180.0), s(1, 180.0), s(0, 180.0), s(1, 180.0)];
+        Scheme::indexed(vec![0.0, 0.0], 20.0, first.into_iter().chain(second).collect(), true)
+    }
+
+    fn moving_vehicle() -> VehicleMotion {
+        use crate::motion::{AngleKind, Wobble};
+        VehicleMotion::new(
+            Attitude { pitch_rad: 10.0 * RAD_PER_DEG, roll_rad: -20.0 * RAD_PER_DEG, heading_rad: 40.0 * RAD_PER_DEG },
+            vec![],
+            vec![
+                Wobble { angle: AngleKind::Pitch, amplitude_rad: 5.0 * RAD_PER_DEG, omega_rad_per_s: 0.3, phase_rad: 0.0 },
+                Wobble { angle: AngleKind::Heading, amplitude_rad: 30.0 * RAD_PER_DEG, omega_rad_per_s: 0.05, phase_rad: 1.0 },
+            ],
+        )
+        .expect("valid motion")
+    }
+
+    fn all_errors() -> TableErrors {
+        let mut e = TableErrors::zero(2);
+        e.installation_rad = Vector3::new(5.0, -5.0, 2.0) * RAD_PER_ARCMIN;
+        e.imu_mount_rad = Vector3::new(1.0, 2.0, -3.0) * RAD_PER_ARCMIN;
+        e.axes[0].swing_half_angle_rad = 10.0 * RAD_PER_ARCMIN;
+        e.axes[0].swing_phase_rad = 1.0 * RAD_PER_DEG;
+        e.axes[1].swing_half_angle_rad = 5.0 * RAD_PER_ARCMIN;
+        e.axes[1].swing_phase_rad = 1.0 * RAD_PER_DEG;
+        e.axes[1].non_orthogonality_rad = 20.0 * RAD_PER_ARCSEC;
+        e.axes[0].encoder_offset_rad = 30.0 * RAD_PER_ARCSEC;
+        e.axes[1].encoder_scale = 20e-6;
+        e
+    }
+
+    fn peak_arcsec(stats: &ErrorStats, variant: usize) -> f64 {
+        stats.stats[variant].iter().map(|s| s.peak()).fold(0.0, f64::max) * ARCSEC_PER_RAD
+    }
+
+    #[test]
+    fn zero_errors_give_zero_error_over_a_full_scheme() {
+        // Analytic anchor: with a perfect table the nominal demodulation is exact (issue: < 1e-6 arcsec).
+        let scheme = sixteen_position();
+        let duration = 20.0 + scheme.period_s();
+        let model = Model::from_parts(dual_axis_chain(), moving_vehicle(), scheme, TableErrors::zero(2), TableErrors::zero(2), 1.0);
+        let stats = run_stats(&model, duration, 50.0);
+        for v in 0..3 {
+            assert!(peak_arcsec(&stats, v) < 1e-6, "variant {v}: {}", peak_arcsec(&stats, v));
+        }
+    }
+
+    #[test]
+    fn compensation_with_true_parameters_leaves_no_residual() {
+        // Issue: compensated with the true parameters -> residual below 1e-3 arcsec.
+        let scheme = sixteen_position();
+        let truth = all_errors();
+        let model = Model::from_parts(dual_axis_chain(), moving_vehicle(), scheme, truth.clone(), truth, 1.0);
+        let stats = run_stats(&model, 400.0, 50.0);
+        assert!(peak_arcsec(&stats, 0) > 60.0, "the uncompensated error is arcminutes");
+        assert!(peak_arcsec(&stats, 1) < 1e-3, "compensated residual {}", peak_arcsec(&stats, 1));
+    }
+
+    #[test]
+    fn closed_form_minus_exact_is_second_order() {
+        // Halving all errors halves the error (first order) and quarters closed-form minus exact.
+        let scheme = sixteen_position();
+        let deviation = |f: f64| {
+            let truth = all_errors().scaled(f);
+            let model = Model::from_parts(dual_axis_chain(), moving_vehicle(), scheme.clone(), truth, TableErrors::zero(2), 1.0);
+            let mut st = DemodState::default();
+            let (mut dev, mut mag) = (0.0f64, 0.0f64);
+            for i in 0..4000 {
+                let out = step(&model, &mut st, i as f64 * 0.1);
+                for (a, b) in out.errors[0].as_array().iter().zip(out.errors[2].as_array()) {
+                    dev = dev.max((a - b).abs());
+                    mag = mag.max(a.abs());
+                }
+            }
+            (dev, mag)
+        };
+        let (d1, m1) = deviation(1.0);
+        let (d2, m2) = deviation(0.5);
+        assert!((m1 / m2 - 2.0).abs() < 0.02, "error is first order: {m1} / {m2}");
+        assert!((d1 / d2 - 4.0).abs() < 0.3, "closed form deviation is second order: {d1} / {d2}");
+    }
+
+    #[test]
+    fn non_orthogonality_alone_turns_with_the_outer_gimbal_and_scales_linearly() {
+        // η alone, level vehicle at heading 0, outer axis (body y) turning at ω, inner at rest.
+        // Exact: E_b = R_y(ζ) T R_y(-ζ), T = exp(η (z × y)) = exp(-η x), so to first order
+        // Φ_b = R_y(ζ)(-η x) = (-η cos ζ, 0, η sin ζ): pitch error -η cos ζ, heading error -η sin ζ
+        // (docs/closed-form.md). Amplitude η, period one outer revolution (36 s at 10 deg/s).
+        let omega = 10.0 * RAD_PER_DEG;
+        let scheme = Scheme::continuous(vec![0.0, 0.0], vec![omega, 0.0]);
+        let run = |eta_arcsec: f64| {
+            let mut e = TableErrors::zero(2);
+            e.axes[1].non_orthogonality_rad = eta_arcsec * RAD_PER_ARCSEC;
+            let model = Model::from_parts(dual_axis_chain(), VehicleMotion::fixed(Attitude::default()), scheme.clone(), e, TableErrors::zero(2), 1.0);
+            let mut st = DemodState::default();
+            (0..=720).map(|i| step(&model, &mut st, i as f64 * 0.1).errors[0]).collect::<Vec<_>>()
+        };
+        let eta = 20.0;
+        let small = run(eta);
+        for (i, e) in small.iter().enumerate() {
+            let zeta = omega * i as f64 * 0.1;
+            // Second-order remainder ~ η² = (1e-4 rad)² ~ 0.002".
+            assert!((e.pitch_rad * ARCSEC_PER_RAD + eta * zeta.cos()).abs() < 0.01, "pitch at {i}");
+            assert!((e.heading_rad * ARCSEC_PER_RAD + eta * zeta.sin()).abs() < 0.01, "heading at {i}");
+            assert!(e.roll_rad.abs() * ARCSEC_PER_RAD < 0.01, "roll at {i}");
+        }
+        // Linear while small: doubling η doubles the error.
+        let double = run(2.0 * eta);
+        for (a, b) in small.iter().zip(&double) {
+            assert!((2.0 * a.pitch_rad - b.pitch_rad).abs() * ARCSEC_PER_RAD < 0.01);
+        }
+    }
+
+    #[test]
+    fn encoder_delay_is_compensated_from_the_observed_rate() {
+        // A 1 ms latch delay at 10 deg/s is a 36" angle error; the compensator extrapolates it away
+        // except at the single step where the rate changes.
+        let chain = dual_axis_chain();
+        let scheme = Scheme::continuous(vec![0.0, 0.0], vec![0.0, 10.0 * RAD_PER_DEG]);
+        let mut e = TableErrors::zero(2);
+        e.axes[1].encoder_delay_s = 1e-3;
+        let model = Model::from_parts(chain, VehicleMotion::fixed(Attitude::default()), scheme, e.clone(), e, 1.0);
+        let mut st = DemodState::default();
+        let outs: Vec<_> = (0..200).map(|i| step(&model, &mut st, i as f64 * 0.01)).collect();
+        let heading = |o: &StepOutput, v: usize| o.errors[v].heading_rad * ARCSEC_PER_RAD;
+        // The reading lags by ωτ, so the computed body is turned +ωτ about up: heading (clockwise)
+        // error -ωτ = -36".
+        assert!((heading(&outs[100], 0) + 36.0).abs() < 1e-6, "{}", heading(&outs[100], 0));
+        // Closed form says the same.
+        assert!((heading(&outs[100], 2) + 36.0).abs() < 1e-6);
+        // Compensated: exact after the first step at constant rate.
+        for o in &outs[2..] {
+            assert!(heading(o, 1).abs() < 1e-6, "{}", heading(o, 1));
+        }
+    }
+}

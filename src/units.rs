@@ -1,0 +1,60 @@
+//! Unit conversions: SI and radians inside, units in the name at every edge.
+
+/// Radians per degree.
+pub const RAD_PER_DEG: f64 = std::f64::consts::PI / 180.0;
+/// Radians per arcminute.
+pub const RAD_PER_ARCMIN: f64 = RAD_PER_DEG / 60.0;
+/// Radians per arcsecond.
+pub const RAD_PER_ARCSEC: f64 = RAD_PER_DEG / 3600.0;
+/// Arcseconds per radian.
+pub const ARCSEC_PER_RAD: f64 = 1.0 / RAD_PER_ARCSEC;
+/// Degrees per radian.
+pub const DEG_PER_RAD: f64 = 1.0 / RAD_PER_DEG;
+
+/// Wraps an angle difference into (-pi, pi].
+#[must_use]
+pub fn wrap_pi(angle_rad: f64) -> f64 {
+    let two_pi = std::f64::consts::TAU;
+    let mut a = angle_rad % two_pi;
+    if a <= -std::f64::consts::PI {
+        a += two_pi;
+    } else if a > std::f64::consts::PI {
+        a -= two_pi;
+    }
+    a
+}
+
+/// Formats an angle given in radians the way an inertial engineer reads it:
+/// arcseconds below 1', arcminutes below 1 deg, degrees above.
+#[must_use]
+pub fn fmt_angle(angle_rad: f64) -> String {
+    let arcsec = angle_rad * ARCSEC_PER_RAD;
+    if arcsec.abs() < 60.0 {
+        format!("{arcsec:.2}″")
+    } else if arcsec.abs() < 3600.0 {
+        format!("{:.3}′", arcsec / 60.0)
+    } else {
+        format!("{:.4}°", arcsec / 3600.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wrap_pi_keeps_small_angles_and_folds_large_ones() {
+        assert!((wrap_pi(0.1) - 0.1).abs() < 1e-15);
+        assert!((wrap_pi(-0.1) + 0.1).abs() < 1e-15);
+        // 350 deg - 0 deg is a -10 deg difference.
+        assert!((wrap_pi(350.0 * RAD_PER_DEG) + 10.0 * RAD_PER_DEG).abs() < 1e-12);
+        assert!((wrap_pi(-190.0 * RAD_PER_DEG) - 170.0 * RAD_PER_DEG).abs() < 1e-12);
+    }
+
+    #[test]
+    fn arcsec_conversions_round_trip() {
+        // 1 deg = 3600 arcsec by definition.
+        assert!((3600.0 * RAD_PER_ARCSEC - RAD_PER_DEG).abs() < 1e-18);
+        assert!((RAD_PER_ARCMIN * 60.0 - RAD_PER_DEG).abs() < 1e-18);
+    }
+}
