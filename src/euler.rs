@@ -36,12 +36,15 @@ impl Attitude {
     /// Extracts the Euler angles from C_b^n (seed 000 eq. 19 with the slip T31/T32 read as T31/T33).
     #[must_use]
     pub fn from_n_from_b(n_from_b: &Rot<N, B>) -> Self {
-        let c = n_from_b.matrix();
-        Self {
-            pitch_rad: c[(2, 1)].clamp(-1.0, 1.0).asin(),
-            roll_rad: (-c[(2, 0)]).atan2(c[(2, 2)]),
-            heading_rad: c[(0, 1)].atan2(c[(1, 1)]),
-        }
+        // Only five DCM elements are needed; computed straight from the quaternion (hot path).
+        let q = n_from_b.quaternion();
+        let (w, x, y, z) = (q.w, q.i, q.j, q.k);
+        let c01 = 2.0 * (x * y - w * z);
+        let c11 = 1.0 - 2.0 * (x * x + z * z);
+        let c20 = 2.0 * (x * z - w * y);
+        let c21 = 2.0 * (y * z + w * x);
+        let c22 = 1.0 - 2.0 * (x * x + y * y);
+        Self { pitch_rad: c21.clamp(-1.0, 1.0).asin(), roll_rad: (-c20).atan2(c22), heading_rad: c01.atan2(c11) }
     }
 
     /// Component-wise difference `self - truth`, with roll and heading wrapped into (-pi, pi].
@@ -123,6 +126,18 @@ mod tests {
                 assert!(c.abs() < 1e-12, "{a:?} -> {back:?}");
             }
         }
+    }
+
+    #[test]
+    fn extraction_from_the_quaternion_matches_the_full_matrix() {
+        // Independent computation: nalgebra's rotation matrix, eq. 19 element by element.
+        let a = att(23.0, -67.0, 131.0);
+        let n_from_b = a.n_from_b();
+        let c = n_from_b.matrix();
+        let e = Attitude::from_n_from_b(&n_from_b);
+        assert!((e.pitch_rad - c[(2, 1)].asin()).abs() < 1e-14);
+        assert!((e.roll_rad - (-c[(2, 0)]).atan2(c[(2, 2)])).abs() < 1e-14);
+        assert!((e.heading_rad - c[(0, 1)].atan2(c[(1, 1)])).abs() < 1e-14);
     }
 
     #[test]

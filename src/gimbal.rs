@@ -229,12 +229,29 @@ impl Chain {
         }
     }
 
+    /// The shaft rotations R(a_k, λ_k) for gimbal angles `angles_rad` (computed once per step and
+    /// shared by the exact, nominal and closed-form chains).
+    #[must_use]
+    pub fn shaft_rotations(&self, angles_rad: &AxisValues) -> ShaftRotations {
+        let mut r = [UnitQuaternion::identity(); MAX_AXES];
+        for (k, g) in self.axes.iter().enumerate() {
+            r[k] = axis_angle(&g.axis, angles_rad[k]);
+        }
+        ShaftRotations(r)
+    }
+
     /// Exact IMU-to-body rotation for gimbal angles `angles_rad` and the given error rotations.
     #[must_use]
     pub fn b_from_s(&self, err: &ErrorRotations, angles_rad: &AxisValues) -> Rot<B, S> {
+        self.b_from_s_with(err, &self.shaft_rotations(angles_rad))
+    }
+
+    /// [`Self::b_from_s`] with precomputed shaft rotations.
+    #[must_use]
+    pub fn b_from_s_with(&self, err: &ErrorRotations, shafts: &ShaftRotations) -> Rot<B, S> {
         let mut q = err.installation;
-        for (k, g) in self.axes.iter().enumerate() {
-            q = q * err.tilt[k] * axis_angle(&g.axis, angles_rad[k]) * err.swing_rotor[k];
+        for k in 0..self.axes.len() {
+            q = q * err.tilt[k] * shafts.0[k] * err.swing_rotor[k];
         }
         // FRAME: the chain composes body <- base <- gimbals <- IMU link by link (module doc).
         Rot::from_quaternion(q * err.mount)
@@ -243,9 +260,15 @@ impl Chain {
     /// The nominal (error-free) IMU-to-body rotation a real RINS uses to demodulate.
     #[must_use]
     pub fn b_from_s_nominal(&self, angles_rad: &AxisValues) -> Rot<B, S> {
-        let mut q = UnitQuaternion::identity();
-        for (k, g) in self.axes.iter().enumerate() {
-            q *= axis_angle(&g.axis, angles_rad[k]);
+        self.b_from_s_nominal_with(&self.shaft_rotations(angles_rad))
+    }
+
+    /// [`Self::b_from_s_nominal`] with precomputed shaft rotations.
+    #[must_use]
+    pub fn b_from_s_nominal_with(&self, shafts: &ShaftRotations) -> Rot<B, S> {
+        let mut q = shafts.0[0];
+        for r in &shafts.0[1..self.axes.len()] {
+            q *= r;
         }
         // FRAME: the same chain with every error rotation set to identity.
         Rot::from_quaternion(q)
@@ -271,6 +294,12 @@ impl Chain {
     /// vector, m the mounting vector, and the encoder error λ̂_k - λ_k ≈ b_k + s_k λ_k - λ̇_k τ_k.
     #[must_use]
     pub fn first_order_phi_b(&self, errors: &TableErrors, angles_rad: &AxisValues, rates_rad_per_s: &AxisValues) -> V3<B> {
+        self.first_order_phi_b_with(errors, angles_rad, rates_rad_per_s, &self.shaft_rotations(angles_rad))
+    }
+
+    /// [`Self::first_order_phi_b`] with the shaft rotations of `angles_rad` precomputed.
+    #[must_use]
+    pub fn first_order_phi_b_with(&self, errors: &TableErrors, angles_rad: &AxisValues, rates_rad_per_s: &AxisValues, shafts: &ShaftRotations) -> V3<B> {
         let mut phi = errors.installation_rad;
         let mut prefix = UnitQuaternion::identity();
         for (k, (g, e)) in self.axes.iter().zip(&errors.axes).enumerate() {
@@ -278,13 +307,17 @@ impl Chain {
             let encoder_error = e.encoder_offset_rad + e.encoder_scale * lambda - rates_rad_per_s[k] * e.encoder_delay_s;
             let local = self.tilt_vector(k, e) - g.axis * encoder_error + self.swing_vector(k, e, lambda);
             phi += prefix * local;
-            prefix *= axis_angle(&g.axis, lambda);
+            prefix *= shafts.0[k];
         }
         phi += prefix * errors.imu_mount_rad;
         // FRAME: every term was carried into the body frame by its nominal prefix rotation.
         V3::new(phi)
     }
 }
+
+/// The shaft rotations R(a_k, λ_k) of one set of gimbal angles.
+#[derive(Debug, Clone, Copy)]
+pub struct ShaftRotations(pub [UnitQuaternion<f64>; MAX_AXES]);
 
 #[cfg(test)]
 mod tests {

@@ -103,7 +103,8 @@ pub fn step(model: &Model, state: &mut DemodState, t_s: f64) -> StepOutput {
     let n = model.n_axes();
 
     // Truth: the IMU attitude through the exact chain (an ideal INS reports it without error).
-    let n_from_s = n_from_b * model.chain.b_from_s(&model.truth_rot, &gimbal_rad);
+    let true_shafts = model.chain.shaft_rotations(&gimbal_rad);
+    let n_from_s = n_from_b * model.chain.b_from_s_with(&model.truth_rot, &true_shafts);
 
     // Encoders: latched `delay` before the IMU sample, then offset and scale applied.
     let mut encoder_rad = [0.0; MAX_AXES];
@@ -112,9 +113,11 @@ pub fn step(model: &Model, state: &mut DemodState, t_s: f64) -> StepOutput {
         let latched = if e.encoder_delay_s == 0.0 { gimbal_rad[k] } else { model.scheme.state(t_s - e.encoder_delay_s).0[k] };
         encoder_rad[k] = e.encoder_reading(latched);
     }
+    // Shaft rotations of other angles; reuses the true ones when the angles are identical.
+    let shafts_of = |angles: &AxisValues| if *angles == gimbal_rad { true_shafts } else { model.chain.shaft_rotations(angles) };
 
     // 1. Uncompensated: the nominal table with the raw encoder angles.
-    let uncompensated = demodulate(n_from_s, model.chain.b_from_s_nominal(&encoder_rad));
+    let uncompensated = demodulate(n_from_s, model.chain.b_from_s_nominal_with(&shafts_of(&encoder_rad)));
 
     // 2. Compensated: the exact chain with the assumed errors, encoder corrected and extrapolated
     //    over the assumed delay with the rate seen in successive corrected readings.
@@ -127,15 +130,18 @@ pub fn step(model: &Model, state: &mut DemodState, t_s: f64) -> StepOutput {
         let dt = t_s - t_prev;
         if dt > 0.0 {
             for k in 0..n {
-                corrected[k] += (raw_corrected[k] - prev[k]) / dt * model.compensation.axes[k].encoder_delay_s;
+                let delay = model.compensation.axes[k].encoder_delay_s;
+                if delay != 0.0 {
+                    corrected[k] += (raw_corrected[k] - prev[k]) / dt * delay;
+                }
             }
         }
     }
     state.previous = Some((t_s, raw_corrected));
-    let compensated = demodulate(n_from_s, model.chain.b_from_s(&model.compensation_rot, &corrected));
+    let compensated = demodulate(n_from_s, model.chain.b_from_s_with(&model.compensation_rot, &shafts_of(&corrected)));
 
     // 3. Closed form: first-order error model (docs/closed-form.md).
-    let phi_b = model.chain.first_order_phi_b(&model.truth, &gimbal_rad, &rate_rad_per_s);
+    let phi_b = model.chain.first_order_phi_b_with(&model.truth, &gimbal_rad, &rate_rad_per_s, &true_shafts);
     let closed_form = AttitudeError::first_order(&attitude, n_from_b.apply(phi_b));
 
     StepOutput {
@@ -182,6 +188,8 @@ impl Stat {
 pub struct ErrorStats {
     /// `[variant][axis]`, radians.
     pub stats: [[Stat; 3]; 3],
+    /// Closed form minus exact (uncompensated), per axis, radians: where the small-angle theory holds.
+    pub closed_form_deviation: [Stat; 3],
 }
 
 impl ErrorStats {
@@ -192,6 +200,16 @@ impl ErrorStats {
                 self.stats[v][a].add(x);
             }
         }
+        let (exact, closed) = (out.errors[0].as_array(), out.errors[2].as_array());
+        for a in 0..3 {
+            self.closed_form_deviation[a].add(closed[a] - exact[a]);
+        }
+    }
+
+    /// Largest peak over the three axes of one variant, radians.
+    #[must_use]
+    pub fn peak_over_axes(&self, variant: usize) -> f64 {
+        self.stats[variant].iter().map(Stat::peak).fold(0.0, f64::max)
     }
 }
 

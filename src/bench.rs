@@ -1,0 +1,63 @@
+//! `rinscope bench`: simulation speed without recording, and a full recorded run's speed and size.
+
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use crate::scenarios;
+use crate::sim::{step, DemodState, Model};
+use crate::sink::{self, SinkRequest};
+
+/// Peak resident memory of this process, bytes (Linux; 0 elsewhere).
+#[must_use]
+pub fn peak_rss_bytes() -> u64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| s.lines().find(|l| l.starts_with("VmHWM:")).and_then(|l| l.split_whitespace().nth(1)?.parse::<u64>().ok()))
+        .map_or(0, |kb| kb * 1024)
+}
+
+/// Runs the benchmarks and prints their numbers.
+pub fn run(steps: u64) -> anyhow::Result<()> {
+    // 1. Pure simulation: truth + encoders + three demodulations, one core, no recording.
+    for name in ["jiang2017-dual-axis", "rotary-table-2016-wobble"] {
+        let p = scenarios::load(name)?;
+        let model = Model::new(&p);
+        let mut state = DemodState::default();
+        let mut checksum = 0.0;
+        let started = Instant::now();
+        for i in 0..steps {
+            let out = step(&model, &mut state, i as f64 / p.step_hz);
+            checksum += out.errors[0].heading_rad + out.errors[1].pitch_rad + out.errors[2].roll_rad;
+        }
+        let secs = started.elapsed().as_secs_f64();
+        println!(
+            "simulation only   {name:<28} {steps} steps in {secs:.3} s = {:.2} M steps/s (all three variants; checksum {checksum:.3e})",
+            steps as f64 / secs / 1e6
+        );
+    }
+
+    // 2. A 3600 s scenario at 200 Hz with its default recording rates, saved to a file.
+    let dir = std::env::temp_dir().join(format!("rinscope-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)?;
+    for name in ["rotary-table-2016-wobble", "jiang2017-dual-axis"] {
+        let mut p = scenarios::load(name)?;
+        p.duration_s = 3600.0;
+        let path = dir.join(format!("{name}.rrd"));
+        let sinks = sink::open(&SinkRequest { save: Some(path.clone()), ..Default::default() }, "rinscope-bench", name)?;
+        let started = Instant::now();
+        let summary = crate::run::run_recorded(&p, &sinks, &AtomicBool::new(false), false)?;
+        let (_, bytes) = sinks.finish()?.ok_or_else(|| anyhow::anyhow!("no file written"))?;
+        let secs = started.elapsed().as_secs_f64();
+        println!(
+            "recorded run      {name:<28} 3600 s at {} Hz (series {} Hz, scene {} Hz): {} steps in {secs:.2} s, {:.2} MB per simulated hour",
+            p.step_hz,
+            p.recording.series_hz,
+            p.recording.scene_hz,
+            summary.steps,
+            bytes as f64 / 1e6
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+    println!("peak resident memory: {:.1} MB", peak_rss_bytes() as f64 / 1e6);
+    Ok(())
+}

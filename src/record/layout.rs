@@ -1,0 +1,163 @@
+//! The viewer layout sent with every recording: a small declarative blueprint that, unlike the SDK's
+//! `rerun::blueprint` builders (0.36), can also set view properties — the 3D eye and the plots' time
+//! range — so the recording opens ready to read.
+
+use rerun::blueprint::components::{ContainerKind, PanelState, PlayState, RootContainer};
+use rerun::external::re_log_types::{BlueprintActivationCommand, LogMsg};
+use rerun::{AsComponents, RecordingStream, RecordingStreamBuilder, RecordingStreamResult};
+use rerun::external::re_sdk_types::blueprint::archetypes as bp;
+use rerun::external::re_sdk_types::blueprint::components as bpc;
+use rerun::external::re_sdk_types::datatypes;
+
+/// A view or a container of the layout.
+pub enum Node {
+    /// A container of children.
+    Container {
+        /// Tabs, horizontal, vertical or grid.
+        kind: ContainerKind,
+        /// Children in order.
+        children: Vec<Node>,
+        /// Relative sizes along the container's axis (empty: equal).
+        shares: Vec<f32>,
+    },
+    /// A view.
+    View {
+        /// "3D", "TimeSeries", "TextDocument", "TextLog".
+        class: &'static str,
+        /// Title.
+        name: String,
+        /// Space origin (entity path).
+        origin: String,
+        /// (property archetype name, its components).
+        properties: Vec<(&'static str, Vec<rerun::SerializedComponentBatch>)>,
+    },
+}
+
+impl Node {
+    /// A container.
+    #[must_use]
+    pub fn container(kind: ContainerKind, children: Vec<Node>, shares: &[f32]) -> Self {
+        Self::Container { kind, children, shares: shares.to_vec() }
+    }
+
+    /// A view with no properties.
+    #[must_use]
+    pub fn view(class: &'static str, name: impl Into<String>, origin: impl Into<String>) -> Self {
+        Self::View { class, name: name.into(), origin: origin.into(), properties: Vec::new() }
+    }
+
+    /// Adds a view property (e.g. `EyeControls3D`, `TimeAxis`).
+    #[must_use]
+    pub fn with_property(mut self, name: &'static str, archetype: &dyn AsComponents) -> Self {
+        if let Self::View { properties, .. } = &mut self {
+            properties.push((name, archetype.as_serialized_batches()));
+        }
+        self
+    }
+}
+
+/// A plot that always shows the whole run, not a window around the time cursor.
+#[must_use]
+pub fn whole_run_time_axis() -> bp::TimeAxis {
+    bp::TimeAxis::new().with_view_range(bpc::TimeRange(datatypes::TimeRange::EVERYTHING))
+}
+
+/// A 3D eye looking at `target` from `position` with +z up.
+#[must_use]
+pub fn eye(position: [f32; 3], target: [f32; 3]) -> bp::EyeControls3D {
+    bp::EyeControls3D::new().with_kind(bpc::Eye3DKind::Orbital).with_position(position).with_look_target(target).with_eye_up([0.0, 0.0, 1.0])
+}
+
+/// Deterministic UUID-shaped ids: the same scenario gives the same blueprint.
+struct Ids(u64);
+
+impl Ids {
+    fn next(&mut self) -> String {
+        self.0 += 1;
+        format!("00000000-0000-4000-8000-{:012x}", self.0)
+    }
+
+    /// The bytes of the id `next` last returned.
+    fn last_bytes(&self) -> [u8; 16] {
+        let mut b = [0u8; 16];
+        b[6] = 0x40;
+        b[8] = 0x80;
+        b[10..].copy_from_slice(&self.0.to_be_bytes()[2..]);
+        b
+    }
+}
+
+fn log_node(node: &Node, stream: &RecordingStream, ids: &mut Ids) -> RecordingStreamResult<String> {
+    match node {
+        Node::View { class, name, origin, properties } => {
+            let path = format!("view/{}", ids.next());
+            stream.log(format!("{path}/ViewContents"), &bp::ViewContents::new([bpc::QueryExpression("$origin/**".into())]))?;
+            stream.log(
+                path.as_str(),
+                &bp::ViewBlueprint::new(bpc::ViewClass((*class).into())).with_display_name(name.as_str()).with_space_origin(origin.as_str()),
+            )?;
+            for (prop, batches) in properties {
+                stream.log_serialized_batches(format!("{path}/{prop}"), false, batches.iter().cloned())?;
+            }
+            Ok(path)
+        }
+        Node::Container { kind, children, shares } => {
+            let mut child_paths = Vec::new();
+            for c in children {
+                child_paths.push(log_node(c, stream, ids)?);
+            }
+            let path = format!("container/{}", ids.next());
+            let mut arch = bp::ContainerBlueprint::new(*kind).with_contents(child_paths.iter().map(|p| bpc::IncludedContent(p.as_str().into())));
+            if !shares.is_empty() {
+                let s = shares.iter().map(|&x| bpc::ColumnShare(datatypes::Float32(x)));
+                let r = shares.iter().map(|&x| bpc::RowShare(datatypes::Float32(x)));
+                arch = match kind {
+                    ContainerKind::Horizontal => arch.with_col_shares(s),
+                    _ => arch.with_row_shares(r),
+                };
+            }
+            stream.log(path.as_str(), &arch)?;
+            Ok(path)
+        }
+    }
+}
+
+/// Time-panel settings.
+pub struct Playback {
+    /// Timeline name.
+    pub timeline: &'static str,
+    /// Playback speed multiplier.
+    pub speed: f64,
+}
+
+/// Sends `root` as the active and default layout of `rec`'s application.
+pub fn send(rec: &RecordingStream, application_id: &'static str, root: &Node, playback: &Playback) -> RecordingStreamResult<()> {
+    let (bp_stream, storage) = RecordingStreamBuilder::new(application_id).blueprint().memory()?;
+    bp_stream.set_time_sequence("blueprint", 0);
+    let mut ids = Ids(0);
+    // The root is a container, logged last, so its id is the last one handed out.
+    log_node(root, &bp_stream, &mut ids)?;
+    let root_uuid = datatypes::Uuid { bytes: ids.last_bytes() };
+    bp_stream.log(
+        "viewport",
+        &bp::ViewportBlueprint::new().with_root_container(RootContainer(root_uuid)).with_auto_layout(false).with_auto_views(false),
+    )?;
+    bp_stream.log("blueprint_panel", &bp::PanelBlueprint::new().with_state(PanelState::Collapsed))?;
+    bp_stream.log("selection_panel", &bp::PanelBlueprint::new().with_state(PanelState::Collapsed))?;
+    bp_stream.log(
+        "time_panel",
+        &bp::TimePanelBlueprint::new()
+            .with_state(PanelState::Collapsed)
+            .with_timeline(bpc::TimelineName(playback.timeline.into()))
+            .with_playback_speed(bpc::PlaybackSpeed(datatypes::Float64(playback.speed)))
+            .with_play_state(PlayState::Playing),
+    )?;
+    // The memory sink is read after a flush; a flush failure only loses the layout, never data.
+    let _ = bp_stream.flush_blocking();
+    let msgs: Vec<LogMsg> = storage.take();
+    let Some(blueprint_id) = msgs.first().map(|m| m.store_id().clone()) else {
+        return Ok(());
+    };
+    rec.send_blueprint(msgs, BlueprintActivationCommand { blueprint_id, make_active: true, make_default: true });
+    Ok(())
+}
