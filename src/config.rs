@@ -618,7 +618,7 @@ fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigError> {
     let mut geometry = Vec::new();
     let mut axis_errors = Vec::new();
     for (i, a) in t.axis.iter().enumerate() {
-        let k = |f: &str| format!("turntable.axis[{i}].{f}");
+        let k = |f: &str| format!("turntable.axis[{i}] (\"{}\").{f}", a.name);
         if a.name.trim().is_empty() || geometry.iter().any(|g: &AxisGeometry| g.name == a.name) {
             return Err(c.invalid(&k("name"), format!("\"{}\" must be non-empty and unique", a.name)));
         }

@@ -8,7 +8,7 @@
 //! ```
 //!
 //! Exit codes: 0 success, 1 a failure while running (or a reproduction outside tolerance),
-//! 2 bad input (config, path, viewer), 130 interrupted before anything was simulated.
+//! 2 bad input (config, path, viewer), 130 interrupted by Ctrl-C (what was simulated is saved).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -188,6 +188,9 @@ fn run_command(args: &RunArgs) -> Result<(), Failure> {
     }
     if let Some(p) = &summary.recording_path {
         println!("open it with:  rerun {p}     (viewer: {})", sink::VIEWER_INSTALL_HINT);
+    }
+    if summary.interrupted {
+        return Err(Failure { code: 130, message: "interrupted: the recording is complete up to the moment of Ctrl-C".into() });
     }
     Ok(())
 }

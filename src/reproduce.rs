@@ -141,3 +141,19 @@ pub fn run_all() -> anyhow::Result<Table> {
     });
     Ok(Table { rows })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_paper_number_is_reproduced_within_its_band() {
+        // The bands and the papers' values are in `run_all`; this fails if a model change moves a
+        // reproduction out of agreement (the same check `rinscope reproduce` makes with exit code 1).
+        let table = run_all().expect("scenarios load");
+        assert!(table.rows.len() >= 7);
+        for r in &table.rows {
+            assert!(r.agrees(), "{} / {}: {} not in {:?}", r.scenario, r.quantity, r.value, r.band);
+        }
+    }
+}

@@ -359,6 +359,67 @@ mod tests {
         }
     }
 
+    /// Runs one error source alone (level vehicle, heading 0, both gimbals turning at different
+    /// rates so that every angle combination appears) and checks the exact error against the
+    /// analytic first-order expectation at every sample, and linearity in the error angle.
+    fn check_source_alone(set: impl Fn(&mut TableErrors, f64), expected: impl Fn(f64, f64, f64) -> [f64; 3]) {
+        let (w_outer, w_inner) = (7.0 * RAD_PER_DEG, 11.0 * RAD_PER_DEG);
+        let scheme = Scheme::continuous(vec![0.0, 0.0], vec![w_outer, w_inner]);
+        let angle = 100.0 * RAD_PER_ARCSEC;
+        let run = |a: f64| {
+            let mut e = TableErrors::zero(2);
+            set(&mut e, a);
+            let model = Model::from_parts(dual_axis_chain(), VehicleMotion::fixed(Attitude::default()), scheme.clone(), e, TableErrors::zero(2), 1.0);
+            let mut st = DemodState::default();
+            (0..=600).map(|i| step(&model, &mut st, i as f64 * 0.1)).collect::<Vec<_>>()
+        };
+        let single = run(angle);
+        let double = run(2.0 * angle);
+        let mut peak = 0.0f64;
+        for (o, o2) in single.iter().zip(&double) {
+            let exp = expected(angle, w_outer * o.t_s, w_inner * o.t_s);
+            for ((got, want), got2) in o.errors[0].as_array().iter().zip(exp).zip(o2.errors[0].as_array()) {
+                // Second-order remainder: (100")^2 ~ 0.05".
+                assert!((got - want).abs() * ARCSEC_PER_RAD < 0.1, "t = {}: {} vs {}", o.t_s, got * ARCSEC_PER_RAD, want * ARCSEC_PER_RAD);
+                assert!((got2 - 2.0 * got).abs() * ARCSEC_PER_RAD < 0.2, "linear in the error angle");
+                peak = peak.max(got.abs());
+            }
+        }
+        // The amplitude is of the order of the error angle.
+        assert!(peak > 0.5 * angle && peak < 2.1 * angle, "peak {}", peak * ARCSEC_PER_RAD);
+    }
+
+    #[test]
+    fn each_error_source_alone_has_its_analytic_signature() {
+        // Level vehicle at heading 0: pitch error = Φ_b.x, roll error = Φ_b.y, heading error = -Φ_b.z
+        // (euler.rs). ζ = outer angle about body y, β = inner angle; R_y(ζ) x = (cos ζ, 0, -sin ζ).
+        let ry = |zeta: f64, v: Vector3<f64>| nalgebra::Rotation3::from_axis_angle(&Vector3::y_axis(), zeta) * v;
+        let rz = |beta: f64, v: Vector3<f64>| nalgebra::Rotation3::from_axis_angle(&Vector3::z_axis(), beta) * v;
+        let to_euler = |phi: Vector3<f64>| [phi.x, phi.y, -phi.z];
+        // Installation about body x: a constant pitch error, not modulated by the table.
+        check_source_alone(|e, a| e.installation_rad.x = a, |a, _, _| [a, 0.0, 0.0]);
+        // Inner swing (phase 0): Φ_b = R_y(ζ) α (cos β x + sin β y), turning with both gimbals.
+        check_source_alone(
+            |e, a| e.axes[1].swing_half_angle_rad = a,
+            |a, z, b| to_euler(ry(z, Vector3::new(b.cos(), b.sin(), 0.0) * a)),
+        );
+        // Outer swing (phase 30°): Φ_b = α (cos(ζ+φ) z + sin(ζ+φ) x), once per outer revolution.
+        check_source_alone(
+            |e, a| {
+                e.axes[0].swing_half_angle_rad = a;
+                e.axes[0].swing_phase_rad = 30.0 * RAD_PER_DEG;
+            },
+            |a, z, _| {
+                let p = z + 30.0 * RAD_PER_DEG;
+                to_euler(Vector3::new(p.sin(), 0.0, p.cos()) * a)
+            },
+        );
+        // Inner encoder offset b: the body is turned by -b about the inner axis R_y(ζ) z.
+        check_source_alone(|e, a| e.axes[1].encoder_offset_rad = a, |a, z, _| to_euler(-ry(z, Vector3::z()) * a));
+        // IMU mounting about its y: carried by both gimbals, Φ_b = R_y(ζ) R_z(β) y.
+        check_source_alone(|e, a| e.imu_mount_rad.y = a, |a, z, b| to_euler(ry(z, rz(b, Vector3::y())) * a));
+    }
+
     #[test]
     fn encoder_delay_is_compensated_from_the_observed_rate() {
         // A 1 ms latch delay at 10 deg/s is a 36" angle error; the compensator extrapolates it away

@@ -1,0 +1,142 @@
+//! End-to-end checks of the `rinscope` binary: bad input is refused with exit code 2 and a message
+//! naming key, value and unit, leaving no file behind; a good run writes a complete recording and
+//! a summary whose numbers are consistent with the physics.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn rinscope() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_rinscope"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("rinscope-cli-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+const PRESET: &str = include_str!("../assets/scenarios/jiang2017-dual-axis.toml");
+
+/// The preset with one line replaced (the test's typo).
+fn with_edit(dir: &Path, from: &str, to: &str) -> PathBuf {
+    assert!(PRESET.contains(from), "the preset has `{from}`");
+    let path = dir.join("edited.toml");
+    std::fs::write(&path, PRESET.replacen(from, to, 1)).expect("write config");
+    path
+}
+
+fn refused(dir: &Path, cfg: &Path, expected: &[&str]) {
+    let out_file = dir.join("out.rrd");
+    let o = rinscope().args(["run", "--config"]).arg(cfg).arg("--save").arg(&out_file).output().expect("run");
+    assert_eq!(o.status.code(), Some(2), "exit code; stderr: {}", stderr(&o));
+    for e in expected {
+        assert!(stderr(&o).contains(e), "stderr should mention `{e}`: {}", stderr(&o));
+    }
+    assert!(!out_file.exists(), "no recording for a refused config");
+    assert!(!dir.join("out.rrd.partial").exists(), "no partial file either");
+}
+
+#[test]
+fn a_typo_in_a_key_is_refused_with_its_line() {
+    let dir = scratch("typo");
+    let cfg = with_edit(&dir, "swing_half_angle_arcsec = 300.0", "swing_half_angl_arcsec = 300.0");
+    refused(&dir, &cfg, &["unknown field `swing_half_angl_arcsec`", "swing_half_angle_arcsec"]);
+}
+
+#[test]
+fn a_wrong_type_is_refused() {
+    let dir = scratch("type");
+    let cfg = with_edit(&dir, "duration_s = 360.0", "duration_s = \"long\"");
+    refused(&dir, &cfg, &["duration_s", "invalid type"]);
+}
+
+#[test]
+fn nan_and_out_of_range_angles_are_refused_with_key_value_and_unit() {
+    let dir = scratch("nan");
+    let cfg = with_edit(&dir, "swing_half_angle_arcsec = 300.0", "swing_half_angle_arcsec = nan");
+    refused(&dir, &cfg, &["swing_half_angle_arcsec", "NaN", "arcsec", "not a finite number"]);
+    // 20 deg typed into an arcsec key: over the 10 deg limit.
+    let cfg = with_edit(&dir, "swing_half_angle_arcsec = 300.0", "swing_half_angle_arcsec = 72000");
+    refused(&dir, &cfg, &["swing_half_angle_arcsec", "72000 arcsec", "out of range", "36000"]);
+    let cfg = with_edit(&dir, "latitude_deg = 39.9042", "latitude_deg = 123");
+    refused(&dir, &cfg, &["site.latitude_deg", "123 deg"]);
+}
+
+#[test]
+fn an_unknown_axis_in_the_scheme_is_refused() {
+    let dir = scratch("axis");
+    let cfg = with_edit(&dir, "axis = \"outer\"          # axis name (required)", "axis = \"middle\"");
+    refused(&dir, &cfg, &["scheme.rate[0].axis", "middle", "outer"]);
+}
+
+#[test]
+fn a_missing_file_is_refused() {
+    let o = rinscope().args(["run", "--config", "/nonexistent/scenario.toml"]).output().expect("run");
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("/nonexistent/scenario.toml"));
+}
+
+#[test]
+fn spawn_without_a_viewer_says_how_to_get_one() {
+    let dir = scratch("spawn");
+    let o = rinscope().args(["run", "--spawn"]).env("PATH", &dir).current_dir(&dir).output().expect("run");
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("pip install rerun-sdk==0.36.3"), "{}", stderr(&o));
+    assert!(!dir.join("recordings").exists(), "nothing written");
+}
+
+#[test]
+fn connect_to_nothing_is_refused() {
+    // A port nobody listens on: bind one, read its number, close it.
+    let port = std::net::TcpListener::bind("127.0.0.1:0").expect("bind").local_addr().expect("addr").port();
+    let url = format!("rerun+http://127.0.0.1:{port}/proxy");
+    let o = rinscope().args(["run", "--connect", &url]).output().expect("run");
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no viewer is listening"), "{}", stderr(&o));
+}
+
+#[test]
+fn a_run_writes_a_complete_recording_and_a_consistent_summary() {
+    let dir = scratch("run");
+    let rrd = dir.join("short.rrd");
+    let json = dir.join("summary.json");
+    let o = rinscope()
+        .args(["run", "--scenario", "jiang2017-dual-axis", "--duration-s", "40", "--save"])
+        .arg(&rrd)
+        .arg("--summary-json")
+        .arg(&json)
+        .output()
+        .expect("run");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let bytes = std::fs::read(&rrd).expect("recording exists");
+    // RRD files start with the magic "RRF2".
+    assert_eq!(&bytes[..4], b"RRF2", "an RRD file");
+    assert!(!dir.join("short.rrd.partial").exists());
+
+    let summary: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).expect("summary")).expect("json");
+    assert_eq!(summary["steps"], 40 * 200 + 1);
+    let e = &summary["attitude_error_arcsec"];
+    // Seed 000 Table 2 errors are arcminutes: the uncompensated heading error peaks at several arcmin,
+    // bounded by the sum of the error angles (10' + 5' + 20" = 920").
+    let heading = e["uncompensated"]["heading"]["peak_arcsec"].as_f64().expect("number");
+    assert!(heading > 300.0 && heading < 920.0, "heading peak {heading}");
+    // Compensating with the true parameters leaves nothing.
+    for axis in ["pitch", "roll", "heading"] {
+        assert!(e["compensated"][axis]["peak_arcsec"].as_f64().expect("number") < 1e-3);
+    }
+    assert!(summary["wall_time_s"].as_f64().expect("number") > 0.0);
+}
+
+#[test]
+fn scenarios_lists_every_preset() {
+    let o = rinscope().arg("scenarios").output().expect("run");
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout);
+    for name in ["jiang2017-dual-axis (default)", "rotary-table-2016-installation", "rotary-table-2016-wobble", "rotary-table-2016-angular"] {
+        assert!(text.contains(name), "{text}");
+    }
+}
