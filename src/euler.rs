@@ -77,23 +77,24 @@ impl AttitudeError {
     }
 
     /// First-order Euler-angle errors caused by a small rotation error `phi_n`, where the computed
-    /// attitude is `exp([phi_n x]) * n_from_b` and `truth` is the attitude of `n_from_b`.
+    /// attitude is `exp([phi_n x]) * n_from_b`.
     ///
-    /// Derivation (docs/closed-form.md): with h = Rz(heading) applied to phi_n,
+    /// Derivation (docs/closed-form.md): with phi_h = Rz(heading) phi_n,
     /// d_pitch = phi_h.x, d_roll = phi_h.y / cos(pitch), d_heading = tan(pitch) * phi_h.y - phi_h.z.
+    /// The sines and cosines come from the DCM itself (C01 = sin ψ cos θ, C11 = cos ψ cos θ,
+    /// C21 = sin θ), so the hot path needs no trigonometry.
     #[must_use]
-    pub fn first_order(truth: &Attitude, phi_n: V3<N>) -> Self {
-        let (sh, ch) = truth.heading_rad.sin_cos();
-        // phi_h = Rz(heading) * phi_n: the error seen in the heading-levelled frame.
+    pub fn first_order(n_from_b: &Rot<N, B>, phi_n: V3<N>) -> Self {
+        let q = n_from_b.quaternion();
+        let (w, x, y, z) = (q.w, q.i, q.j, q.k);
+        let c01 = 2.0 * (x * y - w * z);
+        let c11 = 1.0 - 2.0 * (x * x + z * z);
+        let c21 = 2.0 * (y * z + w * x);
+        let cos_pitch = c01.hypot(c11);
+        let (sh, ch) = (c01 / cos_pitch, c11 / cos_pitch);
         let phi_hx = ch * phi_n.v.x - sh * phi_n.v.y;
         let phi_hy = sh * phi_n.v.x + ch * phi_n.v.y;
-        let phi_hz = phi_n.v.z;
-        let (sp, cp) = truth.pitch_rad.sin_cos();
-        Self {
-            pitch_rad: phi_hx,
-            roll_rad: phi_hy / cp,
-            heading_rad: sp / cp * phi_hy - phi_hz,
-        }
+        Self { pitch_rad: phi_hx, roll_rad: phi_hy / cos_pitch, heading_rad: c21 / cos_pitch * phi_hy - phi_n.v.z }
     }
 }
 
@@ -164,7 +165,7 @@ mod tests {
             let perturbed: Rot<N, N> = Rot::from_quaternion(exp_rotation(&phi));
             let computed = Attitude::from_n_from_b(&(perturbed * truth.n_from_b()));
             let exact = computed.error_from(&truth).as_array();
-            let linear = AttitudeError::first_order(&truth, V3::new(phi)).as_array();
+            let linear = AttitudeError::first_order(&truth.n_from_b(), V3::new(phi)).as_array();
             for (e, l) in exact.iter().zip(linear) {
                 // Second-order remainder is O(eps^2) ~ 1e-14.
                 assert!((e - l).abs() < 1e-12, "axis {axis:?}: exact {e} linear {l}");

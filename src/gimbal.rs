@@ -145,6 +145,10 @@ pub struct ErrorRotations {
     mount: UnitQuaternion<f64>,
     tilt: [UnitQuaternion<f64>; MAX_AXES],
     swing_rotor: [UnitQuaternion<f64>; MAX_AXES],
+    /// The constants between the shafts, folded: `B·T_0`, `W_0·T_1`, …, `W_{N-1}·M`.
+    between: [UnitQuaternion<f64>; MAX_AXES + 1],
+    /// (sin φ_k, cos φ_k) of each swing phase, for the closed form.
+    swing_phase_sin_cos: [(f64, f64); MAX_AXES],
 }
 
 /// Local transforms of every link, parent_from_child, for drawing the chain.
@@ -221,12 +225,20 @@ impl Chain {
             tilt[k] = exp_rotation(&self.tilt_vector(k, e));
             swing_rotor[k] = exp_rotation(&self.swing_vector(k, e, 0.0));
         }
-        ErrorRotations {
-            installation: exp_rotation(&errors.installation_rad),
-            mount: exp_rotation(&errors.imu_mount_rad),
-            tilt,
-            swing_rotor,
+        let installation = exp_rotation(&errors.installation_rad);
+        let mount = exp_rotation(&errors.imu_mount_rad);
+        let n = self.axes.len();
+        let mut between = [UnitQuaternion::identity(); MAX_AXES + 1];
+        between[0] = installation * tilt[0];
+        for k in 1..n {
+            between[k] = swing_rotor[k - 1] * tilt[k];
         }
+        between[n] = swing_rotor[n - 1] * mount;
+        let mut swing_phase_sin_cos = [(0.0, 1.0); MAX_AXES];
+        for (sc, e) in swing_phase_sin_cos.iter_mut().zip(&errors.axes) {
+            *sc = e.swing_phase_rad.sin_cos();
+        }
+        ErrorRotations { installation, mount, tilt, swing_rotor, between, swing_phase_sin_cos }
     }
 
     /// The shaft rotations R(a_k, λ_k) for gimbal angles `angles_rad` (computed once per step and
@@ -249,12 +261,14 @@ impl Chain {
     /// [`Self::b_from_s`] with precomputed shaft rotations.
     #[must_use]
     pub fn b_from_s_with(&self, err: &ErrorRotations, shafts: &ShaftRotations) -> Rot<B, S> {
-        let mut q = err.installation;
-        for k in 0..self.axes.len() {
-            q = q * err.tilt[k] * shafts.0[k] * err.swing_rotor[k];
+        // B·T_0·R_0·W_0·T_1·R_1·…·W_{N-1}·M with the constant neighbours folded together.
+        let n = self.axes.len();
+        let mut q = err.between[0];
+        for k in 0..n {
+            q = q * shafts.0[k] * err.between[k + 1];
         }
         // FRAME: the chain composes body <- base <- gimbals <- IMU link by link (module doc).
-        Rot::from_quaternion(q * err.mount)
+        Rot::from_quaternion(q)
     }
 
     /// The nominal (error-free) IMU-to-body rotation a real RINS uses to demodulate.
@@ -294,18 +308,35 @@ impl Chain {
     /// vector, m the mounting vector, and the encoder error λ̂_k - λ_k ≈ b_k + s_k λ_k - λ̇_k τ_k.
     #[must_use]
     pub fn first_order_phi_b(&self, errors: &TableErrors, angles_rad: &AxisValues, rates_rad_per_s: &AxisValues) -> V3<B> {
-        self.first_order_phi_b_with(errors, angles_rad, rates_rad_per_s, &self.shaft_rotations(angles_rad))
+        self.first_order_phi_b_with(errors, &self.error_rotations(errors), angles_rad, rates_rad_per_s, &self.shaft_rotations(angles_rad))
     }
 
-    /// [`Self::first_order_phi_b`] with the shaft rotations of `angles_rad` precomputed.
+    /// [`Self::first_order_phi_b`] with the shaft rotations of `angles_rad` and the error rotations of
+    /// `errors` precomputed (the hot path: no trigonometry beyond the shafts').
     #[must_use]
-    pub fn first_order_phi_b_with(&self, errors: &TableErrors, angles_rad: &AxisValues, rates_rad_per_s: &AxisValues, shafts: &ShaftRotations) -> V3<B> {
+    pub fn first_order_phi_b_with(
+        &self,
+        errors: &TableErrors,
+        err: &ErrorRotations,
+        angles_rad: &AxisValues,
+        rates_rad_per_s: &AxisValues,
+        shafts: &ShaftRotations,
+    ) -> V3<B> {
         let mut phi = errors.installation_rad;
         let mut prefix = UnitQuaternion::identity();
         for (k, (g, e)) in self.axes.iter().zip(&errors.axes).enumerate() {
             let lambda = angles_rad[k];
             let encoder_error = e.encoder_offset_rad + e.encoder_scale * lambda - rates_rad_per_s[k] * e.encoder_delay_s;
-            let local = self.tilt_vector(k, e) - g.axis * encoder_error + self.swing_vector(k, e, lambda);
+            let mut local = self.tilt_vector(k, e) - g.axis * encoder_error;
+            if e.swing_half_angle_rad != 0.0 {
+                // sin λ, cos λ from the shaft quaternion (cos λ/2, sin λ/2 · a), then λ + φ by addition.
+                let q = shafts.0[k];
+                let (c, s) = (q.w, q.imag().dot(&g.axis));
+                let (sin_l, cos_l) = (2.0 * c * s, c * c - s * s);
+                let (sin_p, cos_p) = err.swing_phase_sin_cos[k];
+                let (sin_lp, cos_lp) = (sin_l * cos_p + cos_l * sin_p, cos_l * cos_p - sin_l * sin_p);
+                local += (g.e1 * cos_lp + g.e2 * sin_lp) * e.swing_half_angle_rad;
+            }
             phi += prefix * local;
             prefix *= shafts.0[k];
         }

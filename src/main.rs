@@ -47,8 +47,8 @@ enum Command {
     },
     /// Measure speed and recording size.
     Bench {
-        /// Steps of the pure-simulation benchmark.
-        #[arg(long, default_value_t = 5_000_000)]
+        /// Steps of each pure-simulation repetition.
+        #[arg(long, default_value_t = 2_000_000)]
         steps: u64,
     },
 }
@@ -148,10 +148,8 @@ fn run_command(args: &RunArgs) -> Result<(), Failure> {
         request.save = Some(PathBuf::from("recordings").join(format!("{}.rrd", params.meta.name)));
     }
     // The summary file is checked before anything runs, so a typo costs nothing.
-    if let Some(path) = &args.summary_json {
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty() && !d.is_dir()) {
-            return Err(Failure { code: 2, message: format!("--summary-json: directory {} does not exist", dir.display()) });
-        }
+    if let Some(dir) = args.summary_json.as_deref().and_then(|p| p.parent()).filter(|d| !d.as_os_str().is_empty() && !d.is_dir()) {
+        return Err(Failure { code: 2, message: format!("--summary-json: directory {} does not exist", dir.display()) });
     }
     let recording_id = format!("{}-seed{}", params.meta.name, params.meta.seed);
     let sinks = sink::open(&request, rinscope::record::APPLICATION_ID, &recording_id)?;

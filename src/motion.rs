@@ -95,13 +95,10 @@ impl VehicleMotion {
         for r in &ramps {
             let k = &mut knots[r.angle.index()];
             let current = k.value_rad.last().copied().unwrap_or(base_values[r.angle.index()]);
-            if let Some(&t_last) = k.t_s.last() {
-                if r.start_s < t_last {
-                    return Err(format!(
-                        "a {:?} ramp starts at {} s, before the previous {:?} ramp ends at {} s",
-                        r.angle, r.start_s, r.angle, t_last
-                    ));
-                }
+            if let Some(&t_last) = k.t_s.last()
+                && r.start_s < t_last
+            {
+                return Err(format!("a {:?} ramp starts at {} s, before the previous {:?} ramp ends at {} s", r.angle, r.start_s, r.angle, t_last));
             }
             let duration = (r.target_rad - current).abs() / r.rate_rad_per_s;
             k.t_s.push(r.start_s);
@@ -116,6 +113,12 @@ impl VehicleMotion {
     #[must_use]
     pub fn fixed(base: Attitude) -> Self {
         Self { base, knots: Default::default(), wobble: Vec::new() }
+    }
+
+    /// True when the vehicle never moves (no ramp, no wobble).
+    #[must_use]
+    pub fn is_fixed(&self) -> bool {
+        self.wobble.is_empty() && self.knots.iter().all(|k| k.t_s.is_empty())
     }
 
     /// Attitude at time `t_s`.

@@ -108,7 +108,7 @@ pub fn run_all() -> anyhow::Result<Table> {
         rows.push(Row {
             source: "seed 004 §5, Figs. 5/6/8".into(),
             scenario: name.into(),
-            quantity: "peak |pitch, roll, heading error|, deg".into(),
+            quantity: "peak error, largest of pitch, roll, heading, deg".into(),
             paper: paper.into(),
             value: peak_deg,
             band,

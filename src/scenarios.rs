@@ -12,6 +12,7 @@ pub const PRESETS: &[(&str, &str)] = &[
     ("rotary-table-2016-installation", include_str!("../assets/scenarios/rotary-table-2016-installation.toml")),
     ("rotary-table-2016-wobble", include_str!("../assets/scenarios/rotary-table-2016-wobble.toml")),
     ("rotary-table-2016-angular", include_str!("../assets/scenarios/rotary-table-2016-angular.toml")),
+    ("dual-axis-8-position", include_str!("../assets/scenarios/dual-axis-8-position.toml")),
     ("dual-axis-16-position", include_str!("../assets/scenarios/dual-axis-16-position.toml")),
 ];
 

@@ -166,9 +166,9 @@ impl Scheme {
         }
         match &self.kind {
             Kind::Continuous { rates } => {
-                for k in 0..self.n_axes {
-                    angle[k] += rates[k] * t_s;
-                    rate[k] = rates[k];
+                for ((a, r), w) in angle.iter_mut().zip(&mut rate).zip(rates).take(self.n_axes) {
+                    *a += w * t_s;
+                    *r = *w;
                 }
             }
             Kind::Indexed { initial_dwell_s, period_s, repeat, net_rad, moves } => {

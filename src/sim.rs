@@ -34,6 +34,8 @@ pub struct Model {
     compensation_rot: ErrorRotations,
     /// Exaggerated truth, for drawing.
     drawing_rot: ErrorRotations,
+    /// The attitude of a vehicle at rest, computed once.
+    fixed_attitude: Option<(Attitude, Rot<N, B>)>,
 }
 
 impl Model {
@@ -49,7 +51,11 @@ impl Model {
         let truth_rot = chain.error_rotations(&truth);
         let compensation_rot = chain.error_rotations(&compensation);
         let drawing_rot = chain.error_rotations(&truth.exaggerated(exaggeration));
-        Self { chain, vehicle, scheme, truth, compensation, truth_rot, compensation_rot, drawing_rot }
+        let fixed_attitude = vehicle.is_fixed().then(|| {
+            let a = vehicle.attitude(0.0);
+            (a, a.n_from_b())
+        });
+        Self { chain, vehicle, scheme, truth, compensation, truth_rot, compensation_rot, drawing_rot, fixed_attitude }
     }
 
     /// Number of gimbal axes.
@@ -97,8 +103,10 @@ fn demodulate(n_from_s: Rot<N, S>, b_from_s: Rot<B, S>) -> Attitude {
 /// Advances the simulation to `t_s` (steps must come in increasing time).
 #[must_use]
 pub fn step(model: &Model, state: &mut DemodState, t_s: f64) -> StepOutput {
-    let attitude = model.vehicle.attitude(t_s);
-    let n_from_b = attitude.n_from_b();
+    let (attitude, n_from_b) = model.fixed_attitude.unwrap_or_else(|| {
+        let a = model.vehicle.attitude(t_s);
+        (a, a.n_from_b())
+    });
     let (gimbal_rad, rate_rad_per_s) = model.scheme.state(t_s);
     let n = model.n_axes();
 
@@ -141,8 +149,8 @@ pub fn step(model: &Model, state: &mut DemodState, t_s: f64) -> StepOutput {
     let compensated = demodulate(n_from_s, model.chain.b_from_s_with(&model.compensation_rot, &shafts_of(&corrected)));
 
     // 3. Closed form: first-order error model (docs/closed-form.md).
-    let phi_b = model.chain.first_order_phi_b_with(&model.truth, &gimbal_rad, &rate_rad_per_s, &true_shafts);
-    let closed_form = AttitudeError::first_order(&attitude, n_from_b.apply(phi_b));
+    let phi_b = model.chain.first_order_phi_b_with(&model.truth, &model.truth_rot, &gimbal_rad, &rate_rad_per_s, &true_shafts);
+    let closed_form = AttitudeError::first_order(&n_from_b, n_from_b.apply(phi_b));
 
     StepOutput {
         t_s,

@@ -14,14 +14,17 @@ pub const DEG_PER_RAD: f64 = 1.0 / RAD_PER_DEG;
 /// Wraps an angle difference into (-pi, pi].
 #[must_use]
 pub fn wrap_pi(angle_rad: f64) -> f64 {
-    let two_pi = std::f64::consts::TAU;
-    let mut a = angle_rad % two_pi;
-    if a <= -std::f64::consts::PI {
-        a += two_pi;
-    } else if a > std::f64::consts::PI {
-        a -= two_pi;
+    use std::f64::consts::{PI, TAU};
+    // Differences of wrapped angles are within (-2pi, 2pi): one conditional turn suffices up to 3pi,
+    // and the hot path needs no division.
+    let a = if angle_rad.abs() <= 3.0 * PI { angle_rad } else { angle_rad - TAU * (angle_rad / TAU).round() };
+    if a > PI {
+        a - TAU
+    } else if a <= -PI {
+        a + TAU
+    } else {
+        a
     }
-    a
 }
 
 /// Formats an angle given in radians the way an inertial engineer reads it:
@@ -49,6 +52,14 @@ mod tests {
         // 350 deg - 0 deg is a -10 deg difference.
         assert!((wrap_pi(350.0 * RAD_PER_DEG) + 10.0 * RAD_PER_DEG).abs() < 1e-12);
         assert!((wrap_pi(-190.0 * RAD_PER_DEG) - 170.0 * RAD_PER_DEG).abs() < 1e-12);
+        // Every result is in (-pi, pi] and differs from the input by whole turns.
+        for i in -2000..=2000 {
+            let a = f64::from(i) * 0.0137;
+            let w = wrap_pi(a);
+            assert!(w > -std::f64::consts::PI && w <= std::f64::consts::PI, "{a} -> {w}");
+            let turns = (a - w) / std::f64::consts::TAU;
+            assert!((turns - turns.round()).abs() < 1e-9, "{a} -> {w}");
+        }
     }
 
     #[test]
