@@ -33,6 +33,9 @@ pub const TIMELINE: &str = "sim_time";
 /// Rows buffered per series before one `send_columns` call.
 const SERIES_CHUNK_ROWS: usize = 4096;
 
+/// Chunks sent before waiting for the sinks (see [`Recorder::throttle`]); ~2-4 MB of data.
+const MAX_CHUNKS_IN_FLIGHT: usize = 48;
+
 /// Nominal quaternion (w, i, j, k) to Rerun's (x, y, z, w): the one place this reordering happens.
 #[must_use]
 pub fn to_rerun_quaternion(q: &UnitQuaternion<f64>) -> rerun::Quaternion {
@@ -118,6 +121,8 @@ pub struct Recorder {
     scene_t: Vec<f64>,
     scene_vehicle: Vec<rerun::Quaternion>,
     scene_gimbals: Vec<Vec<rerun::Quaternion>>,
+    /// Chunks sent since the sinks last caught up.
+    chunks_in_flight: usize,
 }
 
 impl Recorder {
@@ -143,6 +148,7 @@ impl Recorder {
             scene_t: Vec::new(),
             scene_vehicle: Vec::new(),
             scene_gimbals: vec![Vec::new(); n],
+            chunks_in_flight: 0,
         };
         me.log_static(params)?;
         me.send_blueprint(params)?;
@@ -436,10 +442,24 @@ impl Recorder {
         Ok(())
     }
 
+    /// Back-pressure: Rerun's queue from `send_columns` to the sinks is unbounded, so a simulation
+    /// faster than the file writer (or a slow viewer connection) would grow memory with the run's
+    /// length. Every few dozen chunks we wait for the sinks to catch up: memory stays flat.
+    fn throttle(&mut self, chunks: usize) {
+        self.chunks_in_flight += chunks;
+        if self.chunks_in_flight >= MAX_CHUNKS_IN_FLIGHT {
+            // A sink that cannot flush (a viewer gone away) must not stop the run; data keeps flowing
+            // to the other sinks.
+            let _ = self.rec.flush_blocking();
+            self.chunks_in_flight = 0;
+        }
+    }
+
     fn flush_series(&mut self) -> RecordingStreamResult<()> {
         if self.series_t.is_empty() {
             return Ok(());
         }
+        self.throttle(self.series.len());
         let times = std::mem::take(&mut self.series_t);
         for s in &mut self.series {
             let values = std::mem::take(&mut s.values);
@@ -454,6 +474,7 @@ impl Recorder {
         if self.scene_t.is_empty() {
             return Ok(());
         }
+        self.throttle(1 + self.scene_gimbals.len());
         let times = std::mem::take(&mut self.scene_t);
         let time = || TimeColumn::new_duration_secs(TIMELINE, times.iter().copied());
         let vehicle = std::mem::take(&mut self.scene_vehicle);
