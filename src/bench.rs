@@ -64,7 +64,60 @@ pub fn run(steps: u64) -> anyhow::Result<()> {
             bytes as f64 / 1e6
         );
     }
+    live_latency(&dir)?;
     std::fs::remove_dir_all(&dir).ok();
     println!("peak resident memory: {:.1} MB", peak_rss_bytes() as f64 / 1e6);
+    Ok(())
+}
+
+/// Live mode: from the moment a save starts to the moment the simulation thread runs on the new
+/// parameters, over 60 saves (half in place, half by rename), with a session running in real time.
+fn live_latency(dir: &std::path::Path) -> anyhow::Result<()> {
+    use crate::live::{self, edit};
+    let path = dir.join("live.toml");
+    let text = crate::scenarios::text("jiang2017-dual-axis").ok_or_else(|| anyhow::anyhow!("preset"))?;
+    std::fs::write(&path, text)?;
+    let params = crate::config::load_file(&path)?;
+    let status = live::new_status(&params, 1.0);
+    let stop = std::sync::Arc::new(AtomicBool::new(false));
+    let opts = live::LiveOptions { config_path: path.clone(), speed: Some(1.0), duration_s: None, panel: false, log_to_stderr: false };
+    let rec_path = dir.join("live.rrd");
+    let sinks = sink::open(&SinkRequest { save: Some(rec_path), ..Default::default() }, "rinscope-bench", "live")?;
+    let session = {
+        let (status, stop, rec) = (status.clone(), stop.clone(), sinks.rec.clone());
+        std::thread::spawn(move || live::run_session_with_status(&opts, params, rec, &stop, &status))
+    };
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let mut latencies = Vec::new();
+    for i in 0..60 {
+        let generation = live::snapshot(&status).generation;
+        let value = 300.0 + f64::from(i % 2 + 1) * 10.0 * f64::from(i + 1);
+        let started = Instant::now();
+        if i % 2 == 0 {
+            let new = edit::set_in_text(text, &edit::KeyPath::parse("turntable.axis[1].swing_half_angle_arcsec"), edit::float(value)).map_err(anyhow::Error::msg)?;
+            std::fs::write(&path, new)?; // truncate and write in place
+        } else {
+            edit::set_in_file(&path, &edit::KeyPath::parse("turntable.axis[1].swing_half_angle_arcsec"), edit::float(value))?; // by rename
+        }
+        while live::snapshot(&status).generation == generation {
+            anyhow::ensure!(started.elapsed().as_secs() < 5, "save {i} was not applied within 5 s");
+            std::thread::sleep(std::time::Duration::from_micros(200));
+        }
+        latencies.push(started.elapsed().as_secs_f64() * 1e3);
+        std::thread::sleep(std::time::Duration::from_millis(120));
+    }
+    stop.store(true, std::sync::atomic::Ordering::SeqCst);
+    session.join().map_err(|_| anyhow::anyhow!("live session panicked"))??;
+    sinks.finish()?;
+    let mut sorted = latencies.clone();
+    sorted.sort_by(f64::total_cmp);
+    println!(
+        "live reload       save -> applied over {} saves: median {:.1} ms, p95 {:.1} ms, max {:.1} ms (debounce {} ms included)",
+        sorted.len(),
+        sorted[sorted.len() / 2],
+        live::p95(&latencies),
+        sorted[sorted.len() - 1],
+        live::watch::DEBOUNCE.as_millis()
+    );
     Ok(())
 }

@@ -77,7 +77,7 @@ pub enum ConfigError {
 // ---------------------------------------------------------------------------------------------
 
 /// The whole scenario file.
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawConfig {
     /// What the scenario is.
@@ -101,10 +101,27 @@ pub struct RawConfig {
     /// Parameters the compensated demodulation assumes (each defaults to the true value).
     #[serde(default)]
     pub compensation: RawCompensation,
+    /// Live mode only.
+    #[serde(default)]
+    pub live: RawLive,
+}
+
+/// `[live]`: read by `rinscope live` only.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RawLive {
+    /// Simulated seconds per wall-clock second.
+    pub speed: f64,
+}
+
+impl Default for RawLive {
+    fn default() -> Self {
+        Self { speed: 1.0 }
+    }
 }
 
 /// `[scenario]`
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawScenario {
     /// Identifier, also the recording's file name.
@@ -120,7 +137,7 @@ pub struct RawScenario {
 }
 
 /// `[simulation]`
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RawSimulation {
     /// Simulated time, s.
@@ -136,7 +153,7 @@ impl Default for RawSimulation {
 }
 
 /// `[recording]`
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RawRecording {
     /// Time-series output rate, Hz of simulated time.
@@ -154,7 +171,7 @@ impl Default for RawRecording {
 }
 
 /// `[site]`
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RawSite {
     /// Geodetic latitude, deg.
@@ -172,7 +189,7 @@ impl Default for RawSite {
 }
 
 /// `[vehicle]`
-#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RawVehicle {
     /// Initial pitch, deg.
@@ -188,7 +205,7 @@ pub struct RawVehicle {
 }
 
 /// `[[vehicle.ramp]]`
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawRamp {
     /// Which Euler angle: "pitch", "roll" or "heading".
@@ -202,7 +219,7 @@ pub struct RawRamp {
 }
 
 /// `[[vehicle.wobble]]`
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawWobble {
     /// Which Euler angle: "pitch", "roll" or "heading".
@@ -217,7 +234,7 @@ pub struct RawWobble {
 }
 
 /// `[turntable]`
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawTurntable {
     /// Installation error of the table base on the body: rotation about body x, arcsec.
@@ -243,7 +260,7 @@ pub struct RawTurntable {
 }
 
 /// `[[turntable.axis]]`
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawAxis {
     /// Name used by the scheme, the compensation and the recording ("outer", "inner", ...).
@@ -274,7 +291,7 @@ pub struct RawAxis {
 }
 
 /// `[scheme]`: one of "static", "continuous", "indexed".
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawScheme {
     /// "static", "continuous" or "indexed".
@@ -294,7 +311,7 @@ pub struct RawScheme {
 }
 
 /// `[[scheme.rate]]`
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawRate {
     /// Axis name.
@@ -304,7 +321,7 @@ pub struct RawRate {
 }
 
 /// `[[scheme.step]]`
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawStep {
     /// Axis name.
@@ -322,9 +339,12 @@ pub struct RawStep {
 }
 
 /// `[compensation]`: every key is optional and defaults to the true value of the same key.
-#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawCompensation {
+    /// false: the "compensated" demodulation uses the nominal table (compensation switched off).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub enabled: Option<bool>,
     /// See `turntable.installation_x_arcsec`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub installation_x_arcsec: Option<f64>,
@@ -349,7 +369,7 @@ pub struct RawCompensation {
 }
 
 /// `[compensation.axis.NAME]`
-#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawAxisCompensation {
     /// arcsec
@@ -436,6 +456,13 @@ pub struct Params {
     pub scheme: Scheme,
     /// The configuration as resolved (defaults and compensation filled in), as TOML.
     pub resolved_toml: String,
+    /// The same, as data.
+    pub resolved: RawConfig,
+    /// The configuration as written (defaults of optional keys not filled in): live mode describes
+    /// reloads as its differences.
+    pub written: RawConfig,
+    /// `[live] speed`: simulated seconds per wall-clock second.
+    pub live_speed: f64,
 }
 
 impl Params {
@@ -684,6 +711,8 @@ fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigError> {
         description: raw.scenario.description.clone(),
         seed: raw.scenario.seed,
     };
+    let live_speed = c.range("live.speed", raw.live.speed, "x real time", 0.01, 10_000.0, "")?;
+    let written = raw.clone();
     let mut resolved = raw;
     resolved.compensation = resolved_comp;
     let resolved_toml = toml::to_string_pretty(&resolved).unwrap_or_else(|e| format!("# could not serialise: {e}"));
@@ -700,7 +729,39 @@ fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigError> {
         compensation,
         scheme,
         resolved_toml,
+        resolved,
+        written,
+        live_speed,
     })
+}
+
+/// Every leaf of a resolved config as `dotted.key -> value text` (arrays of tables indexed `[i]`),
+/// for describing what changed between two versions.
+#[must_use]
+pub fn flatten(raw: &RawConfig) -> BTreeMap<String, String> {
+    fn walk(prefix: &str, v: &toml::Value, out: &mut BTreeMap<String, String>) {
+        match v {
+            toml::Value::Table(t) => {
+                for (k, x) in t {
+                    let key = if prefix.is_empty() { k.clone() } else { format!("{prefix}.{k}") };
+                    walk(&key, x, out);
+                }
+            }
+            toml::Value::Array(a) if a.iter().all(toml::Value::is_table) && !a.is_empty() => {
+                for (i, x) in a.iter().enumerate() {
+                    walk(&format!("{prefix}[{i}]"), x, out);
+                }
+            }
+            other => {
+                out.insert(prefix.to_owned(), other.to_string());
+            }
+        }
+    }
+    let mut out = BTreeMap::new();
+    if let Ok(v) = toml::Value::try_from(raw) {
+        walk("", &v, &mut out);
+    }
+    out
 }
 
 fn axis_index(c: &Checker<'_>, key: &str, chain: &Chain, name: &str) -> Result<usize, ConfigError> {
@@ -793,7 +854,9 @@ fn validate_compensation(
         axis_index(c, &format!("compensation.axis.{name}"), chain, name)?;
     }
     let pick = |v: Option<f64>, default: f64| v.unwrap_or(default);
+    let enabled = comp.enabled.unwrap_or(true);
     let mut resolved = RawCompensation {
+        enabled: Some(enabled),
         installation_x_arcsec: Some(pick(comp.installation_x_arcsec, table.installation_x_arcsec)),
         installation_y_arcsec: Some(pick(comp.installation_y_arcsec, table.installation_y_arcsec)),
         installation_z_arcsec: Some(pick(comp.installation_z_arcsec, table.installation_z_arcsec)),
@@ -833,6 +896,9 @@ fn validate_compensation(
             encoder_delay_s: c.range(&k("encoder_delay_ms"), r.encoder_delay_ms.unwrap_or_default(), "ms", -1000.0, 1000.0, "")? * 1e-3,
         });
         resolved.axis.insert(a.name.clone(), r);
+    }
+    if !enabled {
+        return Ok((TableErrors::zero(chain.axes().len()), resolved));
     }
     let errors = TableErrors {
         installation_rad: Vector3::new(

@@ -32,6 +32,13 @@ struct Cli {
 enum Command {
     /// Simulate a scenario and record it (the default command).
     Run(RunArgs),
+    /// Run in real time, streaming to a viewer, with the config file watched and a slider panel.
+    Live(LiveArgs),
+    /// Print the event log (reloads, errors, summary) of a saved recording.
+    Events {
+        /// The .rrd file.
+        file: PathBuf,
+    },
     /// List the scenario presets.
     Scenarios,
     /// Parse and validate a scenario file without running it.
@@ -51,6 +58,40 @@ enum Command {
         #[arg(long, default_value_t = 2_000_000)]
         steps: u64,
     },
+}
+
+#[derive(Args)]
+struct LiveArgs {
+    /// A preset: an editable copy is written to rinscope-live/<name>.toml (kept if it exists).
+    #[arg(long, conflicts_with = "config")]
+    scenario: Option<String>,
+    /// The scenario file to run and watch.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Simulated seconds per wall-clock second (default: the file's [live] speed, else 1).
+    #[arg(long)]
+    speed: Option<f64>,
+    /// Stop after this much simulated time, s (default: run until you quit).
+    #[arg(long)]
+    duration_s: Option<f64>,
+    /// Start a new Rerun viewer (the default when no other viewer sink is given).
+    #[arg(long)]
+    spawn: bool,
+    /// Stream to a running viewer (default URL rerun+http://127.0.0.1:9876/proxy).
+    #[arg(long, num_args = 0..=1, default_missing_value = sink::DEFAULT_CONNECT_URL)]
+    connect: Option<String>,
+    /// Serve the stream over gRPC on this port (default 9876) for native or web viewers.
+    #[arg(long, num_args = 0..=1, default_missing_value = "9876")]
+    serve: Option<u16>,
+    /// Also save everything streamed to this .rrd file.
+    #[arg(long)]
+    save: Option<PathBuf>,
+    /// No viewer: only --save (for headless sessions and tests).
+    #[arg(long, conflicts_with_all = ["spawn", "connect", "serve"])]
+    no_viewer: bool,
+    /// No terminal panel (edit the file by hand; Ctrl-C ends the session).
+    #[arg(long)]
+    no_panel: bool,
 }
 
 #[derive(Args, Default)]
@@ -110,6 +151,8 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command.unwrap_or(Command::Run(RunArgs::default())) {
         Command::Run(args) => run_command(&args),
+        Command::Live(args) => live_command(&args),
+        Command::Events { file } => events_command(&file),
         Command::Scenarios => {
             list_scenarios();
             Ok(())
@@ -143,7 +186,7 @@ fn load(args: &RunArgs) -> Result<Params, Failure> {
 
 fn run_command(args: &RunArgs) -> Result<(), Failure> {
     let params = load(args)?;
-    let mut request = SinkRequest { save: args.save.clone(), spawn: args.spawn, connect: args.connect.clone() };
+    let mut request = SinkRequest { save: args.save.clone(), spawn: args.spawn, connect: args.connect.clone(), serve: None };
     if request.save.is_none() && !request.spawn && request.connect.is_none() {
         request.save = Some(PathBuf::from("recordings").join(format!("{}.rrd", params.meta.name)));
     }
@@ -198,6 +241,83 @@ fn write_atomically(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()>
     let tmp = sink::partial_path(path);
     std::fs::write(&tmp, bytes)?;
     std::fs::rename(&tmp, path)
+}
+
+fn live_command(args: &LiveArgs) -> Result<(), Failure> {
+    use std::io::IsTerminal;
+    let path = match (&args.config, &args.scenario) {
+        (Some(p), _) => p.clone(),
+        (None, name) => {
+            let name = name.as_deref().unwrap_or(scenarios::DEFAULT_SCENARIO);
+            scenarios::load(name)?; // a clear error for an unknown name
+            let (path, created) = rinscope::live::ensure_preset_copy(name).map_err(|e| Failure { code: 2, message: format!("{e:#}") })?;
+            eprintln!("rinscope live: {} {} — edit it, or move the sliders", if created { "wrote" } else { "using your edited" }, path.display());
+            path
+        }
+    };
+    let params = config::load_file(&path)?;
+    if let Some(s) = args.speed
+        && !(s.is_finite() && s > 0.0 && s <= 10_000.0)
+    {
+        return Err(Failure { code: 2, message: format!("--speed {s}: must be > 0 and <= 10000 (x real time)") });
+    }
+    if let Some(d) = args.duration_s
+        && !(d.is_finite() && d > 0.0)
+    {
+        return Err(Failure { code: 2, message: format!("--duration-s {d} s: must be > 0") });
+    }
+    let viewer_given = args.spawn || args.connect.is_some() || args.serve.is_some();
+    let request = SinkRequest { save: args.save.clone(), spawn: args.spawn || (!viewer_given && !args.no_viewer), connect: args.connect.clone(), serve: args.serve };
+    if args.no_viewer && args.save.is_none() {
+        return Err(Failure { code: 2, message: "--no-viewer needs --save FILE (otherwise nothing would be kept)".into() });
+    }
+    let recording_id = format!("{}-seed{}-live", params.meta.name, params.meta.seed);
+    let sinks = sink::open(&request, rinscope::record::APPLICATION_ID, &recording_id)?;
+    for d in &sinks.description {
+        eprintln!("rinscope live: {d}");
+    }
+    let panel = !args.no_panel && std::io::stdout().is_terminal() && std::io::stdin().is_terminal();
+    let stop = Arc::new(AtomicBool::new(false));
+    if !panel {
+        let stop = Arc::clone(&stop);
+        let _ = ctrlc::set_handler(move || {
+            if stop.swap(true, Ordering::SeqCst) {
+                std::process::exit(130);
+            }
+        });
+        eprintln!("rinscope live: running; edit {} to change parameters, Ctrl-C to stop", path.display());
+    }
+    let options = rinscope::live::LiveOptions { config_path: path, speed: args.speed, duration_s: args.duration_s, panel, log_to_stderr: true };
+    let summary = match rinscope::live::run_session(&options, params, sinks.rec.clone(), &stop) {
+        Ok(s) => s,
+        Err(e) => {
+            sinks.finish().ok();
+            return Err(e.into());
+        }
+    };
+    let saved = sinks.finish()?;
+    println!(
+        "live session: {:.1} s simulated ({} steps), {} reloads applied, save -> applied p95 {:.1} ms",
+        summary.sim_t_s,
+        summary.steps,
+        summary.latencies_ms.len(),
+        rinscope::live::p95(&summary.latencies_ms)
+    );
+    if let Some((p, bytes)) = saved {
+        println!("recording: {} ({:.2} MB) — open with `rerun {}`, list its events with `rinscope events {}`", p.display(), bytes as f64 / 1e6, p.display(), p.display());
+    }
+    Ok(())
+}
+
+fn events_command(file: &std::path::Path) -> Result<(), Failure> {
+    let events = rinscope::record::read::events(file).map_err(|e| Failure { code: 2, message: format!("{e:#}") })?;
+    for e in events {
+        match e.t_s {
+            Some(t) => println!("{t:>10.3} s  {:<5} {}", e.level, e.text),
+            None => println!("{:>12}  {:<5} {}", "static", e.level, e.text),
+        }
+    }
+    Ok(())
 }
 
 fn list_scenarios() {

@@ -135,6 +135,13 @@ impl Scheme {
         }
     }
 
+    /// The same motion started from other initial angles (live mode: a new scheme starts where the
+    /// gimbals are).
+    #[must_use]
+    pub fn with_initial(&self, initial_rad: &AxisValues) -> Self {
+        Self { initial: *initial_rad, ..self.clone() }
+    }
+
     /// Number of axes.
     #[must_use]
     pub fn n_axes(&self) -> usize {

@@ -26,6 +26,8 @@ pub struct Model {
     pub vehicle: VehicleMotion,
     /// Gimbal angles over time.
     pub scheme: Scheme,
+    /// Simulated time at which the scheme's clock started, s (live mode re-anchors it on reload).
+    pub scheme_t0_s: f64,
     /// True errors.
     pub truth: TableErrors,
     /// Errors assumed by the compensated demodulation.
@@ -55,7 +57,7 @@ impl Model {
             let a = vehicle.attitude(0.0);
             (a, a.n_from_b())
         });
-        Self { chain, vehicle, scheme, truth, compensation, truth_rot, compensation_rot, drawing_rot, fixed_attitude }
+        Self { chain, vehicle, scheme, scheme_t0_s: 0.0, truth, compensation, truth_rot, compensation_rot, drawing_rot, fixed_attitude }
     }
 
     /// Number of gimbal axes.
@@ -107,7 +109,8 @@ pub fn step(model: &Model, state: &mut DemodState, t_s: f64) -> StepOutput {
         let a = model.vehicle.attitude(t_s);
         (a, a.n_from_b())
     });
-    let (gimbal_rad, rate_rad_per_s) = model.scheme.state(t_s);
+    let t_scheme = t_s - model.scheme_t0_s;
+    let (gimbal_rad, rate_rad_per_s) = model.scheme.state(t_scheme);
     let n = model.n_axes();
 
     // Truth: the IMU attitude through the exact chain (an ideal INS reports it without error).
@@ -118,7 +121,7 @@ pub fn step(model: &Model, state: &mut DemodState, t_s: f64) -> StepOutput {
     let mut encoder_rad = [0.0; MAX_AXES];
     for k in 0..n {
         let e = &model.truth.axes[k];
-        let latched = if e.encoder_delay_s == 0.0 { gimbal_rad[k] } else { model.scheme.state(t_s - e.encoder_delay_s).0[k] };
+        let latched = if e.encoder_delay_s == 0.0 { gimbal_rad[k] } else { model.scheme.state(t_scheme - e.encoder_delay_s).0[k] };
         encoder_rad[k] = e.encoder_reading(latched);
     }
     // Shaft rotations of other angles; reuses the true ones when the angles are identical.

@@ -43,6 +43,14 @@ pub enum SinkError {
         /// Why.
         reason: String,
     },
+    /// `--serve` on a port that is taken.
+    #[error("--serve: cannot listen on port {port}: {reason}")]
+    Serve {
+        /// The port asked for.
+        port: u16,
+        /// Why.
+        reason: String,
+    },
     /// Spawning the viewer failed.
     #[error("--spawn: {0}")]
     Spawn(String),
@@ -60,6 +68,8 @@ pub struct SinkRequest {
     pub spawn: bool,
     /// Stream to a viewer at this URL.
     pub connect: Option<String>,
+    /// Serve the stream on this gRPC port for viewers (native or web) to connect to.
+    pub serve: Option<u16>,
 }
 
 /// An open recording and the file it will become.
@@ -136,6 +146,19 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
         let uri = url.parse().map_err(|e: rerun::external::re_uri::Error| SinkError::Rerun(e.to_string()))?;
         sinks.push(Box::new(GrpcSink::new(uri)));
         description.push(format!("streaming to a new viewer at {url}"));
+    }
+
+    if let Some(port) = req.serve {
+        // Check the port first: the server binds in a background task and would fail silently.
+        std::net::TcpListener::bind(("0.0.0.0", port)).map_err(|e| SinkError::Serve { port, reason: e.to_string() })?;
+        let options = rerun::ServerOptions { memory_limit: rerun::MemoryLimit::from_bytes(1 << 30), ..Default::default() };
+        let sink = rerun::grpc_server::GrpcServerSink::new("0.0.0.0", port, options).map_err(|e| SinkError::Serve { port, reason: e.to_string() })?;
+        sinks.push(Box::new(sink));
+        let url = format!("rerun+http://127.0.0.1:{port}/proxy");
+        description.push(format!(
+            "serving on {url}: `rerun --connect {url}`, or in a browser https://app.rerun.io/version/0.36.3/index.html?url={}",
+            url.replace(':', "%3A").replace('/', "%2F").replace('+', "%2B")
+        ));
     }
 
     let rec = RecordingStreamBuilder::new(application_id)

@@ -128,6 +128,8 @@ pub struct Playback {
     pub timeline: &'static str,
     /// Playback speed multiplier.
     pub speed: f64,
+    /// Follow the newest data (live sessions) instead of playing from the start.
+    pub follow: bool,
 }
 
 /// Sends `root` as the active and default layout of `rec`'s application.
@@ -150,7 +152,7 @@ pub fn send(rec: &RecordingStream, application_id: &'static str, root: &Node, pl
             .with_state(PanelState::Collapsed)
             .with_timeline(bpc::TimelineName(playback.timeline.into()))
             .with_playback_speed(bpc::PlaybackSpeed(datatypes::Float64(playback.speed)))
-            .with_play_state(PlayState::Playing),
+            .with_play_state(if playback.follow { PlayState::Following } else { PlayState::Playing }),
     )?;
     // The memory sink is read after a flush; a flush failure only loses the layout, never data.
     let _ = bp_stream.flush_blocking();

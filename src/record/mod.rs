@@ -18,9 +18,9 @@ use rerun::{RecordingStream, RecordingStreamResult, TimeColumn};
 use layout::Node;
 
 mod layout;
+pub mod read;
 
 use crate::config::Params;
-use crate::gimbal::LinkRotations;
 use crate::sim::{Model, StepOutput, ERROR_AXES, VARIANTS};
 use crate::units::{fmt_angle, ARCSEC_PER_RAD, DEG_PER_RAD};
 
@@ -123,11 +123,17 @@ pub struct Recorder {
     scene_gimbals: Vec<Vec<rerun::Quaternion>>,
     /// Chunks sent since the sinks last caught up.
     chunks_in_flight: usize,
+    /// Live mode: geometry on the timeline instead of static.
+    live: bool,
 }
 
 impl Recorder {
     /// Logs everything static (documents, styles, geometry, blueprint) and prepares the buffers.
     pub fn new(rec: RecordingStream, params: &Params) -> RecordingStreamResult<Self> {
+        Self::build(rec, params, false)
+    }
+
+    fn build(rec: RecordingStream, params: &Params, live: bool) -> RecordingStreamResult<Self> {
         let model = Model::new(params);
         let axis_names: Vec<String> = params.chain.axes().iter().map(|a| a.name.clone()).collect();
         let paths = ChainPaths::new(&axis_names);
@@ -149,10 +155,35 @@ impl Recorder {
             scene_vehicle: Vec::new(),
             scene_gimbals: vec![Vec::new(); n],
             chunks_in_flight: 0,
+            live,
         };
-        me.log_static(params)?;
+        me.log_once(params)?;
+        me.log_error_geometry(params, me.geometry_at(0.0))?;
         me.send_blueprint(params)?;
+        me.event(0.0, &format!("run started: {} ({} s at {} Hz, seed {})", params.meta.name, params.duration_s, params.step_hz, params.meta.seed), "INFO")?;
         Ok(me)
+    }
+
+    /// A recorder for live mode: everything that a reload can change is logged on the timeline.
+    pub fn new_live(rec: RecordingStream, params: &Params) -> RecordingStreamResult<Self> {
+        Self::build(rec, params, true)
+    }
+
+    fn geometry_at(&self, t_s: f64) -> Option<f64> {
+        self.live.then_some(t_s)
+    }
+
+    /// Live mode: new parameters apply from simulated time `t_s` on (buffered rows go out first).
+    pub fn reconfigure(&mut self, t_s: f64, model: Model, params: &Params) -> RecordingStreamResult<()> {
+        self.flush_now()?;
+        self.model = model;
+        self.log_error_geometry(params, self.geometry_at(t_s))
+    }
+
+    /// Sends every buffered row now (live mode: low latency over large chunks).
+    pub fn flush_now(&mut self) -> RecordingStreamResult<()> {
+        self.flush_series()?;
+        self.flush_scene()
     }
 
     /// The underlying stream (for flushing and sinks).
@@ -161,7 +192,8 @@ impl Recorder {
         &self.rec
     }
 
-    fn log_static(&self, p: &Params) -> RecordingStreamResult<()> {
+    /// Logs what never changes during a run: names, properties, series styles and the fixed geometry.
+    fn log_once(&self, p: &Params) -> RecordingStreamResult<()> {
         let rec = &self.rec;
         rec.send_recording_name(format!("rinscope: {}", p.meta.name))?;
         rec.send_property(
@@ -171,17 +203,6 @@ impl Recorder {
                 .with_component::<rerun::components::Text>("seed", [p.meta.seed.to_string()])
                 .with_component::<rerun::components::Text>("version", [env!("CARGO_PKG_VERSION").to_owned()]),
         )?;
-
-        // Documents: the scenario explains itself; the resolved config makes the run reproducible.
-        let mut doc = format!("# {}\n\n*{}*\n\n{}\n", p.meta.name, p.meta.title, p.meta.description.trim());
-        doc.push_str(&format!(
-            "\n---\nError angles in the 3D view are drawn **×{}**. Plots: red = uncompensated (nominal table model), \
-             green = compensated (`[compensation]` parameters), blue = closed form (first-order theory, docs/closed-form.md). \
-             Seed {}.\n",
-            p.recording.exaggeration, p.meta.seed
-        ));
-        rec.log_static("docs/scenario", &rerun::TextDocument::from_markdown(doc))?;
-        rec.log_static("docs/config", &rerun::TextDocument::from_markdown(format!("```toml\n{}\n```\n", p.resolved_toml)))?;
 
         // Series styles, once.
         let variant_names: Vec<String> = VARIANTS.iter().map(|v| v.replace('_', " ")).collect();
@@ -214,20 +235,6 @@ impl Recorder {
             )?;
         }
 
-        self.log_scene_geometry(p)?;
-        rec.set_duration_secs(TIMELINE, 0.0);
-        rec.log(
-            "events",
-            &rerun::TextLog::new(format!("run started: {} ({} s at {} Hz, seed {})", p.meta.name, p.duration_s, p.step_hz, p.meta.seed))
-                .with_level(rerun::TextLogLevel::INFO),
-        )?;
-        Ok(())
-    }
-
-    /// The static part of the 3D scene: rings, axes, cones, wedges, IMU box, labels.
-    fn log_scene_geometry(&self, p: &Params) -> RecordingStreamResult<()> {
-        let rec = &self.rec;
-        let x = p.recording.exaggeration;
         rec.log_static("world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
         rec.log_static(
             "world/compass",
@@ -236,15 +243,7 @@ impl Recorder {
                 .with_colors([rgba([120, 120, 120], 160); 2])
                 .with_radii([0.006]),
         )?;
-        label(rec, "world/compass/labels", &[([1.7, 0.0, -1.4], "E"), ([0.0, 1.7, -1.4], "N")])?;
-        rec.log_static(
-            "world/legend",
-            &rerun::Points3D::new([[0.0, 0.0, 1.45]])
-                .with_labels([format!("error angles drawn ×{x}")])
-                .with_radii([0.001])
-                .with_colors([rgb([220, 220, 220])]),
-        )?;
-
+        self.label(None, "world/compass/labels", &[([1.7, 0.0, -1.4], "E"), ([0.0, 1.7, -1.4], "N")])?;
         // Vehicle: a deck plate under the table and the body axes.
         rec.log_static(
             format!("{}/deck", self.paths.vehicle),
@@ -259,17 +258,8 @@ impl Recorder {
                 .with_colors([rgba([200, 200, 200], 200); 3])
                 .with_radii([0.01]),
         )?;
-
-        let draw = self.model.drawing_links(&self.model.scheme.state(0.0).0);
-        self.log_static_links(&draw)?;
-
         let n = self.axis_names.len();
         let axes = self.model.chain.axes();
-        let drawing = p.truth.exaggerated(x);
-        // Installation: a wedge in the body between the ideal first axis and the tilted one.
-        let first_tilted = draw.base * axes[0].axis;
-        self.log_wedge(&format!("{}/installation", self.paths.vehicle), axes[0].axis, first_tilted, 1.5, p.truth.installation_rad.norm() * ARCSEC_PER_RAD, x, "installation")?;
-
         for k in 0..n {
             let g = &axes[k];
             let radius = ring_radius(k, n);
@@ -278,51 +268,18 @@ impl Recorder {
             // Nominal axis (grey) in the mount frame; the rotor's own axis (coloured) in the rotor frame.
             rec.log_static(
                 format!("{}/nominal_axis", self.paths.mounts[k]),
-                &rerun::LineStrips3D::new([[p3(-g.axis * half), p3(g.axis * half)]])
-                    .with_colors([rgb(palette::NOMINAL)])
-                    .with_radii([0.006]),
+                &rerun::LineStrips3D::new([[p3(-g.axis * half), p3(g.axis * half)]]).with_colors([rgb(palette::NOMINAL)]).with_radii([0.006]),
             )?;
             rec.log_static(
                 format!("{}/actual_axis", self.paths.gimbals[k]),
-                &rerun::LineStrips3D::new([[p3(-g.axis * half * 1.05), p3(g.axis * half * 1.05)]])
-                    .with_colors([rgb(color)])
-                    .with_radii([0.012]),
+                &rerun::LineStrips3D::new([[p3(-g.axis * half * 1.05), p3(g.axis * half * 1.05)]]).with_colors([rgb(color)]).with_radii([0.012]),
             )?;
-            // Swing cone: a translucent double cone of half-angle α·x around the nominal axis, with rims.
-            let alpha = drawing.axes[k].swing_half_angle_rad;
-            if alpha > 0.0 {
-                let (mesh, rims) = cone(g.axis, g.e1, g.e2, alpha, half);
-                rec.log_static(
-                    format!("{}/swing_cone", self.paths.mounts[k]),
-                    &rerun::Mesh3D::new(mesh.0).with_triangle_indices(mesh.1).with_albedo_factor(albedo(color, 60)),
-                )?;
-                rec.log_static(
-                    format!("{}/swing_cone_rims", self.paths.mounts[k]),
-                    &rerun::LineStrips3D::new(rims).with_colors([rgba(color, 200)]).with_radii([0.004]),
-                )?;
-                let tip = -g.axis * half - g.e1 * (half * alpha.tan());
-                let text = format!(
-                    "{} swing α = {}, φ = {:.1}°",
-                    g.name,
-                    fmt_angle(p.truth.axes[k].swing_half_angle_rad),
-                    p.truth.axes[k].swing_phase_rad * DEG_PER_RAD
-                );
-                label(rec, &format!("{}/swing_cone_label", self.paths.mounts[k]), &[(p3(tip), text.as_str())])?;
-            }
             // Ring of this gimbal: through its own axis and the next one; the last is a platform.
             rec.log_static(
                 format!("{}/ring", self.paths.gimbals[k]),
                 &rerun::LineStrips3D::new(ring(axes, k, radius)).with_colors([rgb(color)]).with_radii([0.02]),
             )?;
-            // Non-orthogonality: a wedge, in the previous rotor, between the normal to the previous
-            // axis and this axis.
-            if k > 0 {
-                let tilted = draw.mount[k] * g.axis;
-                let eta_arcsec = p.truth.axes[k].non_orthogonality_rad * ARCSEC_PER_RAD;
-                self.log_wedge(&format!("{}/non_orthogonality", self.paths.gimbals[k - 1]), g.axis, tilted, half, eta_arcsec, x, "η non-orthogonality")?;
-            }
         }
-
         // The IMU: a box and its three sensor axes.
         rec.log_static(
             format!("{}/case", self.paths.imu),
@@ -338,23 +295,110 @@ impl Recorder {
         Ok(())
     }
 
-    /// Logs the transforms that do not move during a run (base, mounts, IMU) and the initial pose.
-    fn log_static_links(&self, links: &LinkRotations) -> RecordingStreamResult<()> {
-        let rec = &self.rec;
-        let t = |q: &UnitQuaternion<f64>| rerun::Transform3D::from_rotation(to_rerun_quaternion(q));
-        rec.log_static(self.paths.base.as_str(), &t(&links.base))?;
-        for k in 0..self.axis_names.len() {
-            rec.log_static(self.paths.mounts[k].as_str(), &t(&links.mount[k]))?;
+    /// Logs `arch` at `path`: static in a plain run (`at = None`), at simulated time `at` in live mode,
+    /// where a reload can change it and the saved session must show the history.
+    fn put(&self, at: Option<f64>, path: impl Into<rerun::EntityPath>, arch: &dyn rerun::AsComponents) -> RecordingStreamResult<()> {
+        match at {
+            None => self.rec.log_static(path, arch),
+            Some(t) => {
+                self.rec.set_duration_secs(TIMELINE, t);
+                self.rec.log(path, arch)
+            }
         }
-        rec.log_static(self.paths.imu.as_str(), &t(&links.imu))?;
+    }
+
+    /// Removes what `put` drew at `path` (live mode: an error set back to zero).
+    fn clear(&self, at: Option<f64>, path: impl Into<rerun::EntityPath>) -> RecordingStreamResult<()> {
+        match at {
+            None => Ok(()),
+            Some(t) => {
+                self.rec.set_duration_secs(TIMELINE, t);
+                self.rec.log(path, &rerun::Clear::recursive())
+            }
+        }
+    }
+
+    /// Text labels at points (Points3D with tiny dots): labels sit exactly where they belong.
+    fn label(&self, at: Option<f64>, path: &str, items: &[([f32; 3], &str)]) -> RecordingStreamResult<()> {
+        self.put(
+            at,
+            path,
+            &rerun::Points3D::new(items.iter().map(|(p, _)| *p))
+                .with_labels(items.iter().map(|(_, t)| *t))
+                .with_radii([0.002])
+                .with_colors([rgb([230, 230, 230])]),
+        )
+    }
+
+    /// Everything that depends on the error values: the documents, the exaggerated base, mount and
+    /// IMU transforms, the swing cones and the wedges.
+    fn log_error_geometry(&self, p: &Params, at: Option<f64>) -> RecordingStreamResult<()> {
+        // Documents: the scenario explains itself; the resolved config makes the run reproducible.
+        let mut doc = format!("# {}\n\n*{}*\n\n{}\n", p.meta.name, p.meta.title, p.meta.description.trim());
+        doc.push_str(&format!(
+            "\n---\nError angles in the 3D view are drawn **×{}**. Plots: red = uncompensated (nominal table model), \
+             green = compensated (`[compensation]` parameters), blue = closed form (first-order theory, docs/closed-form.md). \
+             Seed {}.\n",
+            p.recording.exaggeration, p.meta.seed
+        ));
+        self.put(at, "docs/scenario", &rerun::TextDocument::from_markdown(doc))?;
+        self.put(at, "docs/config", &rerun::TextDocument::from_markdown(format!("```toml\n{}\n```\n", p.resolved_toml)))?;
+
+        let x = p.recording.exaggeration;
+        self.label(at, "world/legend", &[([0.0, 0.0, 1.45], format!("error angles drawn ×{x}").as_str())])?;
+        let draw = self.model.drawing_links(&self.model.scheme.state(0.0).0);
+        let t = |q: &UnitQuaternion<f64>| rerun::Transform3D::from_rotation(to_rerun_quaternion(q));
+        self.put(at, self.paths.base.as_str(), &t(&draw.base))?;
+        for k in 0..self.axis_names.len() {
+            self.put(at, self.paths.mounts[k].as_str(), &t(&draw.mount[k]))?;
+        }
+        self.put(at, self.paths.imu.as_str(), &t(&draw.imu))?;
+
+        let n = self.axis_names.len();
+        let axes = self.model.chain.axes();
+        let drawing = p.truth.exaggerated(x);
+        // Installation: a wedge in the body between the ideal first axis and the tilted one.
+        let first_tilted = draw.base * axes[0].axis;
+        let installation = p.truth.installation_rad.norm() * ARCSEC_PER_RAD;
+        self.log_wedge(at, &format!("{}/installation", self.paths.vehicle), axes[0].axis, first_tilted, 1.5, installation, x, "installation")?;
+        for k in 0..n {
+            let g = &axes[k];
+            let half = ring_radius(k, n) * 1.25;
+            let color = palette::AXES[k];
+            // Swing cone: a translucent double cone of half-angle α·x around the nominal axis, with rims.
+            let alpha = drawing.axes[k].swing_half_angle_rad;
+            let cone_path = format!("{}/swing_cone", self.paths.mounts[k]);
+            if alpha > 0.0 {
+                let (mesh, rims) = cone(g.axis, g.e1, g.e2, alpha, half);
+                self.put(at, cone_path.as_str(), &rerun::Mesh3D::new(mesh.0).with_triangle_indices(mesh.1).with_albedo_factor(albedo(color, 60)))?;
+                self.put(at, format!("{cone_path}/rims"), &rerun::LineStrips3D::new(rims).with_colors([rgba(color, 200)]).with_radii([0.004]))?;
+                let tip = -g.axis * half - g.e1 * (half * alpha.tan());
+                let text = format!(
+                    "{} swing α = {}, φ = {:.1}°",
+                    g.name,
+                    fmt_angle(p.truth.axes[k].swing_half_angle_rad),
+                    p.truth.axes[k].swing_phase_rad * DEG_PER_RAD
+                );
+                self.label(at, &format!("{cone_path}/label"), &[(p3(tip), text.as_str())])?;
+            } else {
+                self.clear(at, cone_path.as_str())?;
+            }
+            // Non-orthogonality: a wedge, in the previous rotor, between the normal to the previous
+            // axis and this axis.
+            if k > 0 {
+                let tilted = draw.mount[k] * g.axis;
+                let eta_arcsec = p.truth.axes[k].non_orthogonality_rad * ARCSEC_PER_RAD;
+                self.log_wedge(at, &format!("{}/non_orthogonality", self.paths.gimbals[k - 1]), g.axis, tilted, half, eta_arcsec, x, "η non-orthogonality")?;
+            }
+        }
         Ok(())
     }
 
     /// A translucent wedge from `ideal` to `tilted` (both unit, same frame) with a label.
     #[allow(clippy::too_many_arguments)]
-    fn log_wedge(&self, path: &str, ideal: Vector3<f64>, tilted: Vector3<f64>, length: f64, true_arcsec: f64, x: f64, what: &str) -> RecordingStreamResult<()> {
+    fn log_wedge(&self, at: Option<f64>, path: &str, ideal: Vector3<f64>, tilted: Vector3<f64>, length: f64, true_arcsec: f64, x: f64, what: &str) -> RecordingStreamResult<()> {
         if true_arcsec == 0.0 {
-            return Ok(());
+            return self.clear(at, path);
         }
         let mut positions = vec![[0.0f32; 3]];
         let steps = 16;
@@ -363,16 +407,16 @@ impl Recorder {
             positions.push(p3(((1.0 - s) * ideal + s * tilted).normalize() * length));
         }
         let triangles: Vec<[u32; 3]> = (1..=steps as u32).map(|i| [0, i, i + 1]).collect();
-        self.rec.log_static(format!("{path}/wedge"), &rerun::Mesh3D::new(positions).with_triangle_indices(triangles).with_albedo_factor(albedo([255, 200, 60], 110)))?;
-        self.rec.log_static(
+        self.put(at, format!("{path}/wedge"), &rerun::Mesh3D::new(positions).with_triangle_indices(triangles).with_albedo_factor(albedo([255, 200, 60], 110)))?;
+        self.put(
+            at,
             format!("{path}/edges"),
             &rerun::LineStrips3D::new([[[0.0, 0.0, 0.0], p3(ideal * length)], [[0.0, 0.0, 0.0], p3(tilted * length)]])
                 .with_colors([rgb([255, 255, 255]), rgb([255, 200, 60])])
                 .with_radii([0.004]),
         )?;
         let text = format!("{what} {} (drawn ×{x})", fmt_angle(true_arcsec / ARCSEC_PER_RAD));
-        label(&self.rec, &format!("{path}/label"), &[(p3(tilted * length * 1.08), text.as_str())])?;
-        Ok(())
+        self.label(at, &format!("{path}/label"), &[(p3(tilted * length * 1.08), text.as_str())])
     }
 
     fn send_blueprint(&self, p: &Params) -> RecordingStreamResult<()> {
@@ -401,9 +445,9 @@ impl Recorder {
         );
         let right = Node::container(ContainerKind::Vertical, vec![error_view("pitch"), error_view("roll"), error_view("heading"), more], &[]);
         let root = Node::container(ContainerKind::Horizontal, vec![left, right], &[1.1, 1.0]);
-        // Play a whole run in about a minute.
-        let speed = (p.duration_s / 60.0).max(1.0).round();
-        layout::send(&self.rec, APPLICATION_ID, &root, &layout::Playback { timeline: TIMELINE, speed })
+        // Play a whole run in about a minute; a live session follows the newest data.
+        let speed = if self.live { 1.0 } else { (p.duration_s / 60.0).max(1.0).round() };
+        layout::send(&self.rec, APPLICATION_ID, &root, &layout::Playback { timeline: TIMELINE, speed, follow: self.live })
     }
 
     /// Buffers one time-series row; sends a chunk when the buffer is full.
@@ -450,12 +494,13 @@ impl Recorder {
         if self.chunks_in_flight >= MAX_CHUNKS_IN_FLIGHT {
             // A sink that cannot flush (a viewer gone away) must not stop the run; data keeps flowing
             // to the other sinks.
-            let _ = self.rec.flush_blocking();
+            let _ = self.rec.flush_with_timeout(std::time::Duration::from_secs(2));
             self.chunks_in_flight = 0;
         }
     }
 
-    fn flush_series(&mut self) -> RecordingStreamResult<()> {
+    /// Sends the buffered time-series rows.
+    pub fn flush_series(&mut self) -> RecordingStreamResult<()> {
         if self.series_t.is_empty() {
             return Ok(());
         }
@@ -470,7 +515,8 @@ impl Recorder {
         Ok(())
     }
 
-    fn flush_scene(&mut self) -> RecordingStreamResult<()> {
+    /// Sends the buffered scene frames.
+    pub fn flush_scene(&mut self) -> RecordingStreamResult<()> {
         if self.scene_t.is_empty() {
             return Ok(());
         }
@@ -505,17 +551,6 @@ impl Recorder {
         self.flush_series()?;
         self.flush_scene()
     }
-}
-
-/// Text labels at points (Points3D with invisible dots): labels sit exactly where they belong.
-fn label(rec: &RecordingStream, path: &str, items: &[([f32; 3], &str)]) -> RecordingStreamResult<()> {
-    rec.log_static(
-        path,
-        &rerun::Points3D::new(items.iter().map(|(p, _)| *p))
-            .with_labels(items.iter().map(|(_, t)| *t))
-            .with_radii([0.002])
-            .with_colors([rgb([230, 230, 230])]),
-    )
 }
 
 /// "x", "y" or "z" for a coordinate unit vector.

@@ -1,0 +1,573 @@
+//! `rinscope live`: the simulation paced to the wall clock, streamed to a viewer, with the scenario
+//! file watched and reloaded between steps, and a terminal panel of sliders that edits that file.
+//!
+//! Threads: config watcher → (channel) → simulation → (channel) → recorder; the main thread runs the
+//! panel. Sliders and a text editor drive the same path: both write the file, the watcher reloads it.
+
+pub mod edit;
+pub mod panel;
+pub mod watch;
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use crossbeam_channel::{Receiver, Sender};
+
+use crate::config::{self, Params, RawConfig};
+use crate::record::Recorder;
+use crate::run::every_n_steps;
+use crate::sim::{step, DemodState, ErrorStats, Model, StepOutput};
+use watch::WatchEvent;
+
+/// Scene frames per wall-clock second streamed in live mode.
+pub const SCENE_WALL_HZ: f64 = 30.0;
+/// Series rows per wall-clock second streamed in live mode (at most).
+pub const SERIES_WALL_HZ: f64 = 100.0;
+/// At most this many steps between two looks at the reload channel (~10 ms of work).
+const MAX_STEPS_PER_SLICE: u64 = 20_000;
+
+/// The simulation of a live session: a [`Model`] that can be replaced between two steps.
+pub struct LiveSim {
+    /// The parameters in force.
+    pub params: Params,
+    /// Their model (with the scheme re-anchored at the last scheme change).
+    pub model: Model,
+    state: DemodState,
+    step_index: u64,
+    /// RMS and peak over the session.
+    pub stats: ErrorStats,
+    last_gimbal_rad: crate::scheme::AxisValues,
+}
+
+impl LiveSim {
+    /// Starts at t = 0.
+    #[must_use]
+    pub fn new(params: Params) -> Self {
+        let model = Model::new(&params);
+        let last_gimbal_rad = model.scheme.state(0.0).0;
+        Self { params, model, state: DemodState::default(), step_index: 0, stats: ErrorStats::default(), last_gimbal_rad }
+    }
+
+    /// Simulated time of the next step, s.
+    #[must_use]
+    pub fn t_s(&self) -> f64 {
+        self.step_index as f64 / self.params.step_hz
+    }
+
+    /// Number of steps taken.
+    #[must_use]
+    pub fn steps(&self) -> u64 {
+        self.step_index
+    }
+
+    /// One step.
+    pub fn step(&mut self) -> StepOutput {
+        let t = self.t_s();
+        let out = step(&self.model, &mut self.state, t);
+        self.stats.add(&out);
+        self.last_gimbal_rad = out.gimbal_rad;
+        self.step_index += 1;
+        out
+    }
+
+    /// Replaces the parameters between two steps. Returns what changed, in words (empty: nothing did);
+    /// refuses changes the running session cannot take (the old parameters stay in force).
+    pub fn apply(&mut self, new: Params) -> Result<Vec<String>, String> {
+        let old = &self.params;
+        let axes = |p: &Params| p.chain.axes().iter().map(|a| (a.name.clone(), a.axis)).collect::<Vec<_>>();
+        if axes(old) != axes(&new) {
+            return Err("the turntable's axes (names, number or directions) cannot change in a running session; restart `rinscope live`".into());
+        }
+        if old.step_hz != new.step_hz {
+            return Err(format!("simulation.step_hz cannot change in a running session ({} Hz -> {} Hz); restart `rinscope live`", old.step_hz, new.step_hz));
+        }
+        let changes = describe_changes(&old.written, &new.written);
+        if changes.is_empty() {
+            return Ok(changes);
+        }
+        let mut model = Model::new(&new);
+        let initial_changed = old.resolved.turntable.axis.iter().zip(&new.resolved.turntable.axis).any(|(a, b)| a.initial_angle_deg != b.initial_angle_deg);
+        if old.resolved.scheme == new.resolved.scheme && !initial_changed {
+            // Same motion: keep its clock, so nothing jumps.
+            model.scheme = self.model.scheme.clone();
+            model.scheme_t0_s = self.model.scheme_t0_s;
+        } else {
+            // A new motion starts from where the gimbals were at the last step, at that step's time.
+            model.scheme = new.scheme.with_initial(&self.last_gimbal_rad);
+            model.scheme_t0_s = self.step_index.saturating_sub(1) as f64 / self.params.step_hz;
+        }
+        self.model = model;
+        self.params = new;
+        Ok(changes)
+    }
+}
+
+/// Human-readable differences between two resolved configs, e.g. `inner swing half-angle 300″ → 600″`.
+#[must_use]
+pub fn describe_changes(old: &RawConfig, new: &RawConfig) -> Vec<String> {
+    let (a, b) = (config::flatten(old), config::flatten(new));
+    let mut keys: Vec<&String> = a.keys().chain(b.keys()).collect();
+    keys.sort();
+    keys.dedup();
+    let mut out = Vec::new();
+    for key in keys {
+        let (x, y) = (a.get(key), b.get(key));
+        if x == y {
+            continue;
+        }
+        if key.ends_with(".description") {
+            out.push("scenario description edited".to_owned());
+            continue;
+        }
+        let unit = unit_of(key);
+        let show = |v: Option<&String>| v.map_or_else(|| "(unset)".to_owned(), |v| format!("{}{unit}", pretty_value(v)));
+        out.push(format!("{} {} → {}", label_of(key, new), show(x), show(y)));
+    }
+    out
+}
+
+fn pretty_value(v: &str) -> String {
+    match v.parse::<f64>() {
+        Ok(x) if x.fract() == 0.0 && x.abs() < 1e15 => format!("{x:.0}"),
+        Ok(x) => format!("{}", (x * 1e6).round() / 1e6),
+        Err(_) => v.trim_matches('"').to_owned(),
+    }
+}
+
+fn unit_of(key: &str) -> &'static str {
+    let leaf = key.rsplit('.').next().unwrap_or(key);
+    for (suffix, unit) in [
+        ("_arcsec", "″"),
+        ("_deg_per_s2", "°/s²"),
+        ("_deg_per_s", "°/s"),
+        ("_deg", "°"),
+        ("_ppm", " ppm"),
+        ("_ms", " ms"),
+        ("_hz", " Hz"),
+        ("_s", " s"),
+        ("_m", " m"),
+    ] {
+        if leaf.ends_with(suffix) {
+            return unit;
+        }
+    }
+    if leaf == "speed" || leaf == "exaggeration" { "×" } else { "" }
+}
+
+/// `turntable.axis[1].swing_half_angle_arcsec` → `inner swing half-angle`.
+fn label_of(key: &str, raw: &RawConfig) -> String {
+    let parts: Vec<&str> = key.split('.').collect();
+    let leaf = parts.last().copied().unwrap_or(key);
+    let mut name = leaf.to_owned();
+    for suffix in ["_arcsec", "_deg_per_s2", "_deg_per_s", "_deg", "_ppm", "_ms", "_hz", "_s", "_m"] {
+        if let Some(stripped) = name.strip_suffix(suffix) {
+            name = stripped.to_owned();
+            break;
+        }
+    }
+    let name = name.replace('_', " ").replace("swing half angle", "swing half-angle").replace("non orthogonality", "non-orthogonality");
+    let index = |p: &str| p.split_once('[').and_then(|(_, r)| r.trim_end_matches(']').parse::<usize>().ok());
+    match parts.as_slice() {
+        ["turntable", ax, _] if ax.starts_with("axis[") => {
+            let axis = index(ax).and_then(|i| raw.turntable.axis.get(i)).map_or("axis", |a| a.name.as_str());
+            format!("{axis} {name}")
+        }
+        ["turntable", _] => name,
+        ["compensation", "axis", axis, _] => format!("compensation: {axis} {name}"),
+        ["compensation", _] => format!("compensation: {name}"),
+        ["scheme", r, _] if r.starts_with("rate[") => {
+            let axis = index(r).and_then(|i| raw.scheme.rate.get(i)).map_or("axis", |x| x.axis.as_str());
+            format!("{axis} rotation {name}")
+        }
+        ["scheme", s, _] if s.starts_with("step[") => format!("scheme step {} {name}", index(s).map_or(0, |i| i + 1)),
+        _ => key.to_owned(),
+    }
+}
+
+/// What the panel and the terminal see of the session.
+#[derive(Debug, Clone)]
+pub struct Status {
+    /// Simulated time, s.
+    pub sim_t_s: f64,
+    /// Current speed factor.
+    pub speed: f64,
+    /// The configuration in force (bumped `generation` when it changes).
+    pub resolved: RawConfig,
+    /// Incremented at every applied reload.
+    pub generation: u64,
+    /// The last reload message.
+    pub message: String,
+    /// Save-to-applied latency of every applied reload, ms.
+    pub latencies_ms: Vec<f64>,
+    /// False once the simulation has ended.
+    pub running: bool,
+}
+
+/// Shared status.
+pub type SharedStatus = Arc<Mutex<Status>>;
+
+/// A consistent copy of the status.
+#[must_use]
+pub fn snapshot(status: &SharedStatus) -> Status {
+    lock(status).clone()
+}
+
+/// What the simulation sends to the recorder.
+pub enum RecorderMsg {
+    /// Rows for the time series.
+    Series(Vec<StepOutput>),
+    /// Scene frames.
+    Scene(Vec<StepOutput>),
+    /// New parameters from simulated time `t_s`.
+    Reconfigure {
+        /// When.
+        t_s: f64,
+        /// The parameters now in force.
+        params: Box<Params>,
+    },
+    /// A text-log entry.
+    Event {
+        /// When.
+        t_s: f64,
+        /// What.
+        text: String,
+        /// "INFO", "WARN", "ERROR".
+        level: &'static str,
+    },
+}
+
+fn lock(status: &SharedStatus) -> std::sync::MutexGuard<'_, Status> {
+    // A poisoned lock only means another thread panicked mid-update; the data is still usable.
+    status.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// Paces `sim` to the wall clock, applies reloads between steps, streams decimated outputs to `out`.
+/// Returns when `stop` is set, `duration_s` is reached, or the recorder went away.
+pub fn sim_loop(mut sim: LiveSim, reloads: &Receiver<WatchEvent>, out: &Sender<RecorderMsg>, status: &SharedStatus, stop: &AtomicBool, duration_s: Option<f64>, log_to_stderr: bool) -> LiveSim {
+    let mut speed = lock(status).speed;
+    let mut anchor = (Instant::now(), 0.0f64);
+    let decimation = |speed: f64, p: &Params| {
+        let scene = every_n_steps(p.step_hz, (SCENE_WALL_HZ / speed).min(p.step_hz));
+        let series = every_n_steps(p.step_hz, p.recording.series_hz).max(every_n_steps(p.step_hz, (SERIES_WALL_HZ / speed).min(p.step_hz)));
+        (scene, series)
+    };
+    let (mut scene_every, mut series_every) = decimation(speed, &sim.params);
+    let mut pending: Option<WatchEvent> = None;
+    let say = |text: String, level: &'static str, t_s: f64| {
+        if log_to_stderr {
+            eprintln!("rinscope live: {text}");
+        }
+        lock(status).message = text.clone();
+        out.send(RecorderMsg::Event { t_s, text, level }).is_ok()
+    };
+    loop {
+        if stop.load(Ordering::Relaxed) {
+            break;
+        }
+        // Reloads, between two steps.
+        while let Some(ev) = pending.take().or_else(|| reloads.try_recv().ok()) {
+            let t = sim.t_s();
+            match ev {
+                WatchEvent::Loaded { params, seen_at } => {
+                    let new_speed = params.live_speed;
+                    let speed_changed = new_speed != sim.params.live_speed;
+                    match sim.apply(*params) {
+                        Ok(changes) if changes.is_empty() => {}
+                        Ok(changes) => {
+                            let latency_ms = seen_at.elapsed().as_secs_f64() * 1e3;
+                            if speed_changed {
+                                speed = new_speed;
+                                anchor = (Instant::now(), t);
+                            }
+                            (scene_every, series_every) = decimation(speed, &sim.params);
+                            {
+                                let mut s = lock(status);
+                                s.resolved = sim.params.resolved.clone();
+                                s.generation += 1;
+                                s.speed = speed;
+                                s.latencies_ms.push(latency_ms);
+                            }
+                            if out.send(RecorderMsg::Reconfigure { t_s: t, params: Box::new(sim.params.clone()) }).is_err() {
+                                return sim;
+                            }
+                            say(format!("reloaded at t = {t:.2} s ({latency_ms:.0} ms after the save): {}", changes.join("; ")), "INFO", t);
+                        }
+                        Err(why) => {
+                            say(format!("not applied: {why}"), "WARN", t);
+                        }
+                    }
+                }
+                WatchEvent::Invalid { message, .. } => {
+                    say(format!("config error, keeping the last good parameters: {message}"), "ERROR", t);
+                }
+                WatchEvent::Deleted => {
+                    say("the config file was deleted; keeping the last parameters and waiting for it to come back".into(), "WARN", t);
+                }
+                WatchEvent::Restored => {
+                    say("the config file is back".into(), "INFO", t);
+                }
+            }
+        }
+
+        // Catch up with the wall clock (bounded, so reloads are seen within ~10 ms).
+        let mut target = anchor.1 + anchor.0.elapsed().as_secs_f64() * speed;
+        if let Some(d) = duration_s {
+            target = target.min(d);
+        }
+        let (mut series, mut scene) = (Vec::new(), Vec::new());
+        let mut n = 0;
+        while sim.t_s() <= target && n < MAX_STEPS_PER_SLICE {
+            let i = sim.steps();
+            let o = sim.step();
+            if i % series_every == 0 {
+                series.push(o);
+            }
+            if i % scene_every == 0 {
+                scene.push(o);
+            }
+            n += 1;
+        }
+        if !series.is_empty() && out.send(RecorderMsg::Series(series)).is_err() {
+            return sim;
+        }
+        if !scene.is_empty() && out.send(RecorderMsg::Scene(scene)).is_err() {
+            return sim;
+        }
+        lock(status).sim_t_s = sim.t_s();
+        if duration_s.is_some_and(|d| sim.t_s() > d) {
+            break;
+        }
+        if n < MAX_STEPS_PER_SLICE {
+            // Ahead of the clock: sleep until the next step is due, waking at once for a reload.
+            let wait = ((sim.t_s() - target) / speed).clamp(0.0, 0.005);
+            if let Ok(ev) = reloads.recv_timeout(Duration::from_secs_f64(wait)) {
+                pending = Some(ev);
+            }
+        }
+    }
+    let t = sim.t_s();
+    let _ = out.send(RecorderMsg::Event { t_s: t, text: format!("live session ended at t = {t:.2} s"), level: "INFO" });
+    lock(status).running = false;
+    sim
+}
+
+/// How often the recorder hands buffered scene frames to Rerun in live mode: the 3D view moves at
+/// 10 Hz; each chunk carries its own schema (~1 kB), so chunks must hold several rows.
+pub const SCENE_FLUSH: Duration = Duration::from_millis(100);
+/// Same for the plots, which a user reads rather than watches move.
+pub const SERIES_FLUSH: Duration = Duration::from_millis(500);
+
+/// Turns [`RecorderMsg`]s into Rerun calls until the channel closes.
+pub fn recorder_loop(mut recorder: Recorder, msgs: &Receiver<RecorderMsg>) -> anyhow::Result<()> {
+    let (mut last_scene, mut last_series) = (Instant::now(), Instant::now());
+    loop {
+        let msg = match msgs.recv_timeout(SCENE_FLUSH) {
+            Ok(m) => Some(m),
+            Err(crossbeam_channel::RecvTimeoutError::Timeout) => None,
+            Err(crossbeam_channel::RecvTimeoutError::Disconnected) => break,
+        };
+        match msg {
+            Some(RecorderMsg::Series(rows)) => {
+                for r in &rows {
+                    recorder.push_series(r)?;
+                }
+            }
+            Some(RecorderMsg::Scene(rows)) => {
+                for r in &rows {
+                    recorder.push_scene(r)?;
+                }
+            }
+            Some(RecorderMsg::Reconfigure { t_s, params }) => recorder.reconfigure(t_s, Model::new(&params), &params)?,
+            Some(RecorderMsg::Event { t_s, text, level }) => recorder.event(t_s, &text, level)?,
+            None => {}
+        }
+        if last_scene.elapsed() >= SCENE_FLUSH {
+            recorder.flush_scene()?;
+            last_scene = Instant::now();
+        }
+        if last_series.elapsed() >= SERIES_FLUSH {
+            recorder.flush_series()?;
+            last_series = Instant::now();
+        }
+    }
+    recorder.finish()?;
+    Ok(())
+}
+
+/// Where a preset's editable copy lives: `rinscope-live/<name>.toml` in the working directory.
+#[must_use]
+pub fn preset_copy_path(name: &str) -> PathBuf {
+    PathBuf::from("rinscope-live").join(format!("{name}.toml"))
+}
+
+/// Makes the editable copy of a preset (kept if it already exists: it holds the user's edits).
+pub fn ensure_preset_copy(name: &str) -> anyhow::Result<(PathBuf, bool)> {
+    let path = preset_copy_path(name);
+    if path.exists() {
+        return Ok((path, false));
+    }
+    let text = crate::scenarios::text(name).ok_or_else(|| anyhow::anyhow!("no preset named {name}"))?;
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir)?;
+    }
+    edit::write_atomically(&path, text)?;
+    Ok((path, true))
+}
+
+/// Summary of a finished session.
+#[derive(Debug, Clone)]
+pub struct LiveSummary {
+    /// Simulated time, s.
+    pub sim_t_s: f64,
+    /// Steps.
+    pub steps: u64,
+    /// Save-to-applied latencies of the reloads, ms.
+    pub latencies_ms: Vec<f64>,
+}
+
+/// 95th percentile of `values` (nearest rank); 0 for none.
+#[must_use]
+pub fn p95(values: &[f64]) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let rank = ((0.95 * v.len() as f64).ceil() as usize).clamp(1, v.len());
+    v[rank - 1]
+}
+
+/// Builds the shared status for a session starting with `params`.
+#[must_use]
+pub fn new_status(params: &Params, speed: f64) -> SharedStatus {
+    Arc::new(Mutex::new(Status {
+        sim_t_s: 0.0,
+        speed,
+        resolved: params.resolved.clone(),
+        generation: 0,
+        message: String::new(),
+        latencies_ms: Vec::new(),
+        running: true,
+    }))
+}
+
+/// Reads the config text that the watcher will compare saves against.
+pub fn read_text(path: &Path) -> std::io::Result<String> {
+    std::fs::read_to_string(path)
+}
+
+/// How a live session runs.
+#[derive(Debug, Clone)]
+pub struct LiveOptions {
+    /// The watched scenario file.
+    pub config_path: PathBuf,
+    /// Initial speed (overrides `[live] speed` until the file's value changes).
+    pub speed: Option<f64>,
+    /// Stop after this much simulated time (None: until the user quits).
+    pub duration_s: Option<f64>,
+    /// Show the terminal panel (needs a terminal).
+    pub panel: bool,
+    /// Without a panel: print reloads and errors to stderr.
+    pub log_to_stderr: bool,
+}
+
+/// Restores the terminal when dropped (normal exit, error or panic unwinding).
+struct TerminalGuard;
+
+impl Drop for TerminalGuard {
+    fn drop(&mut self) {
+        ratatui::restore();
+    }
+}
+
+/// Runs a live session streaming into `rec` until the user quits, `stop` is set or the duration
+/// is reached. The caller owns the sinks (and finishes the saved file afterwards).
+pub fn run_session(opts: &LiveOptions, params: Params, rec: rerun::RecordingStream, stop: &Arc<AtomicBool>) -> anyhow::Result<LiveSummary> {
+    let status = new_status(&params, opts.speed.unwrap_or(params.live_speed));
+    run_session_with_status(opts, params, rec, stop, &status)
+}
+
+/// [`run_session`] reporting into a status the caller can watch (benchmarks, tests).
+pub fn run_session_with_status(opts: &LiveOptions, params: Params, rec: rerun::RecordingStream, stop: &Arc<AtomicBool>, status: &SharedStatus) -> anyhow::Result<LiveSummary> {
+    let text = read_text(&opts.config_path)?;
+    let (reload_tx, reload_rx) = crossbeam_channel::unbounded();
+    let _watcher = watch::watch(&opts.config_path, text, reload_tx).map_err(|e| anyhow::anyhow!("cannot watch {}: {e}", opts.config_path.display()))?;
+    let recorder = Recorder::new_live(rec, &params)?;
+    // Bounded: a recorder that falls behind slows the simulation instead of growing memory.
+    let (out_tx, out_rx) = crossbeam_channel::bounded::<RecorderMsg>(64);
+    let title = format!("rinscope live — {} — {}", params.meta.name, params.meta.title);
+    let resolved = params.resolved.clone();
+
+    let recorder_thread = std::thread::Builder::new().name("recorder".into()).spawn(move || recorder_loop(recorder, &out_rx))?;
+    let sim_thread = {
+        let (status, stop) = (status.clone(), stop.clone());
+        let (duration, log) = (opts.duration_s, opts.log_to_stderr && !opts.panel);
+        std::thread::Builder::new().name("simulation".into()).spawn(move || sim_loop(LiveSim::new(params), &reload_rx, &out_tx, &status, &stop, duration, log))?
+    };
+
+    let panel_result = if opts.panel { panel_loop(&opts.config_path, &resolved, title, status, stop) } else { Ok(()) };
+    if panel_result.is_err() {
+        stop.store(true, Ordering::SeqCst);
+    }
+    let sim = sim_thread.join().map_err(|_| anyhow::anyhow!("the simulation thread panicked"))?;
+    let recorded = recorder_thread.join().map_err(|_| anyhow::anyhow!("the recorder thread panicked"))?;
+    panel_result?;
+    recorded?;
+    let latencies_ms = lock(status).latencies_ms.clone();
+    Ok(LiveSummary { sim_t_s: sim.t_s(), steps: sim.steps(), latencies_ms })
+}
+
+/// The panel on this thread: draw, read keys, write the config file for every slider move.
+fn panel_loop(path: &Path, resolved: &RawConfig, title: String, status: &SharedStatus, stop: &AtomicBool) -> anyhow::Result<()> {
+    use ratatui::crossterm::event::{self, Event, KeyEventKind};
+    let mut terminal = ratatui::try_init()?;
+    let _guard = TerminalGuard;
+    let mut panel = panel::Panel::new(resolved, title);
+    let shown_path = path.display().to_string();
+    let mut seen_generation = 0;
+    let mut last_write = Instant::now() - Duration::from_secs(10);
+    loop {
+        let st = lock(status).clone();
+        // Follow edits made elsewhere, but not while the user is still moving a slider (the reload of
+        // an older value would pull the slider back).
+        if last_write.elapsed() > Duration::from_millis(400) {
+            if st.generation != seen_generation {
+                panel.sync(&st.resolved);
+                seen_generation = st.generation;
+            }
+            panel.show_speed(st.speed);
+        }
+        terminal.draw(|f| panel.render(f, &st, &shown_path))?;
+        if !st.running || stop.load(Ordering::Relaxed) {
+            break;
+        }
+        if event::poll(Duration::from_millis(50))? {
+            if let Event::Key(key) = event::read()? {
+                if key.kind != KeyEventKind::Press {
+                    continue;
+                }
+                match panel.handle(key) {
+                    panel::Action::Quit => {
+                        stop.store(true, Ordering::SeqCst);
+                        break;
+                    }
+                    panel::Action::Set(writes) => {
+                        last_write = Instant::now();
+                        for (k, v) in writes {
+                            if let Err(e) = edit::set_in_file(path, &k, v.to_value()) {
+                                lock(status).message = format!("slider not written: {e}");
+                            }
+                        }
+                    }
+                    panel::Action::None => {}
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests;
