@@ -84,8 +84,9 @@ fn live_latency(dir: &std::path::Path) -> anyhow::Result<()> {
     let rec_path = dir.join("live.rrd");
     let sinks = sink::open(&SinkRequest { save: Some(rec_path), ..Default::default() }, "rinscope-bench", "live")?;
     let session = {
-        let (status, stop, rec) = (status.clone(), stop.clone(), sinks.rec.clone());
-        std::thread::spawn(move || live::run_session_with_status(&opts, params, rec, &stop, &status))
+        let (status, stop) = (status.clone(), stop.clone());
+        let outputs = live::Outputs { viewer: None, file: Some(sinks.rec.clone()) };
+        std::thread::spawn(move || live::run_session_with_status(&opts, params, outputs, &stop, &status))
     };
     std::thread::sleep(std::time::Duration::from_millis(300));
     let mut latencies = Vec::new();

@@ -186,7 +186,7 @@ fn load(args: &RunArgs) -> Result<Params, Failure> {
 
 fn run_command(args: &RunArgs) -> Result<(), Failure> {
     let params = load(args)?;
-    let mut request = SinkRequest { save: args.save.clone(), spawn: args.spawn, connect: args.connect.clone(), serve: None };
+    let mut request = SinkRequest { save: args.save.clone(), spawn: args.spawn, connect: args.connect.clone(), ..Default::default() };
     if request.save.is_none() && !request.spawn && request.connect.is_none() {
         request.save = Some(PathBuf::from("recordings").join(format!("{}.rrd", params.meta.name)));
     }
@@ -267,13 +267,27 @@ fn live_command(args: &LiveArgs) -> Result<(), Failure> {
         return Err(Failure { code: 2, message: format!("--duration-s {d} s: must be > 0") });
     }
     let viewer_given = args.spawn || args.connect.is_some() || args.serve.is_some();
-    let request = SinkRequest { save: args.save.clone(), spawn: args.spawn || (!viewer_given && !args.no_viewer), connect: args.connect.clone(), serve: args.serve };
     if args.no_viewer && args.save.is_none() {
         return Err(Failure { code: 2, message: "--no-viewer needs --save FILE (otherwise nothing would be kept)".into() });
     }
+    // Two streams: small chunks for viewers, full-size chunks for the saved file (see live::Outputs).
+    let viewer_request = SinkRequest {
+        spawn: args.spawn || (!viewer_given && !args.no_viewer),
+        connect: args.connect.clone(),
+        serve: args.serve,
+        ..Default::default()
+    };
     let recording_id = format!("{}-seed{}-live", params.meta.name, params.meta.seed);
-    let sinks = sink::open(&request, rinscope::record::APPLICATION_ID, &recording_id)?;
-    for d in &sinks.description {
+    let viewer_sinks = if viewer_request.spawn || viewer_request.connect.is_some() || viewer_request.serve.is_some() {
+        Some(sink::open(&viewer_request, rinscope::record::APPLICATION_ID, &recording_id)?)
+    } else {
+        None
+    };
+    let file_sinks = match &args.save {
+        Some(p) => Some(sink::open(&SinkRequest { save: Some(p.clone()), ..Default::default() }, rinscope::record::APPLICATION_ID, &recording_id)?),
+        None => None,
+    };
+    for d in viewer_sinks.iter().chain(file_sinks.iter()).flat_map(|s| &s.description) {
         eprintln!("rinscope live: {d}");
     }
     let panel = !args.no_panel && std::io::stdout().is_terminal() && std::io::stdin().is_terminal();
@@ -288,14 +302,17 @@ fn live_command(args: &LiveArgs) -> Result<(), Failure> {
         eprintln!("rinscope live: running; edit {} to change parameters, Ctrl-C to stop", path.display());
     }
     let options = rinscope::live::LiveOptions { config_path: path, speed: args.speed, duration_s: args.duration_s, panel, log_to_stderr: true };
-    let summary = match rinscope::live::run_session(&options, params, sinks.rec.clone(), &stop) {
-        Ok(s) => s,
-        Err(e) => {
-            sinks.finish().ok();
-            return Err(e.into());
-        }
+    let outputs = rinscope::live::Outputs { viewer: viewer_sinks.as_ref().map(|s| s.rec.clone()), file: file_sinks.as_ref().map(|s| s.rec.clone()) };
+    let result = rinscope::live::run_session(&options, params, outputs, &stop);
+    // Whatever happened, complete the saved file: it holds everything simulated so far.
+    if let Some(v) = viewer_sinks {
+        v.finish().ok();
+    }
+    let saved = match file_sinks {
+        Some(f) => f.finish()?,
+        None => None,
     };
-    let saved = sinks.finish()?;
+    let summary = result?;
     println!(
         "live session: {:.1} s simulated ({} steps), {} reloads applied, save -> applied p95 {:.1} ms",
         summary.sim_t_s,

@@ -173,7 +173,10 @@ impl OpenSinks {
     /// Returns the final path and its size in bytes.
     pub fn finish(self) -> Result<Option<(PathBuf, u64)>, SinkError> {
         let Self { rec, file, .. } = self;
-        rec.flush_blocking().map_err(|e| SinkError::Rerun(e.to_string()))?;
+        // A viewer that went away fails the flush; the file must still be completed and kept.
+        if let Err(e) = rec.flush_with_timeout(std::time::Duration::from_secs(10)) {
+            eprintln!("rinscope: not every sink received the whole stream ({e}); the saved file is complete");
+        }
         // Dropping the last handle joins the batcher and the file writer, which writes the footer.
         drop(rec);
         match file {

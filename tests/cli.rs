@@ -140,3 +140,25 @@ fn scenarios_lists_every_preset() {
         assert!(text.contains(name), "{text}");
     }
 }
+
+#[test]
+fn a_headless_live_session_runs_for_its_duration_and_saves() {
+    let dir = scratch("live");
+    let cfg = dir.join("live.toml");
+    std::fs::write(&cfg, PRESET).expect("config");
+    let rrd = dir.join("live.rrd");
+    let o = rinscope()
+        .args(["live", "--config"])
+        .arg(&cfg)
+        .args(["--no-viewer", "--no-panel", "--speed", "100", "--duration-s", "30", "--save"])
+        .arg(&rrd)
+        .output()
+        .expect("run");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("30.0 s simulated"), "{stdout}");
+    assert_eq!(&std::fs::read(&rrd).expect("saved")[..4], b"RRF2");
+    // Nothing to keep and no viewer: refused.
+    let o = rinscope().args(["live", "--config"]).arg(&cfg).arg("--no-viewer").output().expect("run");
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}

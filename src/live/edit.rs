@@ -27,11 +27,10 @@ impl KeyPath {
         for part in s.split('.') {
             let (name, rest) = part.split_once('[').map_or((part, None), |(n, r)| (n, Some(r)));
             segs.push(Seg::Key(name.to_owned()));
-            if let Some(r) = rest {
-                if let Ok(i) = r.trim_end_matches(']').parse() {
+            if let Some(r) = rest
+                && let Ok(i) = r.trim_end_matches(']').parse() {
                     segs.push(Seg::Index(i));
                 }
-            }
         }
         Self(segs)
     }

@@ -321,10 +321,10 @@ pub fn sim_loop(mut sim: LiveSim, reloads: &Receiver<WatchEvent>, out: &Sender<R
         while sim.t_s() <= target && n < MAX_STEPS_PER_SLICE {
             let i = sim.steps();
             let o = sim.step();
-            if i % series_every == 0 {
+            if i.is_multiple_of(series_every) {
                 series.push(o);
             }
-            if i % scene_every == 0 {
+            if i.is_multiple_of(scene_every) {
                 scene.push(o);
             }
             n += 1;
@@ -359,8 +359,18 @@ pub const SCENE_FLUSH: Duration = Duration::from_millis(100);
 /// Same for the plots, which a user reads rather than watches move.
 pub const SERIES_FLUSH: Duration = Duration::from_millis(500);
 
-/// Turns [`RecorderMsg`]s into Rerun calls until the channel closes.
-pub fn recorder_loop(mut recorder: Recorder, msgs: &Receiver<RecorderMsg>) -> anyhow::Result<()> {
+/// Where a live session's data goes.
+pub struct Outputs {
+    /// Viewers (spawned, connected or served): small chunks, sent every [`SCENE_FLUSH`] / [`SERIES_FLUSH`].
+    pub viewer: Option<rerun::RecordingStream>,
+    /// The saved file: full-size chunks like a plain run, so the file stays compact and its footer
+    /// (chunk manifest, kept in memory until the file closes) small — an hour-long session stays flat.
+    pub file: Option<rerun::RecordingStream>,
+}
+
+/// Turns [`RecorderMsg`]s into Rerun calls until the channel closes. `viewer` flushes on a timer,
+/// `file` only when its chunks are full.
+pub fn recorder_loop(mut viewer: Option<Recorder>, mut file: Option<Recorder>, msgs: &Receiver<RecorderMsg>) -> anyhow::Result<()> {
     let (mut last_scene, mut last_series) = (Instant::now(), Instant::now());
     loop {
         let msg = match msgs.recv_timeout(SCENE_FLUSH) {
@@ -368,31 +378,30 @@ pub fn recorder_loop(mut recorder: Recorder, msgs: &Receiver<RecorderMsg>) -> an
             Err(crossbeam_channel::RecvTimeoutError::Timeout) => None,
             Err(crossbeam_channel::RecvTimeoutError::Disconnected) => break,
         };
-        match msg {
-            Some(RecorderMsg::Series(rows)) => {
-                for r in &rows {
-                    recorder.push_series(r)?;
+        if let Some(msg) = msg {
+            for recorder in viewer.iter_mut().chain(file.iter_mut()) {
+                match &msg {
+                    RecorderMsg::Series(rows) => rows.iter().try_for_each(|r| recorder.push_series(r))?,
+                    RecorderMsg::Scene(rows) => rows.iter().try_for_each(|r| recorder.push_scene(r))?,
+                    RecorderMsg::Reconfigure { t_s, params } => recorder.reconfigure(*t_s, Model::new(params), params)?,
+                    RecorderMsg::Event { t_s, text, level } => recorder.event(*t_s, text, level)?,
                 }
             }
-            Some(RecorderMsg::Scene(rows)) => {
-                for r in &rows {
-                    recorder.push_scene(r)?;
-                }
+        }
+        if let Some(v) = viewer.as_mut() {
+            if last_scene.elapsed() >= SCENE_FLUSH {
+                v.flush_scene()?;
+                last_scene = Instant::now();
             }
-            Some(RecorderMsg::Reconfigure { t_s, params }) => recorder.reconfigure(t_s, Model::new(&params), &params)?,
-            Some(RecorderMsg::Event { t_s, text, level }) => recorder.event(t_s, &text, level)?,
-            None => {}
-        }
-        if last_scene.elapsed() >= SCENE_FLUSH {
-            recorder.flush_scene()?;
-            last_scene = Instant::now();
-        }
-        if last_series.elapsed() >= SERIES_FLUSH {
-            recorder.flush_series()?;
-            last_series = Instant::now();
+            if last_series.elapsed() >= SERIES_FLUSH {
+                v.flush_series()?;
+                last_series = Instant::now();
+            }
         }
     }
-    recorder.finish()?;
+    for recorder in viewer.iter_mut().chain(file.iter_mut()) {
+        recorder.finish()?;
+    }
     Ok(())
 }
 
@@ -484,23 +493,24 @@ impl Drop for TerminalGuard {
 
 /// Runs a live session streaming into `rec` until the user quits, `stop` is set or the duration
 /// is reached. The caller owns the sinks (and finishes the saved file afterwards).
-pub fn run_session(opts: &LiveOptions, params: Params, rec: rerun::RecordingStream, stop: &Arc<AtomicBool>) -> anyhow::Result<LiveSummary> {
+pub fn run_session(opts: &LiveOptions, params: Params, outputs: Outputs, stop: &Arc<AtomicBool>) -> anyhow::Result<LiveSummary> {
     let status = new_status(&params, opts.speed.unwrap_or(params.live_speed));
-    run_session_with_status(opts, params, rec, stop, &status)
+    run_session_with_status(opts, params, outputs, stop, &status)
 }
 
 /// [`run_session`] reporting into a status the caller can watch (benchmarks, tests).
-pub fn run_session_with_status(opts: &LiveOptions, params: Params, rec: rerun::RecordingStream, stop: &Arc<AtomicBool>, status: &SharedStatus) -> anyhow::Result<LiveSummary> {
+pub fn run_session_with_status(opts: &LiveOptions, params: Params, outputs: Outputs, stop: &Arc<AtomicBool>, status: &SharedStatus) -> anyhow::Result<LiveSummary> {
     let text = read_text(&opts.config_path)?;
     let (reload_tx, reload_rx) = crossbeam_channel::unbounded();
     let _watcher = watch::watch(&opts.config_path, text, reload_tx).map_err(|e| anyhow::anyhow!("cannot watch {}: {e}", opts.config_path.display()))?;
-    let recorder = Recorder::new_live(rec, &params)?;
+    let viewer = outputs.viewer.map(|rec| Recorder::new_live(rec, &params)).transpose()?;
+    let file = outputs.file.map(|rec| Recorder::new_live(rec, &params)).transpose()?;
     // Bounded: a recorder that falls behind slows the simulation instead of growing memory.
     let (out_tx, out_rx) = crossbeam_channel::bounded::<RecorderMsg>(64);
     let title = format!("rinscope live — {} — {}", params.meta.name, params.meta.title);
     let resolved = params.resolved.clone();
 
-    let recorder_thread = std::thread::Builder::new().name("recorder".into()).spawn(move || recorder_loop(recorder, &out_rx))?;
+    let recorder_thread = std::thread::Builder::new().name("recorder".into()).spawn(move || recorder_loop(viewer, file, &out_rx))?;
     let sim_thread = {
         let (status, stop) = (status.clone(), stop.clone());
         let (duration, log) = (opts.duration_s, opts.log_to_stderr && !opts.panel);
@@ -543,8 +553,8 @@ fn panel_loop(path: &Path, resolved: &RawConfig, title: String, status: &SharedS
         if !st.running || stop.load(Ordering::Relaxed) {
             break;
         }
-        if event::poll(Duration::from_millis(50))? {
-            if let Event::Key(key) = event::read()? {
+        if event::poll(Duration::from_millis(50))?
+            && let Event::Key(key) = event::read()? {
                 if key.kind != KeyEventKind::Press {
                     continue;
                 }
@@ -564,7 +574,6 @@ fn panel_loop(path: &Path, resolved: &RawConfig, title: String, status: &SharedS
                     panel::Action::None => {}
                 }
             }
-        }
     }
     Ok(())
 }

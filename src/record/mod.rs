@@ -361,8 +361,7 @@ impl Recorder {
         let first_tilted = draw.base * axes[0].axis;
         let installation = p.truth.installation_rad.norm() * ARCSEC_PER_RAD;
         self.log_wedge(at, &format!("{}/installation", self.paths.vehicle), axes[0].axis, first_tilted, 1.5, installation, x, "installation")?;
-        for k in 0..n {
-            let g = &axes[k];
+        for (k, g) in axes.iter().enumerate() {
             let half = ring_radius(k, n) * 1.25;
             let color = palette::AXES[k];
             // Swing cone: a translucent double cone of half-angle α·x around the nominal axis, with rims.
