@@ -8,6 +8,7 @@ pub mod config;
 pub mod euler;
 pub mod frames;
 pub mod gimbal;
+pub mod ins;
 pub mod live;
 pub mod motion;
 pub mod record;
