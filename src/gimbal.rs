@@ -271,6 +271,21 @@ impl Chain {
         Rot::from_quaternion(q)
     }
 
+    /// [`Self::b_from_s_with`] and the angular rate of s relative to b, in s, for gimbal rates
+    /// `rates_rad_per_s`: `ω_bs^s = Σ_k λ̇_k Q_kᵀ a_k` with Q_k everything in the chain after shaft k.
+    #[must_use]
+    pub fn b_from_s_and_rate(&self, err: &ErrorRotations, shafts: &ShaftRotations, rates_rad_per_s: &AxisValues) -> (Rot<B, S>, V3<S>) {
+        let n = self.axes.len();
+        let mut suffix = err.between[n];
+        let mut omega = Vector3::zeros();
+        for k in (0..n).rev() {
+            omega += suffix.inverse() * (self.axes[k].axis * rates_rad_per_s[k]);
+            suffix = err.between[k] * shafts.0[k] * suffix;
+        }
+        // FRAME: `suffix` is now the whole chain B·T_0·R_0·…·M = b_from_s; ω summed in s.
+        (Rot::from_quaternion(suffix), V3::new(omega))
+    }
+
     /// The nominal (error-free) IMU-to-body rotation a real RINS uses to demodulate.
     #[must_use]
     pub fn b_from_s_nominal(&self, angles_rad: &AxisValues) -> Rot<B, S> {
@@ -461,6 +476,26 @@ mod tests {
         assert!((r1 / r2 - 4.0).abs() < 0.2, "second order: {r1} / {r2}");
         // And the residual is tiny compared with the error (ratio ~ error angle ~ 1e-3).
         assert!(r1 < 5e-3 * m1, "{r1} vs {m1}");
+    }
+
+    #[test]
+    fn gimbal_rate_matches_the_derivative_of_the_chain() {
+        // Independent computation: finite difference of the exact chain along a gimbal trajectory.
+        let chain = dual_axis();
+        let rot = chain.error_rotations(&seed000_errors());
+        let (a0, rates) = ([0.4, -1.2, 0.0], [0.3, -0.7, 0.0]);
+        let at = |t: f64| {
+            let mut a = a0;
+            for k in 0..2 {
+                a[k] += rates[k] * t;
+            }
+            chain.b_from_s(&rot, &a)
+        };
+        let h = 1e-6;
+        let fd = (at(-h).inverse() * at(h)).quaternion().scaled_axis() / (2.0 * h);
+        let (b_from_s, w) = chain.b_from_s_and_rate(&rot, &chain.shaft_rotations(&a0), &rates);
+        assert!((fd - w.v).norm() < 1e-8, "{fd:?} vs {:?}", w.v);
+        assert!((b_from_s.inverse() * at(0.0)).angle_rad() < 1e-14);
     }
 
     #[test]

@@ -78,7 +78,7 @@ fn move_duration(step: &IndexedStep) -> f64 {
 #[derive(Debug, Clone)]
 enum Kind {
     Continuous { rates: AxisValues },
-    Indexed { initial_dwell_s: f64, period_s: f64, repeat: bool, net_rad: AxisValues, moves: Vec<Vec<Move>> },
+    Indexed { initial_dwell_s: f64, period_s: f64, repeat: bool, net_rad: AxisValues, moves: Vec<Vec<Move>>, breakpoints: Vec<f64> },
 }
 
 /// Gimbal angles over time.
@@ -114,8 +114,12 @@ impl Scheme {
         let mut moves = vec![Vec::new(); n_axes];
         let mut rel = [0.0; MAX_AXES];
         let mut t = 0.0;
+        let mut breakpoints = Vec::new();
         for s in &steps {
             let duration_s = move_duration(s);
+            // Where the rate jumps or its slope changes: start, end of acceleration, start of braking, end.
+            let t_acc = if s.accel_rad_per_s2 > 0.0 { (s.rate_rad_per_s / s.accel_rad_per_s2).min(0.5 * duration_s) } else { 0.0 };
+            breakpoints.extend([t, t + t_acc, t + duration_s - t_acc, t + duration_s]);
             moves[s.axis].push(Move {
                 t0_s: t,
                 duration_s,
@@ -130,7 +134,11 @@ impl Scheme {
         Self {
             n_axes,
             initial: to_values(&initial_rad),
-            kind: Kind::Indexed { initial_dwell_s, period_s: t, repeat, net_rad: rel, moves },
+            kind: Kind::Indexed { initial_dwell_s, period_s: t, repeat, net_rad: rel, moves, breakpoints: {
+                breakpoints.sort_by(f64::total_cmp);
+                breakpoints.dedup();
+                breakpoints
+            } },
             steps,
         }
     }
@@ -163,12 +171,37 @@ impl Scheme {
         &self.steps
     }
 
+    /// First time after `t_s` where a gimbal rate jumps or bends (the IMU truth integrates piecewise
+    /// between these so that a rate step does not spoil the quadrature).
+    #[must_use]
+    pub fn next_breakpoint_after(&self, t_s: f64) -> f64 {
+        let Kind::Indexed { initial_dwell_s, period_s, repeat, breakpoints, .. } = &self.kind else {
+            return if t_s < 0.0 { 0.0 } else { f64::INFINITY };
+        };
+        let tau = t_s - initial_dwell_s;
+        let (cycle_start, within) = if tau < 0.0 {
+            (*initial_dwell_s, -1.0)
+        } else if *repeat {
+            let c = (tau / period_s).floor();
+            (initial_dwell_s + c * period_s, tau - c * period_s)
+        } else {
+            (*initial_dwell_s, tau)
+        };
+        let j = breakpoints.partition_point(|&b| b <= within);
+        match breakpoints.get(j) {
+            Some(b) => cycle_start + b,
+            None if *repeat => cycle_start + period_s + breakpoints.first().copied().unwrap_or(0.0),
+            None => f64::INFINITY,
+        }
+    }
+
     /// True gimbal angles and rates at `t_s`.
     #[must_use]
     pub fn state(&self, t_s: f64) -> (AxisValues, AxisValues) {
         let mut angle = self.initial;
         let mut rate = [0.0; MAX_AXES];
-        if t_s <= 0.0 {
+        // At rest before t = 0; from t = 0 on the rates are the right-hand limits.
+        if t_s < 0.0 {
             return (angle, rate);
         }
         match &self.kind {
@@ -178,9 +211,9 @@ impl Scheme {
                     *r = *w;
                 }
             }
-            Kind::Indexed { initial_dwell_s, period_s, repeat, net_rad, moves } => {
+            Kind::Indexed { initial_dwell_s, period_s, repeat, net_rad, moves, .. } => {
                 let tau = t_s - initial_dwell_s;
-                if tau <= 0.0 {
+                if tau < 0.0 {
                     return (angle, rate);
                 }
                 let (cycles, within) = if *repeat {
@@ -238,6 +271,18 @@ mod tests {
         assert!(deg(1300.0).abs() < 1e-9);
         // Next period: same positions shifted by 1214 s.
         assert!((deg(400.0 + 1214.0) - 90.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn breakpoints_are_the_move_boundaries() {
+        let s = four_position();
+        // Moves start at 290, 589, 888 and 1187 s; they last 9, 9, 9 and 27 s.
+        assert!((s.next_breakpoint_after(0.0) - 290.0).abs() < 1e-9);
+        assert!((s.next_breakpoint_after(290.0) - 299.0).abs() < 1e-9);
+        assert!((s.next_breakpoint_after(300.0) - 589.0).abs() < 1e-9);
+        assert!((s.next_breakpoint_after(1190.0) - 1214.0).abs() < 1e-9);
+        // Next period: 290 + 1214.
+        assert!((s.next_breakpoint_after(1214.5) - (290.0 + 1214.0)).abs() < 1e-9);
     }
 
     #[test]

@@ -53,10 +53,7 @@ impl Model {
         let truth_rot = chain.error_rotations(&truth);
         let compensation_rot = chain.error_rotations(&compensation);
         let drawing_rot = chain.error_rotations(&truth.exaggerated(exaggeration));
-        let fixed_attitude = vehicle.is_fixed().then(|| {
-            let a = vehicle.attitude(0.0);
-            (a, a.n_from_b())
-        });
+        let fixed_attitude = vehicle.is_fixed().then(|| vehicle.state(0.0));
         Self { chain, vehicle, scheme, scheme_t0_s: 0.0, truth, compensation, truth_rot, compensation_rot, drawing_rot, fixed_attitude }
     }
 
@@ -64,6 +61,18 @@ impl Model {
     #[must_use]
     pub fn n_axes(&self) -> usize {
         self.chain.axes().len()
+    }
+
+    /// The precomputed true error rotations.
+    #[must_use]
+    pub fn truth_rotations(&self) -> &ErrorRotations {
+        &self.truth_rot
+    }
+
+    /// The precomputed error rotations assumed by the compensation.
+    #[must_use]
+    pub fn compensation_rotations(&self) -> &ErrorRotations {
+        &self.compensation_rot
     }
 
     /// The exaggerated link rotations at gimbal angles `angles_rad`, for the 3D scene.
@@ -105,10 +114,7 @@ fn demodulate(n_from_s: Rot<N, S>, b_from_s: Rot<B, S>) -> Attitude {
 /// Advances the simulation to `t_s` (steps must come in increasing time).
 #[must_use]
 pub fn step(model: &Model, state: &mut DemodState, t_s: f64) -> StepOutput {
-    let (attitude, n_from_b) = model.fixed_attitude.unwrap_or_else(|| {
-        let a = model.vehicle.attitude(t_s);
-        (a, a.n_from_b())
-    });
+    let (attitude, n_from_b) = model.fixed_attitude.unwrap_or_else(|| model.vehicle.state(t_s));
     let t_scheme = t_s - model.scheme_t0_s;
     let (gimbal_rad, rate_rad_per_s) = model.scheme.state(t_scheme);
     let n = model.n_axes();

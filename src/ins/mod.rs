@@ -3,3 +3,4 @@
 
 pub mod coning;
 pub mod strapdown;
+pub mod truth;
