@@ -4,3 +4,5 @@
 pub mod coning;
 pub mod strapdown;
 pub mod truth;
+pub mod fir;
+pub mod sensor;
