@@ -104,6 +104,156 @@ pub struct RawConfig {
     /// Live mode only.
     #[serde(default)]
     pub live: RawLive,
+    /// A simulated IMU and strapdown INS in the loop (absent: the IMU attitude is exact).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub imu: Option<RawImu>,
+    /// Navigation of velocity and position (needs `[imu]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub navigation: Option<RawNavigation>,
+}
+
+/// A per-axis value: a number is a 1σ drawn per axis with the seed, an array fixes the three values.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum RawSpec {
+    /// 1σ.
+    Sigma(f64),
+    /// Per axis.
+    Fixed([f64; 3]),
+}
+
+/// `[imu]`
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawImu {
+    /// Starting values of the sensor errors: "none", "jiang2017-table1", "zheng2016", "li2014-table4".
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub preset: Option<String>,
+    /// Attitude algorithm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub algorithm: Option<String>,
+    /// Run every algorithm on the same IMU stream.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compare: Option<bool>,
+    /// IMU samples summed per algorithm sample, after the FIR.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub decimation: Option<u32>,
+    /// "seed001", "none", or the taps.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fir: Option<RawFir>,
+    /// Model the navigation computer's zero-order hold as a T/2 output delay.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub zero_order_hold: Option<bool>,
+    /// Δt of seed 001's synchronisation: outputs are compared with the truth Δt earlier, ms.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output_compensation_ms: Option<f64>,
+    /// Raw and filtered gyro signals are recorded for this long, s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub signal_window_s: Option<f64>,
+    /// Gyro errors.
+    #[serde(default)]
+    pub gyro: RawGyro,
+    /// Accelerometer errors.
+    #[serde(default)]
+    pub accel: RawAccel,
+    /// Ring-laser-gyro dither.
+    #[serde(default)]
+    pub dither: RawDither,
+}
+
+/// `[imu] fir`
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum RawFir {
+    /// A named filter.
+    Named(String),
+    /// Taps.
+    Taps(Vec<f64>),
+}
+
+/// `[imu.gyro]`
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawGyro {
+    /// deg/h
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bias_deg_per_h: Option<RawSpec>,
+    /// ppm
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scale_ppm: Option<RawSpec>,
+    /// arcsec (1σ of each small angle)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub misalignment_arcsec: Option<f64>,
+    /// deg/√h
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub arw_deg_per_sqrt_h: Option<f64>,
+    /// deg/h (1σ of a Gauss-Markov bias)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bias_instability_deg_per_h: Option<f64>,
+    /// s
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub correlation_time_s: Option<f64>,
+    /// deg/h per g
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub g_sensitivity_deg_per_h_per_g: Option<f64>,
+}
+
+/// `[imu.accel]`
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawAccel {
+    /// µg
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bias_ug: Option<RawSpec>,
+    /// ppm
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scale_ppm: Option<RawSpec>,
+    /// arcsec
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub misalignment_arcsec: Option<f64>,
+    /// µg/√Hz
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vrw_ug_per_sqrt_hz: Option<f64>,
+    /// µg (1σ of a Gauss-Markov bias)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bias_instability_ug: Option<f64>,
+    /// s
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub correlation_time_s: Option<f64>,
+}
+
+/// `[imu.dither]`
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawDither {
+    /// Hz, x/y/z gyro.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frequencies_hz: Option<[f64; 3]>,
+    /// arcsec, x/y/z gyro.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub amplitudes_arcsec: Option<[f64; 3]>,
+    /// Fraction sensed by the other gyros.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coupling: Option<f64>,
+}
+
+/// `[navigation]`
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawNavigation {
+    /// "held" or "free".
+    #[serde(default = "default_vertical")]
+    pub vertical: String,
+    /// Horizontal velocity damping toward zero velocity (seed 003).
+    #[serde(default)]
+    pub velocity_damping: bool,
+    /// Alignment error (east tilt, north tilt, heading), arcmin.
+    #[serde(default)]
+    pub initial_attitude_error_arcmin: [f64; 3],
+}
+
+fn default_vertical() -> String {
+    "held".into()
 }
 
 /// `[live]`: read by `rinscope live` only.
@@ -463,6 +613,8 @@ pub struct Params {
     pub written: RawConfig,
     /// `[live] speed`: simulated seconds per wall-clock second.
     pub live_speed: f64,
+    /// The INS in the loop, if any.
+    pub ins: Option<crate::ins::InsConfig>,
 }
 
 impl Params {
@@ -712,6 +864,15 @@ fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigError> {
         seed: raw.scenario.seed,
     };
     let live_speed = c.range("live.speed", raw.live.speed, "x real time", 0.01, 10_000.0, "")?;
+    let ins = match &raw.imu {
+        None => {
+            if raw.navigation.is_some() {
+                return Err(c.invalid("navigation", "needs an [imu] section (navigation runs on the simulated IMU)"));
+            }
+            None
+        }
+        Some(imu) => Some(validate_imu(&c, imu, raw.navigation.as_ref(), step_hz)?),
+    };
     let written = raw.clone();
     let mut resolved = raw;
     resolved.compensation = resolved_comp;
@@ -732,6 +893,7 @@ fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigError> {
         resolved,
         written,
         live_speed,
+        ins,
     })
 }
 
@@ -762,6 +924,142 @@ pub fn flatten(raw: &RawConfig) -> BTreeMap<String, String> {
         walk("", &v, &mut out);
     }
     out
+}
+
+fn spec(c: &Checker<'_>, key: &str, v: RawSpec, unit: &'static str, max: f64, to_si: f64) -> Result<crate::ins::sensor::Spec, ConfigError> {
+    use crate::ins::sensor::Spec;
+    Ok(match v {
+        RawSpec::Sigma(s) => Spec::Sigma(c.range(key, s, unit, 0.0, max, "a number is the 1σ of a per-axis draw")? * to_si),
+        RawSpec::Fixed(a) => {
+            let mut out = [0.0; 3];
+            for (i, x) in a.iter().enumerate() {
+                out[i] = c.range(&format!("{key}[{i}]"), *x, unit, -max, max, "")? * to_si;
+            }
+            Spec::Fixed(out)
+        }
+    })
+}
+
+fn validate_imu(c: &Checker<'_>, raw: &RawImu, nav: Option<&RawNavigation>, step_hz: f64) -> Result<crate::ins::InsConfig, ConfigError> {
+    use crate::ins::coning::Algorithm;
+    use crate::ins::nav::{NavOptions, Vertical};
+    use crate::ins::preset;
+    const DEG_PER_H: f64 = RAD_PER_DEG / 3600.0;
+    const UG: f64 = 9.806_65e-6;
+    let preset_name = raw.preset.as_deref().unwrap_or("none");
+    let mut cfg = preset(preset_name).ok_or_else(|| {
+        c.invalid("imu.preset", format!("\"{preset_name}\" is not a preset; use \"none\", \"jiang2017-table1\", \"zheng2016\" or \"li2014-table4\""))
+    })?;
+    cfg.rate_hz = step_hz;
+    if let Some(a) = &raw.algorithm {
+        cfg.algorithm = Algorithm::from_name(a).ok_or_else(|| {
+            let names: Vec<&str> = Algorithm::ALL.iter().map(|a| a.name()).collect();
+            c.invalid("imu.algorithm", format!("\"{a}\" is not an algorithm; use one of {names:?}"))
+        })?;
+    }
+    if let Some(x) = raw.compare {
+        cfg.compare = x;
+    }
+    if let Some(d) = raw.decimation {
+        cfg.decimation = c.range("imu.decimation", f64::from(d), "samples", 1.0, 1000.0, "")? as usize;
+    }
+    match &raw.fir {
+        None => {}
+        Some(RawFir::Named(n)) if n == "seed001" => cfg.fir_taps = crate::ins::fir::SEED001_TAPS.to_vec(),
+        Some(RawFir::Named(n)) if n == "none" => cfg.fir_taps = vec![1.0],
+        Some(RawFir::Named(n)) => return Err(c.invalid("imu.fir", format!("\"{n}\" is not a filter; use \"seed001\", \"none\" or a list of taps"))),
+        Some(RawFir::Taps(t)) => {
+            if t.is_empty() || t.len() > 1001 {
+                return Err(c.invalid("imu.fir", format!("{} taps given; 1 to 1001 are supported", t.len())));
+            }
+            for (i, x) in t.iter().enumerate() {
+                c.finite(&format!("imu.fir[{i}]"), *x, "")?;
+            }
+            if t.iter().sum::<f64>().abs() < 1e-6 {
+                return Err(c.invalid("imu.fir", "the taps sum to zero: the filter would remove the signal itself"));
+            }
+            cfg.fir_taps = t.clone();
+        }
+    }
+    if let Some(z) = raw.zero_order_hold {
+        cfg.zero_order_hold = z;
+    }
+    if let Some(ms) = raw.output_compensation_ms {
+        cfg.output_compensation_s = c.range("imu.output_compensation_ms", ms, "ms", -1000.0, 1000.0, "")? * 1e-3;
+    }
+    if let Some(w) = raw.signal_window_s {
+        cfg.signal_window_s = c.range("imu.signal_window_s", w, "s", 0.0, 60.0, "")?;
+    }
+    let g = &raw.gyro;
+    let e = &mut cfg.errors;
+    if let Some(v) = g.bias_deg_per_h {
+        e.gyro.bias = spec(c, "imu.gyro.bias_deg_per_h", v, "deg/h", 3600.0, DEG_PER_H)?;
+    }
+    if let Some(v) = g.scale_ppm {
+        e.gyro.scale = spec(c, "imu.gyro.scale_ppm", v, "ppm", 1e5, 1e-6)?;
+    }
+    if let Some(v) = g.misalignment_arcsec {
+        e.gyro.misalignment_rad = c.range("imu.gyro.misalignment_arcsec", v, "arcsec", 0.0, MAX_ERROR_ANGLE_ARCSEC, ERROR_HINT)? * RAD_PER_ARCSEC;
+    }
+    if let Some(v) = g.arw_deg_per_sqrt_h {
+        e.gyro.white = c.range("imu.gyro.arw_deg_per_sqrt_h", v, "deg/√h", 0.0, 100.0, "")? * RAD_PER_DEG / 60.0;
+    }
+    if let Some(v) = g.bias_instability_deg_per_h {
+        e.gyro.instability = c.range("imu.gyro.bias_instability_deg_per_h", v, "deg/h", 0.0, 3600.0, "")? * DEG_PER_H;
+    }
+    if let Some(v) = g.correlation_time_s {
+        e.gyro.correlation_s = c.positive("imu.gyro.correlation_time_s", v, "s", 1e9)?;
+    }
+    if let Some(v) = g.g_sensitivity_deg_per_h_per_g {
+        e.g_sensitivity = c.range("imu.gyro.g_sensitivity_deg_per_h_per_g", v, "deg/h/g", -3600.0, 3600.0, "")? * DEG_PER_H / 9.806_65;
+    }
+    let a = &raw.accel;
+    if let Some(v) = a.bias_ug {
+        e.accel.bias = spec(c, "imu.accel.bias_ug", v, "µg", 1e5, UG)?;
+    }
+    if let Some(v) = a.scale_ppm {
+        e.accel.scale = spec(c, "imu.accel.scale_ppm", v, "ppm", 1e5, 1e-6)?;
+    }
+    if let Some(v) = a.misalignment_arcsec {
+        e.accel.misalignment_rad = c.range("imu.accel.misalignment_arcsec", v, "arcsec", 0.0, MAX_ERROR_ANGLE_ARCSEC, ERROR_HINT)? * RAD_PER_ARCSEC;
+    }
+    if let Some(v) = a.vrw_ug_per_sqrt_hz {
+        e.accel.white = c.range("imu.accel.vrw_ug_per_sqrt_hz", v, "µg/√Hz", 0.0, 1e5, "")? * UG;
+    }
+    if let Some(v) = a.bias_instability_ug {
+        e.accel.instability = c.range("imu.accel.bias_instability_ug", v, "µg", 0.0, 1e5, "")? * UG;
+    }
+    if let Some(v) = a.correlation_time_s {
+        e.accel.correlation_s = c.positive("imu.accel.correlation_time_s", v, "s", 1e9)?;
+    }
+    let d = &raw.dither;
+    if let Some(f) = d.frequencies_hz {
+        for (i, x) in f.iter().enumerate() {
+            e.dither.frequencies_hz[i] = c.range(&format!("imu.dither.frequencies_hz[{i}]"), *x, "Hz", 0.0, 0.5 * step_hz, "below half the IMU rate (simulation.step_hz)")?;
+        }
+    }
+    if let Some(amp) = d.amplitudes_arcsec {
+        for (i, x) in amp.iter().enumerate() {
+            e.dither.amplitudes_rad[i] = c.range(&format!("imu.dither.amplitudes_arcsec[{i}]"), *x, "arcsec", 0.0, MAX_ERROR_ANGLE_ARCSEC, "")? * RAD_PER_ARCSEC;
+        }
+    }
+    if let Some(k) = d.coupling {
+        e.dither.coupling = c.range("imu.dither.coupling", k, "", 0.0, 1.0, "")?;
+    }
+    if let Some(n) = nav {
+        let vertical = match n.vertical.as_str() {
+            "held" => Vertical::Held,
+            "free" => Vertical::Free,
+            other => return Err(c.invalid("navigation.vertical", format!("\"{other}\" is not a mode; use \"held\" or \"free\""))),
+        };
+        let mut err = [0.0; 3];
+        for (i, x) in n.initial_attitude_error_arcmin.iter().enumerate() {
+            err[i] = c.range(&format!("navigation.initial_attitude_error_arcmin[{i}]"), *x, "arcmin", -600.0, 600.0, "")? * RAD_PER_DEG / 60.0;
+        }
+        cfg.navigation = Some(NavOptions { vertical, damping_per_s: if n.velocity_damping { crate::ins::nav::schuler_rate() } else { 0.0 } });
+        cfg.initial_error_rad = Vector3::from(err);
+    }
+    Ok(cfg)
 }
 
 fn axis_index(c: &Checker<'_>, key: &str, chain: &Chain, name: &str) -> Result<usize, ConfigError> {

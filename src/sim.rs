@@ -89,6 +89,46 @@ pub struct DemodState {
     previous: Option<(f64, AxisValues)>,
 }
 
+/// Encoder readings handed to the navigation computer with the IMU sample at `t_s`: latched
+/// `delay` earlier, then offset and scale applied (docs/model.md, "Encoder").
+#[must_use]
+pub fn encoder_readings(model: &Model, t_s: f64) -> AxisValues {
+    let t_scheme = t_s - model.scheme_t0_s;
+    let mut encoder_rad = [0.0; MAX_AXES];
+    let now = model.scheme.state(t_scheme).0;
+    for (k, e) in model.truth.axes.iter().enumerate() {
+        let latched = if e.encoder_delay_s == 0.0 { now[k] } else { model.scheme.state(t_scheme - e.encoder_delay_s).0[k] };
+        encoder_rad[k] = e.encoder_reading(latched);
+    }
+    encoder_rad
+}
+
+impl DemodState {
+    /// Encoder angles corrected with the assumed parameters: offset and scale removed, then
+    /// extrapolated over the assumed delay with the rate seen in successive corrected readings.
+    pub fn correct(&mut self, model: &Model, t_s: f64, encoder_rad: &AxisValues) -> AxisValues {
+        let n = model.n_axes();
+        let mut corrected = [0.0; MAX_AXES];
+        for k in 0..n {
+            corrected[k] = model.compensation.axes[k].encoder_correct(encoder_rad[k]);
+        }
+        let raw_corrected = corrected;
+        if let Some((t_prev, prev)) = self.previous {
+            let dt = t_s - t_prev;
+            if dt > 0.0 {
+                for k in 0..n {
+                    let delay = model.compensation.axes[k].encoder_delay_s;
+                    if delay != 0.0 {
+                        corrected[k] += (raw_corrected[k] - prev[k]) / dt * delay;
+                    }
+                }
+            }
+        }
+        self.previous = Some((t_s, raw_corrected));
+        corrected
+    }
+}
+
 /// Everything one step produces.
 #[derive(Debug, Clone, Copy)]
 pub struct StepOutput {
@@ -107,7 +147,8 @@ pub struct StepOutput {
 }
 
 /// The body attitude a RINS computes from the IMU attitude and a model of the table.
-fn demodulate(n_from_s: Rot<N, S>, b_from_s: Rot<B, S>) -> Attitude {
+#[must_use]
+pub fn demodulate(n_from_s: Rot<N, S>, b_from_s: Rot<B, S>) -> Attitude {
     Attitude::from_n_from_b(&(n_from_s * b_from_s.inverse()))
 }
 
@@ -115,46 +156,21 @@ fn demodulate(n_from_s: Rot<N, S>, b_from_s: Rot<B, S>) -> Attitude {
 #[must_use]
 pub fn step(model: &Model, state: &mut DemodState, t_s: f64) -> StepOutput {
     let (attitude, n_from_b) = model.fixed_attitude.unwrap_or_else(|| model.vehicle.state(t_s));
-    let t_scheme = t_s - model.scheme_t0_s;
-    let (gimbal_rad, rate_rad_per_s) = model.scheme.state(t_scheme);
-    let n = model.n_axes();
+    let (gimbal_rad, rate_rad_per_s) = model.scheme.state(t_s - model.scheme_t0_s);
 
     // Truth: the IMU attitude through the exact chain (an ideal INS reports it without error).
     let true_shafts = model.chain.shaft_rotations(&gimbal_rad);
     let n_from_s = n_from_b * model.chain.b_from_s_with(&model.truth_rot, &true_shafts);
 
-    // Encoders: latched `delay` before the IMU sample, then offset and scale applied.
-    let mut encoder_rad = [0.0; MAX_AXES];
-    for k in 0..n {
-        let e = &model.truth.axes[k];
-        let latched = if e.encoder_delay_s == 0.0 { gimbal_rad[k] } else { model.scheme.state(t_scheme - e.encoder_delay_s).0[k] };
-        encoder_rad[k] = e.encoder_reading(latched);
-    }
+    let encoder_rad = encoder_readings(model, t_s);
     // Shaft rotations of other angles; reuses the true ones when the angles are identical.
     let shafts_of = |angles: &AxisValues| if *angles == gimbal_rad { true_shafts } else { model.chain.shaft_rotations(angles) };
 
     // 1. Uncompensated: the nominal table with the raw encoder angles.
     let uncompensated = demodulate(n_from_s, model.chain.b_from_s_nominal_with(&shafts_of(&encoder_rad)));
 
-    // 2. Compensated: the exact chain with the assumed errors, encoder corrected and extrapolated
-    //    over the assumed delay with the rate seen in successive corrected readings.
-    let mut corrected = [0.0; MAX_AXES];
-    for k in 0..n {
-        corrected[k] = model.compensation.axes[k].encoder_correct(encoder_rad[k]);
-    }
-    let raw_corrected = corrected;
-    if let Some((t_prev, prev)) = state.previous {
-        let dt = t_s - t_prev;
-        if dt > 0.0 {
-            for k in 0..n {
-                let delay = model.compensation.axes[k].encoder_delay_s;
-                if delay != 0.0 {
-                    corrected[k] += (raw_corrected[k] - prev[k]) / dt * delay;
-                }
-            }
-        }
-    }
-    state.previous = Some((t_s, raw_corrected));
+    // 2. Compensated: the exact chain with the assumed errors and corrected encoder angles.
+    let corrected = state.correct(model, t_s, &encoder_rad);
     let compensated = demodulate(n_from_s, model.chain.b_from_s_with(&model.compensation_rot, &shafts_of(&corrected)));
 
     // 3. Closed form: first-order error model (docs/closed-form.md).
