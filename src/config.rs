@@ -352,6 +352,10 @@ pub struct RawVehicle {
     pub ramp: Vec<RawRamp>,
     /// Sinusoidal wobble of one Euler angle.
     pub wobble: Vec<RawWobble>,
+    /// Pure coning of the body about its z axis: half-angle, deg (0: none).
+    pub coning_half_angle_deg: f64,
+    /// Pure coning frequency, Hz.
+    pub coning_frequency_hz: f64,
 }
 
 /// `[[vehicle.ramp]]`
@@ -776,7 +780,12 @@ fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigError> {
             phase_rad: c.finite(&k("phase_deg"), w.phase_deg, "deg")? * RAD_PER_DEG,
         });
     }
-    let vehicle = VehicleMotion::new(base, ramps, wobbles).map_err(|m| c.invalid("vehicle.ramp", m))?;
+    let coning = crate::motion::Coning {
+        half_angle_rad: c.range("vehicle.coning_half_angle_deg", raw.vehicle.coning_half_angle_deg, "deg", 0.0, 45.0, "")? * RAD_PER_DEG,
+        omega_rad_per_s: c.range("vehicle.coning_frequency_hz", raw.vehicle.coning_frequency_hz, "Hz", 0.0, 0.25 * step_hz, "at most a quarter of simulation.step_hz")?
+            * std::f64::consts::TAU,
+    };
+    let vehicle = VehicleMotion::new(base, ramps, wobbles).map_err(|m| c.invalid("vehicle.ramp", m))?.with_coning(coning);
     // Pitch must stay clear of the Euler singularity over the whole profile (ramps + wobble).
     let max_pitch = vehicle.max_abs_pitch_rad(duration_s);
     if max_pitch > 85.0 * RAD_PER_DEG {

@@ -237,6 +237,13 @@ impl VehicleMotion {
         r
     }
 
+    /// Highest oscillation frequency of the motion (wobble, coning), rad/s.
+    #[must_use]
+    pub fn max_angular_frequency(&self) -> f64 {
+        let w = self.wobble.iter().map(|w| w.omega_rad_per_s).fold(0.0, f64::max);
+        w.max(self.coning.map_or(0.0, |c| c.omega_rad_per_s))
+    }
+
     /// First time after `t_s` where a rate jumps (a ramp starts or ends).
     #[must_use]
     pub fn next_breakpoint_after(&self, t_s: f64) -> f64 {

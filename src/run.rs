@@ -8,8 +8,9 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::config::Params;
+use crate::ins::pipeline::{InsRun, InsView, SampleOut};
 use crate::record::Recorder;
-use crate::sim::{step, DemodState, ErrorStats, Model, StepOutput, ERROR_AXES, VARIANTS};
+use crate::sim::{step, DemodState, ErrorStats, Model, Stat, StepOutput, ERROR_AXES, VARIANTS};
 use crate::sink::OpenSinks;
 use crate::units::ARCSEC_PER_RAD;
 
@@ -25,10 +26,48 @@ pub fn every_n_steps(step_hz: f64, output_hz: f64) -> u64 {
     ((step_hz / output_hz).round() as u64).max(1)
 }
 
+/// One output instant: the turntable-only variants and, with an IMU in the loop, the INS's view.
+#[derive(Debug, Clone)]
+pub struct Row {
+    /// Ideal-INS step (truth, encoders, the three demodulations).
+    pub core: StepOutput,
+    /// The INS in the loop, if any.
+    pub ins: Option<InsView>,
+}
+
 /// What the simulation thread sends.
 enum Batch {
-    Series(Vec<StepOutput>),
-    Scene(Vec<StepOutput>),
+    Series(Vec<Row>),
+    Scene(Vec<Row>),
+    Signal(Vec<SampleOut>),
+}
+
+/// Statistics of the INS in the loop.
+#[derive(Debug, Clone, Default)]
+pub struct InsStats {
+    /// Algorithm names, in integrator order.
+    pub algorithms: Vec<String>,
+    /// `[algorithm][axis]`, radians.
+    pub stats: Vec<[Stat; 3]>,
+    /// Peak and last radial position error, m, and last (east, north), m.
+    pub nav: Option<(f64, f64, f64, f64)>,
+}
+
+impl InsStats {
+    fn add(&mut self, v: &InsView) {
+        if self.stats.len() < v.errors.len() {
+            self.stats.resize(v.errors.len(), [Stat::default(); 3]);
+        }
+        for (k, e) in v.errors.iter().enumerate() {
+            for (a, x) in e.as_array().into_iter().enumerate() {
+                self.stats[k][a].add(x);
+            }
+        }
+        if let Some((pos, _)) = v.nav {
+            let peak = self.nav.map_or(0.0, |n| n.0).max(pos.z);
+            self.nav = Some((peak, pos.z, pos.x, pos.y));
+        }
+    }
 }
 
 /// RMS and peak of one component, arcsec.
@@ -64,8 +103,27 @@ pub struct RunSummary {
     /// Its size, bytes.
     pub recording_bytes: Option<u64>,
     /// `[variant][axis]`: "uncompensated" / "compensated" / "closed_form" / "closed_form_minus_exact"
-    /// x "pitch" / "roll" / "heading".
+    /// x "pitch" / "roll" / "heading" (with an IMU in the loop: at the output instants).
     pub attitude_error_arcsec: std::collections::BTreeMap<String, std::collections::BTreeMap<String, RmsPeak>>,
+    /// With an IMU in the loop: the INS body-attitude error `[algorithm][axis]`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ins_attitude_error_arcsec: Option<std::collections::BTreeMap<String, std::collections::BTreeMap<String, RmsPeak>>>,
+    /// With navigation: radial position error, m (peak and final) and the final east/north error.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub navigation: Option<NavSummary>,
+}
+
+/// Navigation errors of a run.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct NavSummary {
+    /// Largest radial position error, m.
+    pub peak_radial_m: f64,
+    /// Radial position error at the end, m.
+    pub final_radial_m: f64,
+    /// East position error at the end, m.
+    pub final_east_m: f64,
+    /// North position error at the end, m.
+    pub final_north_m: f64,
 }
 
 impl RunSummary {
@@ -97,7 +155,27 @@ impl RunSummary {
             recording_path: None,
             recording_bytes: None,
             attitude_error_arcsec: table,
+            ins_attitude_error_arcsec: None,
+            navigation: None,
         }
+    }
+
+    fn with_ins(mut self, ins: &InsStats) -> Self {
+        if ins.algorithms.is_empty() {
+            return self;
+        }
+        let mut table = std::collections::BTreeMap::new();
+        for (k, name) in ins.algorithms.iter().enumerate() {
+            let mut row = std::collections::BTreeMap::new();
+            for (a, axis) in ERROR_AXES.iter().enumerate() {
+                let s = ins.stats.get(k).map_or(Stat::default(), |s| s[a]);
+                row.insert((*axis).to_owned(), RmsPeak { rms_arcsec: s.rms() * ARCSEC_PER_RAD, peak_arcsec: s.peak() * ARCSEC_PER_RAD });
+            }
+            table.insert(name.clone(), row);
+        }
+        self.ins_attitude_error_arcsec = Some(table);
+        self.navigation = ins.nav.map(|(peak, fin, e, n)| NavSummary { peak_radial_m: peak, final_radial_m: fin, final_east_m: e, final_north_m: n });
+        self
     }
 
     /// RMS and peak of one variant and axis.
@@ -129,6 +207,23 @@ impl RunSummary {
             }
             s.push('\n');
         }
+        if let Some(ins) = &self.ins_attitude_error_arcsec {
+            s.push_str("INS attitude error, arcsec\n");
+            for (name, row) in ins {
+                s.push_str(&format!("{:<24}", format!("  {name}")));
+                for axis in ERROR_AXES {
+                    let v = row[axis];
+                    s.push_str(&format!(" {:>11.3} {:>11.3}", v.rms_arcsec, v.peak_arcsec));
+                }
+                s.push('\n');
+            }
+        }
+        if let Some(n) = &self.navigation {
+            s.push_str(&format!(
+                "navigation: radial position error peak {:.1} m, final {:.1} m (east {:.1} m, north {:.1} m)\n",
+                n.peak_radial_m, n.final_radial_m, n.final_east_m, n.final_north_m
+            ));
+        }
         if let (Some(p), Some(b)) = (&self.recording_path, self.recording_bytes) {
             s.push_str(&format!("recording: {p} ({:.2} MB)\n", b as f64 / 1e6));
         }
@@ -159,51 +254,19 @@ pub fn run_recorded(params: &Params, sinks: &OpenSinks, stop: &AtomicBool, progr
     };
 
     let (tx, rx) = crossbeam_channel::bounded::<Batch>(8);
-    let (stats, done, interrupted) = std::thread::scope(|scope| -> anyhow::Result<(ErrorStats, u64, bool)> {
+    let (stats, ins_stats, done, interrupted) = std::thread::scope(|scope| -> anyhow::Result<(ErrorStats, InsStats, u64, bool)> {
         let sim = scope.spawn(|| {
-            let mut state = DemodState::default();
-            let mut stats = ErrorStats::default();
-            let mut series = Vec::with_capacity(BATCH_ROWS);
-            let mut scene = Vec::with_capacity(BATCH_ROWS);
-            let mut done = 0;
-            let mut interrupted = false;
-            for i in 0..steps {
-                if i % 65_536 == 0 {
-                    if stop.load(Ordering::Relaxed) {
-                        interrupted = true;
-                        break;
-                    }
-                    if let Some(b) = &bar {
-                        b.set_position(i);
-                    }
-                }
-                let out = step(&model, &mut state, i as f64 / step_hz);
-                stats.add(&out);
-                if i % series_every == 0 {
-                    series.push(out);
-                    if series.len() == BATCH_ROWS && tx.send(Batch::Series(std::mem::replace(&mut series, Vec::with_capacity(BATCH_ROWS)))).is_err() {
-                        break;
-                    }
-                }
-                if i % scene_every == 0 {
-                    scene.push(out);
-                    if scene.len() == BATCH_ROWS && tx.send(Batch::Scene(std::mem::replace(&mut scene, Vec::with_capacity(BATCH_ROWS)))).is_err() {
-                        break;
-                    }
-                }
-                done = i + 1;
-            }
-            // A closed receiver means the recorder failed; it reports the error itself.
-            let _ = tx.send(Batch::Series(series));
-            let _ = tx.send(Batch::Scene(scene));
+            let ctx = Producer { model: &model, params, stop, bar: bar.as_ref(), tx: &tx, series_every, scene_every };
+            let r = if params.ins.is_some() { ctx.run_ins(steps) } else { ctx.run_ideal(steps) };
             drop(tx);
-            (stats, done, interrupted)
+            r
         });
         let mut result = Ok(());
         for batch in &rx {
             let r = match batch {
-                Batch::Series(rows) => rows.iter().try_for_each(|o| recorder.push_series(o)),
-                Batch::Scene(rows) => rows.iter().try_for_each(|o| recorder.push_scene(o)),
+                Batch::Series(rows) => rows.iter().try_for_each(|o| recorder.push_row(&o.core, o.ins.as_ref())),
+                Batch::Scene(rows) => rows.iter().try_for_each(|o| recorder.push_scene_row(&o.core, o.ins.as_ref())),
+                Batch::Signal(samples) => samples.iter().try_for_each(|o| recorder.push_signal(o)),
             };
             if let Err(e) = r {
                 result = Err(e);
@@ -211,15 +274,15 @@ pub fn run_recorded(params: &Params, sinks: &OpenSinks, stop: &AtomicBool, progr
             }
         }
         drop(rx);
-        let (stats, done, interrupted) = sim.join().map_err(|_| anyhow::anyhow!("simulation thread panicked"))?;
+        let r = sim.join().map_err(|_| anyhow::anyhow!("simulation thread panicked"))?;
         result?;
-        Ok((stats, done, interrupted))
+        Ok(r)
     })?;
     if let Some(b) = bar {
         b.finish_and_clear();
     }
 
-    let summary = RunSummary::new(params, &stats, done, started.elapsed().as_secs_f64(), interrupted);
+    let summary = RunSummary::new(params, &stats, done, started.elapsed().as_secs_f64(), interrupted).with_ins(&ins_stats);
     let t_end = done.saturating_sub(1) as f64 / step_hz;
     let end_text = if interrupted {
         format!("run interrupted by the user at {t_end:.3} s; the recording holds everything simulated until then")
@@ -230,6 +293,132 @@ pub fn run_recorded(params: &Params, sinks: &OpenSinks, stop: &AtomicBool, progr
     recorder.event(t_end, &format!("summary:\n{}", summary.table()), "INFO")?;
     recorder.finish()?;
     Ok(summary)
+}
+
+/// The simulation thread's side of a recorded run.
+struct Producer<'a> {
+    model: &'a Model,
+    params: &'a Params,
+    stop: &'a AtomicBool,
+    bar: Option<&'a indicatif::ProgressBar>,
+    tx: &'a crossbeam_channel::Sender<Batch>,
+    series_every: u64,
+    scene_every: u64,
+}
+
+/// Buffers rows and sends them in batches; `false` when the recorder has gone away.
+struct Outbox<'a> {
+    tx: &'a crossbeam_channel::Sender<Batch>,
+    series: Vec<Row>,
+    scene: Vec<Row>,
+    signal: Vec<SampleOut>,
+}
+
+impl Outbox<'_> {
+    fn series(&mut self, r: Row) -> bool {
+        self.series.push(r);
+        self.series.len() < BATCH_ROWS || self.tx.send(Batch::Series(std::mem::take(&mut self.series))).is_ok()
+    }
+    fn scene(&mut self, r: Row) -> bool {
+        self.scene.push(r);
+        self.scene.len() < BATCH_ROWS || self.tx.send(Batch::Scene(std::mem::take(&mut self.scene))).is_ok()
+    }
+    fn signal(&mut self, s: SampleOut) -> bool {
+        self.signal.push(s);
+        self.signal.len() < BATCH_ROWS || self.tx.send(Batch::Signal(std::mem::take(&mut self.signal))).is_ok()
+    }
+    fn close(self) {
+        // A closed receiver means the recorder failed; it reports the error itself.
+        let _ = self.tx.send(Batch::Signal(self.signal));
+        let _ = self.tx.send(Batch::Series(self.series));
+        let _ = self.tx.send(Batch::Scene(self.scene));
+    }
+}
+
+impl Producer<'_> {
+    fn check(&self, i: u64) -> bool {
+        if let Some(b) = self.bar {
+            b.set_position(i);
+        }
+        self.stop.load(Ordering::Relaxed)
+    }
+
+    /// The IMU attitude is exact: one core step per simulation step.
+    fn run_ideal(&self, steps: u64) -> (ErrorStats, InsStats, u64, bool) {
+        let mut state = DemodState::default();
+        let mut stats = ErrorStats::default();
+        let mut out = Outbox { tx: self.tx, series: Vec::new(), scene: Vec::new(), signal: Vec::new() };
+        let (mut done, mut interrupted) = (0, false);
+        for i in 0..steps {
+            if i % 65_536 == 0 && self.check(i) {
+                interrupted = true;
+                break;
+            }
+            let o = step(self.model, &mut state, i as f64 / self.params.step_hz);
+            stats.add(&o);
+            if i % self.series_every == 0 && !out.series(Row { core: o, ins: None }) {
+                break;
+            }
+            if i % self.scene_every == 0 && !out.scene(Row { core: o, ins: None }) {
+                break;
+            }
+            done = i + 1;
+        }
+        out.close();
+        (stats, InsStats::default(), done, interrupted)
+    }
+
+    /// An IMU in the loop: one IMU sample per step; outputs at the attitude updates closest to the
+    /// recording rates (statistics at the series outputs).
+    fn run_ins(&self, steps: u64) -> (ErrorStats, InsStats, u64, bool) {
+        let Some(mut ins) = InsRun::new(self.params, self.model.clone()) else {
+            return self.run_ideal(steps);
+        };
+        let mut state = DemodState::default();
+        let mut stats = ErrorStats::default();
+        let mut ins_stats = InsStats { algorithms: ins.algorithms().iter().map(|a| a.name().to_owned()).collect(), ..InsStats::default() };
+        let mut out = Outbox { tx: self.tx, series: Vec::new(), scene: Vec::new(), signal: Vec::new() };
+        let window = ins.config().signal_window_s;
+        let (mut done, mut interrupted) = (1, false);
+        let (mut next_series, mut next_scene) = (0u64, 0u64);
+        for i in 1..steps {
+            if i % 65_536 == 0 && self.check(i) {
+                interrupted = true;
+                break;
+            }
+            let s = ins.step();
+            if s.t_s <= window && !out.signal(s) {
+                break;
+            }
+            done = i + 1;
+            if !s.updated {
+                continue;
+            }
+            let want_series = i >= next_series;
+            let want_scene = i >= next_scene;
+            if !(want_series || want_scene) {
+                continue;
+            }
+            let core = step(self.model, &mut state, s.t_s);
+            let view = ins.view(s.t_s);
+            if want_series {
+                next_series = i + self.series_every;
+                stats.add(&core);
+                ins_stats.add(&view);
+                if !out.series(Row { core, ins: Some(view.clone()) }) {
+                    break;
+                }
+            }
+            if want_scene {
+                next_scene = i + self.scene_every;
+                if !out.scene(Row { core, ins: Some(view) }) {
+                    break;
+                }
+            }
+        }
+        out.close();
+        (stats, ins_stats, done, interrupted)
+    }
 }
 
 #[cfg(test)]

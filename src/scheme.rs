@@ -156,6 +156,15 @@ impl Scheme {
         self.n_axes
     }
 
+    /// Largest gimbal rate magnitude, rad/s (the frame rotation frequency it causes).
+    #[must_use]
+    pub fn max_rate(&self) -> f64 {
+        match &self.kind {
+            Kind::Continuous { rates } => rates.iter().fold(0.0, |m, r| m.max(r.abs())),
+            Kind::Indexed { .. } => self.steps.iter().fold(0.0, |m, s| m.max(s.rate_rad_per_s)),
+        }
+    }
+
     /// Length of one indexed sequence, s (0 for continuous schemes).
     #[must_use]
     pub fn period_s(&self) -> f64 {

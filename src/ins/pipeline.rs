@@ -69,7 +69,7 @@ pub struct InsRun {
     nav_start: UnitQuaternion<f64>,
     upd_g: Vec<Vector3<f64>>,
     upd_a: Vec<Vector3<f64>>,
-    demod: DemodState,
+    demod: Vec<DemodState>,
     /// FIR group delay, s.
     pub fir_delay_s: f64,
     /// Zero-order-hold delay, s.
@@ -87,8 +87,9 @@ impl InsRun {
         let fir_a = Fir::new(&cfg.fir_taps);
         let fir_delay_s = fir_g.group_delay_samples() * h;
         let zoh_delay_s = if cfg.zero_order_hold { 0.5 * h } else { 0.0 };
-        // Pre-roll: the filter has been running before t = 0 on the same motion.
-        let pre = cfg.fir_taps.len().saturating_sub(1);
+        // Pre-roll: the filter has been running before t = 0 on the same motion, and the algorithms
+        // that use previous samples have them.
+        let pre = cfg.fir_taps.len().saturating_sub(1).max(2 * cfg.decimation);
         let t_start = -(pre as f64) * h;
         let truth = TruthImu::new(model, earth, t_start);
         let sensors = Sensors::new(&cfg.errors, h, params.meta.seed, t_start);
@@ -113,24 +114,39 @@ impl InsRun {
             nav_start: UnitQuaternion::identity(),
             upd_g: Vec::new(),
             upd_a: Vec::new(),
-            demod: DemodState::default(),
+            demod: Vec::new(),
             fir_delay_s,
             zoh_delay_s,
             cfg,
         };
+        let mut primed = Vec::new();
+        let mut acc = (Vector3::zeros(), 0);
         for i in 0..pre {
             let t1 = t_start + (i + 1) as f64 * h;
             let (g, a) = me.truth.increments(t1);
             let (g, a) = me.sensors.measure(&g, &a, t1);
-            me.fir_g.push(g);
+            acc.0 += me.fir_g.push(g);
+            acc.1 += 1;
             me.fir_a.push(a);
+            if acc.1 == me.cfg.decimation {
+                primed.push(acc.0);
+                acc = (Vector3::zeros(), 0);
+            }
         }
         // The filtered stream now stands at the truth of t = −d: start the attitude there, with the
         // alignment error φ applied as C = (I − [φ×]) C_true.
         let start = *me.truth.eval(-fir_delay_s).n_from_s.quaternion();
         let start = exp_small(&-me.cfg.initial_error_rad) * start;
-        me.integrators = algorithms.iter().map(|a| AttitudeIntegrator::new(*a, start)).collect();
+        me.integrators = algorithms
+            .iter()
+            .map(|a| {
+                let mut i = AttitudeIntegrator::new(*a, start);
+                i.prime(&primed);
+                i
+            })
+            .collect();
         me.history = vec![[(-fir_delay_s, start), (-fir_delay_s, start)]; me.integrators.len()];
+        me.demod = vec![DemodState::default(); me.integrators.len()];
         me.nav_start = start;
         Some(me)
     }
@@ -224,26 +240,27 @@ impl InsRun {
         }
     }
 
-    /// The INS body attitude errors at output time `t_s` (call right after an update).
+    /// The INS body attitude errors (call right after a primary update at `t_s`). Each algorithm is
+    /// compared at the instant its own latest output stands for (algorithms with more samples per
+    /// update update less often), against the truth `output_compensation` earlier.
     pub fn view(&mut self, t_s: f64) -> InsView {
         let model = self.truth.model().clone();
-        let t_ref = t_s - self.cfg.output_compensation_s;
-        // The output represents the truth at t − d − zoh; the encoders are read for that instant.
-        let t_repr = t_s - self.fir_delay_s - self.zoh_delay_s;
-        let encoder = encoder_readings(&model, t_repr);
-        let corrected = self.demod.correct(&model, t_repr, &encoder);
-        let b_from_s_comp = model.chain.b_from_s(model.compensation_rotations(), &corrected);
-        let (truth_att, _) = model.vehicle.state(t_ref);
-        let errors = (0..self.integrators.len())
-            .map(|k| {
-                let (_, q) = self.output_attitude(k);
-                // FRAME: the integrator propagates C_s^n.
-                let n_from_s: Rot<N, S> = Rot::from_quaternion(q);
-                demodulate(n_from_s, b_from_s_comp).error_from(&truth_att)
-            })
-            .collect();
+        let mut errors = Vec::with_capacity(self.integrators.len());
+        for k in 0..self.integrators.len() {
+            let (t_repr, q) = self.output_attitude(k);
+            // The output left the computer d + zoh after the instant it represents.
+            let t_ref = t_repr + self.fir_delay_s + self.zoh_delay_s - self.cfg.output_compensation_s;
+            // The encoders are read for the instant the IMU data represent (matched synchronisation).
+            let encoder = encoder_readings(&model, t_repr);
+            let corrected = self.demod[k].correct(&model, t_repr, &encoder);
+            let b_from_s_comp = model.chain.b_from_s(model.compensation_rotations(), &corrected);
+            let (truth_att, _) = model.vehicle.state(t_ref);
+            // FRAME: the integrator propagates C_s^n.
+            let n_from_s: Rot<N, S> = Rot::from_quaternion(q);
+            errors.push(demodulate(n_from_s, b_from_s_comp).error_from(&truth_att));
+        }
+        let (t_repr, imu_ins) = self.output_attitude(0);
         let imu_true = *self.truth.eval(t_repr).n_from_s.quaternion();
-        let imu_ins = self.output_attitude(0).1;
         let nav = self.nav.as_ref().map(|n| {
             let s = &n.state;
             let site = self.earth.site;
@@ -252,7 +269,7 @@ impl InsRun {
             let east = (s.longitude_rad - site.longitude_rad) * (rn + site.height_m) * site.latitude_rad.cos();
             (Vector3::new(east, north, north.hypot(east)), s.v_n)
         });
-        InsView { t_s, t_ref_s: t_ref, errors, imu_true, imu_ins, nav }
+        InsView { t_s, t_ref_s: t_s - self.cfg.output_compensation_s, errors, imu_true, imu_ins, nav }
     }
 
     /// The body attitude the primary INS outputs (for tests and resets).

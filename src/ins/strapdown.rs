@@ -48,6 +48,18 @@ impl AttitudeIntegrator {
         Self { algorithm, n, p, k: coefficients(n, p), cur: [Vector3::zeros(); 3], prev: [Vector3::zeros(); 2], filled: 0, n_from_s, updates: 0 }
     }
 
+    /// Sets the previous samples (oldest first) as if the integrator had been running: the
+    /// algorithms with P > 0 would otherwise start with zero history and a first-update error.
+    pub fn prime(&mut self, previous: &[Vector3<f64>]) {
+        let n = previous.len();
+        if n >= 1 {
+            self.prev[0] = previous[n - 1];
+        }
+        if n >= 2 {
+            self.prev[1] = previous[n - 2];
+        }
+    }
+
     /// Gyro samples per attitude update (N).
     #[must_use]
     pub fn samples_per_update(&self) -> usize {

@@ -21,6 +21,7 @@ mod layout;
 pub mod read;
 
 use crate::config::Params;
+use crate::ins::pipeline::{InsView, SampleOut};
 use crate::sim::{Model, StepOutput, ERROR_AXES, VARIANTS};
 use crate::units::{fmt_angle, ARCSEC_PER_RAD, DEG_PER_RAD};
 
@@ -53,6 +54,7 @@ mod palette {
     pub const EULER: [[u8; 3]; 3] = [[230, 90, 90], [90, 200, 90], [90, 140, 240]];
     pub const NOMINAL: [u8; 3] = [150, 150, 150];
     pub const SENSOR: [[u8; 3]; 3] = [[235, 50, 50], [50, 200, 50], [60, 110, 255]];
+    pub const ALGORITHMS: [[u8; 3]; 5] = [[250, 200, 60], [230, 76, 60], [46, 170, 90], [70, 130, 240], [200, 90, 230]];
 }
 
 fn rgb(c: [u8; 3]) -> rerun::Color {
@@ -125,7 +127,28 @@ pub struct Recorder {
     chunks_in_flight: usize,
     /// Live mode: geometry on the timeline instead of static.
     live: bool,
+    /// With an IMU in the loop.
+    ins: Option<InsLayout>,
 }
+
+/// What a run with an IMU in the loop adds to the recording.
+struct InsLayout {
+    algorithms: Vec<String>,
+    nav: bool,
+    /// Index in `Recorder::series` of the first INS entity.
+    first_series: usize,
+    signal_t: Vec<f64>,
+    raw: Vec<f64>,
+    filtered: Vec<f64>,
+    trace_true: Vec<rerun::Quaternion>,
+    trace_ins: Vec<rerun::Quaternion>,
+    exaggeration: f64,
+    fir_taps: Vec<f64>,
+    rate_hz: f64,
+}
+
+/// Where the INS trace (true and computed IMU axes) is drawn, beside the table.
+const TRACE_OFFSET: [f32; 3] = [0.0, 2.6, 0.0];
 
 impl Recorder {
     /// Logs everything static (documents, styles, geometry, blueprint) and prepares the buffers.
@@ -144,6 +167,34 @@ impl Recorder {
         for name in &axis_names {
             series.push(Series::new(format!("swing_arcsec/{name}"), 2));
         }
+        let ins = params.ins.as_ref().map(|cfg| {
+            let algorithms: Vec<String> = if cfg.compare {
+                std::iter::once(cfg.algorithm).chain(crate::ins::coning::Algorithm::ALL.into_iter().filter(|a| *a != cfg.algorithm)).map(|a| a.name().to_owned()).collect()
+            } else {
+                vec![cfg.algorithm.name().to_owned()]
+            };
+            let first_series = series.len();
+            for axis in ERROR_AXES {
+                series.push(Series::new(format!("ins/attitude_error_arcsec/{axis}"), algorithms.len()));
+            }
+            if cfg.navigation.is_some() {
+                series.push(Series::new("ins/position_error_m".into(), 3));
+                series.push(Series::new("ins/velocity_error_mps".into(), 3));
+            }
+            InsLayout {
+                algorithms,
+                nav: cfg.navigation.is_some(),
+                first_series,
+                signal_t: Vec::new(),
+                raw: Vec::new(),
+                filtered: Vec::new(),
+                trace_true: Vec::new(),
+                trace_ins: Vec::new(),
+                exaggeration: params.recording.exaggeration,
+                fir_taps: cfg.fir_taps.clone(),
+                rate_hz: params.step_hz,
+            }
+        });
         let me = Self {
             rec,
             model,
@@ -156,8 +207,10 @@ impl Recorder {
             scene_gimbals: vec![Vec::new(); n],
             chunks_in_flight: 0,
             live,
+            ins,
         };
         me.log_once(params)?;
+        me.log_ins_once()?;
         me.log_error_geometry(params, me.geometry_at(0.0))?;
         me.send_blueprint(params)?;
         me.event(0.0, &format!("run started: {} ({} s at {} Hz, seed {})", params.meta.name, params.duration_s, params.step_hz, params.meta.seed), "INFO")?;
@@ -433,16 +486,36 @@ impl Recorder {
             &[],
         );
         let left = Node::container(ContainerKind::Vertical, vec![scene, docs], &[3.0, 1.3]);
-        let more = Node::container(
-            ContainerKind::Tabs,
-            vec![
-                plot("gimbal angles (deg)".into(), "gimbal_angle_deg"),
-                plot("vehicle attitude (deg)".into(), "vehicle_attitude_deg"),
-                plot("swing angles (arcsec)".into(), "swing_arcsec"),
-            ],
-            &[],
-        );
-        let right = Node::container(ContainerKind::Vertical, vec![error_view("pitch"), error_view("roll"), error_view("heading"), more], &[]);
+        let mut more = vec![
+            plot("gimbal angles (deg)".into(), "gimbal_angle_deg"),
+            plot("vehicle attitude (deg)".into(), "vehicle_attitude_deg"),
+            plot("swing angles (arcsec)".into(), "swing_arcsec"),
+        ];
+        let right = match &self.ins {
+            None => {
+                let more = Node::container(ContainerKind::Tabs, more, &[]);
+                Node::container(ContainerKind::Vertical, vec![error_view("pitch"), error_view("roll"), error_view("heading"), more], &[])
+            }
+            Some(layout) => {
+                // The INS in the loop leads; the turntable-only (ideal-INS) plots go into the tabs.
+                let ins_view = |axis: &str| plot(format!("INS {axis} error (arcsec)"), &format!("ins/attitude_error_arcsec/{axis}"));
+                let mut tabs = Vec::new();
+                if layout.nav {
+                    tabs.push(plot("position error (m)".into(), "ins/position_error_m"));
+                    tabs.push(plot("velocity error (m/s)".into(), "ins/velocity_error_mps"));
+                }
+                tabs.push(plot("gyro raw (deg/s)".into(), "ins/gyro_raw_deg_per_s"));
+                tabs.push(plot("gyro after FIR (deg/s)".into(), "ins/gyro_filtered_deg_per_s"));
+                if layout.fir_taps.len() > 1 {
+                    tabs.push(Node::view("2D", "FIR response (x: Hz, y: −5·dB)", "ins/fir_response"));
+                }
+                for axis in ERROR_AXES {
+                    tabs.push(plot(format!("table only: {axis} (arcsec)"), &format!("attitude_error_arcsec/{axis}")));
+                }
+                tabs.append(&mut more);
+                Node::container(ContainerKind::Vertical, vec![ins_view("pitch"), ins_view("roll"), ins_view("heading"), Node::container(ContainerKind::Tabs, tabs, &[])], &[])
+            }
+        };
         let root = Node::container(ContainerKind::Horizontal, vec![left, right], &[1.1, 1.0]);
         // Play a whole run in about a minute; a live session follows the newest data.
         let speed = if self.live { 1.0 } else { (p.duration_s / 60.0).max(1.0).round() };
@@ -451,6 +524,11 @@ impl Recorder {
 
     /// Buffers one time-series row; sends a chunk when the buffer is full.
     pub fn push_series(&mut self, out: &StepOutput) -> RecordingStreamResult<()> {
+        self.push_row(out, None)
+    }
+
+    /// Buffers one row: the turntable-only variants and, with an IMU in the loop, the INS's view.
+    pub fn push_row(&mut self, out: &StepOutput, ins: Option<&InsView>) -> RecordingStreamResult<()> {
         for a in 0..3 {
             for e in &out.errors {
                 self.series[a].values.push(e.as_array()[a] * ARCSEC_PER_RAD);
@@ -464,6 +542,22 @@ impl Recorder {
             let s = self.model.chain.swing_vector(k, &self.model.truth.axes[k], out.gimbal_rad[k]);
             self.series[5 + k].values.extend([s.dot(&g.e1) * ARCSEC_PER_RAD, s.dot(&g.e2) * ARCSEC_PER_RAD]);
         }
+        if let Some(layout) = &self.ins {
+            let i0 = layout.first_series;
+            let width = layout.algorithms.len();
+            for a in 0..3 {
+                let values = &mut self.series[i0 + a].values;
+                match ins {
+                    Some(v) => values.extend(v.errors.iter().map(|e| e.as_array()[a] * ARCSEC_PER_RAD)),
+                    None => values.extend(std::iter::repeat_n(f64::NAN, width)),
+                }
+            }
+            if layout.nav {
+                let (pos, vel) = ins.and_then(|v| v.nav).unwrap_or((Vector3::repeat(f64::NAN), Vector3::repeat(f64::NAN)));
+                self.series[i0 + 3].values.extend([pos.x, pos.y, pos.z]);
+                self.series[i0 + 4].values.extend([vel.x, vel.y, vel.z]);
+            }
+        }
         self.series_t.push(out.t_s);
         if self.series_t.len() >= SERIES_CHUNK_ROWS {
             self.flush_series()?;
@@ -473,14 +567,109 @@ impl Recorder {
 
     /// Buffers one scene frame; sends a chunk when the buffer is full.
     pub fn push_scene(&mut self, out: &StepOutput) -> RecordingStreamResult<()> {
+        self.push_scene_row(out, None)
+    }
+
+    /// Buffers one scene frame with, if any, the INS trace (true and computed IMU axes, the
+    /// computed one's error exaggerated).
+    pub fn push_scene_row(&mut self, out: &StepOutput, ins: Option<&InsView>) -> RecordingStreamResult<()> {
         let links = self.model.drawing_links(&out.gimbal_rad);
         self.scene_t.push(out.t_s);
         self.scene_vehicle.push(to_rerun_quaternion(&out.n_from_b));
         for (k, col) in self.scene_gimbals.iter_mut().enumerate() {
             col.push(to_rerun_quaternion(&links.gimbal[k]));
         }
+        if let Some(layout) = self.ins.as_mut() {
+            let (t, c) = ins.map_or((UnitQuaternion::identity(), UnitQuaternion::identity()), |v| (v.imu_true, v.imu_ins));
+            let err = (c * t.inverse()).scaled_axis() * layout.exaggeration;
+            layout.trace_true.push(to_rerun_quaternion(&t));
+            layout.trace_ins.push(to_rerun_quaternion(&(UnitQuaternion::from_scaled_axis(err) * t)));
+        }
         if self.scene_t.len() >= SERIES_CHUNK_ROWS {
             self.flush_scene()?;
+        }
+        Ok(())
+    }
+
+    /// Buffers one raw and filtered gyro sample (the signal window at the IMU rate).
+    pub fn push_signal(&mut self, s: &SampleOut) -> RecordingStreamResult<()> {
+        let Some(layout) = self.ins.as_mut() else { return Ok(()) };
+        layout.signal_t.push(s.t_s);
+        layout.raw.extend(s.raw_rate_s.iter().map(|x| x * DEG_PER_RAD));
+        layout.filtered.extend(s.filtered_rate_s.iter().map(|x| x * DEG_PER_RAD));
+        if layout.signal_t.len() >= SERIES_CHUNK_ROWS {
+            self.flush_signal()?;
+        }
+        Ok(())
+    }
+
+    fn flush_signal(&mut self) -> RecordingStreamResult<()> {
+        let Some(layout) = self.ins.as_mut() else { return Ok(()) };
+        if layout.signal_t.is_empty() {
+            return Ok(());
+        }
+        let times = std::mem::take(&mut layout.signal_t);
+        for (path, values) in [("ins/gyro_raw_deg_per_s", std::mem::take(&mut layout.raw)), ("ins/gyro_filtered_deg_per_s", std::mem::take(&mut layout.filtered))] {
+            let time = TimeColumn::new_duration_secs(TIMELINE, times.iter().copied());
+            self.rec.send_columns(path, [time], rerun::Scalars::new(values).columns(std::iter::repeat_n(3, times.len()))?)?;
+        }
+        Ok(())
+    }
+
+    /// Static parts of an INS run: series styles, the FIR's amplitude response, the trace's axes.
+    fn log_ins_once(&self) -> RecordingStreamResult<()> {
+        let Some(layout) = &self.ins else { return Ok(()) };
+        let rec = &self.rec;
+        let algo_colors: Vec<rerun::Color> = (0..layout.algorithms.len()).map(|k| rgb(palette::ALGORITHMS[k % palette::ALGORITHMS.len()])).collect();
+        for axis in ERROR_AXES {
+            rec.log_static(
+                format!("ins/attitude_error_arcsec/{axis}"),
+                &rerun::SeriesLines::new().with_colors(algo_colors.clone()).with_names(layout.algorithms.clone()),
+            )?;
+        }
+        let enu = ["east", "north"];
+        rec.log_static("ins/position_error_m", &rerun::SeriesLines::new().with_colors(palette::EULER.map(rgb)).with_names([enu[0], enu[1], "radial"]))?;
+        rec.log_static("ins/velocity_error_mps", &rerun::SeriesLines::new().with_colors(palette::EULER.map(rgb)).with_names([enu[0], enu[1], "up"]))?;
+        for path in ["ins/gyro_raw_deg_per_s", "ins/gyro_filtered_deg_per_s"] {
+            rec.log_static(path, &rerun::SeriesLines::new().with_colors(palette::SENSOR.map(rgb)).with_names(["gyro x", "gyro y", "gyro z"]))?;
+        }
+        // FIR amplitude response, dB, drawn in a 2D view: x = frequency (Hz), y = 5 × dB (so that
+        // 0..-150 dB spans a readable height next to 0..1000 Hz).
+        if layout.fir_taps.len() > 1 {
+            let fir = crate::ins::fir::Fir::new(&layout.fir_taps);
+            let nyquist = 0.5 * layout.rate_hz;
+            let curve: Vec<[f32; 2]> = (0..=1000)
+                .map(|i| {
+                    let f = nyquist * f64::from(i) / 1000.0;
+                    let db = (20.0 * fir.amplitude(f, layout.rate_hz).log10()).max(-160.0);
+                    [f as f32, (-5.0 * db) as f32]
+                })
+                .collect();
+            rec.log_static("ins/fir_response/curve", &rerun::LineStrips2D::new([curve]).with_colors([rgb([90, 200, 250])]).with_radii([1.5]))?;
+            let mut grid = Vec::new();
+            for db in [0.0f32, -50.0, -100.0, -150.0] {
+                grid.push(vec![[0.0, -5.0 * db], [nyquist as f32, -5.0 * db]]);
+            }
+            rec.log_static("ins/fir_response/grid", &rerun::LineStrips2D::new(grid).with_colors([rgba([120, 120, 120], 120)]).with_radii([0.8]).with_labels(["0 dB", "-50 dB", "-100 dB", "-150 dB"]))?;
+            let tones: Vec<[f32; 2]> = [335.4f64, 375.5, 425.7]
+                .iter()
+                .filter(|f| **f < nyquist)
+                .map(|f| [*f as f32, (-5.0 * (20.0 * fir.amplitude(*f, layout.rate_hz).log10()).max(-160.0)) as f32])
+                .collect();
+            let labels: Vec<String> = [335.4f64, 375.5, 425.7].iter().filter(|f| **f < nyquist).map(|f| format!("{f} Hz dither")).collect();
+            rec.log_static("ins/fir_response/dither", &rerun::Points2D::new(tones).with_labels(labels).with_radii([6.0]).with_colors([rgb([240, 90, 90])]))?;
+        }
+        // The INS trace: true IMU axes (grey) and computed (coloured, error ×N), beside the table.
+        for (path, colors, label) in [
+            ("world/ins_trace/true", [[170, 170, 170]; 3], "true IMU"),
+            ("world/ins_trace/ins", palette::SENSOR, "INS (error ×N)"),
+        ] {
+            rec.log_static(path, &rerun::Transform3D::from_translation(TRACE_OFFSET))?;
+            rec.log_static(
+                format!("{path}/axes"),
+                &rerun::Arrows3D::from_vectors([[0.6, 0.0, 0.0], [0.0, 0.6, 0.0], [0.0, 0.0, 0.6]]).with_colors(colors.map(rgb)).with_radii([0.012]),
+            )?;
+            rec.log_static(format!("{path}/label"), &rerun::Points3D::new([[0.0f32, 0.0, 0.75]]).with_labels([label.replace('N', &layout.exaggeration.to_string())]).with_radii([0.002]))?;
         }
         Ok(())
     }
@@ -536,6 +725,19 @@ impl Recorder {
                 rerun::Transform3D::update_fields().with_many_quaternion(q).columns_of_unit_batches()?,
             )?;
         }
+        if let Some(layout) = self.ins.as_mut() {
+            for (path, q) in [("world/ins_trace/true", std::mem::take(&mut layout.trace_true)), ("world/ins_trace/ins", std::mem::take(&mut layout.trace_ins))] {
+                let n = q.len();
+                self.rec.send_columns(
+                    path,
+                    [time()],
+                    rerun::Transform3D::update_fields()
+                        .with_many_translation(std::iter::repeat_n(TRACE_OFFSET, n))
+                        .with_many_quaternion(q)
+                        .columns_of_unit_batches()?,
+                )?;
+            }
+        }
         Ok(())
     }
 
@@ -547,6 +749,7 @@ impl Recorder {
 
     /// Sends everything still buffered.
     pub fn finish(&mut self) -> RecordingStreamResult<()> {
+        self.flush_signal()?;
         self.flush_series()?;
         self.flush_scene()
     }
