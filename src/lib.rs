@@ -10,6 +10,7 @@ pub mod frames;
 pub mod gimbal;
 pub mod ins;
 pub mod live;
+pub mod modulation;
 pub mod motion;
 pub mod record;
 pub mod reproduce;

@@ -34,6 +34,19 @@ enum Command {
     Run(RunArgs),
     /// Run in real time, streaming to a viewer, with the config file watched and a slider panel.
     Live(LiveArgs),
+    /// Rotation modulation: static INS with constant biases, no rotation vs continuous vs 16-position,
+    /// simulated together and recorded side by side.
+    Modulation {
+        /// Simulated hours.
+        #[arg(long, default_value_t = 24.0)]
+        hours: f64,
+        /// Save to this .rrd (default recordings/rotation-modulation.rrd unless a viewer is asked for).
+        #[arg(long)]
+        save: Option<PathBuf>,
+        /// Start a new Rerun viewer and stream to it.
+        #[arg(long)]
+        spawn: bool,
+    },
     /// Print the event log (reloads, errors, summary) of a saved recording.
     Events {
         /// The .rrd file.
@@ -153,6 +166,7 @@ fn main() -> ExitCode {
         Command::Run(args) => run_command(&args),
         Command::Live(args) => live_command(&args),
         Command::Events { file } => events_command(&file),
+        Command::Modulation { hours, save, spawn } => modulation_command(hours, save, spawn),
         Command::Scenarios => {
             list_scenarios();
             Ok(())
@@ -322,6 +336,45 @@ fn live_command(args: &LiveArgs) -> Result<(), Failure> {
     );
     if let Some((p, bytes)) = saved {
         println!("recording: {} ({:.2} MB) — open with `rerun {}`, list its events with `rinscope events {}`", p.display(), bytes as f64 / 1e6, p.display(), p.display());
+    }
+    Ok(())
+}
+
+fn modulation_command(hours: f64, save: Option<PathBuf>, spawn: bool) -> Result<(), Failure> {
+    if !(hours.is_finite() && hours > 0.0 && hours <= 24.0 * 30.0) {
+        return Err(Failure { code: 2, message: format!("--hours {hours}: must be > 0 and at most 720 h") });
+    }
+    let mut request = SinkRequest { save, spawn, ..Default::default() };
+    if request.save.is_none() && !spawn {
+        request.save = Some(PathBuf::from("recordings/rotation-modulation.rrd"));
+    }
+    let sinks = sink::open(&request, rinscope::record::APPLICATION_ID, "rotation-modulation")?;
+    for d in &sinks.description {
+        eprintln!("rinscope: {d}");
+    }
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = Arc::clone(&stop);
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
+    let started = std::time::Instant::now();
+    eprintln!("rinscope: simulating {hours} h three times in parallel (no rotation, continuous azimuth, 16-position)...");
+    let traces = match rinscope::modulation::run(hours, &stop) {
+        Ok(t) => t,
+        Err(e) => {
+            sinks.abandon();
+            return Err(e.into());
+        }
+    };
+    let table = rinscope::modulation::table(&traces, started.elapsed().as_secs_f64());
+    if let Err(e) = rinscope::record::modulation::log(&sinks.rec, &traces, &table) {
+        sinks.abandon();
+        return Err(Failure { code: 1, message: format!("rerun: {e}") });
+    }
+    let saved = sinks.finish()?;
+    print!("{table}");
+    if let Some((p, bytes)) = saved {
+        println!("recording: {} ({:.2} MB) — open with `rerun {}`", p.display(), bytes as f64 / 1e6, p.display());
     }
     Ok(())
 }

@@ -18,6 +18,7 @@ use rerun::{RecordingStream, RecordingStreamResult, TimeColumn};
 use layout::Node;
 
 mod layout;
+pub mod modulation;
 pub mod read;
 
 use crate::config::Params;

@@ -1,0 +1,73 @@
+//! The recording of `rinscope modulation`: the three variants' position and heading errors overlaid.
+
+use rerun::blueprint::components::ContainerKind;
+use rerun::{RecordingStream, RecordingStreamResult, TimeColumn};
+
+use super::layout::{self, Node};
+use super::{rgb, APPLICATION_ID, TIMELINE};
+use crate::modulation::Trace;
+
+const COLORS: [[u8; 3]; 3] = [[230, 76, 60], [240, 180, 40], [46, 170, 90]];
+
+/// Logs the traces (sampled at the same instants) with their explanation and a layout.
+pub fn log(rec: &RecordingStream, traces: &[Trace], table: &str) -> RecordingStreamResult<()> {
+    rec.send_recording_name("rinscope: rotation modulation")?;
+    let names: Vec<String> = traces.iter().map(|t| t.label.clone()).collect();
+    let doc = format!(
+        "# Rotation modulation\n\nOne IMU with constant biases (gyros 0.01°/h, accelerometers 50 µg on every axis) on a static \
+         vehicle at 40° N navigates with the table at rest, turning continuously about the azimuth axis at 10°/s, and \
+         running the 16-position sequence (docs/schemes.md). The presets are `rotation-modulation-none`, `-continuous` \
+         and `-16-position`.\n\n- Without rotation the biases integrate: Schuler (84 min) and Earth-rate (24 h) oscillations \
+         on a growing position error.\n- Azimuth rotation averages the horizontal sensors' biases out, not the vertical \
+         gyro's: the heading error remains and drives the position error.\n- The 16-position sequence turns every sensor \
+         over: what is left is small.\n\n```\n{table}```\n"
+    );
+    rec.log_static("docs/modulation", &rerun::TextDocument::from_markdown(doc))?;
+    let colors: Vec<rerun::Color> = COLORS.iter().map(|c| rgb(*c)).collect();
+    for path in ["modulation/radial_position_error_m", "modulation/east_error_m", "modulation/north_error_m", "modulation/heading_error_arcsec"] {
+        rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors.clone()).with_names(names.clone()))?;
+    }
+    let n = traces.iter().map(|t| t.samples.len()).min().unwrap_or(0);
+    let times: Vec<f64> = traces.first().map(|t| t.samples[..n].iter().map(|s| s.t_s).collect()).unwrap_or_default();
+    let column = |f: &dyn Fn(&crate::modulation::Sample) -> f64| -> Vec<f64> {
+        let mut v = Vec::with_capacity(n * traces.len());
+        for i in 0..n {
+            for t in traces {
+                v.push(f(&t.samples[i]));
+            }
+        }
+        v
+    };
+    let width = traces.len();
+    for (path, values) in [
+        ("modulation/radial_position_error_m", column(&|s| s.position_m[2])),
+        ("modulation/east_error_m", column(&|s| s.position_m[0])),
+        ("modulation/north_error_m", column(&|s| s.position_m[1])),
+        ("modulation/heading_error_arcsec", column(&|s| s.heading_arcsec)),
+    ] {
+        let time = TimeColumn::new_duration_secs(TIMELINE, times.iter().copied());
+        rec.send_columns(path, [time], rerun::Scalars::new(values).columns(std::iter::repeat_n(width, n))?)?;
+    }
+    let plot = |name: &str, origin: &str| Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::whole_run_time_axis());
+    let root = Node::container(
+        ContainerKind::Horizontal,
+        vec![
+            Node::container(
+                ContainerKind::Vertical,
+                vec![plot("radial position error (m)", "modulation/radial_position_error_m"), plot("heading error (arcsec)", "modulation/heading_error_arcsec")],
+                &[],
+            ),
+            Node::container(
+                ContainerKind::Vertical,
+                vec![
+                    Node::view("TextDocument", "about", "docs/modulation"),
+                    plot("east error (m)", "modulation/east_error_m"),
+                    plot("north error (m)", "modulation/north_error_m"),
+                ],
+                &[1.2, 1.0, 1.0],
+            ),
+        ],
+        &[1.4, 1.0],
+    );
+    layout::send(rec, APPLICATION_ID, &root, &layout::Playback { timeline: TIMELINE, speed: 3600.0, follow: true })
+}
