@@ -62,6 +62,16 @@ pub fn whole_run_time_axis() -> bp::TimeAxis {
     bp::TimeAxis::new().with_view_range(bpc::TimeRange(datatypes::TimeRange::EVERYTHING))
 }
 
+/// A plot of the first `seconds` of the run only (signals recorded over a short window).
+#[must_use]
+pub fn window_time_axis(seconds: f64) -> bp::TimeAxis {
+    let end = datatypes::TimeInt((seconds * 1e9) as i64);
+    bp::TimeAxis::new().with_view_range(bpc::TimeRange(datatypes::TimeRange {
+        start: datatypes::TimeRangeBoundary::Absolute(datatypes::TimeInt(0)),
+        end: datatypes::TimeRangeBoundary::Absolute(end),
+    }))
+}
+
 /// A 3D eye looking at `target` from `position` with +z up.
 #[must_use]
 pub fn eye(position: [f32; 3], target: [f32; 3]) -> bp::EyeControls3D {

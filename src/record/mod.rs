@@ -146,10 +146,11 @@ struct InsLayout {
     exaggeration: f64,
     fir_taps: Vec<f64>,
     rate_hz: f64,
+    signal_window_s: f64,
 }
 
 /// Where the INS trace (true and computed IMU axes) is drawn, beside the table.
-const TRACE_OFFSET: [f32; 3] = [0.0, 2.6, 0.0];
+const TRACE_OFFSET: [f32; 3] = [1.3, 1.3, -0.5];
 
 impl Recorder {
     /// Logs everything static (documents, styles, geometry, blueprint) and prepares the buffers.
@@ -194,6 +195,7 @@ impl Recorder {
                 exaggeration: params.recording.exaggeration,
                 fir_taps: cfg.fir_taps.clone(),
                 rate_hz: params.step_hz,
+                signal_window_s: cfg.signal_window_s.max(0.01),
             }
         });
         let me = Self {
@@ -476,7 +478,11 @@ impl Recorder {
         let plot = |name: String, origin: &str| Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::whole_run_time_axis());
         let error_view = |axis: &str| plot(format!("{axis} error (arcsec)"), &format!("attitude_error_arcsec/{axis}"));
         let scene = Node::view("3D", format!("3D: gimbal chain (errors ×{})", p.recording.exaggeration), "world")
-            .with_property("EyeControls3D", &layout::eye([2.6, -1.1, 0.95], [0.0, 0.1, -0.2]));
+            .with_property(
+                "EyeControls3D",
+                // With an INS, the trace stands beside the table: step back to frame both.
+                &if self.ins.is_some() { layout::eye([3.6, -1.7, 1.5], [0.7, 0.7, -0.3]) } else { layout::eye([2.6, -1.1, 0.95], [0.0, 0.1, -0.2]) },
+            );
         let docs = Node::container(
             ContainerKind::Tabs,
             vec![
@@ -505,8 +511,9 @@ impl Recorder {
                     tabs.push(plot("position error (m)".into(), "ins/position_error_m"));
                     tabs.push(plot("velocity error (m/s)".into(), "ins/velocity_error_mps"));
                 }
-                tabs.push(plot("gyro raw (deg/s)".into(), "ins/gyro_raw_deg_per_s"));
-                tabs.push(plot("gyro after FIR (deg/s)".into(), "ins/gyro_filtered_deg_per_s"));
+                let window = |name: &str, origin: &str| Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::window_time_axis(layout.signal_window_s));
+                tabs.push(window("gyro raw (deg/s)", "ins/gyro_raw_deg_per_s"));
+                tabs.push(window("gyro after FIR (deg/s)", "ins/gyro_filtered_deg_per_s"));
                 if layout.fir_taps.len() > 1 {
                     tabs.push(Node::view("2D", "FIR response (x: Hz, y: −5·dB)", "ins/fir_response"));
                 }
@@ -661,16 +668,15 @@ impl Recorder {
             rec.log_static("ins/fir_response/dither", &rerun::Points2D::new(tones).with_labels(labels).with_radii([6.0]).with_colors([rgb([240, 90, 90])]))?;
         }
         // The INS trace: true IMU axes (grey) and computed (coloured, error ×N), beside the table.
-        for (path, colors, label) in [
-            ("world/ins_trace/true", [[170, 170, 170]; 3], "true IMU"),
-            ("world/ins_trace/ins", palette::SENSOR, "INS (error ×N)"),
-        ] {
+        let ins_label = format!("INS IMU axes (error ×{})", layout.exaggeration);
+        for (path, colors, label) in [("world/ins_trace/true", [[170, 170, 170]; 3], "true IMU axes"), ("world/ins_trace/ins", palette::SENSOR, ins_label.as_str())] {
             rec.log_static(path, &rerun::Transform3D::from_translation(TRACE_OFFSET))?;
             rec.log_static(
                 format!("{path}/axes"),
                 &rerun::Arrows3D::from_vectors([[0.6, 0.0, 0.0], [0.0, 0.6, 0.0], [0.0, 0.0, 0.6]]).with_colors(colors.map(rgb)).with_radii([0.012]),
             )?;
-            rec.log_static(format!("{path}/label"), &rerun::Points3D::new([[0.0f32, 0.0, 0.75]]).with_labels([label.replace('N', &layout.exaggeration.to_string())]).with_radii([0.002]))?;
+            let at = if path.ends_with("true") { [0.0f32, 0.0, -0.2] } else { [0.0f32, 0.0, 0.75] };
+            rec.log_static(format!("{path}/label"), &rerun::Points3D::new([at]).with_labels([label]).with_radii([0.002]))?;
         }
         Ok(())
     }
