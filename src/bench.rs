@@ -43,7 +43,11 @@ pub fn run(steps: u64) -> anyhow::Result<()> {
         );
     }
 
-    // 2. A 3600 s scenario at 200 Hz with its default recording rates, saved to a file.
+    // 2. The INS in the loop.
+    strapdown_speed();
+    pipeline_speed()?;
+
+    // 3. A 3600 s scenario at 200 Hz with its default recording rates, saved to a file.
     let dir = std::env::temp_dir().join(format!("rinscope-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
     for name in ["rotary-table-2016-wobble", "jiang2017-dual-axis"] {
@@ -64,9 +68,86 @@ pub fn run(steps: u64) -> anyhow::Result<()> {
             bytes as f64 / 1e6
         );
     }
+    // 4. A 24-hour INS run at 200 Hz with navigation, recorded.
+    let p = scenarios::load("rotation-modulation-16-position")?;
+    let path = dir.join("ins24h.rrd");
+    let sinks = sink::open(&SinkRequest { save: Some(path), ..Default::default() }, "rinscope-bench", "ins24h")?;
+    let started = Instant::now();
+    let summary = crate::run::run_recorded(&p, &sinks, &AtomicBool::new(false), false)?;
+    let (_, bytes) = sinks.finish()?.ok_or_else(|| anyhow::anyhow!("no file written"))?;
+    println!(
+        "INS 24 h          rotation-modulation-16-position: {} IMU samples at 200 Hz with navigation and recording in {:.2} s ({:.2} MB)",
+        summary.steps,
+        started.elapsed().as_secs_f64(),
+        bytes as f64 / 1e6
+    );
+
     live_latency(&dir)?;
     std::fs::remove_dir_all(&dir).ok();
     println!("peak resident memory: {:.1} MB", peak_rss_bytes() as f64 / 1e6);
+    Ok(())
+}
+
+/// Strapdown attitude update alone: samples per second through each algorithm (one core).
+fn strapdown_speed() {
+    use crate::ins::coning::Algorithm;
+    use crate::ins::strapdown::AttitudeIntegrator;
+    use nalgebra::{UnitQuaternion, Vector3};
+    // A realistic stream: pure coning increments at 2 kHz, precomputed so that only the update is timed.
+    let n = 4096usize;
+    let samples: Vec<Vector3<f64>> = (0..n)
+        .map(|i| {
+            let (t0, t1) = (i as f64 / 2000.0, (i + 1) as f64 / 2000.0);
+            let w = std::f64::consts::TAU * 5.0;
+            let a = 0.01f64;
+            Vector3::new(a.sin() * ((w * t1).cos() - (w * t0).cos()), a.sin() * ((w * t1).sin() - (w * t0).sin()), -2.0 * (0.5 * a).sin().powi(2) * w / 2000.0)
+        })
+        .collect();
+    let zeta = Vector3::new(0.0, 3e-8, 4e-8);
+    for alg in Algorithm::ALL {
+        let mut best = 0.0f64;
+        for _ in 0..5 {
+            let mut integ = AttitudeIntegrator::new(alg, UnitQuaternion::identity());
+            let reps = 4000;
+            let started = Instant::now();
+            for _ in 0..reps {
+                for s in &samples {
+                    std::hint::black_box(integ.push(*s, &zeta));
+                }
+            }
+            best = best.max((reps * n) as f64 / started.elapsed().as_secs_f64());
+            std::hint::black_box(integ.n_from_s);
+        }
+        println!("strapdown update  {:<28} best of 5: {:.1} M samples/s (one core)", alg.name(), best / 1e6);
+    }
+}
+
+/// The whole INS pipeline (truth, IMU errors, strapdown, navigation, demodulation at 100 Hz).
+fn pipeline_speed() -> anyhow::Result<()> {
+    use crate::ins::pipeline::InsRun;
+    let jiang = format!("{}\n[imu]\npreset = \"jiang2017-table1\"\n[navigation]\n", crate::scenarios::text("jiang2017-dual-axis").unwrap_or_default());
+    let cases = [
+        ("jiang2017-dual-axis + table-1 IMU", crate::config::parse(&jiang, "bench")?),
+        ("rotation-modulation-16-position", scenarios::load("rotation-modulation-16-position")?),
+        ("li2014-wobble-1 (2 kHz, dither, FIR)", scenarios::load("li2014-wobble-1")?),
+    ];
+    for (name, p) in cases {
+        let mut best = 0.0f64;
+        for _ in 0..3 {
+            let mut ins = InsRun::new(&p, Model::new(&p)).ok_or_else(|| anyhow::anyhow!("no [imu]"))?;
+            let every = (p.step_hz / 100.0).round().max(1.0) as u64;
+            let n = 400_000u64;
+            let started = Instant::now();
+            for i in 0..n {
+                let s = ins.step();
+                if s.updated && i % every == 0 {
+                    std::hint::black_box(ins.view(s.t_s));
+                }
+            }
+            best = best.max(n as f64 / started.elapsed().as_secs_f64());
+        }
+        println!("INS pipeline      {name:<38} best of 3: {:.2} M samples/s (truth + IMU + strapdown + navigation + demodulation)", best / 1e6);
+    }
     Ok(())
 }
 

@@ -63,6 +63,12 @@ impl Model {
         self.chain.axes().len()
     }
 
+    /// The vehicle's constant state when it never moves.
+    #[must_use]
+    pub fn fixed_state(&self) -> Option<(Attitude, Rot<N, B>)> {
+        self.fixed_attitude
+    }
+
     /// The precomputed true error rotations.
     #[must_use]
     pub fn truth_rotations(&self) -> &ErrorRotations {

@@ -50,6 +50,18 @@ pub struct InsView {
     pub nav: Option<(Vector3<f64>, Vector3<f64>)>,
 }
 
+/// The attitude output `zoh` after the latest of two (time, attitude) updates, interpolated.
+fn output_attitude(history: &[(f64, UnitQuaternion<f64>); 2], zoh: f64) -> (f64, UnitQuaternion<f64>) {
+    let [(t0, q0), (t1, q1)] = *history;
+    let t = t1 - zoh;
+    if t1 > t0 && t < t1 {
+        let f = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
+        (t, q0.slerp(&q1, f))
+    } else {
+        (t1, q1)
+    }
+}
+
 /// The INS in the loop.
 pub struct InsRun {
     cfg: InsConfig,
@@ -230,29 +242,22 @@ impl InsRun {
     /// hold, the value h/2 earlier, interpolated between the two latest updates.
     #[must_use]
     pub fn output_attitude(&self, k: usize) -> (f64, UnitQuaternion<f64>) {
-        let [(t0, q0), (t1, q1)] = self.history[k];
-        let t = t1 - self.zoh_delay_s;
-        if t1 > t0 && t < t1 {
-            let f = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
-            (t, q0.slerp(&q1, f))
-        } else {
-            (t1, q1)
-        }
+        output_attitude(&self.history[k], self.zoh_delay_s)
     }
 
     /// The INS body attitude errors (call right after a primary update at `t_s`). Each algorithm is
     /// compared at the instant its own latest output stands for (algorithms with more samples per
     /// update update less often), against the truth `output_compensation` earlier.
     pub fn view(&mut self, t_s: f64) -> InsView {
-        let model = self.truth.model().clone();
+        let model = self.truth.model();
         let mut errors = Vec::with_capacity(self.integrators.len());
         for k in 0..self.integrators.len() {
-            let (t_repr, q) = self.output_attitude(k);
+            let (t_repr, q) = output_attitude(&self.history[k], self.zoh_delay_s);
             // The output left the computer d + zoh after the instant it represents.
             let t_ref = t_repr + self.fir_delay_s + self.zoh_delay_s - self.cfg.output_compensation_s;
             // The encoders are read for the instant the IMU data represent (matched synchronisation).
-            let encoder = encoder_readings(&model, t_repr);
-            let corrected = self.demod[k].correct(&model, t_repr, &encoder);
+            let encoder = encoder_readings(model, t_repr);
+            let corrected = self.demod[k].correct(model, t_repr, &encoder);
             let b_from_s_comp = model.chain.b_from_s(model.compensation_rotations(), &corrected);
             let (truth_att, _) = model.vehicle.state(t_ref);
             // FRAME: the integrator propagates C_s^n.

@@ -6,6 +6,9 @@ use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::config::Site;
 use crate::frames::{Rot, N, S};
+use crate::frames::axis_angle;
+use crate::gimbal::ShaftRotations;
+use crate::scheme::{AxisValues, MAX_AXES};
 use crate::sim::Model;
 
 /// Earth's rotation rate, rad/s (WGS84).
@@ -76,6 +79,64 @@ pub struct TruthImu {
     next_break: f64,
     /// Fastest oscillation or rotation of the motion, rad/s (sets the quadrature panels).
     max_omega: f64,
+    /// With the vehicle at rest, the last gimbal state and its truth (a dwell of an indexed
+    /// sequence repeats it for minutes: no trigonometry needed).
+    memo: Option<(AxisValues, AxisValues, TruthPoint)>,
+    shafts: ShaftCache,
+}
+
+/// Shaft rotations by angle stepping: successive quadrature nodes advance each gimbal by the same
+/// small angle (constant rate), so R(a, λ + δ) = R(a, λ)·R(a, δ) with R(a, δ) reused — no
+/// trigonometry. Re-anchored exactly every `REANCHOR` evaluations and whenever the step changes,
+/// so rounding never accumulates beyond ~1e-12 rad.
+#[derive(Debug, Clone, Copy)]
+struct ShaftCache {
+    angle: AxisValues,
+    q: [UnitQuaternion<f64>; MAX_AXES],
+    step: AxisValues,
+    step_q: [UnitQuaternion<f64>; MAX_AXES],
+    valid: bool,
+    since_anchor: u32,
+}
+
+const REANCHOR: u32 = 4096;
+
+impl ShaftCache {
+    fn new() -> Self {
+        Self {
+            angle: [0.0; MAX_AXES],
+            q: [UnitQuaternion::identity(); MAX_AXES],
+            step: [f64::NAN; MAX_AXES],
+            step_q: [UnitQuaternion::identity(); MAX_AXES],
+            valid: false,
+            since_anchor: 0,
+        }
+    }
+
+    fn rotations(&mut self, chain: &crate::gimbal::Chain, angles: &AxisValues) -> ShaftRotations {
+        let n = chain.axes().len();
+        let reanchor = !self.valid || self.since_anchor >= REANCHOR;
+        for k in 0..n {
+            let axis = &chain.axes()[k].axis;
+            let delta = angles[k] - self.angle[k];
+            if delta == 0.0 && !reanchor {
+                continue;
+            }
+            if !reanchor && (delta - self.step[k]).abs() <= 1e-15 * (1.0 + angles[k].abs()) {
+                self.q[k] *= self.step_q[k];
+            } else {
+                self.q[k] = axis_angle(axis, angles[k]);
+                if delta != 0.0 && delta.abs() < 0.1 {
+                    self.step[k] = delta;
+                    self.step_q[k] = axis_angle(axis, delta);
+                }
+            }
+            self.angle[k] = angles[k];
+        }
+        self.since_anchor = if reanchor { 0 } else { self.since_anchor + 1 };
+        self.valid = true;
+        ShaftRotations(self.q)
+    }
 }
 
 /// Phase advance of the fastest motion per Simpson panel: its relative error is ~λ⁴/2880, so 0.01
@@ -93,6 +154,8 @@ impl TruthImu {
             earth,
             next_break: 0.0,
             max_omega,
+            memo: None,
+            shafts: ShaftCache::new(),
         };
         me.last = me.eval(t0_s);
         me.next_break = me.breakpoint_after(t0_s);
@@ -118,20 +181,38 @@ impl TruthImu {
 
     /// The exact state of s at `t_s`.
     #[must_use]
-    pub fn eval(&self, t_s: f64) -> TruthPoint {
+    pub fn eval(&mut self, t_s: f64) -> TruthPoint {
         let m = &self.model;
-        let n_from_b = m.vehicle.n_from_b(t_s);
+        // A vehicle at rest: its attitude is computed once, its rate is zero.
+        let (n_from_b, omega_nb_b) = match m.fixed_state() {
+            Some((_, r)) => (r, Vector3::zeros()),
+            None => (m.vehicle.n_from_b(t_s), m.vehicle.omega_nb_b(t_s)),
+        };
         let (angles, rates) = m.scheme.state(t_s - m.scheme_t0_s);
-        let shafts = m.chain.shaft_rotations(&angles);
+        let fixed = m.fixed_state().is_some();
+        if fixed
+            && let Some((a, r, point)) = &self.memo
+            && *a == angles
+            && *r == rates
+        {
+            return TruthPoint { t_s, ..*point };
+        }
+        let shafts = self.shafts.rotations(&m.chain, &angles);
         let (b_from_s, omega_bs_s) = m.chain.b_from_s_and_rate(m.truth_rotations(), &shafts, &rates);
         let n_from_s = n_from_b * b_from_s;
         let s_from_n: UnitQuaternion<f64> = n_from_s.quaternion().inverse();
-        let omega_nb_b = m.vehicle.omega_nb_b(t_s);
         // ω_is^s = C_n^s ω_ie^n + C_b^s ω_nb^b + ω_bs^s (the site is fixed: ω_en = 0).
-        let omega_is_s = s_from_n * self.earth.omega_ie_n + b_from_s.quaternion().inverse() * omega_nb_b + omega_bs_s.v;
+        let mut omega_is_s = s_from_n * self.earth.omega_ie_n + omega_bs_s.v;
+        if omega_nb_b != Vector3::zeros() {
+            omega_is_s += b_from_s.quaternion().inverse() * omega_nb_b;
+        }
         // At rest on the Earth the specific force is the reaction to gravity: f^n = −g^n.
         let f_s = s_from_n * -self.earth.gravity_n;
-        TruthPoint { t_s, n_from_s, omega_is_s, f_s }
+        let point = TruthPoint { t_s, n_from_s, omega_is_s, f_s };
+        if fixed {
+            self.memo = Some((angles, rates, point));
+        }
+        point
     }
 
     /// Gyro and accelerometer increments (Δθ_s, Δv_s) from the last instant to `t1_s`: Simpson's rule
