@@ -329,7 +329,7 @@ mod tests {
         let mut k = 0u64;
         run(&p, 86_400.0, |ins, t| {
             k += 1;
-            if k % 2000 == 0 {
+            if k.is_multiple_of(2000) {
                 let v = ins.view(t);
                 for e in &v.errors {
                     worst_att = worst_att.max(e.as_array().iter().fold(0.0f64, |m, x| m.max(x.abs())));
