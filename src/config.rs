@@ -110,6 +110,110 @@ pub struct RawConfig {
     /// Navigation of velocity and position (needs `[imu]`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub navigation: Option<RawNavigation>,
+    /// Static calibration of the swing cones and non-orthogonality (`rinscope calibrate`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub calibration: Option<RawCalibration>,
+    /// Position fixes and resets (`rinscope reset`, needs `[navigation]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub position_fix: Option<RawPositionFix>,
+}
+
+/// `[calibration]`: the static Kalman filter and least-squares fit of `rinscope calibrate`
+/// (docs/calibration.md). Everything the calibration does not estimate (installation, IMU mount,
+/// encoder offset/scale/delay) is taken as known from `[compensation]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawCalibration {
+    /// 1σ of each measured attitude-error component, arcsec (default: the encoders' noise, at least 1″).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub measurement_sigma_arcsec: Option<f64>,
+    /// Prior 1σ of each swing component α·cos φ, α·sin φ, arcsec (prior mean 0).
+    #[serde(default = "default_prior_swing")]
+    pub prior_swing_sigma_arcsec: f64,
+    /// Prior mean of each non-orthogonality, arcsec (an independent measurement, if there is one).
+    #[serde(default)]
+    pub prior_non_orthogonality_arcsec: f64,
+    /// Its 1σ, arcsec.
+    #[serde(default = "default_prior_eta")]
+    pub prior_non_orthogonality_sigma_arcsec: f64,
+    /// Slow errors of the attitude reference estimated alongside: "none", "offset" or "offset+drift".
+    #[serde(default = "default_nuisance")]
+    pub nuisance: String,
+    /// Rate of the state/σ snapshots in the recording, Hz.
+    #[serde(default = "default_calib_record_hz")]
+    pub record_hz: f64,
+    /// `rinscope montecarlo`: the distributions the true parameters are drawn from.
+    #[serde(default)]
+    pub montecarlo: RawMonteCarlo,
+}
+
+impl Default for RawCalibration {
+    fn default() -> Self {
+        Self {
+            measurement_sigma_arcsec: None,
+            prior_swing_sigma_arcsec: default_prior_swing(),
+            prior_non_orthogonality_arcsec: 0.0,
+            prior_non_orthogonality_sigma_arcsec: default_prior_eta(),
+            nuisance: default_nuisance(),
+            record_hz: default_calib_record_hz(),
+            montecarlo: RawMonteCarlo::default(),
+        }
+    }
+}
+
+fn default_prior_swing() -> f64 {
+    3600.0
+}
+fn default_prior_eta() -> f64 {
+    60.0
+}
+fn default_nuisance() -> String {
+    "offset+drift".into()
+}
+fn default_calib_record_hz() -> f64 {
+    10.0
+}
+
+/// `[calibration.montecarlo]`: uniform distributions `[low, high]` of the true parameters (every
+/// axis alike), and the number of runs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RawMonteCarlo {
+    /// Runs.
+    pub runs: u32,
+    /// Swing half-angle α, arcsec.
+    pub swing_half_angle_arcsec: [f64; 2],
+    /// Swing phase φ, deg.
+    pub swing_phase_deg: [f64; 2],
+    /// Non-orthogonality η, arcsec.
+    pub non_orthogonality_arcsec: [f64; 2],
+    /// 1σ of an independent measurement of η given to the calibration as its prior, arcsec
+    /// (absent: the prior is the distribution itself, i.e. nothing is known beyond its range).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub non_orthogonality_measured_sigma_arcsec: Option<f64>,
+}
+
+impl Default for RawMonteCarlo {
+    /// Seed 000 §6.1: "swaying angle S(−10°, +10°)", "phase A(−1°, +1°)", "non-orthogonal angle
+    /// Q(−20″, +20″)". Its Table 2 uses α of 5′ and 10′, so the printed "10°" is read as 10′, and a
+    /// half-angle is taken in [0, 10′] (a negative half-angle is the same cone with φ + 180°).
+    fn default() -> Self {
+        Self {
+            runs: 500,
+            swing_half_angle_arcsec: [0.0, 600.0],
+            swing_phase_deg: [-1.0, 1.0],
+            non_orthogonality_arcsec: [-20.0, 20.0],
+            non_orthogonality_measured_sigma_arcsec: None,
+        }
+    }
+}
+
+/// `[position_fix]`: position fixes during a navigation run (seed 003 §4).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawPositionFix {
+    /// Times of the fixes, hours; `rinscope reset` uses the first two (seed 003: 17 and 21).
+    pub at_h: Vec<f64>,
 }
 
 /// A per-axis value: a number is a 1σ drawn per axis with the seed, an array fixes the three values.
@@ -442,6 +546,9 @@ pub struct RawAxis {
     /// Encoder latch time minus IMU sample time, ms (positive: the angle is older than the IMU data).
     #[serde(default)]
     pub encoder_delay_ms: f64,
+    /// Encoder white noise, 1σ per reading, arcsec.
+    #[serde(default)]
+    pub encoder_noise_arcsec: f64,
 }
 
 /// `[scheme]`: one of "static", "continuous", "indexed".
@@ -619,6 +726,10 @@ pub struct Params {
     pub live_speed: f64,
     /// The INS in the loop, if any.
     pub ins: Option<crate::ins::InsConfig>,
+    /// `[calibration]` (its defaults when the section is absent).
+    pub calibration: crate::calib::CalibConfig,
+    /// Times of the position fixes, s (`[position_fix]`).
+    pub position_fix_s: Vec<f64>,
 }
 
 impl Params {
@@ -843,6 +954,7 @@ fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigError> {
             encoder_offset_rad: err_angle(&k("encoder_offset_arcsec"), a.encoder_offset_arcsec)?,
             encoder_scale: c.range(&k("encoder_scale_ppm"), a.encoder_scale_ppm, "ppm", -10_000.0, 10_000.0, "1% at most")? * 1e-6,
             encoder_delay_s: c.range(&k("encoder_delay_ms"), a.encoder_delay_ms, "ms", -1000.0, 1000.0, "")? * 1e-3,
+            encoder_noise_rad: c.range(&k("encoder_noise_arcsec"), a.encoder_noise_arcsec, "arcsec", 0.0, 3600.0, "1σ per reading, 1° at most")? * RAD_PER_ARCSEC,
         });
     }
     let chain = Chain::new(geometry);
@@ -882,6 +994,21 @@ fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigError> {
         }
         Some(imu) => Some(validate_imu(&c, imu, raw.navigation.as_ref(), step_hz)?),
     };
+    let calibration = validate_calibration(&c, &raw.calibration.clone().unwrap_or_default(), &truth)?;
+    let mut position_fix_s = Vec::new();
+    if let Some(fix) = &raw.position_fix {
+        if raw.navigation.is_none() {
+            return Err(c.invalid("position_fix", "needs a [navigation] section (a position fix resets the navigation)"));
+        }
+        for (i, h) in fix.at_h.iter().enumerate() {
+            let key = format!("position_fix.at_h[{i}]");
+            let t = c.positive(&key, *h, "h", duration_s / 3600.0)? * 3600.0;
+            if position_fix_s.last().is_some_and(|prev| t <= *prev) {
+                return Err(c.invalid(&key, format!("{h} h is not after the previous fix; list the fixes in increasing time")));
+            }
+            position_fix_s.push(t);
+        }
+    }
     let written = raw.clone();
     let mut resolved = raw;
     resolved.compensation = resolved_comp;
@@ -903,6 +1030,8 @@ fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigError> {
         written,
         live_speed,
         ins,
+        calibration,
+        position_fix_s,
     })
 }
 
@@ -1071,6 +1200,52 @@ fn validate_imu(c: &Checker<'_>, raw: &RawImu, nav: Option<&RawNavigation>, step
     Ok(cfg)
 }
 
+fn validate_calibration(c: &Checker<'_>, cal: &RawCalibration, truth: &TableErrors) -> Result<crate::calib::CalibConfig, ConfigError> {
+    use crate::calib::{CalibConfig, MonteCarloConfig, Nuisance};
+    let noise_rms = (truth.axes.iter().map(|a| a.encoder_noise_rad.powi(2)).sum::<f64>() / truth.axes.len().max(1) as f64).sqrt();
+    let measurement_sigma_rad = match cal.measurement_sigma_arcsec {
+        Some(v) => c.positive("calibration.measurement_sigma_arcsec", v, "arcsec", MAX_ERROR_ANGLE_ARCSEC)? * RAD_PER_ARCSEC,
+        None => noise_rms.max(RAD_PER_ARCSEC),
+    };
+    let nuisance = match cal.nuisance.as_str() {
+        "none" => Nuisance::None,
+        "offset" => Nuisance::Offset,
+        "offset+drift" => Nuisance::OffsetDrift,
+        other => return Err(c.invalid("calibration.nuisance", format!("\"{other}\" is not a choice; use \"none\", \"offset\" or \"offset+drift\""))),
+    };
+    let mc = &cal.montecarlo;
+    let pair = |key: &str, v: [f64; 2], unit: &'static str, lo: f64, hi: f64| -> Result<[f64; 2], ConfigError> {
+        let a = c.range(&format!("calibration.montecarlo.{key}[0]"), v[0], unit, lo, hi, "")?;
+        let b = c.range(&format!("calibration.montecarlo.{key}[1]"), v[1], unit, lo, hi, "")?;
+        if b < a {
+            return Err(c.invalid(&format!("calibration.montecarlo.{key}"), format!("[{a}, {b}]: the upper bound is below the lower one")));
+        }
+        Ok([a, b])
+    };
+    let montecarlo = MonteCarloConfig {
+        runs: mc.runs,
+        swing_half_angle_rad: pair("swing_half_angle_arcsec", mc.swing_half_angle_arcsec, "arcsec", 0.0, MAX_ERROR_ANGLE_ARCSEC)?.map(|x| x * RAD_PER_ARCSEC),
+        swing_phase_rad: pair("swing_phase_deg", mc.swing_phase_deg, "deg", -360.0, 360.0)?.map(|x| x * RAD_PER_DEG),
+        non_orthogonality_rad: pair("non_orthogonality_arcsec", mc.non_orthogonality_arcsec, "arcsec", -MAX_ERROR_ANGLE_ARCSEC, MAX_ERROR_ANGLE_ARCSEC)?.map(|x| x * RAD_PER_ARCSEC),
+        eta_measured_sigma_rad: mc
+            .non_orthogonality_measured_sigma_arcsec
+            .map(|v| c.positive("calibration.montecarlo.non_orthogonality_measured_sigma_arcsec", v, "arcsec", MAX_ERROR_ANGLE_ARCSEC))
+            .transpose()?
+            .map(|v| v * RAD_PER_ARCSEC),
+    };
+    Ok(CalibConfig {
+        measurement_sigma_rad,
+        prior_swing_sigma_rad: c.positive("calibration.prior_swing_sigma_arcsec", cal.prior_swing_sigma_arcsec, "arcsec", MAX_ERROR_ANGLE_ARCSEC)? * RAD_PER_ARCSEC,
+        prior_eta_rad: c.range("calibration.prior_non_orthogonality_arcsec", cal.prior_non_orthogonality_arcsec, "arcsec", -MAX_ERROR_ANGLE_ARCSEC, MAX_ERROR_ANGLE_ARCSEC, ERROR_HINT)?
+            * RAD_PER_ARCSEC,
+        prior_eta_sigma_rad: c.positive("calibration.prior_non_orthogonality_sigma_arcsec", cal.prior_non_orthogonality_sigma_arcsec, "arcsec", MAX_ERROR_ANGLE_ARCSEC)?
+            * RAD_PER_ARCSEC,
+        nuisance,
+        record_hz: c.positive("calibration.record_hz", cal.record_hz, "Hz", 1000.0)?,
+        montecarlo,
+    })
+}
+
 fn axis_index(c: &Checker<'_>, key: &str, chain: &Chain, name: &str) -> Result<usize, ConfigError> {
     chain.index_of(name).ok_or_else(|| {
         let names: Vec<&str> = chain.axes().iter().map(|a| a.name.as_str()).collect();
@@ -1201,6 +1376,8 @@ fn validate_compensation(
             encoder_offset_rad: err_angle(&k("encoder_offset_arcsec"), r.encoder_offset_arcsec.unwrap_or_default())?,
             encoder_scale: c.range(&k("encoder_scale_ppm"), r.encoder_scale_ppm.unwrap_or_default(), "ppm", -10_000.0, 10_000.0, "1% at most")? * 1e-6,
             encoder_delay_s: c.range(&k("encoder_delay_ms"), r.encoder_delay_ms.unwrap_or_default(), "ms", -1000.0, 1000.0, "")? * 1e-3,
+            // Noise is not a parameter a compensation can remove.
+            encoder_noise_rad: 0.0,
         });
         resolved.axis.insert(a.name.clone(), r);
     }

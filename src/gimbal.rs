@@ -63,6 +63,8 @@ pub struct AxisErrors {
     pub encoder_scale: f64,
     /// Encoder latch time behind the IMU sample, s.
     pub encoder_delay_s: f64,
+    /// Encoder white noise, 1σ per reading, rad (seed 000 Table 1: "Turntable (1σ) 12″").
+    pub encoder_noise_rad: f64,
 }
 
 impl AxisErrors {
@@ -132,6 +134,7 @@ impl TableErrors {
                     encoder_offset_rad: a.encoder_offset_rad * factor,
                     encoder_scale: a.encoder_scale * factor,
                     encoder_delay_s: a.encoder_delay_s * factor,
+                    encoder_noise_rad: a.encoder_noise_rad * factor,
                 })
                 .collect(),
         }

@@ -4,6 +4,7 @@
 //! of Rerun; `record` is the only module that talks to the viewer, `sink` opens its outputs.
 
 pub mod bench;
+pub mod calib;
 pub mod config;
 pub mod euler;
 pub mod frames;
@@ -12,6 +13,7 @@ pub mod ins;
 pub mod live;
 pub mod modulation;
 pub mod motion;
+pub mod noise;
 pub mod record;
 pub mod reproduce;
 pub mod run;

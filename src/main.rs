@@ -47,6 +47,11 @@ enum Command {
         #[arg(long)]
         spawn: bool,
     },
+    /// Static calibration of the swing cones and non-orthogonality (seed 000 §5): static Kalman
+    /// filter and exact least squares, compensation before/after, a recording with ghost cones.
+    Calibrate(CalibrateArgs),
+    /// Seed 000's Monte Carlo (Tables 2-3): many calibrations with drawn parameters, in parallel.
+    Montecarlo(MonteCarloArgs),
     /// Print the event log (reloads, errors, summary) of a saved recording.
     Events {
         /// The .rrd file.
@@ -132,6 +137,47 @@ struct RunArgs {
     duration_s: Option<f64>,
 }
 
+#[derive(Args)]
+struct CalibrateArgs {
+    /// A preset (default jiang2017-calibration).
+    #[arg(long, conflicts_with = "config")]
+    scenario: Option<String>,
+    /// A scenario file (static vehicle; its [calibration] section, or the defaults).
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Save the recording to this .rrd (default recordings/<scenario>-calibration.rrd unless a viewer is asked for).
+    #[arg(long)]
+    save: Option<PathBuf>,
+    /// Start a new Rerun viewer and stream to it.
+    #[arg(long)]
+    spawn: bool,
+    /// Write the estimates, 1σ, observability and compensation as JSON.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// No recording (print and JSON only).
+    #[arg(long, conflicts_with_all = ["save", "spawn"])]
+    no_recording: bool,
+}
+
+#[derive(Args)]
+struct MonteCarloArgs {
+    /// A preset (default jiang2017-calibration).
+    #[arg(long, conflicts_with = "config")]
+    scenario: Option<String>,
+    /// A scenario file.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Number of runs (default: [calibration.montecarlo] runs).
+    #[arg(long)]
+    runs: Option<usize>,
+    /// Give the filter an independent measurement of η with this 1σ, arcsec.
+    #[arg(long)]
+    eta_measured_sigma_arcsec: Option<f64>,
+    /// Write the statistics as JSON.
+    #[arg(long)]
+    json: Option<PathBuf>,
+}
+
 /// A failure with the exit code it deserves.
 struct Failure {
     code: u8,
@@ -165,6 +211,8 @@ fn main() -> ExitCode {
     let result = match cli.command.unwrap_or(Command::Run(RunArgs::default())) {
         Command::Run(args) => run_command(&args),
         Command::Live(args) => live_command(&args),
+        Command::Calibrate(args) => calibrate_command(&args),
+        Command::Montecarlo(args) => montecarlo_command(&args),
         Command::Events { file } => events_command(&file),
         Command::Modulation { hours, save, spawn } => modulation_command(hours, save, spawn),
         Command::Scenarios => {
@@ -375,6 +423,108 @@ fn modulation_command(hours: f64, save: Option<PathBuf>, spawn: bool) -> Result<
     print!("{table}");
     if let Some((p, bytes)) = saved {
         println!("recording: {} ({:.2} MB) — open with `rerun {}`", p.display(), bytes as f64 / 1e6, p.display());
+    }
+    Ok(())
+}
+
+fn check_output_dir(flag: &str, path: Option<&std::path::Path>) -> Result<(), Failure> {
+    if let Some(dir) = path.and_then(|p| p.parent()).filter(|d| !d.as_os_str().is_empty() && !d.is_dir()) {
+        return Err(Failure { code: 2, message: format!("{flag}: directory {} does not exist", dir.display()) });
+    }
+    Ok(())
+}
+
+fn calibrate_command(args: &CalibrateArgs) -> Result<(), Failure> {
+    let params = match &args.config {
+        Some(path) => config::load_file(path)?,
+        None => scenarios::load(args.scenario.as_deref().unwrap_or("jiang2017-calibration"))?,
+    };
+    check_output_dir("--json", args.json.as_deref())?;
+    let sinks = if args.no_recording {
+        None
+    } else {
+        let mut request = SinkRequest { save: args.save.clone(), spawn: args.spawn, ..Default::default() };
+        if request.save.is_none() && !request.spawn {
+            request.save = Some(PathBuf::from("recordings").join(format!("{}-calibration.rrd", params.meta.name)));
+        }
+        let sinks = sink::open(&request, rinscope::record::APPLICATION_ID, &format!("{}-calibration-seed{}", params.meta.name, params.meta.seed))?;
+        for d in &sinks.description {
+            eprintln!("rinscope: {d}");
+        }
+        Some(sinks)
+    };
+    let started = std::time::Instant::now();
+    let outcome = match rinscope::calib::run(&params, sinks.is_some()) {
+        Ok(o) => o,
+        Err(e) => {
+            if let Some(s) = sinks {
+                s.abandon();
+            }
+            let code = if matches!(e, rinscope::calib::CalibError::VehicleMoves(_)) { 2 } else { 1 };
+            return Err(Failure { code, message: format!("calibrate: {e}") });
+        }
+    };
+    let wall = started.elapsed().as_secs_f64();
+    print!("{}", outcome.report.text());
+    println!("({wall:.2} s wall: two {:.0}-s runs simulated, filter and least squares)", params.duration_s);
+    if let Some(path) = &args.json {
+        let json = serde_json::to_string_pretty(&outcome.report).map_err(|e| Failure { code: 1, message: e.to_string() })?;
+        write_atomically(path, json.as_bytes()).map_err(|e| Failure { code: 2, message: format!("--json {}: {e}", path.display()) })?;
+    }
+    if let Some(sinks) = sinks {
+        let traces = rinscope::record::calibration::ErrorTraces {
+            t_s: outcome.validation.samples.iter().map(|s| s.t_s).collect(),
+            errors: [&outcome.validation_errors[0], &outcome.validation_errors[1], &outcome.validation_errors[2]],
+        };
+        if let Err(e) = rinscope::record::calibration::log(sinks.rec.clone(), &params, &outcome.cal, &outcome.report, &traces) {
+            sinks.abandon();
+            return Err(Failure { code: 1, message: format!("rerun: {e}") });
+        }
+        if let Some((p, bytes)) = sinks.finish()? {
+            println!("recording: {} ({:.2} MB) — open with `rerun {}`", p.display(), bytes as f64 / 1e6, p.display());
+        }
+    }
+    Ok(())
+}
+
+fn montecarlo_command(args: &MonteCarloArgs) -> Result<(), Failure> {
+    let mut params = match &args.config {
+        Some(path) => config::load_file(path)?,
+        None => scenarios::load(args.scenario.as_deref().unwrap_or("jiang2017-calibration"))?,
+    };
+    check_output_dir("--json", args.json.as_deref())?;
+    let runs = args.runs.unwrap_or(params.calibration.montecarlo.runs as usize);
+    if runs == 0 || runs > 1_000_000 {
+        return Err(Failure { code: 2, message: format!("--runs {runs}: must be 1 ..= 1000000") });
+    }
+    if let Some(s) = args.eta_measured_sigma_arcsec {
+        if !(s.is_finite() && s > 0.0 && s <= 3600.0) {
+            return Err(Failure { code: 2, message: format!("--eta-measured-sigma-arcsec {s}: must be > 0 and <= 3600 arcsec") });
+        }
+        params.calibration.montecarlo.eta_measured_sigma_rad = Some(s * rinscope::units::RAD_PER_ARCSEC);
+    }
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = Arc::clone(&stop);
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
+    let bar = indicatif::ProgressBar::new(runs as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} {pos}/{len} calibrations [{bar:40}] {elapsed_precise} (eta {eta})")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    let tick = || bar.inc(1);
+    let result = rinscope::calib::montecarlo::run(&params, runs, &tick, &stop);
+    bar.finish_and_clear();
+    let summary = result.map_err(|e| Failure { code: 1, message: format!("montecarlo: {e}") })?;
+    print!("{}", summary.text());
+    if let Some(path) = &args.json {
+        let json = serde_json::to_string_pretty(&summary).map_err(|e| Failure { code: 1, message: e.to_string() })?;
+        write_atomically(path, json.as_bytes()).map_err(|e| Failure { code: 2, message: format!("--json {}: {e}", path.display()) })?;
+    }
+    if summary.runs < summary.runs_requested {
+        return Err(Failure { code: 130, message: format!("interrupted after {} runs (statistics above are over those)", summary.runs) });
     }
     Ok(())
 }

@@ -9,6 +9,7 @@ pub const DEFAULT_SCENARIO: &str = "jiang2017-dual-axis";
 /// (name, TOML text) of every preset, in display order.
 pub const PRESETS: &[(&str, &str)] = &[
     ("jiang2017-dual-axis", include_str!("../assets/scenarios/jiang2017-dual-axis.toml")),
+    ("jiang2017-calibration", include_str!("../assets/scenarios/jiang2017-calibration.toml")),
     ("rotary-table-2016-installation", include_str!("../assets/scenarios/rotary-table-2016-installation.toml")),
     ("rotary-table-2016-wobble", include_str!("../assets/scenarios/rotary-table-2016-wobble.toml")),
     ("rotary-table-2016-angular", include_str!("../assets/scenarios/rotary-table-2016-angular.toml")),

@@ -32,6 +32,8 @@ pub struct Model {
     pub truth: TableErrors,
     /// Errors assumed by the compensated demodulation.
     pub compensation: TableErrors,
+    /// Seed of the encoder noise (the scenario's seed).
+    pub noise_seed: u64,
     truth_rot: ErrorRotations,
     compensation_rot: ErrorRotations,
     /// Exaggerated truth, for drawing.
@@ -44,7 +46,9 @@ impl Model {
     /// Precomputes the constant rotations of a scenario.
     #[must_use]
     pub fn new(p: &Params) -> Self {
-        Self::from_parts(p.chain.clone(), p.vehicle.clone(), p.scheme.clone(), p.truth.clone(), p.compensation.clone(), p.recording.exaggeration)
+        let mut m = Self::from_parts(p.chain.clone(), p.vehicle.clone(), p.scheme.clone(), p.truth.clone(), p.compensation.clone(), p.recording.exaggeration);
+        m.noise_seed = p.meta.seed;
+        m
     }
 
     /// Builds a model from its parts (tests and benchmarks vary them independently).
@@ -54,7 +58,7 @@ impl Model {
         let compensation_rot = chain.error_rotations(&compensation);
         let drawing_rot = chain.error_rotations(&truth.exaggerated(exaggeration));
         let fixed_attitude = vehicle.is_fixed().then(|| vehicle.state(0.0));
-        Self { chain, vehicle, scheme, scheme_t0_s: 0.0, truth, compensation, truth_rot, compensation_rot, drawing_rot, fixed_attitude }
+        Self { chain, vehicle, scheme, scheme_t0_s: 0.0, truth, compensation, noise_seed: 0, truth_rot, compensation_rot, drawing_rot, fixed_attitude }
     }
 
     /// Number of gimbal axes.
@@ -96,7 +100,8 @@ pub struct DemodState {
 }
 
 /// Encoder readings handed to the navigation computer with the IMU sample at `t_s`: latched
-/// `delay` earlier, then offset and scale applied (docs/model.md, "Encoder").
+/// `delay` earlier, then offset and scale applied, plus white noise (docs/model.md, "Encoder").
+/// The noise is a pure function of (seed, axis, `t_s`): asking twice gives the same reading.
 #[must_use]
 pub fn encoder_readings(model: &Model, t_s: f64) -> AxisValues {
     let t_scheme = t_s - model.scheme_t0_s;
@@ -105,6 +110,9 @@ pub fn encoder_readings(model: &Model, t_s: f64) -> AxisValues {
     for (k, e) in model.truth.axes.iter().enumerate() {
         let latched = if e.encoder_delay_s == 0.0 { now[k] } else { model.scheme.state(t_scheme - e.encoder_delay_s).0[k] };
         encoder_rad[k] = e.encoder_reading(latched);
+        if e.encoder_noise_rad > 0.0 {
+            encoder_rad[k] += e.encoder_noise_rad * crate::noise::gaussian(model.noise_seed, k as u64, t_s);
+        }
     }
     encoder_rad
 }

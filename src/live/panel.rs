@@ -97,6 +97,7 @@ impl Panel {
             controls.push(slider(format!("{n} encoder offset"), &k("encoder_offset_arcsec"), "″", (-600.0, 600.0), 5.0));
             controls.push(slider(format!("{n} encoder scale"), &k("encoder_scale_ppm"), " ppm", (-1000.0, 1000.0), 10.0));
             controls.push(slider(format!("{n} encoder delay"), &k("encoder_delay_ms"), " ms", (0.0, 50.0), 0.5));
+            controls.push(slider(format!("{n} encoder noise"), &k("encoder_noise_arcsec"), "″ 1σ", (0.0, 60.0), 1.0));
         }
         controls.push(slider("installation about x".into(), "turntable.installation_x_arcsec", "″", (-1800.0, 1800.0), 10.0));
         controls.push(slider("installation about y".into(), "turntable.installation_y_arcsec", "″", (-1800.0, 1800.0), 10.0));

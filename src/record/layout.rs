@@ -72,6 +72,18 @@ pub fn window_time_axis(seconds: f64) -> bp::TimeAxis {
     }))
 }
 
+/// A plot's value axis fixed to `[lo, hi]` (a filter's prior would otherwise set the scale).
+#[must_use]
+pub fn scalar_range(lo: f64, hi: f64) -> bp::ScalarAxis {
+    bp::ScalarAxis::new().with_range(rerun::components::Range1D(datatypes::Range1D([lo, hi])))
+}
+
+/// No legend (the view's title names the lines).
+#[must_use]
+pub fn no_legend() -> bp::PlotLegend {
+    bp::PlotLegend::new().with_visible(false)
+}
+
 /// A 3D eye looking at `target` from `position` with +z up.
 #[must_use]
 pub fn eye(position: [f32; 3], target: [f32; 3]) -> bp::EyeControls3D {

@@ -17,6 +17,7 @@ use rerun::{RecordingStream, RecordingStreamResult, TimeColumn};
 
 use layout::Node;
 
+pub mod calibration;
 mod layout;
 pub mod modulation;
 pub mod read;
@@ -149,16 +150,30 @@ struct InsLayout {
     signal_window_s: f64,
 }
 
+/// What a command adds to the standard layout.
+pub(crate) struct CustomLayout {
+    /// The right column (replaces the error plots).
+    pub right: Node,
+    /// Document tabs shown before the scenario's.
+    pub docs: Vec<Node>,
+}
+
 /// Where the INS trace (true and computed IMU axes) is drawn, beside the table.
 const TRACE_OFFSET: [f32; 3] = [1.3, 1.3, -0.5];
 
 impl Recorder {
     /// Logs everything static (documents, styles, geometry, blueprint) and prepares the buffers.
     pub fn new(rec: RecordingStream, params: &Params) -> RecordingStreamResult<Self> {
-        Self::build(rec, params, false)
+        Self::build(rec, params, false, None)
     }
 
-    fn build(rec: RecordingStream, params: &Params, live: bool) -> RecordingStreamResult<Self> {
+    /// A recorder whose layout has `custom.right` as its right column and `custom.docs` as extra
+    /// document tabs (commands that add their own panels to the table's 3D scene).
+    pub(crate) fn with_layout(rec: RecordingStream, params: &Params, custom: CustomLayout) -> RecordingStreamResult<Self> {
+        Self::build(rec, params, false, Some(custom))
+    }
+
+    fn build(rec: RecordingStream, params: &Params, live: bool, custom: Option<CustomLayout>) -> RecordingStreamResult<Self> {
         let model = Model::new(params);
         let axis_names: Vec<String> = params.chain.axes().iter().map(|a| a.name.clone()).collect();
         let paths = ChainPaths::new(&axis_names);
@@ -215,14 +230,14 @@ impl Recorder {
         me.log_once(params)?;
         me.log_ins_once()?;
         me.log_error_geometry(params, me.geometry_at(0.0))?;
-        me.send_blueprint(params)?;
+        me.send_blueprint(params, custom)?;
         me.event(0.0, &format!("run started: {} ({} s at {} Hz, seed {})", params.meta.name, params.duration_s, params.step_hz, params.meta.seed), "INFO")?;
         Ok(me)
     }
 
     /// A recorder for live mode: everything that a reload can change is logged on the timeline.
     pub fn new_live(rec: RecordingStream, params: &Params) -> RecordingStreamResult<Self> {
-        Self::build(rec, params, true)
+        Self::build(rec, params, true, None)
     }
 
     fn geometry_at(&self, t_s: f64) -> Option<f64> {
@@ -474,7 +489,7 @@ impl Recorder {
         self.label(at, &format!("{path}/label"), &[(p3(tilted * length * 1.08), text.as_str())])
     }
 
-    fn send_blueprint(&self, p: &Params) -> RecordingStreamResult<()> {
+    fn send_blueprint(&self, p: &Params, custom: Option<CustomLayout>) -> RecordingStreamResult<()> {
         let plot = |name: String, origin: &str| Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::whole_run_time_axis());
         let error_view = |axis: &str| plot(format!("{axis} error (arcsec)"), &format!("attitude_error_arcsec/{axis}"));
         let scene = Node::view("3D", format!("3D: gimbal chain (errors ×{})", p.recording.exaggeration), "world")
@@ -483,27 +498,29 @@ impl Recorder {
                 // With an INS, the trace stands beside the table: step back to frame both.
                 &if self.ins.is_some() { layout::eye([3.6, -1.7, 1.5], [0.7, 0.7, -0.3]) } else { layout::eye([2.6, -1.1, 0.95], [0.0, 0.1, -0.2]) },
             );
-        let docs = Node::container(
-            ContainerKind::Tabs,
-            vec![
-                Node::view("TextDocument", "scenario", "docs/scenario"),
-                Node::view("TextDocument", "config", "docs/config"),
-                Node::view("TextLog", "events", "events"),
-            ],
-            &[],
-        );
+        let (custom_right, mut doc_tabs) = match custom {
+            Some(c) => (Some(c.right), c.docs),
+            None => (None, Vec::new()),
+        };
+        doc_tabs.extend([
+            Node::view("TextDocument", "scenario", "docs/scenario"),
+            Node::view("TextDocument", "config", "docs/config"),
+            Node::view("TextLog", "events", "events"),
+        ]);
+        let docs = Node::container(ContainerKind::Tabs, doc_tabs, &[]);
         let left = Node::container(ContainerKind::Vertical, vec![scene, docs], &[3.0, 1.3]);
         let mut more = vec![
             plot("gimbal angles (deg)".into(), "gimbal_angle_deg"),
             plot("vehicle attitude (deg)".into(), "vehicle_attitude_deg"),
             plot("swing angles (arcsec)".into(), "swing_arcsec"),
         ];
-        let right = match &self.ins {
-            None => {
+        let right = match (&self.ins, custom_right) {
+            (_, Some(right)) => right,
+            (None, None) => {
                 let more = Node::container(ContainerKind::Tabs, more, &[]);
                 Node::container(ContainerKind::Vertical, vec![error_view("pitch"), error_view("roll"), error_view("heading"), more], &[])
             }
-            Some(layout) => {
+            (Some(layout), None) => {
                 // The INS in the loop leads; the turntable-only (ideal-INS) plots go into the tabs.
                 let ins_view = |axis: &str| plot(format!("INS {axis} error (arcsec)"), &format!("ins/attitude_error_arcsec/{axis}"));
                 let mut tabs = Vec::new();

@@ -1,0 +1,248 @@
+//! The Monte Carlo of seed 000 §6.1 (Tables 2-3): many calibrations, each with its own true
+//! parameters drawn from `[calibration.montecarlo]` and its own noise, run in parallel; the error
+//! statistics of each estimator per quantity, the paper's beside.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use super::{CalibConfig, CalibError, Param, ParamSet, calibrate, collect};
+use crate::config::Params;
+use crate::gimbal::{Chain, TableErrors};
+use crate::units::{ARCSEC_PER_RAD, wrap_pi};
+
+/// Seed 000 Table 3 (500 runs): (quantity, error mean ″, standard deviation ″).
+pub const PAPER_TABLE3: [(&str, f64, f64); 5] = [("α1", 0.98, 0.0238), ("φ1", 1.14, 0.6103), ("α2", 0.78, 0.0078), ("φ2", 0.65, 0.0317), ("η", 1.05, 0.0091)];
+
+/// One quantity's error statistics, arcsec.
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct Stats {
+    /// Mean of the signed errors.
+    pub mean: f64,
+    /// Their standard deviation.
+    pub std: f64,
+    /// Mean of |error|.
+    pub mean_abs: f64,
+    /// Largest |error|.
+    pub max_abs: f64,
+}
+
+impl Stats {
+    fn of(errors: &[f64]) -> Self {
+        let n = errors.len().max(1) as f64;
+        let mean = errors.iter().sum::<f64>() / n;
+        let var = errors.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+        Self { mean, std: var.sqrt(), mean_abs: errors.iter().map(|e| e.abs()).sum::<f64>() / n, max_abs: errors.iter().fold(0.0, |m, e| m.max(e.abs())) }
+    }
+}
+
+/// One quantity's row.
+#[derive(Debug, Clone, Serialize)]
+pub struct QuantityRow {
+    /// What.
+    pub label: String,
+    /// Static Kalman filter.
+    pub kf: Stats,
+    /// Exact least squares.
+    pub nls: Stats,
+    /// Seed 000 Table 3's (mean, std), when it has the quantity.
+    pub paper: Option<(f64, f64)>,
+    /// Determined by the data (false: the prior / an independent measurement decides).
+    pub identifiable: bool,
+}
+
+/// The Monte Carlo's result.
+#[derive(Debug, Clone, Serialize)]
+pub struct Summary {
+    /// Scenario.
+    pub scenario: String,
+    /// Runs completed.
+    pub runs: usize,
+    /// Runs asked for.
+    pub runs_requested: usize,
+    /// Wall time, s.
+    pub wall_s: f64,
+    /// Threads used.
+    pub threads: usize,
+    /// How the true values were drawn and what the filter was told about η.
+    pub setup: String,
+    /// One row per quantity.
+    pub rows: Vec<QuantityRow>,
+}
+
+/// The quantities compared: for each axis from the IMU inward α and φ (φ in arcsec of phase, and as
+/// the arc α·δφ), then η and the effective η of every axis that has one.
+struct Quantities {
+    /// (label, the paper's (mean, std), identifiable).
+    labels: Vec<Quantity>,
+}
+
+type Quantity = (String, Option<(f64, f64)>, bool);
+
+/// One run's errors: (filter, least squares), in the order of the quantities.
+type RunErrors = (Vec<f64>, Vec<f64>);
+
+fn quantities(chain: &Chain, set: &ParamSet, eta_known: bool) -> Quantities {
+    let n = chain.axes().len();
+    let mut labels = Vec::new();
+    // The paper numbers its axes 1 (inner) and 2 (outer): the IMU-side axis first.
+    let paper = |name: &str| PAPER_TABLE3.iter().find(|(q, _, _)| *q == name).map(|(_, m, s)| (*m, *s));
+    let dual = n == 2;
+    for (j, k) in (0..n).rev().enumerate() {
+        let name = &chain.axes()[k].name;
+        let num = j + 1;
+        // Without an independent η, the swing of the axis before an η (its sin component) is seen
+        // only in the combination η_eff.
+        let swing_ok = eta_known || set.index(Param::NonOrth(k + 1)).is_none();
+        labels.push((format!("{name} α"), if dual { paper(&format!("α{num}")) } else { None }, swing_ok));
+        labels.push((format!("{name} φ (″ of phase)"), if dual { paper(&format!("φ{num}")) } else { None }, swing_ok));
+        labels.push((format!("{name} α·δφ (arc, ″)"), None, swing_ok));
+    }
+    for k in (1..n).rev() {
+        let name = &chain.axes()[k].name;
+        labels.push((format!("{name} η"), if dual { paper("η") } else { None }, eta_known));
+        labels.push((format!("{name} η_eff"), None, true));
+    }
+    Quantities { labels }
+}
+
+/// Errors (″) of one estimate, in the order of [`quantities`].
+fn errors(chain: &Chain, set: &ParamSet, theta: &[f64], truth: &[f64]) -> Vec<f64> {
+    let n = chain.axes().len();
+    let mut out = Vec::new();
+    for k in (0..n).rev() {
+        let (ic, is) = (set.index(Param::SwingCos(k)).unwrap_or(0), set.index(Param::SwingSin(k)).unwrap_or(0));
+        let (a, at) = (theta[ic].hypot(theta[is]), truth[ic].hypot(truth[is]));
+        let dphi = wrap_pi(theta[is].atan2(theta[ic]) - truth[is].atan2(truth[ic]));
+        out.push((a - at) * ARCSEC_PER_RAD);
+        out.push(dphi * ARCSEC_PER_RAD);
+        out.push(at * dphi * ARCSEC_PER_RAD);
+    }
+    for k in (1..n).rev() {
+        let ie = set.index(Param::NonOrth(k)).unwrap_or(0);
+        out.push((theta[ie] - truth[ie]) * ARCSEC_PER_RAD);
+        let f = super::report::effective_eta(chain, set, k);
+        out.push(f.map_or(f64::NAN, |f| (f(theta) - f(truth)) * ARCSEC_PER_RAD));
+    }
+    out
+}
+
+/// Draws run `i`'s true errors.
+fn draw(base: &TableErrors, mc: &super::MonteCarloConfig, seed: u64, i: u64) -> (TableErrors, ChaCha8Rng) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x4D43_5F43_414C_4942);
+    rng.set_stream(i);
+    let mut t = base.clone();
+    let u = |rng: &mut ChaCha8Rng, r: [f64; 2]| {
+        if r[1] > r[0] { rng.random_range(r[0]..r[1]) } else { r[0] }
+    };
+    for (k, a) in t.axes.iter_mut().enumerate() {
+        a.swing_half_angle_rad = u(&mut rng, mc.swing_half_angle_rad);
+        a.swing_phase_rad = u(&mut rng, mc.swing_phase_rad);
+        a.non_orthogonality_rad = if k > 0 { u(&mut rng, mc.non_orthogonality_rad) } else { 0.0 };
+    }
+    (t, rng)
+}
+
+/// Runs `runs` calibrations of `params` in parallel (`progress` ticks once per run; `stop` ends early).
+pub fn run(params: &Params, runs: usize, progress: &(dyn Fn() + Sync), stop: &AtomicBool) -> Result<Summary, CalibError> {
+    let started = std::time::Instant::now();
+    let mc = &params.calibration.montecarlo;
+    let eta_known = mc.eta_measured_sigma_rad.is_some();
+    let set = ParamSet::new(&params.chain, params.calibration.nuisance);
+    let q = quantities(&params.chain, &set, eta_known);
+    let base_seed = params.meta.seed;
+    let results: Vec<Result<Option<RunErrors>, CalibError>> = (0..runs as u64)
+        .into_par_iter()
+        .map(|i| {
+            if stop.load(Ordering::Relaxed) {
+                return Ok(None);
+            }
+            let (truth, mut rng) = draw(&params.truth, mc, base_seed, i);
+            let mut p = params.clone();
+            p.truth = truth;
+            let mut cfg: CalibConfig = p.calibration.clone();
+            // What the calibration is told about η: an independent measurement, or only the range.
+            let [lo, hi] = mc.non_orthogonality_rad;
+            match mc.eta_measured_sigma_rad {
+                Some(s) => {
+                    let eta = p.truth.axes.get(1).map_or(0.0, |a| a.non_orthogonality_rad);
+                    let noise: f64 = StandardNormal.sample(&mut rng);
+                    cfg.prior_eta_rad = eta + s * noise;
+                    cfg.prior_eta_sigma_rad = s;
+                }
+                None => {
+                    cfg.prior_eta_rad = 0.5 * (lo + hi);
+                    cfg.prior_eta_sigma_rad = ((hi - lo) / 12f64.sqrt()).max(1e-9);
+                }
+            }
+            let data = collect(&p, base_seed.wrapping_add(1000).wrapping_add(i))?;
+            let cal = calibrate(&p.chain, &p.compensation, &data, &cfg, -1.0)?;
+            let truth_v = cal.set.values(&p.truth);
+            let out = (errors(&p.chain, &cal.set, &cal.kf.theta, &truth_v), errors(&p.chain, &cal.set, &cal.nls.theta, &truth_v));
+            progress();
+            Ok(Some(out))
+        })
+        .collect();
+    let mut done = Vec::new();
+    for r in results {
+        if let Some(x) = r? {
+            done.push(x);
+        }
+    }
+    let rows = q
+        .labels
+        .iter()
+        .enumerate()
+        .map(|(j, (label, paper, identifiable))| {
+            let kf: Vec<f64> = done.iter().map(|(k, _)| k[j]).collect();
+            let nls: Vec<f64> = done.iter().map(|(_, n)| n[j]).collect();
+            QuantityRow { label: label.clone(), kf: Stats::of(&kf), nls: Stats::of(&nls), paper: *paper, identifiable: *identifiable }
+        })
+        .collect();
+    let deg = |r: [f64; 2]| [r[0].to_degrees(), r[1].to_degrees()];
+    let setup = format!(
+        "α ~ U({:.0}″, {:.0}″), φ ~ U({:.1}°, {:.1}°), η ~ U({:.0}″, {:.0}″); η prior: {}",
+        mc.swing_half_angle_rad[0] * ARCSEC_PER_RAD,
+        mc.swing_half_angle_rad[1] * ARCSEC_PER_RAD,
+        deg(mc.swing_phase_rad)[0],
+        deg(mc.swing_phase_rad)[1],
+        mc.non_orthogonality_rad[0] * ARCSEC_PER_RAD,
+        mc.non_orthogonality_rad[1] * ARCSEC_PER_RAD,
+        match mc.eta_measured_sigma_rad {
+            Some(s) => format!("an independent measurement with 1σ = {:.2}″", s * ARCSEC_PER_RAD),
+            None => "the distribution only (no independent measurement)".into(),
+        }
+    );
+    Ok(Summary {
+        scenario: params.meta.name.clone(),
+        runs: done.len(),
+        runs_requested: runs,
+        wall_s: started.elapsed().as_secs_f64(),
+        threads: rayon::current_num_threads(),
+        setup,
+        rows,
+    })
+}
+
+impl Summary {
+    /// The table printed by `rinscope montecarlo`.
+    #[must_use]
+    pub fn text(&self) -> String {
+        let mut s = format!(
+            "Monte Carlo: {} of {} runs of {} in {:.1} s on {} threads\n{}\nerrors in arcsec (mean ± std of the signed error, mean |error|)\n",
+            self.runs, self.runs_requested, self.scenario, self.wall_s, self.threads, self.setup
+        );
+        s.push_str(&format!("  {:<24} {:>28} {:>28} {:>22}\n", "", "static KF", "exact least squares", "seed 000 Table 3"));
+        for r in &self.rows {
+            let f = |st: &Stats| format!("{:>+9.4} ±{:>8.4} |{:>8.4}|", st.mean, st.std, st.mean_abs);
+            let paper = r.paper.map_or(String::new(), |(m, sd)| format!("{m:>9.2} ±{sd:>8.4}"));
+            let mark = if r.identifiable { "" } else { "   not identifiable: set by the η prior" };
+            s.push_str(&format!("  {:<24} {} {} {:>22}{}\n", r.label, f(&r.kf), f(&r.nls), paper, mark));
+        }
+        s
+    }
+}

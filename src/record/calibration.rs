@@ -1,0 +1,169 @@
+//! The recording of `rinscope calibrate`: the table turning in 3D with the estimated swing cones as
+//! white ghosts over the true ones (converging as the filter does), each state's estimate with its
+//! ±3σ band beside the true value, and the attitude error before and after compensation.
+
+use nalgebra::Vector3;
+use rerun::blueprint::components::ContainerKind;
+use rerun::{RecordingStream, RecordingStreamResult, TimeColumn};
+
+use super::layout::{self, Node};
+use super::{CustomLayout, Recorder, TIMELINE, albedo, cone, p3, rgb, rgba, ring_radius};
+use crate::calib::report::Report;
+use crate::calib::{Calibration, Param};
+use crate::config::Params;
+use crate::frames::exp_rotation;
+use crate::run::every_n_steps;
+use crate::sim::{DemodState, ERROR_AXES, Model, step};
+use crate::units::{ARCSEC_PER_RAD, fmt_angle};
+
+const GHOST: [u8; 3] = [245, 245, 245];
+const STATE_COLORS: [[u8; 3]; 5] = [[250, 200, 60], [120, 120, 120], [120, 120, 120], [90, 220, 120], [90, 160, 250]];
+const ERROR_COLORS: [[u8; 3]; 3] = [[230, 76, 60], [250, 200, 60], [90, 160, 250]];
+
+/// Per-sample attitude errors (pitch, roll, heading, rad) of the validation run: before, after the
+/// filter's compensation, after the least squares'.
+pub struct ErrorTraces<'a> {
+    /// Sample times, s.
+    pub t_s: Vec<f64>,
+    /// Before, after KF, after LSQ.
+    pub errors: [&'a [[f64; 3]]; 3],
+}
+
+/// Writes the calibration recording into `rec`.
+pub fn log(rec: RecordingStream, params: &Params, cal: &Calibration, report: &Report, traces: &ErrorTraces<'_>) -> RecordingStreamResult<()> {
+    let chain = &params.chain;
+    let set = &cal.set;
+    let table: Vec<(usize, Param)> = set.params.iter().copied().enumerate().filter(|(_, p)| p.is_table()).collect();
+    let plot = |name: String, origin: String| Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::whole_run_time_axis());
+    // Each state's plot is framed on where the filter ends: the final estimate ± 4 × its 3σ band
+    // (at least ±1″), widened to include the true value; the prior's ±3σ start falls off the top.
+    let truth = set.values(&params.truth);
+    let states: Vec<Node> = table
+        .iter()
+        .map(|(i, p)| {
+            let (x, sd, t) = (cal.kf.theta[*i] * ARCSEC_PER_RAD, cal.kf.sigma(*i) * ARCSEC_PER_RAD, truth[*i] * ARCSEC_PER_RAD);
+            let half = (12.0 * sd).max(1.0).max(1.5 * (x - t).abs());
+            plot(format!("{}″: KF yellow ±3σ grey, true green, LSQ blue", p.label(chain)), format!("calibration/state/{}", p.key(chain)))
+                .with_property("ScalarAxis", &layout::scalar_range(x - half, x + half))
+                .with_property("PlotLegend", &layout::no_legend())
+        })
+        .collect();
+    let errors: Vec<Node> = ERROR_AXES.iter().map(|a| plot(format!("{a} error before/after (arcsec)"), format!("calibration/error_arcsec/{a}"))).collect();
+    let right = Node::container(ContainerKind::Vertical, vec![Node::container(ContainerKind::Grid, states, &[]), Node::container(ContainerKind::Tabs, errors, &[])], &[1.6, 1.0]);
+    let custom = CustomLayout { right, docs: vec![Node::view("TextDocument", "calibration", "docs/calibration")] };
+    // The table scene of the ideal demodulation; the INS is the calibration's business here.
+    let mut drawing = params.clone();
+    drawing.ins = None;
+    let mut recorder = Recorder::with_layout(rec, &drawing, custom)?;
+    let rec = recorder.stream().clone();
+
+    rec.log_static(
+        "docs/calibration",
+        &rerun::TextDocument::from_markdown(format!(
+            "# Calibration\n\nWhite: the cones and rotor axes as estimated, converging on the coloured true ones \
+             (errors drawn ×{}). Plots: each state's static-Kalman-filter estimate (yellow) inside its ±3σ band (grey), \
+             the true value (green) and the exact least-squares result (blue). docs/calibration.md explains the model.\n\n```\n{}```\n",
+            params.recording.exaggeration,
+            report.text()
+        )),
+    )?;
+
+    // Styles.
+    for (_, p) in &table {
+        rec.log_static(
+            format!("calibration/state/{}", p.key(chain)),
+            &rerun::SeriesLines::new()
+                .with_colors(STATE_COLORS.map(rgb))
+                .with_names(["static KF", "+3σ", "−3σ", "true", "exact LSQ (final)"])
+                .with_widths([2.5, 1.0, 1.0, 1.5, 1.5]),
+        )?;
+    }
+    for a in ERROR_AXES {
+        rec.log_static(
+            format!("calibration/error_arcsec/{a}"),
+            &rerun::SeriesLines::new().with_colors(ERROR_COLORS.map(rgb)).with_names(["before (no swing/η model)", "after: static KF", "after: exact LSQ"]),
+        )?;
+    }
+
+    // The filter over time.
+    let times: Vec<f64> = cal.history.iter().map(|s| s.t_s).collect();
+    for (i, p) in &table {
+        let mut values = Vec::with_capacity(5 * times.len());
+        for s in &cal.history {
+            let (x, sd) = (s.theta[*i] * ARCSEC_PER_RAD, s.sigma[*i] * ARCSEC_PER_RAD);
+            values.extend([x, x + 3.0 * sd, x - 3.0 * sd, truth[*i] * ARCSEC_PER_RAD, cal.nls.theta[*i] * ARCSEC_PER_RAD]);
+        }
+        let time = TimeColumn::new_duration_secs(TIMELINE, times.iter().copied());
+        rec.send_columns(format!("calibration/state/{}", p.key(chain)), [time], rerun::Scalars::new(values).columns(std::iter::repeat_n(5, times.len()))?)?;
+    }
+
+    // Before / after, decimated to the series rate.
+    let every = (traces.t_s.len() as f64 / (params.duration_s * params.recording.series_hz)).max(1.0).round() as usize;
+    let idx: Vec<usize> = (0..traces.t_s.len()).step_by(every).collect();
+    for (a, name) in ERROR_AXES.iter().enumerate() {
+        let mut values = Vec::with_capacity(3 * idx.len());
+        for &i in &idx {
+            values.extend(traces.errors.iter().map(|e| e[i][a] * ARCSEC_PER_RAD));
+        }
+        let time = TimeColumn::new_duration_secs(TIMELINE, idx.iter().map(|&i| traces.t_s[i]));
+        rec.send_columns(format!("calibration/error_arcsec/{name}"), [time], rerun::Scalars::new(values).columns(std::iter::repeat_n(3, idx.len()))?)?;
+    }
+
+    // Ghost cones and estimated rotor axes, once per second of the test.
+    let x = params.recording.exaggeration;
+    let n = chain.axes().len();
+    let mut next = 0.0;
+    let last = cal.history.len().saturating_sub(1);
+    for (j, s) in cal.history.iter().enumerate() {
+        if s.t_s < next && j != last {
+            continue;
+        }
+        next = s.t_s.floor() + 1.0;
+        rec.set_duration_secs(TIMELINE, s.t_s);
+        let est = set.errors(&s.theta, &params.compensation);
+        for k in 0..n {
+            let (Some(_), Some(_)) = (set.index(Param::SwingCos(k)), set.index(Param::SwingSin(k))) else {
+                continue;
+            };
+            let g = &chain.axes()[k];
+            let half = ring_radius(k, n) * 1.25;
+            let alpha = est.axes[k].swing_half_angle_rad;
+            let (mesh, rims) = cone(g.axis, g.e1, g.e2, alpha * x, half * 1.02);
+            let mount = &recorder.paths.mounts[k];
+            rec.log(format!("{mount}/estimated_cone"), &rerun::Mesh3D::new(mesh.0).with_triangle_indices(mesh.1).with_albedo_factor(albedo(GHOST, 35)))?;
+            rec.log(format!("{mount}/estimated_cone/rims"), &rerun::LineStrips3D::new(rims).with_colors([rgba(GHOST, 230)]).with_radii([0.003]))?;
+            // The estimated rotor axis, drawn in the (truly tilted) rotor frame: W_trueᵀ W_est a.
+            let w_true = exp_rotation(&(chain.swing_vector(k, &params.truth.axes[k], 0.0) * x));
+            let w_est = exp_rotation(&(chain.swing_vector(k, &est.axes[k], 0.0) * x));
+            let dir: Vector3<f64> = (w_true.inverse() * w_est) * g.axis;
+            rec.log(
+                format!("{}/estimated_axis", recorder.paths.gimbals[k]),
+                &rerun::LineStrips3D::new([[p3(-dir * half * 1.1), p3(dir * half * 1.1)]]).with_colors([rgb(GHOST)]).with_radii([0.006]),
+            )?;
+            let tip = -g.axis * half * 1.02 + g.e2 * (half * (alpha * x).tan());
+            let label = format!("estimate: α = {}, φ = {:.2}°", fmt_angle(alpha), est.axes[k].swing_phase_rad.to_degrees());
+            rec.log(format!("{mount}/estimated_cone/label"), &rerun::Points3D::new([p3(tip)]).with_labels([label]).with_radii([0.002]).with_colors([rgb(GHOST)]))?;
+        }
+    }
+
+    // The table turning, and the ideal-INS error plots the standard layout keeps in its tabs.
+    let model = Model::new(&drawing);
+    let mut state = DemodState::default();
+    let steps = drawing.steps();
+    let (series_every, scene_every) = (every_n_steps(drawing.step_hz, drawing.recording.series_hz), every_n_steps(drawing.step_hz, drawing.recording.scene_hz));
+    for i in 0..=steps {
+        let t = i as f64 / drawing.step_hz;
+        let out = step(&model, &mut state, t);
+        if i % series_every == 0 {
+            recorder.push_series(&out)?;
+        }
+        if i % scene_every == 0 {
+            recorder.push_scene(&out)?;
+        }
+    }
+    recorder.event(drawing.duration_s, &format!("calibration: {} samples, {} Gauss–Newton iterations", cal.samples, cal.nls_iterations), "INFO")?;
+    for w in &report.warnings {
+        recorder.event(drawing.duration_s, w, "WARN")?;
+    }
+    recorder.finish()
+}
