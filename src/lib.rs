@@ -21,4 +21,5 @@ pub mod scenarios;
 pub mod scheme;
 pub mod sim;
 pub mod sink;
+pub mod tpr;
 pub mod units;

@@ -52,6 +52,8 @@ enum Command {
     Calibrate(CalibrateArgs),
     /// Seed 000's Monte Carlo (Tables 2-3): many calibrations with drawn parameters, in parallel.
     Montecarlo(MonteCarloArgs),
+    /// Seed 003's Twice Position-fix Reset against the conventional reset, from one IMU stream.
+    Tpr(TprArgs),
     /// Print the event log (reloads, errors, summary) of a saved recording.
     Events {
         /// The .rrd file.
@@ -178,6 +180,29 @@ struct MonteCarloArgs {
     json: Option<PathBuf>,
 }
 
+#[derive(Args)]
+struct TprArgs {
+    /// A preset (default zheng2016-tpr).
+    #[arg(long, conflicts_with = "config")]
+    scenario: Option<String>,
+    /// A scenario file with [imu], [navigation] and [position_fix].
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Save the recording to this .rrd (default recordings/<scenario>.rrd unless a viewer is asked for).
+    #[arg(long)]
+    save: Option<PathBuf>,
+    /// Start a new Rerun viewer and stream to it.
+    #[arg(long)]
+    spawn: bool,
+    /// Write the comparison (and the sampled traces) as JSON.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Also run this many seeds (the scenario's and the following ones) in parallel and print the
+    /// distribution: one realisation of the random walk says little.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=10_000))]
+    seeds: Option<u64>,
+}
+
 /// A failure with the exit code it deserves.
 struct Failure {
     code: u8,
@@ -213,6 +238,7 @@ fn main() -> ExitCode {
         Command::Live(args) => live_command(&args),
         Command::Calibrate(args) => calibrate_command(&args),
         Command::Montecarlo(args) => montecarlo_command(&args),
+        Command::Tpr(args) => tpr_command(&args),
         Command::Events { file } => events_command(&file),
         Command::Modulation { hours, save, spawn } => modulation_command(hours, save, spawn),
         Command::Scenarios => {
@@ -525,6 +551,63 @@ fn montecarlo_command(args: &MonteCarloArgs) -> Result<(), Failure> {
     }
     if summary.runs < summary.runs_requested {
         return Err(Failure { code: 130, message: format!("interrupted after {} runs (statistics above are over those)", summary.runs) });
+    }
+    Ok(())
+}
+
+fn tpr_command(args: &TprArgs) -> Result<(), Failure> {
+    let params = match &args.config {
+        Some(path) => config::load_file(path)?,
+        None => scenarios::load(args.scenario.as_deref().unwrap_or("zheng2016-tpr"))?,
+    };
+    check_output_dir("--json", args.json.as_deref())?;
+    let mut request = SinkRequest { save: args.save.clone(), spawn: args.spawn, ..Default::default() };
+    if request.save.is_none() && !request.spawn {
+        request.save = Some(PathBuf::from("recordings").join(format!("{}.rrd", params.meta.name)));
+    }
+    let sinks = sink::open(&request, rinscope::record::APPLICATION_ID, &format!("{}-seed{}", params.meta.name, params.meta.seed))?;
+    for d in &sinks.description {
+        eprintln!("rinscope: {d}");
+    }
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = Arc::clone(&stop);
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
+    eprintln!("rinscope: navigating {:.1} h (forking at the second fix)...", params.duration_s / 3600.0);
+    let result = match rinscope::tpr::run(&params, 60.0, &stop) {
+        Ok(r) => r,
+        Err(e) => {
+            sinks.abandon();
+            return Err(Failure { code: 2, message: format!("tpr: {e}") });
+        }
+    };
+    let text = result.text();
+    if let Err(e) = rinscope::record::tpr::log(&sinks.rec, &params, &result, &text) {
+        sinks.abandon();
+        return Err(Failure { code: 1, message: format!("rerun: {e}") });
+    }
+    let saved = sinks.finish()?;
+    print!("{text}");
+    if let Some(path) = &args.json {
+        let json = serde_json::to_string_pretty(&result).map_err(|e| Failure { code: 1, message: e.to_string() })?;
+        write_atomically(path, json.as_bytes()).map_err(|e| Failure { code: 2, message: format!("--json {}: {e}", path.display()) })?;
+    }
+    if let Some((p, bytes)) = saved {
+        println!("recording: {} ({:.2} MB) — open with `rerun {}`", p.display(), bytes as f64 / 1e6, p.display());
+    }
+    if !result.complete {
+        return Err(Failure { code: 130, message: "interrupted: the recording holds what was simulated".into() });
+    }
+    if let Some(n) = args.seeds {
+        eprintln!("rinscope: {n} seeds from {} in parallel...", params.meta.seed);
+        let started = std::time::Instant::now();
+        let rows = rinscope::tpr::sweep(&params, n, &stop).map_err(|e| Failure { code: 2, message: format!("tpr: {e}") })?;
+        if stop.load(Ordering::SeqCst) {
+            return Err(Failure { code: 130, message: "interrupted".into() });
+        }
+        print!("{}", rinscope::tpr::sweep_text(&rows));
+        println!("  {n} runs of {:.1} h in {:.1} s", params.duration_s / 3600.0, started.elapsed().as_secs_f64());
     }
     Ok(())
 }

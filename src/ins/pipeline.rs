@@ -62,7 +62,8 @@ fn output_attitude(history: &[(f64, UnitQuaternion<f64>); 2], zoh: f64) -> (f64,
     }
 }
 
-/// The INS in the loop.
+/// The INS in the loop (cloned to fork one IMU stream into two navigation strategies).
+#[derive(Clone)]
 pub struct InsRun {
     cfg: InsConfig,
     truth: TruthImu,
@@ -191,6 +192,30 @@ impl InsRun {
     pub fn set_primary_attitude(&mut self, n_from_s: UnitQuaternion<f64>) {
         if let Some(i) = self.integrators.first_mut() {
             i.n_from_s = n_from_s;
+        }
+    }
+
+    /// Position fix: the navigation's latitude and longitude set to the truth (the site), velocity
+    /// and the attitude relative to local level kept (the usual reset; docs/tpr.md).
+    pub fn reset_position(&mut self) {
+        let site = self.earth.site;
+        if let Some(nav) = self.nav.as_mut() {
+            nav.state.latitude_rad = site.latitude_rad;
+            nav.state.longitude_rad = site.longitude_rad;
+        }
+    }
+
+    /// Turns the primary attitude about the local vertical by `angle_rad` (counter-clockwise seen from
+    /// above: the heading decreases by `angle_rad`): an azimuth correction.
+    pub fn rotate_azimuth(&mut self, angle_rad: f64) {
+        let r = UnitQuaternion::from_scaled_axis(Vector3::z() * angle_rad);
+        if let Some(i) = self.integrators.first_mut() {
+            i.n_from_s = r * i.n_from_s;
+        }
+        if let Some(h) = self.history.first_mut() {
+            for (_, q) in h.iter_mut() {
+                *q = r * *q;
+            }
         }
     }
 

@@ -43,7 +43,7 @@ pub fn log(rec: RecordingStream, params: &Params, cal: &Calibration, report: &Re
         .map(|(i, p)| {
             let (x, sd, t) = (cal.kf.theta[*i] * ARCSEC_PER_RAD, cal.kf.sigma(*i) * ARCSEC_PER_RAD, truth[*i] * ARCSEC_PER_RAD);
             let half = (12.0 * sd).max(1.0).max(1.5 * (x - t).abs());
-            plot(format!("{}″: KF yellow ±3σ grey, true green, LSQ blue", p.label(chain)), format!("calibration/state/{}", p.key(chain)))
+            plot(format!("{} (″)", p.label(chain)), format!("calibration/state/{}", p.key(chain)))
                 .with_property("ScalarAxis", &layout::scalar_range(x - half, x + half))
                 .with_property("PlotLegend", &layout::no_legend())
         })

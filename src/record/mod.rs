@@ -20,6 +20,7 @@ use layout::Node;
 pub mod calibration;
 mod layout;
 pub mod modulation;
+pub mod tpr;
 pub mod read;
 
 use crate::config::Params;
