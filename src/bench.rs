@@ -84,6 +84,7 @@ pub fn run(steps: u64) -> anyhow::Result<()> {
 
     live_latency(&dir)?;
     std::fs::remove_dir_all(&dir).ok();
+    calibration_speed()?;
     println!("peak resident memory: {:.1} MB", peak_rss_bytes() as f64 / 1e6);
     Ok(())
 }
@@ -200,6 +201,38 @@ fn live_latency(dir: &std::path::Path) -> anyhow::Result<()> {
         live::p95(&latencies),
         sorted[sorted.len() - 1],
         live::watch::DEBOUNCE.as_millis()
+    );
+    Ok(())
+}
+
+/// Issue targets for calibration and resets: one static calibration (200 s at 200 Hz, KF and exact
+/// least squares), 500 Monte Carlo calibrations on all cores (target < 10 s on 2 cores), the 30 h
+/// twice-position-fix comparison ("seconds, not minutes").
+fn calibration_speed() -> anyhow::Result<()> {
+    let stop = AtomicBool::new(false);
+    let p = scenarios::load("jiang2017-calibration")?;
+    let started = Instant::now();
+    let outcome = crate::calib::run(&p, false)?;
+    println!(
+        "calibration       jiang2017-calibration: 200 s at 200 Hz, static KF + exact least squares + validation run in {:.2} s ({} measurements)",
+        started.elapsed().as_secs_f64(),
+        outcome.data.samples.len()
+    );
+    let started = Instant::now();
+    let mc = crate::calib::montecarlo::run(&p, 500, &|| {}, &stop)?;
+    println!(
+        "Monte Carlo       jiang2017-calibration: {} calibrations in {:.2} s on {} threads",
+        mc.runs,
+        started.elapsed().as_secs_f64(),
+        mc.threads
+    );
+    let p = scenarios::load("zheng2016-tpr")?;
+    let r = crate::tpr::run(&p, 600.0, &stop)?;
+    println!(
+        "TPR vs reset      zheng2016-tpr: {:.0} h at {:.0} Hz, both branches after the fork, in {:.2} s",
+        p.duration_s / 3600.0,
+        p.step_hz,
+        r.wall_s
     );
     Ok(())
 }

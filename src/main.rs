@@ -561,6 +561,7 @@ fn tpr_command(args: &TprArgs) -> Result<(), Failure> {
         None => scenarios::load(args.scenario.as_deref().unwrap_or("zheng2016-tpr"))?,
     };
     check_output_dir("--json", args.json.as_deref())?;
+    rinscope::tpr::check(&params).map_err(|e| Failure { code: 2, message: format!("tpr: {e}") })?;
     let mut request = SinkRequest { save: args.save.clone(), spawn: args.spawn, ..Default::default() };
     if request.save.is_none() && !request.spawn {
         request.save = Some(PathBuf::from("recordings").join(format!("{}.rrd", params.meta.name)));

@@ -244,6 +244,38 @@ pub fn run_all() -> anyhow::Result<Table> {
             tolerance: "the paper's accuracy claim; its values also hold the turntable's and alignment errors".into(),
         });
     }
+    // Seed 000 §6.2.2: compensation with calibrated parameters lowers the peak error 3.0-3.8×;
+    // rinscope's must lower it at least as much on an independent run with the same kind of noise.
+    let p = scenarios::load("jiang2017-calibration")?;
+    let outcome = crate::calib::run(&p, false)?;
+    if let Some(c) = outcome.report.compensation {
+        for (axis, name) in ["pitch", "roll", "heading"].iter().enumerate() {
+            let (before, after) = crate::calib::report::PAPER_LAB[axis];
+            let paper = before / after;
+            rows.push(Row {
+                source: "seed 000 §6.2.2".into(),
+                scenario: "jiang2017-calibration".into(),
+                quantity: format!("{name}: peak error before / after compensation with the least-squares estimates (independent run)"),
+                paper: format!("{paper:.2} ({before}″ → {after}″)"),
+                value: c.before.peak_rad[axis] / c.after_nls.peak_rad[axis],
+                band: (paper, f64::INFINITY),
+                tolerance: "at least the paper's factor (the issue's target)".into(),
+            });
+        }
+    }
+    // Seed 000 Table 3: mean calibration errors 0.65-1.14″ over 500 runs; rinscope's mean |error| of
+    // every quantity the data determine must be below the paper's smallest (200 runs here: ~3 s).
+    let mc = crate::calib::montecarlo::run(&p, 200, &|| {}, &std::sync::atomic::AtomicBool::new(false))?;
+    let worst = mc.rows.iter().filter(|r| r.identifiable && !r.label.contains("of phase")).map(|r| r.nls.mean_abs).fold(0.0, f64::max);
+    rows.push(Row {
+        source: "seed 000 §6.1, Table 3".into(),
+        scenario: "jiang2017-calibration".into(),
+        quantity: "Monte Carlo (200 runs): largest mean |error| of the identifiable parameters (α, arc α·δφ, η_eff), arcsec".into(),
+        paper: "0.65-1.14".into(),
+        value: worst,
+        band: (0.0, 0.65),
+        tolerance: "below the paper's best mean error (the issue: beat Table 3)".into(),
+    });
     Ok(Table { rows })
 }
 

@@ -139,12 +139,21 @@ pub fn azimuth_error_at_second_fix(psi_x1: f64, dlat2_rad: f64, dt_s: f64, latit
     psi_z2 / latitude_rad.cos()
 }
 
-/// Runs the scenario with its first two position fixes, conventional and TPR, sampling every `sample_s`.
-pub fn run(params: &Params, sample_s: f64, stop: &AtomicBool) -> Result<TprResult, TprError> {
-    let started = std::time::Instant::now();
+/// Whether the scenario can run the comparison: an INS with navigation and two position fixes.
+pub fn check(params: &Params) -> Result<(), TprError> {
+    if params.ins.as_ref().is_none_or(|i| i.navigation.is_none()) {
+        return Err(TprError::Config(format!("{}: needs an [imu] and a [navigation] section (see assets/scenarios/zheng2016-tpr.toml)", params.meta.name)));
+    }
     if params.position_fix_s.len() < 2 {
         return Err(TprError::Config(format!("{}: [position_fix] at_h needs two fixes (seed 003: at_h = [17.0, 21.0])", params.meta.name)));
     }
+    Ok(())
+}
+
+/// Runs the scenario with its first two position fixes, conventional and TPR, sampling every `sample_s`.
+pub fn run(params: &Params, sample_s: f64, stop: &AtomicBool) -> Result<TprResult, TprError> {
+    let started = std::time::Instant::now();
+    check(params)?;
     let (t1, t2) = (params.position_fix_s[0], params.position_fix_s[1]);
     let Some(mut ins) = InsRun::new(params, Model::new(params)) else {
         return Err(TprError::Config(format!("{}: needs [imu] and [navigation]", params.meta.name)));

@@ -162,3 +162,18 @@ fn a_headless_live_session_runs_for_its_duration_and_saves() {
     let o = rinscope().args(["live", "--config"]).arg(&cfg).arg("--no-viewer").output().expect("run");
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
 }
+
+#[test]
+fn tpr_refuses_a_scenario_without_fixes_and_leaves_no_file() {
+    // The dual-axis preset has no [imu], [navigation] or position fixes: tpr must say what is
+    // missing, exit 2, and write nothing.
+    let dir = scratch("tpr-refused");
+    let cfg = dir.join("plain.toml");
+    std::fs::write(&cfg, PRESET).expect("write config");
+    let out_file = dir.join("tpr.rrd");
+    let o = rinscope().args(["tpr", "--config"]).arg(&cfg).arg("--save").arg(&out_file).output().expect("run");
+    assert_eq!(o.status.code(), Some(2), "stderr: {}", stderr(&o));
+    assert!(stderr(&o).contains("position_fix") || stderr(&o).contains("navigation"), "{}", stderr(&o));
+    assert!(!out_file.exists() && !dir.join("tpr.rrd.partial").exists(), "no file for a refused run");
+    std::fs::remove_dir_all(&dir).ok();
+}
