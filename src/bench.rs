@@ -229,7 +229,7 @@ fn calibration_speed() -> anyhow::Result<()> {
     let p = scenarios::load("zheng2016-tpr")?;
     let r = crate::tpr::run(&p, 600.0, &stop)?;
     println!(
-        "TPR vs reset      zheng2016-tpr: {:.0} h at {:.0} Hz, both branches after the fork, in {:.2} s",
+        "TPR vs reset      zheng2016-tpr: {:.0} h at {:.0} Hz, three branches after the fork, in {:.2} s",
         p.duration_s / 3600.0,
         p.step_hz,
         r.wall_s

@@ -7,10 +7,9 @@ use rerun::{RecordingStream, RecordingStreamResult, TimeColumn};
 use super::layout::{self, Node};
 use super::{rgb, APPLICATION_ID, TIMELINE};
 use crate::config::Params;
-use crate::tpr::{TprResult, PAPER_RADIAL_M};
+use crate::tpr::{TprResult, BRANCHES, BRANCH_NAMES, PAPER_RADIAL_M};
 
-const COLORS: [[u8; 3]; 2] = [[230, 76, 60], [46, 170, 90]];
-const NAMES: [&str; 2] = ["conventional reset", "TPR"];
+const COLORS: [[u8; 3]; BRANCHES] = [[230, 76, 60], [46, 170, 90], [70, 130, 230]];
 
 /// Logs the comparison.
 pub fn log(rec: &RecordingStream, params: &Params, r: &TprResult, table: &str) -> RecordingStreamResult<()> {
@@ -36,7 +35,7 @@ pub fn log(rec: &RecordingStream, params: &Params, r: &TprResult, table: &str) -
     let colors: Vec<rerun::Color> = COLORS.iter().map(|c| rgb(*c)).collect();
     let paths = ["tpr/heading_error_arcsec", "tpr/radial_position_error_m", "tpr/east_error_m", "tpr/north_error_m"];
     for path in paths {
-        rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors.clone()).with_names(NAMES))?;
+        rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors.clone()).with_names(BRANCH_NAMES))?;
     }
     let n = r.samples.len();
     let times: Vec<f64> = r.samples.iter().map(|s| s.t_s).collect();
@@ -48,11 +47,18 @@ pub fn log(rec: &RecordingStream, params: &Params, r: &TprResult, table: &str) -
     ];
     for (path, values) in paths.iter().zip(columns) {
         let time = TimeColumn::new_duration_secs(TIMELINE, times.iter().copied());
-        rec.send_columns(*path, [time], rerun::Scalars::new(values).columns(std::iter::repeat_n(2, n))?)?;
+        rec.send_columns(*path, [time], rerun::Scalars::new(values).columns(std::iter::repeat_n(BRANCHES, n))?)?;
     }
     for (k, t) in r.fixes_s.iter().enumerate() {
         rec.set_duration_secs(TIMELINE, *t);
-        let what = if k == 0 { "first position fix: both reset the position".to_owned() } else { format!("second fix: both reset the position; TPR corrects the azimuth by {:+.2}″", -r.tpr_heading_estimate_arcsec) };
+        let what = if k == 0 {
+            "first position fix: the position is reset".to_owned()
+        } else {
+            format!(
+                "second fix: every branch resets the position; TPR corrects the heading by {:+.2}″, TPR + level by {:+.2}″ (the heading error was {:+.2}″)",
+                -r.tpr_heading_estimate_arcsec, -r.level_heading_estimate_arcsec, r.heading_at_second_fix_arcsec
+            )
+        };
         rec.log("events", &rerun::TextLog::new(what).with_level("INFO"))?;
     }
     let plot = |name: &str, origin: &str| Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::whole_run_time_axis());
