@@ -48,11 +48,14 @@ enum Command {
         spawn: bool,
     },
     /// Static calibration of the swing cones and non-orthogonality (seed 000 §5): static Kalman
-    /// filter and exact least squares, compensation before/after, a recording with ghost cones.
+    /// filter and exact least squares, compensation before/after, a recording with ghost cones
+    /// (default scenario: jiang2017-calibration).
     Calibrate(CalibrateArgs),
-    /// Seed 000's Monte Carlo (Tables 2-3): many calibrations with drawn parameters, in parallel.
+    /// Seed 000's Monte Carlo (Tables 2-3): many calibrations with drawn parameters, in parallel
+    /// (default scenario: jiang2017-calibration).
     Montecarlo(MonteCarloArgs),
-    /// Seed 003's Twice Position-fix Reset against the conventional reset, from one IMU stream.
+    /// Seed 003's Twice Position-fix Reset against the conventional reset, from one IMU stream
+    /// (default scenario: zheng2016-tpr; needs [imu], [navigation] and two [position_fix] times).
     Tpr(TprArgs),
     /// Print the event log (reloads, errors, summary) of a saved recording.
     Events {
@@ -114,14 +117,31 @@ struct LiveArgs {
     no_panel: bool,
 }
 
+/// Where a command's scenario comes from (each command has its own default preset).
 #[derive(Args, Default)]
-struct RunArgs {
+struct Source {
     /// A preset from assets/scenarios (see `rinscope scenarios`).
     #[arg(long, conflicts_with = "config")]
     scenario: Option<String>,
     /// A scenario file.
     #[arg(long)]
     config: Option<PathBuf>,
+}
+
+impl Source {
+    /// The scenario file if given, else the named preset, else `default`.
+    fn load(&self, default: &str) -> Result<Params, ConfigError> {
+        match &self.config {
+            Some(path) => config::load_file(path),
+            None => scenarios::load(self.scenario.as_deref().unwrap_or(default)),
+        }
+    }
+}
+
+#[derive(Args, Default)]
+struct RunArgs {
+    #[command(flatten)]
+    source: Source,
     /// Save the recording to this .rrd file (default: recordings/<scenario>.rrd when no viewer is asked for).
     #[arg(long)]
     save: Option<PathBuf>,
@@ -141,12 +161,9 @@ struct RunArgs {
 
 #[derive(Args)]
 struct CalibrateArgs {
-    /// A preset (default jiang2017-calibration).
-    #[arg(long, conflicts_with = "config")]
-    scenario: Option<String>,
-    /// A scenario file (static vehicle; its [calibration] section, or the defaults).
-    #[arg(long)]
-    config: Option<PathBuf>,
+    // Default jiang2017-calibration: a static vehicle; its [calibration] section, or the defaults.
+    #[command(flatten)]
+    source: Source,
     /// Save the recording to this .rrd (default recordings/<scenario>-calibration.rrd unless a viewer is asked for).
     #[arg(long)]
     save: Option<PathBuf>,
@@ -163,12 +180,9 @@ struct CalibrateArgs {
 
 #[derive(Args)]
 struct MonteCarloArgs {
-    /// A preset (default jiang2017-calibration).
-    #[arg(long, conflicts_with = "config")]
-    scenario: Option<String>,
-    /// A scenario file.
-    #[arg(long)]
-    config: Option<PathBuf>,
+    // Default jiang2017-calibration.
+    #[command(flatten)]
+    source: Source,
     /// Number of runs (default: [calibration.montecarlo] runs).
     #[arg(long)]
     runs: Option<usize>,
@@ -182,12 +196,9 @@ struct MonteCarloArgs {
 
 #[derive(Args)]
 struct TprArgs {
-    /// A preset (default zheng2016-tpr).
-    #[arg(long, conflicts_with = "config")]
-    scenario: Option<String>,
-    /// A scenario file with [imu], [navigation] and [position_fix].
-    #[arg(long)]
-    config: Option<PathBuf>,
+    // Default zheng2016-tpr.
+    #[command(flatten)]
+    source: Source,
     /// Save the recording to this .rrd (default recordings/<scenario>.rrd unless a viewer is asked for).
     #[arg(long)]
     save: Option<PathBuf>,
@@ -259,10 +270,7 @@ fn main() -> ExitCode {
 }
 
 fn load(args: &RunArgs) -> Result<Params, Failure> {
-    let mut params = match &args.config {
-        Some(path) => config::load_file(path)?,
-        None => scenarios::load(args.scenario.as_deref().unwrap_or(scenarios::DEFAULT_SCENARIO))?,
-    };
+    let mut params = args.source.load(scenarios::DEFAULT_SCENARIO)?;
     if let Some(d) = args.duration_s {
         if !(d.is_finite() && d > 0.0 && d * params.step_hz <= 2.0e9) {
             return Err(Failure { code: 2, message: format!("--duration-s {d} s: must be > 0 and at most 2e9 steps at {} Hz", params.step_hz) });
@@ -461,10 +469,7 @@ fn check_output_dir(flag: &str, path: Option<&std::path::Path>) -> Result<(), Fa
 }
 
 fn calibrate_command(args: &CalibrateArgs) -> Result<(), Failure> {
-    let params = match &args.config {
-        Some(path) => config::load_file(path)?,
-        None => scenarios::load(args.scenario.as_deref().unwrap_or("jiang2017-calibration"))?,
-    };
+    let params = args.source.load("jiang2017-calibration")?;
     check_output_dir("--json", args.json.as_deref())?;
     let sinks = if args.no_recording {
         None
@@ -514,10 +519,7 @@ fn calibrate_command(args: &CalibrateArgs) -> Result<(), Failure> {
 }
 
 fn montecarlo_command(args: &MonteCarloArgs) -> Result<(), Failure> {
-    let mut params = match &args.config {
-        Some(path) => config::load_file(path)?,
-        None => scenarios::load(args.scenario.as_deref().unwrap_or("jiang2017-calibration"))?,
-    };
+    let mut params = args.source.load("jiang2017-calibration")?;
     check_output_dir("--json", args.json.as_deref())?;
     let runs = args.runs.unwrap_or(params.calibration.montecarlo.runs as usize);
     if runs == 0 || runs > 1_000_000 {
@@ -556,10 +558,7 @@ fn montecarlo_command(args: &MonteCarloArgs) -> Result<(), Failure> {
 }
 
 fn tpr_command(args: &TprArgs) -> Result<(), Failure> {
-    let params = match &args.config {
-        Some(path) => config::load_file(path)?,
-        None => scenarios::load(args.scenario.as_deref().unwrap_or("zheng2016-tpr"))?,
-    };
+    let params = args.source.load("zheng2016-tpr")?;
     check_output_dir("--json", args.json.as_deref())?;
     rinscope::tpr::check(&params).map_err(|e| Failure { code: 2, message: format!("tpr: {e}") })?;
     let mut request = SinkRequest { save: args.save.clone(), spawn: args.spawn, ..Default::default() };
