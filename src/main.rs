@@ -282,19 +282,10 @@ fn load(args: &RunArgs) -> Result<Params, Failure> {
 
 fn run_command(args: &RunArgs) -> Result<(), Failure> {
     let params = load(args)?;
-    let mut request = SinkRequest { save: args.save.clone(), spawn: args.spawn, connect: args.connect.clone(), ..Default::default() };
-    if request.save.is_none() && !request.spawn && request.connect.is_none() {
-        request.save = Some(PathBuf::from("recordings").join(format!("{}.rrd", params.meta.name)));
-    }
     // The summary file is checked before anything runs, so a typo costs nothing.
-    if let Some(dir) = args.summary_json.as_deref().and_then(|p| p.parent()).filter(|d| !d.as_os_str().is_empty() && !d.is_dir()) {
-        return Err(Failure { code: 2, message: format!("--summary-json: directory {} does not exist", dir.display()) });
-    }
-    let recording_id = format!("{}-seed{}", params.meta.name, params.meta.seed);
-    let sinks = sink::open(&request, rinscope::record::APPLICATION_ID, &recording_id)?;
-    for d in &sinks.description {
-        eprintln!("rinscope: {d}");
-    }
+    check_output_dir("--summary-json", args.summary_json.as_deref())?;
+    let request = SinkRequest { save: args.save.clone(), spawn: args.spawn, connect: args.connect.clone(), ..Default::default() };
+    let sinks = open_sinks(request, PathBuf::from("recordings").join(format!("{}.rrd", params.meta.name)), &format!("{}-seed{}", params.meta.name, params.meta.seed))?;
 
     let stop = Arc::new(AtomicBool::new(false));
     {
@@ -320,8 +311,7 @@ fn run_command(args: &RunArgs) -> Result<(), Failure> {
     }
     print!("{}", summary.table());
     if let Some(path) = &args.summary_json {
-        let json = serde_json::to_string_pretty(&summary).map_err(|e| Failure { code: 1, message: e.to_string() })?;
-        write_atomically(path, json.as_bytes()).map_err(|e| Failure { code: 2, message: format!("--summary-json {}: {e}", path.display()) })?;
+        write_json("--summary-json", path, &summary)?;
     }
     if let Some(p) = &summary.recording_path {
         println!("open it with:  rerun {p}     (viewer: {})", sink::VIEWER_INSTALL_HINT);
@@ -426,19 +416,8 @@ fn modulation_command(hours: f64, save: Option<PathBuf>, spawn: bool) -> Result<
     if !(hours.is_finite() && hours > 0.0 && hours <= 24.0 * 30.0) {
         return Err(Failure { code: 2, message: format!("--hours {hours}: must be > 0 and at most 720 h") });
     }
-    let mut request = SinkRequest { save, spawn, ..Default::default() };
-    if request.save.is_none() && !spawn {
-        request.save = Some(PathBuf::from("recordings/rotation-modulation.rrd"));
-    }
-    let sinks = sink::open(&request, rinscope::record::APPLICATION_ID, "rotation-modulation")?;
-    for d in &sinks.description {
-        eprintln!("rinscope: {d}");
-    }
-    let stop = Arc::new(AtomicBool::new(false));
-    {
-        let stop = Arc::clone(&stop);
-        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
-    }
+    let sinks = open_sinks(SinkRequest { save, spawn, ..Default::default() }, PathBuf::from("recordings/rotation-modulation.rrd"), "rotation-modulation")?;
+    let stop = stop_on_ctrl_c();
     let started = std::time::Instant::now();
     eprintln!("rinscope: simulating {hours} h three times in parallel (no rotation, continuous azimuth, 16-position)...");
     let traces = match rinscope::modulation::run(hours, &stop) {
@@ -455,9 +434,7 @@ fn modulation_command(hours: f64, save: Option<PathBuf>, spawn: bool) -> Result<
     }
     let saved = sinks.finish()?;
     print!("{table}");
-    if let Some((p, bytes)) = saved {
-        println!("recording: {} ({:.2} MB) — open with `rerun {}`", p.display(), bytes as f64 / 1e6, p.display());
-    }
+    print_saved(saved);
     Ok(())
 }
 
@@ -468,21 +445,48 @@ fn check_output_dir(flag: &str, path: Option<&std::path::Path>) -> Result<(), Fa
     Ok(())
 }
 
+/// Opens the sinks a command asked for; with no viewer asked for, saves to `default_save`.
+fn open_sinks(mut request: SinkRequest, default_save: PathBuf, recording_id: &str) -> Result<sink::OpenSinks, Failure> {
+    if request.save.is_none() && !request.spawn && request.connect.is_none() {
+        request.save = Some(default_save);
+    }
+    let sinks = sink::open(&request, rinscope::record::APPLICATION_ID, recording_id)?;
+    for d in &sinks.description {
+        eprintln!("rinscope: {d}");
+    }
+    Ok(sinks)
+}
+
+/// A flag Ctrl-C sets: long computations stop at their next check and keep what they have.
+fn stop_on_ctrl_c() -> Arc<AtomicBool> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+    stop
+}
+
+/// Writes `value` as pretty JSON to the file given with `flag`, atomically.
+fn write_json(flag: &str, path: &std::path::Path, value: &impl serde::Serialize) -> Result<(), Failure> {
+    let json = serde_json::to_string_pretty(value).map_err(|e| Failure { code: 1, message: e.to_string() })?;
+    write_atomically(path, json.as_bytes()).map_err(|e| Failure { code: 2, message: format!("{flag} {}: {e}", path.display()) })
+}
+
+/// The line that tells where a saved recording is and how to open it.
+fn print_saved(saved: Option<(PathBuf, u64)>) {
+    if let Some((p, bytes)) = saved {
+        println!("recording: {} ({:.2} MB) — open with `rerun {}`", p.display(), bytes as f64 / 1e6, p.display());
+    }
+}
+
 fn calibrate_command(args: &CalibrateArgs) -> Result<(), Failure> {
     let params = args.source.load("jiang2017-calibration")?;
     check_output_dir("--json", args.json.as_deref())?;
     let sinks = if args.no_recording {
         None
     } else {
-        let mut request = SinkRequest { save: args.save.clone(), spawn: args.spawn, ..Default::default() };
-        if request.save.is_none() && !request.spawn {
-            request.save = Some(PathBuf::from("recordings").join(format!("{}-calibration.rrd", params.meta.name)));
-        }
-        let sinks = sink::open(&request, rinscope::record::APPLICATION_ID, &format!("{}-calibration-seed{}", params.meta.name, params.meta.seed))?;
-        for d in &sinks.description {
-            eprintln!("rinscope: {d}");
-        }
-        Some(sinks)
+        let request = SinkRequest { save: args.save.clone(), spawn: args.spawn, ..Default::default() };
+        let default_save = PathBuf::from("recordings").join(format!("{}-calibration.rrd", params.meta.name));
+        Some(open_sinks(request, default_save, &format!("{}-calibration-seed{}", params.meta.name, params.meta.seed))?)
     };
     let started = std::time::Instant::now();
     let outcome = match rinscope::calib::run(&params, sinks.is_some()) {
@@ -499,8 +503,7 @@ fn calibrate_command(args: &CalibrateArgs) -> Result<(), Failure> {
     print!("{}", outcome.report.text());
     println!("({wall:.2} s wall: two {:.0}-s runs simulated, filter and least squares)", params.duration_s);
     if let Some(path) = &args.json {
-        let json = serde_json::to_string_pretty(&outcome.report).map_err(|e| Failure { code: 1, message: e.to_string() })?;
-        write_atomically(path, json.as_bytes()).map_err(|e| Failure { code: 2, message: format!("--json {}: {e}", path.display()) })?;
+        write_json("--json", path, &outcome.report)?;
     }
     if let Some(sinks) = sinks {
         let traces = rinscope::record::calibration::ErrorTraces {
@@ -511,9 +514,7 @@ fn calibrate_command(args: &CalibrateArgs) -> Result<(), Failure> {
             sinks.abandon();
             return Err(Failure { code: 1, message: format!("rerun: {e}") });
         }
-        if let Some((p, bytes)) = sinks.finish()? {
-            println!("recording: {} ({:.2} MB) — open with `rerun {}`", p.display(), bytes as f64 / 1e6, p.display());
-        }
+        print_saved(sinks.finish()?);
     }
     Ok(())
 }
@@ -531,11 +532,7 @@ fn montecarlo_command(args: &MonteCarloArgs) -> Result<(), Failure> {
         }
         params.calibration.montecarlo.eta_measured_sigma_rad = Some(s * rinscope::units::RAD_PER_ARCSEC);
     }
-    let stop = Arc::new(AtomicBool::new(false));
-    {
-        let stop = Arc::clone(&stop);
-        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
-    }
+    let stop = stop_on_ctrl_c();
     let bar = indicatif::ProgressBar::new(runs as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{spinner} {pos}/{len} calibrations [{bar:40}] {elapsed_precise} (eta {eta})")
@@ -548,8 +545,7 @@ fn montecarlo_command(args: &MonteCarloArgs) -> Result<(), Failure> {
     let summary = result.map_err(|e| Failure { code: 1, message: format!("montecarlo: {e}") })?;
     print!("{}", summary.text());
     if let Some(path) = &args.json {
-        let json = serde_json::to_string_pretty(&summary).map_err(|e| Failure { code: 1, message: e.to_string() })?;
-        write_atomically(path, json.as_bytes()).map_err(|e| Failure { code: 2, message: format!("--json {}: {e}", path.display()) })?;
+        write_json("--json", path, &summary)?;
     }
     if summary.runs < summary.runs_requested {
         return Err(Failure { code: 130, message: format!("interrupted after {} runs (statistics above are over those)", summary.runs) });
@@ -561,19 +557,9 @@ fn tpr_command(args: &TprArgs) -> Result<(), Failure> {
     let params = args.source.load("zheng2016-tpr")?;
     check_output_dir("--json", args.json.as_deref())?;
     rinscope::tpr::check(&params).map_err(|e| Failure { code: 2, message: format!("tpr: {e}") })?;
-    let mut request = SinkRequest { save: args.save.clone(), spawn: args.spawn, ..Default::default() };
-    if request.save.is_none() && !request.spawn {
-        request.save = Some(PathBuf::from("recordings").join(format!("{}.rrd", params.meta.name)));
-    }
-    let sinks = sink::open(&request, rinscope::record::APPLICATION_ID, &format!("{}-seed{}", params.meta.name, params.meta.seed))?;
-    for d in &sinks.description {
-        eprintln!("rinscope: {d}");
-    }
-    let stop = Arc::new(AtomicBool::new(false));
-    {
-        let stop = Arc::clone(&stop);
-        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
-    }
+    let request = SinkRequest { save: args.save.clone(), spawn: args.spawn, ..Default::default() };
+    let sinks = open_sinks(request, PathBuf::from("recordings").join(format!("{}.rrd", params.meta.name)), &format!("{}-seed{}", params.meta.name, params.meta.seed))?;
+    let stop = stop_on_ctrl_c();
     eprintln!("rinscope: navigating {:.1} h (forking at the second fix)...", params.duration_s / 3600.0);
     let result = match rinscope::tpr::run(&params, 60.0, &stop) {
         Ok(r) => r,
@@ -590,12 +576,9 @@ fn tpr_command(args: &TprArgs) -> Result<(), Failure> {
     let saved = sinks.finish()?;
     print!("{text}");
     if let Some(path) = &args.json {
-        let json = serde_json::to_string_pretty(&result).map_err(|e| Failure { code: 1, message: e.to_string() })?;
-        write_atomically(path, json.as_bytes()).map_err(|e| Failure { code: 2, message: format!("--json {}: {e}", path.display()) })?;
+        write_json("--json", path, &result)?;
     }
-    if let Some((p, bytes)) = saved {
-        println!("recording: {} ({:.2} MB) — open with `rerun {}`", p.display(), bytes as f64 / 1e6, p.display());
-    }
+    print_saved(saved);
     if !result.complete {
         return Err(Failure { code: 130, message: "interrupted: the recording holds what was simulated".into() });
     }

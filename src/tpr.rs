@@ -147,11 +147,12 @@ impl TprResult {
     }
 }
 
-/// The INS's latitude error (m, computed − true) and its view at the latest update.
-fn errors(ins: &mut InsRun, t_s: f64) -> (f64, f64, [f64; 2]) {
+/// The INS's heading error (arcsec) and east/north position errors (m, computed − true) at the
+/// latest update.
+fn errors(ins: &mut InsRun, t_s: f64) -> (f64, [f64; 2]) {
     let v = ins.view(t_s);
     let (pos, _) = v.nav.unwrap_or_default();
-    (pos.y, v.errors[0].heading_rad * ARCSEC_PER_RAD, [pos.x, pos.y])
+    (v.errors[0].heading_rad * ARCSEC_PER_RAD, [pos.x, pos.y])
 }
 
 /// Seed 003 eq. 25 and 22 in rinscope's signs: the azimuth error φ_U at the second fix (rad, a
@@ -256,7 +257,7 @@ pub fn run(params: &Params, sample_s: f64, stop: &AtomicBool) -> Result<TprResul
             }
         }
         if !fix1_done && s.t_s >= t1 {
-            dlat[0] = errors(&mut ins, s.t_s).0;
+            dlat[0] = errors(&mut ins, s.t_s).1[1];
             phi1 = level(&ins, v_before[0]);
             ins.reset_position();
             fix1_done = true;
@@ -266,7 +267,7 @@ pub fn run(params: &Params, sample_s: f64, stop: &AtomicBool) -> Result<TprResul
         }
         if s.t_s >= next {
             next += sample_s;
-            let (_, h, en) = errors(&mut ins, s.t_s);
+            let (h, en) = errors(&mut ins, s.t_s);
             let r = en[0].hypot(en[1]);
             samples.push(Sample { t_s: s.t_s, heading_arcsec: [h; BRANCHES], radial_m: [r; BRANCHES], east_north_m: [[en[0]; BRANCHES], [en[1]; BRANCHES]] });
         }
@@ -277,7 +278,7 @@ pub fn run(params: &Params, sample_s: f64, stop: &AtomicBool) -> Result<TprResul
     }
     // The second fix: every branch resets the position; TPR also corrects the azimuth.
     let t_fix2 = i as f64 / params.step_hz;
-    let (lat2, heading2, _) = errors(&mut ins, t_fix2);
+    let (heading2, [_, lat2]) = errors(&mut ins, t_fix2);
     dlat[1] = lat2;
     let phi2 = level(&ins, v_before[1]);
     let dlat2 = lat2 / (rm + earth.site.height_m);
@@ -297,10 +298,8 @@ pub fn run(params: &Params, sample_s: f64, stop: &AtomicBool) -> Result<TprResul
             let s = ins.step();
             if s.updated && s.t_s >= next {
                 next += sample_s;
-                out.push({
-                    let (_, h, en) = errors(&mut ins, s.t_s);
-                    (s.t_s, h, en)
-                });
+                let (h, en) = errors(&mut ins, s.t_s);
+                out.push((s.t_s, h, en));
             }
             if j.is_multiple_of(200_000) && stop.load(Ordering::Relaxed) {
                 break;
