@@ -1,25 +1,26 @@
 //! rinscope: see the errors of a rotational inertial navigation system.
 //!
-//! The simulation (`frames`, `euler`, `gimbal`, `motion`, `scheme`, `sim`) is pure and knows nothing
-//! of Rerun; `record` is the only module that talks to the viewer, `sink` opens its outputs.
+//! Layers, lowest first; a module imports only the layers above it in this list (enforced by
+//! `tests/layers.rs`), and only `record` imports Rerun:
+//!
+//! 0. [`math`], [`io`] — frames and typed rotations, units, attitude, noise, statistics, the
+//!    sampling rule; atomic output files.
+//! 1. [`model`] — the gimbal chain with its exact errors, rotation schemes, vehicle motion, Earth.
+//! 2. [`sim`] — the turntable step: truth, encoders, three demodulations (pure).
+//! 3. [`ins`], [`calib`] — the INS in the loop (IMU truth, sensors, algorithms, navigation,
+//!    resets) and the calibration estimators; each takes the parameter struct it owns.
+//! 4. [`scenario`] — the only code that knows the TOML: raw structs, validation, presets.
+//! 5. [`record`] — the only door to Rerun: entity tree, series, layout, sinks; it never steps a model.
+//! 6. [`app`] — the commands' orchestration: threads, channels, progress, files.
+//! 7. [`cli`] — clap, the sink flags declared once, exit codes.
 
-pub mod bench;
+pub mod app;
 pub mod calib;
-pub mod config;
-pub mod euler;
-pub mod frames;
-pub mod gimbal;
+pub mod cli;
 pub mod ins;
-pub mod live;
-pub mod modulation;
-pub mod motion;
-pub mod noise;
+pub mod io;
+pub mod math;
+pub mod model;
 pub mod record;
-pub mod reproduce;
-pub mod run;
-pub mod scenarios;
-pub mod scheme;
+pub mod scenario;
 pub mod sim;
-pub mod sink;
-pub mod tpr;
-pub mod units;

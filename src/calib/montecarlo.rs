@@ -10,17 +10,16 @@ use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::{CalibConfig, CalibError, Param, ParamSet, calibrate, collect};
-use crate::config::Params;
-use crate::gimbal::{Chain, TableErrors};
-use crate::units::{ARCSEC_PER_RAD, wrap_pi};
+use super::{CalibConfig, CalibError, Data, History, Param, ParamSet, calibrate};
+use crate::model::gimbal::{Chain, TableErrors};
+use crate::math::units::{ARCSEC_PER_RAD, wrap_pi};
 
 /// Seed 000 Table 3 (500 runs): (quantity, error mean ″, standard deviation ″).
 pub const PAPER_TABLE3: [(&str, f64, f64); 5] = [("α1", 0.98, 0.0238), ("φ1", 1.14, 0.6103), ("α2", 0.78, 0.0078), ("φ2", 0.65, 0.0317), ("η", 1.05, 0.0091)];
 
 /// One quantity's error statistics, arcsec.
 #[derive(Debug, Clone, Copy, Default, Serialize)]
-pub struct Stats {
+pub struct ErrorSpread {
     /// Mean of the signed errors.
     pub mean: f64,
     /// Their standard deviation.
@@ -31,7 +30,7 @@ pub struct Stats {
     pub max_abs: f64,
 }
 
-impl Stats {
+impl ErrorSpread {
     fn of(errors: &[f64]) -> Self {
         let n = errors.len().max(1) as f64;
         let mean = errors.iter().sum::<f64>() / n;
@@ -46,9 +45,9 @@ pub struct QuantityRow {
     /// What.
     pub label: String,
     /// Static Kalman filter.
-    pub kf: Stats,
+    pub kf: ErrorSpread,
     /// Exact least squares.
-    pub nls: Stats,
+    pub nls: ErrorSpread,
     /// Seed 000 Table 3's (mean, std), when it has the quantity.
     pub paper: Option<(f64, f64)>,
     /// Determined by the data (false: the prior / an independent measurement decides).
@@ -147,29 +146,49 @@ fn draw(base: &TableErrors, mc: &super::MonteCarloConfig, seed: u64, i: u64) -> 
     (t, rng)
 }
 
-/// Runs `runs` calibrations of `params` in parallel (`progress` ticks once per run; `stop` ends early).
-pub fn run(params: &Params, runs: usize, progress: &(dyn Fn() + Sync), stop: &AtomicBool) -> Result<Summary, CalibError> {
+/// What a Monte Carlo keeps fixed: the table (its truth is the base that each run's draw replaces),
+/// what the demodulation knows, the calibration's configuration and the base seed.
+#[derive(Debug, Clone, Copy)]
+pub struct Setup<'a> {
+    /// Scenario name, for the summary.
+    pub scenario: &'a str,
+    /// The nominal chain.
+    pub chain: &'a Chain,
+    /// The scenario's true errors (each run redraws the swing cones and non-orthogonalities).
+    pub truth: &'a TableErrors,
+    /// Every error not estimated, as known to the calibration.
+    pub compensation: &'a TableErrors,
+    /// The calibration's configuration (with `[calibration.montecarlo]`).
+    pub cfg: &'a CalibConfig,
+    /// Base seed of the draws and the noise.
+    pub seed: u64,
+}
+
+/// Simulates one static test for true errors `truth` with noise seed `seed`.
+pub type Collect<'a> = dyn Fn(&TableErrors, u64) -> Result<Data, CalibError> + Sync + 'a;
+
+/// Runs `runs` calibrations in parallel, each on the data `collect` simulates for a drawn table
+/// (`progress` ticks once per run; `stop` ends early).
+pub fn run(setup: &Setup<'_>, runs: usize, collect: &Collect<'_>, progress: &(dyn Fn() + Sync), stop: &AtomicBool) -> Result<Summary, CalibError> {
     let started = std::time::Instant::now();
-    let mc = &params.calibration.montecarlo;
+    let mc = &setup.cfg.montecarlo;
     let eta_known = mc.eta_measured_sigma_rad.is_some();
-    let set = ParamSet::new(&params.chain, params.calibration.nuisance);
-    let q = quantities(&params.chain, &set, eta_known);
-    let base_seed = params.meta.seed;
+    let set = ParamSet::new(setup.chain, setup.cfg.nuisance);
+    let q = quantities(setup.chain, &set, eta_known);
+    let base_seed = setup.seed;
     let results: Vec<Result<Option<RunErrors>, CalibError>> = (0..runs as u64)
         .into_par_iter()
         .map(|i| {
             if stop.load(Ordering::Relaxed) {
                 return Ok(None);
             }
-            let (truth, mut rng) = draw(&params.truth, mc, base_seed, i);
-            let mut p = params.clone();
-            p.truth = truth;
-            let mut cfg: CalibConfig = p.calibration.clone();
+            let (truth, mut rng) = draw(setup.truth, mc, base_seed, i);
+            let mut cfg: CalibConfig = setup.cfg.clone();
             // What the calibration is told about η: an independent measurement, or only the range.
             let [lo, hi] = mc.non_orthogonality_rad;
             match mc.eta_measured_sigma_rad {
                 Some(s) => {
-                    let eta = p.truth.axes.get(1).map_or(0.0, |a| a.non_orthogonality_rad);
+                    let eta = truth.axes.get(1).map_or(0.0, |a| a.non_orthogonality_rad);
                     let noise: f64 = StandardNormal.sample(&mut rng);
                     cfg.prior_eta_rad = eta + s * noise;
                     cfg.prior_eta_sigma_rad = s;
@@ -179,10 +198,10 @@ pub fn run(params: &Params, runs: usize, progress: &(dyn Fn() + Sync), stop: &At
                     cfg.prior_eta_sigma_rad = ((hi - lo) / 12f64.sqrt()).max(1e-9);
                 }
             }
-            let data = collect(&p, base_seed.wrapping_add(1000).wrapping_add(i))?;
-            let cal = calibrate(&p.chain, &p.compensation, &data, &cfg, -1.0)?;
-            let truth_v = cal.set.values(&p.truth);
-            let out = (errors(&p.chain, &cal.set, &cal.kf.theta, &truth_v), errors(&p.chain, &cal.set, &cal.nls.theta, &truth_v));
+            let data = collect(&truth, base_seed.wrapping_add(1000).wrapping_add(i))?;
+            let cal = calibrate(setup.chain, setup.compensation, &data, &cfg, History::Lean)?;
+            let truth_v = cal.set.values(&truth);
+            let out = (errors(setup.chain, &cal.set, &cal.kf.theta, &truth_v), errors(setup.chain, &cal.set, &cal.nls.theta, &truth_v));
             progress();
             Ok(Some(out))
         })
@@ -200,11 +219,11 @@ pub fn run(params: &Params, runs: usize, progress: &(dyn Fn() + Sync), stop: &At
         .map(|(j, (label, paper, identifiable))| {
             let kf: Vec<f64> = done.iter().map(|(k, _)| k[j]).collect();
             let nls: Vec<f64> = done.iter().map(|(_, n)| n[j]).collect();
-            QuantityRow { label: label.clone(), kf: Stats::of(&kf), nls: Stats::of(&nls), paper: *paper, identifiable: *identifiable }
+            QuantityRow { label: label.clone(), kf: ErrorSpread::of(&kf), nls: ErrorSpread::of(&nls), paper: *paper, identifiable: *identifiable }
         })
         .collect();
     let deg = |r: [f64; 2]| [r[0].to_degrees(), r[1].to_degrees()];
-    let setup = format!(
+    let described = format!(
         "α ~ U({:.0}″, {:.0}″), φ ~ U({:.1}°, {:.1}°), η ~ U({:.0}″, {:.0}″); η prior: {}",
         mc.swing_half_angle_rad[0] * ARCSEC_PER_RAD,
         mc.swing_half_angle_rad[1] * ARCSEC_PER_RAD,
@@ -218,12 +237,12 @@ pub fn run(params: &Params, runs: usize, progress: &(dyn Fn() + Sync), stop: &At
         }
     );
     Ok(Summary {
-        scenario: params.meta.name.clone(),
+        scenario: setup.scenario.to_owned(),
         runs: done.len(),
         runs_requested: runs,
         wall_s: started.elapsed().as_secs_f64(),
         threads: rayon::current_num_threads(),
-        setup,
+        setup: described,
         rows,
     })
 }
@@ -238,7 +257,7 @@ impl Summary {
         );
         s.push_str(&format!("  {:<24} {:>28} {:>28} {:>22}\n", "", "static KF", "exact least squares", "seed 000 Table 3"));
         for r in &self.rows {
-            let f = |st: &Stats| format!("{:>+9.4} ±{:>8.4} |{:>8.4}|", st.mean, st.std, st.mean_abs);
+            let f = |st: &ErrorSpread| format!("{:>+9.4} ±{:>8.4} |{:>8.4}|", st.mean, st.std, st.mean_abs);
             let paper = r.paper.map_or(String::new(), |(m, sd)| format!("{m:>9.2} ±{sd:>8.4}"));
             let mark = if r.identifiable { "" } else { "   not identifiable: set by the η prior" };
             s.push_str(&format!("  {:<24} {} {} {:>22}{}\n", r.label, f(&r.kf), f(&r.nls), paper, mark));

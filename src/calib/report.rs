@@ -5,8 +5,8 @@ use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use serde::Serialize;
 
 use super::{Calibration, ErrorSummary, Estimate, Param};
-use crate::gimbal::{Chain, TableErrors};
-use crate::units::{ARCSEC_PER_RAD, DEG_PER_RAD};
+use crate::model::gimbal::{Chain, TableErrors};
+use crate::math::units::{ARCSEC_PER_RAD, DEG_PER_RAD};
 
 /// A function of the parameter vector.
 type ParamFn = Box<dyn Fn(&[f64]) -> f64>;
@@ -281,7 +281,7 @@ pub fn build(scenario: &str, chain: &Chain, truth: &TableErrors, cal: &Calibrati
             phase_flag = format!("α = {:.3}″ is within 3σ of 0: the phase is undefined", a_nls.value);
             warnings.push(format!("{name}: {phase_flag}"));
         }
-        let wrap = |v: Value, t: f64| Value { value: t + crate::units::wrap_pi((v.value - t) / DEG_PER_RAD) * DEG_PER_RAD, sigma: v.sigma };
+        let wrap = |v: Value, t: f64| Value { value: t + crate::math::units::wrap_pi((v.value - t) / DEG_PER_RAD) * DEG_PER_RAD, sigma: v.sigma };
         let t_phi = truth.axes[k].swing_phase_rad * DEG_PER_RAD;
         angles.push(Row {
             key: format!("{name}.swing_phase"),
@@ -387,8 +387,8 @@ pub fn build(scenario: &str, chain: &Chain, truth: &TableErrors, cal: &Calibrati
         scenario: scenario.to_owned(),
         seed: data.seed,
         source: match data.source {
-            super::Source::Ins => "INS in the loop ([imu])".into(),
-            super::Source::Ideal => "exact IMU attitude (no [imu])".into(),
+            super::AttitudeSource::Ins => "INS in the loop ([imu])".into(),
+            super::AttitudeSource::Ideal => "exact IMU attitude (no [imu])".into(),
         },
         samples: cal.samples,
         duration_s: data.samples.last().map_or(0.0, |s| s.t_s),

@@ -2,15 +2,19 @@ use std::sync::atomic::AtomicBool;
 
 use nalgebra::{DMatrix, DVector, Vector3};
 
+use crate::math::frames::Rot;
+
+use super::estimate::exact_residual;
 use super::*;
-use crate::scenarios;
-use crate::units::{ARCSEC_PER_RAD, RAD_PER_ARCSEC, RAD_PER_DEG};
+use crate::app::calibrate::{calibrate_scenario, collect, monte_carlo};
+use crate::scenario::{presets, Params};
+use crate::math::units::{ARCSEC_PER_RAD, RAD_PER_ARCSEC, RAD_PER_DEG};
 
 /// The calibration preset (seed 000 Table 2 truth) with the IMU and encoder noise removed.
 fn noise_free() -> Params {
-    let mut p = scenarios::load("jiang2017-calibration").expect("preset");
+    let mut p = presets::load("jiang2017-calibration").expect("preset");
     p.ins = None;
-    for a in &mut p.truth.axes {
+    for a in &mut p.table.truth.axes {
         a.encoder_noise_rad = 0.0;
     }
     p
@@ -25,7 +29,7 @@ fn first_order_columns_are_the_closed_form_model() {
     // H·θ must equal the closed form of docs/closed-form.md (gimbal::first_order_phi_b, written
     // independently), for any parameters and angles: checked at 50 random-ish angle pairs.
     let p = noise_free();
-    let set = ParamSet::new(&p.chain, Nuisance::None);
+    let set = ParamSet::new(&p.table.chain, Nuisance::None);
     let theta = [120.0, -75.0, 40.0, 310.0, -25.0].map(|x| x * RAD_PER_ARCSEC);
     let errors = set.errors(&theta, &TableErrors::zero(2));
     let n_from_b = Attitude { pitch_rad: 0.1, roll_rad: -0.2, heading_rad: 0.7 }.n_from_b();
@@ -33,10 +37,10 @@ fn first_order_columns_are_the_closed_form_model() {
     let mut h = [[0.0; MAX_TABLE]; 3];
     for i in 0..50 {
         let angles = [0.37 * i as f64, -1.13 * i as f64 + 0.2, 0.0];
-        let s = Sample { t_s: 0.0, tau: 0.0, n_from_s: UnitQuaternion::identity(), shafts: p.chain.shaft_rotations(&angles) };
-        set.table_rows(&p.chain, &nb, &s, &mut h);
+        let s = Measurement { t_s: 0.0, tau: 0.0, n_from_s: Rot::identity(), shafts: p.table.chain.shaft_rotations(&angles) };
+        set.table_rows(&p.table.chain, &nb, &s, &mut h);
         let ours = Vector3::from_fn(|r, _| (0..5).map(|j| h[r][j] * theta[j]).sum::<f64>());
-        let closed = nb * p.chain.first_order_phi_b(&errors, &angles, &[0.0; 3]).v;
+        let closed = nb * p.table.chain.first_order_phi_b(&errors, &angles, &[0.0; 3]).v;
         assert!((ours - closed).norm() < 1e-15, "angles {angles:?}: {ours:?} vs {closed:?}");
     }
 }
@@ -46,23 +50,23 @@ fn the_filter_is_eq_33_in_information_form() {
     // Seed 000 eq. 33 literally (x̂_k = x̂_{k−1} + P_k H R⁻¹ (z − H x̂_{k−1}),
     // P_k = (P_{k−1}⁻¹ + Hᵀ R⁻¹ H)⁻¹), run sample by sample on the first 2000 measurements, against
     // the information form the calibration uses: the same estimate to rounding.
-    let mut p = scenarios::load("jiang2017-calibration").expect("preset");
+    let mut p = presets::load("jiang2017-calibration").expect("preset");
     p.duration_s = 10.0;
     p.calibration.nuisance = Nuisance::None;
     let data = collect(&p, 5).expect("data");
-    let cal = calibrate(&p.chain, &p.compensation, &data, &p.calibration, 0.0).expect("calibration");
+    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final).expect("calibration");
     let set = &cal.set;
     let (x0, s0) = set.prior(&p.calibration);
     let mut x = DVector::from_vec(x0);
     let mut pm = DMatrix::from_diagonal(&DVector::from_iterator(5, s0.iter().map(|s| s * s)));
     let r_inv = 1.0 / p.calibration.measurement_sigma_rad.powi(2);
-    let nb = data.n_from_b.to_rotation_matrix().into_inner();
-    let before = p.chain.error_rotations(&set.without_estimated(&p.compensation));
+    let nb = data.n_from_b.matrix();
+    let before = p.table.chain.error_rotations(&set.without_estimated(&p.table.compensation));
     let mut h = [[0.0; MAX_TABLE]; 3];
     for s in &data.samples {
-        set.table_rows(&p.chain, &nb, s, &mut h);
+        set.table_rows(&p.table.chain, &nb, s, &mut h);
         let hm = DMatrix::from_fn(3, 5, |r, j| h[r][j]);
-        let z = exact_residual(&p.chain, &before, s, &data.n_from_b.inverse());
+        let z = exact_residual(&p.table.chain, &before, s, &data.n_from_b.inverse());
         let z = DVector::from_column_slice(z.as_slice());
         let p_inv = pm.clone().try_inverse().expect("invertible") + hm.transpose() * &hm * r_inv;
         pm = p_inv.try_inverse().expect("invertible");
@@ -80,8 +84,8 @@ fn noise_free_data_give_the_true_parameters() {
     // of phase angle); the first-order filter is off by its neglected second-order terms.
     let p = noise_free();
     let data = collect(&p, 1).expect("data");
-    let cal = calibrate(&p.chain, &p.compensation, &data, &p.calibration, 0.0).expect("calibration");
-    let report = report::build("t", &p.chain, &p.truth, &cal, &data, None);
+    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final).expect("calibration");
+    let report = report::build("t", &p.table.chain, &p.table.truth, &cal, &data, None);
     let row = |key: &str| report.angles.iter().chain(&report.state).find(|r| r.key == key).unwrap_or_else(|| panic!("no row {key}"));
     for key in ["inner.swing_half_angle", "outer.swing_cos", "inner.effective_non_orthogonality"] {
         let r = row(key);
@@ -95,10 +99,10 @@ fn noise_free_data_give_the_true_parameters() {
 
     // Given η from an independent measurement (exactly), all five of the paper's parameters follow.
     let mut p = p;
-    p.calibration.prior_eta_rad = p.truth.axes[1].non_orthogonality_rad;
+    p.calibration.prior_eta_rad = p.table.truth.axes[1].non_orthogonality_rad;
     p.calibration.prior_eta_sigma_rad = 1e-9 * RAD_PER_ARCSEC;
-    let cal = calibrate(&p.chain, &p.compensation, &data, &p.calibration, 0.0).expect("calibration");
-    let report = report::build("t", &p.chain, &p.truth, &cal, &data, None);
+    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final).expect("calibration");
+    let report = report::build("t", &p.table.chain, &p.table.truth, &cal, &data, None);
     assert!(report.unobservable.iter().all(|u| u.resolved_by_prior), "{:?}", report.unobservable);
     assert!(report.warnings.is_empty(), "{:?}", report.warnings);
     for r in &report.angles {
@@ -113,23 +117,23 @@ fn outer_swing_and_eta_are_one_rotation_and_the_report_says_so() {
     // side by side in gimbal 1 (docs/calibration.md), so swapping one for the other changes the
     // IMU attitude by the commutator term only (second order: ½·η·α2 cos φ2 ≈ 0.03″ here).
     let p = noise_free();
-    let set = ParamSet::new(&p.chain, Nuisance::None);
-    let mut a = set.values(&p.truth);
+    let set = ParamSet::new(&p.table.chain, Nuisance::None);
+    let mut a = set.values(&p.table.truth);
     let mut b = a.clone();
     let shift = 15.0 * RAD_PER_ARCSEC;
     a[3] += shift; // outer α sin φ
     b[4] -= shift; // inner η, the opposite way: η_eff unchanged
-    let (ea, eb) = (set.errors(&a, &p.truth), set.errors(&b, &p.truth));
-    let (ra, rb) = (p.chain.error_rotations(&ea), p.chain.error_rotations(&eb));
+    let (ea, eb) = (set.errors(&a, &p.table.truth), set.errors(&b, &p.table.truth));
+    let (ra, rb) = (p.table.chain.error_rotations(&ea), p.table.chain.error_rotations(&eb));
     for i in 0..40 {
         let angles = [0.3 * i as f64, 0.71 * i as f64, 0.0];
-        let d = (p.chain.b_from_s(&ra, &angles).quaternion().inverse() * p.chain.b_from_s(&rb, &angles).quaternion()).angle();
+        let d = (p.table.chain.b_from_s(&ra, &angles).quaternion().inverse() * p.table.chain.b_from_s(&rb, &angles).quaternion()).angle();
         assert!(arcsec(d) < 0.05, "difference {}″", arcsec(d));
     }
     // And the calibration reports exactly that direction as unobservable, with η_eff determined.
     let data = collect(&p, 1).expect("data");
-    let cal = calibrate(&p.chain, &p.compensation, &data, &p.calibration, 0.0).expect("calibration");
-    let report = report::build("t", &p.chain, &p.truth, &cal, &data, None);
+    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final).expect("calibration");
+    let report = report::build("t", &p.table.chain, &p.table.truth, &cal, &data, None);
     assert_eq!(report.unobservable.len(), 1, "{:?}", report.unobservable);
     let dir = &report.unobservable[0].direction;
     let keys: Vec<&str> = dir.iter().map(|(k, _)| k.as_str()).collect();
@@ -138,7 +142,7 @@ fn outer_swing_and_eta_are_one_rotation_and_the_report_says_so() {
     let (name, v) = report.unobservable[0].determined.clone().expect("a determined combination");
     assert!(name.contains("outer α·sin φ") && name.contains("inner η"), "{name}");
     // outer α sin φ − η = 10.47″ − 20″.
-    let expected = arcsec(set.values(&p.truth)[3] - set.values(&p.truth)[4]);
+    let expected = arcsec(set.values(&p.table.truth)[3] - set.values(&p.table.truth)[4]);
     assert!((v.value.abs() - expected.abs()).abs() < 0.01, "{} vs {expected}", v.value);
     assert!(report.warnings.iter().any(|w| w.contains("not observable")), "{:?}", report.warnings);
     for key in ["outer.swing_half_angle", "outer.swing_phase", "inner.non_orthogonality"] {
@@ -151,39 +155,27 @@ fn outer_swing_and_eta_are_one_rotation_and_the_report_says_so() {
 fn phase_and_eq_34_warnings_trigger_where_they_should() {
     // φ1 = 90°: x1 = α1 cos φ1 = 0, so seed 000 eq. 34's η = atan(x4/x1) is undefined → warning.
     // α1 = 0.02″ under 12″ encoder noise: the inner phase is undefined → warning.
-    let mut p = scenarios::load("jiang2017-calibration").expect("preset");
+    let mut p = presets::load("jiang2017-calibration").expect("preset");
     p.ins = None;
     p.duration_s = 60.0;
-    p.truth.axes[1].swing_phase_rad = 90.0 * RAD_PER_DEG;
+    p.table.truth.axes[1].swing_phase_rad = 90.0 * RAD_PER_DEG;
     let data = collect(&p, 3).expect("data");
-    let cal = calibrate(&p.chain, &p.compensation, &data, &p.calibration, 0.0).expect("calibration");
-    let report = report::build("t", &p.chain, &p.truth, &cal, &data, None);
+    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final).expect("calibration");
+    let report = report::build("t", &p.table.chain, &p.table.truth, &cal, &data, None);
     assert!(report.warnings.iter().any(|w| w.contains("eq. 34")), "{:?}", report.warnings);
     assert!(!report.warnings.iter().any(|w| w.contains("phase is undefined")), "{:?}", report.warnings);
 
-    p.truth.axes[1].swing_half_angle_rad = 0.02 * RAD_PER_ARCSEC;
+    p.table.truth.axes[1].swing_half_angle_rad = 0.02 * RAD_PER_ARCSEC;
     let data = collect(&p, 3).expect("data");
-    let cal = calibrate(&p.chain, &p.compensation, &data, &p.calibration, 0.0).expect("calibration");
-    let report = report::build("t", &p.chain, &p.truth, &cal, &data, None);
+    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final).expect("calibration");
+    let report = report::build("t", &p.table.chain, &p.table.truth, &cal, &data, None);
     assert!(report.warnings.iter().any(|w| w.starts_with("inner: ") && w.contains("phase is undefined")), "{:?}", report.warnings);
     // A clearly non-zero α1 at φ1 = 1° raises neither.
-    let p = scenarios::load("jiang2017-calibration").expect("preset");
+    let p = presets::load("jiang2017-calibration").expect("preset");
     let data = collect(&p, 3).expect("data");
-    let cal = calibrate(&p.chain, &p.compensation, &data, &p.calibration, 0.0).expect("calibration");
-    let report = report::build("t", &p.chain, &p.truth, &cal, &data, None);
+    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final).expect("calibration");
+    let report = report::build("t", &p.table.chain, &p.table.truth, &cal, &data, None);
     assert!(!report.warnings.iter().any(|w| w.contains("eq. 34") || w.contains("phase is undefined")), "{:?}", report.warnings);
-}
-
-#[test]
-fn rotation_vector_matches_the_library_log() {
-    for angle in [1e-9, 1e-5, 1e-3, 0.019, 0.021, 0.5, 3.0] {
-        let v = Vector3::new(0.3, -0.5, 0.81).normalize() * angle;
-        let q = UnitQuaternion::from_scaled_axis(v);
-        assert!((rotation_vector(&q) - v).norm() <= 1e-15 * angle.max(1e-3), "angle {angle}");
-        // The same rotation with the quaternion's other sign.
-        let neg = UnitQuaternion::new_unchecked(-q.into_inner());
-        assert!((rotation_vector(&neg) - v).norm() <= 1e-15 * angle.max(1e-3), "angle {angle} (−q)");
-    }
 }
 
 #[test]
@@ -191,8 +183,8 @@ fn compensation_with_the_estimates_beats_the_papers_factors() {
     // Seed 000's laboratory: peaks 1.6′ → 25.2″ (pitch), 1.86′ → 30.24″ (roll), 2.5′ → 49.32″
     // (heading). Under the paper's noise (Table 1 INS, 12″ encoders) rinscope's compensation with
     // its own estimates, on an independent run, must reduce each peak at least as much.
-    let p = scenarios::load("jiang2017-calibration").expect("preset");
-    let out = run(&p, false).expect("calibration");
+    let p = presets::load("jiang2017-calibration").expect("preset");
+    let out = calibrate_scenario(&p, false).expect("calibration");
     let c = out.report.compensation.expect("compensation");
     for (i, (before, after)) in report::PAPER_LAB.iter().enumerate() {
         let ours = c.before.peak_rad[i] / c.after_nls.peak_rad[i];
@@ -209,10 +201,10 @@ fn monte_carlo_statistics_are_stable_across_seeds() {
     // within the sampling spread of 40 runs (ratio within 0.55..1.8: the 99.9 % range of an F(39, 39)
     // ratio of variances is 0.36..2.8, of deviations 0.6..1.7).
     let stop = AtomicBool::new(false);
-    let mut p = scenarios::load("jiang2017-calibration").expect("preset");
-    let a = montecarlo::run(&p, 40, &|| {}, &stop).expect("mc");
+    let mut p = presets::load("jiang2017-calibration").expect("preset");
+    let a = monte_carlo(&p, 40, &|| {}, &stop).expect("mc");
     p.meta.seed = 99;
-    let b = montecarlo::run(&p, 40, &|| {}, &stop).expect("mc");
+    let b = monte_carlo(&p, 40, &|| {}, &stop).expect("mc");
     assert_eq!(a.runs, 40);
     let mut checked = 0;
     for (ra, rb) in a.rows.iter().zip(&b.rows) {
@@ -233,8 +225,8 @@ fn monte_carlo_statistics_are_stable_across_seeds() {
 
 #[test]
 fn a_moving_vehicle_is_refused() {
-    let mut p = scenarios::load("jiang2017-calibration").expect("preset");
-    let wobble = crate::motion::Wobble { angle: crate::motion::AngleKind::Roll, amplitude_rad: 0.01, omega_rad_per_s: 0.5, phase_rad: 0.0 };
-    p.vehicle = crate::motion::VehicleMotion::new(Attitude::default(), vec![], vec![wobble]).expect("motion");
+    let mut p = presets::load("jiang2017-calibration").expect("preset");
+    let wobble = crate::model::motion::Wobble { angle: crate::model::motion::AngleKind::Roll, amplitude_rad: 0.01, omega_rad_per_s: 0.5, phase_rad: 0.0 };
+    p.table.vehicle = crate::model::motion::VehicleMotion::new(Attitude::default(), vec![], vec![wobble]).expect("motion");
     assert!(matches!(collect(&p, 0), Err(CalibError::VehicleMoves(_))));
 }

@@ -2,9 +2,11 @@
 //! sculling compensation, Coriolis and transport rate, normal gravity, latitude/longitude/height;
 //! the vertical channel held or free; optional horizontal velocity damping (seed 003 §4.1).
 
-use nalgebra::{UnitQuaternion, Vector3};
+use nalgebra::Vector3;
 
-use super::truth::{normal_gravity, Earth, EARTH_RATE};
+use crate::math::frames::{Rot, N, S};
+
+use crate::model::earth::{normal_gravity, omega_ie_n, Earth};
 
 /// How the vertical channel is handled (it is unstable when free).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -47,12 +49,6 @@ pub struct Navigator {
     height0: f64,
 }
 
-/// Schuler frequency, rad/s: √(g/R) ≈ 1.24e-3.
-#[must_use]
-pub fn schuler_rate() -> f64 {
-    (normal_gravity(0.0, 0.0) / super::truth::EARTH_A).sqrt()
-}
-
 impl Navigator {
     /// Starts at rest at `earth`'s site.
     #[must_use]
@@ -68,7 +64,7 @@ impl Navigator {
         let (sl, cl) = st.latitude_rad.sin_cos();
         let (rm, rn) = Earth::radii(st.latitude_rad);
         let (rm, rn) = (rm + st.height_m, rn + st.height_m);
-        let w_ie = Vector3::new(0.0, EARTH_RATE * cl, EARTH_RATE * sl);
+        let w_ie = omega_ie_n(st.latitude_rad);
         let w_en = Vector3::new(-st.v_n.y / rm, st.v_n.x / rn, st.v_n.x * sl / (cl * rn));
         w_ie + w_en
     }
@@ -76,7 +72,7 @@ impl Navigator {
     /// One velocity/position update over `h` seconds from the sensor increments of the update (one
     /// entry per gyro/accel sample), with the attitude C_s^n at the start of the update and the
     /// navigation-frame rotation `zeta_n` over it.
-    pub fn update(&mut self, n_from_s_start: &UnitQuaternion<f64>, dtheta: &[Vector3<f64>], dv: &[Vector3<f64>], zeta_n: &Vector3<f64>, h: f64) {
+    pub fn update(&mut self, n_from_s_start: &Rot<N, S>, dtheta: &[Vector3<f64>], dv: &[Vector3<f64>], zeta_n: &Vector3<f64>, h: f64) {
         let theta: Vector3<f64> = dtheta.iter().sum();
         let vel: Vector3<f64> = dv.iter().sum();
         // Rotation compensation and sculling (Savage's two- and three-sample forms).
@@ -89,13 +85,14 @@ impl Navigator {
             }
             _ => {}
         }
-        let dv_sf_n = n_from_s_start * dv_s - 0.5 * zeta_n.cross(&(n_from_s_start * dv_s));
+        let c = n_from_s_start.quaternion();
+        let dv_sf_n = c * dv_s - 0.5 * zeta_n.cross(&(c * dv_s));
 
         let st = &mut self.state;
         let (sl, cl) = st.latitude_rad.sin_cos();
         let (rm, rn) = Earth::radii(st.latitude_rad);
         let (rm, rn) = (rm + st.height_m, rn + st.height_m);
-        let w_ie = Vector3::new(0.0, EARTH_RATE * cl, EARTH_RATE * sl);
+        let w_ie = omega_ie_n(st.latitude_rad);
         let w_en = Vector3::new(-st.v_n.y / rm, st.v_n.x / rn, st.v_n.x * sl / (cl * rn));
         let g = Vector3::new(0.0, 0.0, -normal_gravity(st.latitude_rad, st.height_m));
         let v_old = st.v_n;

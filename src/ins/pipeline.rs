@@ -12,12 +12,14 @@ use super::coning::Algorithm;
 use super::fir::Fir;
 use super::nav::{NavState, Navigator};
 use super::sensor::Sensors;
-use super::strapdown::{exp_small, AttitudeIntegrator};
-use super::truth::{Earth, TruthImu};
-use super::InsConfig;
-use crate::config::Params;
-use crate::euler::{Attitude, AttitudeError};
-use crate::frames::{Rot, B, N, S};
+use super::strapdown::AttitudeIntegrator;
+use super::truth::TruthImu;
+use crate::math::rotvec::exp_small;
+use crate::model::earth::Earth;
+use super::InsParams;
+use crate::math::attitude::{Attitude, AttitudeError};
+use crate::math::frames::{Rot, B, N, S};
+use crate::model::earth::Site;
 use crate::sim::{demodulate, encoder_readings, DemodState, Model};
 
 /// What one IMU sample produced.
@@ -42,21 +44,35 @@ pub struct InsView {
     pub t_ref_s: f64,
     /// Body attitude error of each algorithm (computed minus true), in integrator order.
     pub errors: Vec<AttitudeError>,
-    /// True C_s^n at the instant the INS output represents, and the primary INS's C_s^n.
-    pub imu_true: UnitQuaternion<f64>,
+    /// True C_s^n at the instant the INS output represents.
+    pub imu_true: Rot<N, S>,
     /// The primary algorithm's C_s^n.
-    pub imu_ins: UnitQuaternion<f64>,
-    /// Navigation errors: (east, north) position m, (east, north, up) velocity m/s.
-    pub nav: Option<(Vector3<f64>, Vector3<f64>)>,
+    pub imu_ins: Rot<N, S>,
+    /// Navigation errors, when navigating.
+    pub nav: Option<NavError>,
+}
+
+/// Navigation errors (computed − true) at one output instant.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct NavError {
+    /// East position error, m.
+    pub east_m: f64,
+    /// North position error, m.
+    pub north_m: f64,
+    /// Horizontal (radial) position error, m.
+    pub radial_m: f64,
+    /// Velocity error (East, North, Up), m/s (the vehicle is at rest: this is the velocity).
+    pub velocity_enu_mps: Vector3<f64>,
 }
 
 /// The attitude output `zoh` after the latest of two (time, attitude) updates, interpolated.
-fn output_attitude(history: &[(f64, UnitQuaternion<f64>); 2], zoh: f64) -> (f64, UnitQuaternion<f64>) {
+fn output_attitude(history: &[(f64, Rot<N, S>); 2], zoh: f64) -> (f64, Rot<N, S>) {
     let [(t0, q0), (t1, q1)] = *history;
     let t = t1 - zoh;
     if t1 > t0 && t < t1 {
         let f = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
-        (t, q0.slerp(&q1, f))
+        // FRAME: between two C_s^n the interpolated rotation is C_s^n at the instant in between.
+        (t, Rot::from_quaternion(q0.quaternion().slerp(q1.quaternion(), f)))
     } else {
         (t1, q1)
     }
@@ -65,7 +81,7 @@ fn output_attitude(history: &[(f64, UnitQuaternion<f64>); 2], zoh: f64) -> (f64,
 /// The INS in the loop (cloned to fork one IMU stream into two navigation strategies).
 #[derive(Clone)]
 pub struct InsRun {
-    cfg: InsConfig,
+    cfg: InsParams,
     truth: TruthImu,
     earth: Earth,
     sensors: Sensors,
@@ -77,9 +93,9 @@ pub struct InsRun {
     /// The integrators; `[0]` is the configured algorithm (the navigation's).
     integrators: Vec<AttitudeIntegrator>,
     /// (time, attitude) of each integrator's previous and latest update.
-    history: Vec<[(f64, UnitQuaternion<f64>); 2]>,
+    history: Vec<[(f64, Rot<N, S>); 2]>,
     nav: Option<Navigator>,
-    nav_start: UnitQuaternion<f64>,
+    nav_start: Rot<N, S>,
     upd_g: Vec<Vector3<f64>>,
     upd_a: Vec<Vector3<f64>>,
     demod: Vec<DemodState>,
@@ -90,12 +106,13 @@ pub struct InsRun {
 }
 
 impl InsRun {
-    /// Builds the INS for a scenario (which must have an `[imu]` section) and pre-rolls the FIR.
+    /// Builds the INS `cfg` at `site` on the table `model` (sensor noise seeded with `seed`) and
+    /// pre-rolls the FIR.
     #[must_use]
-    pub fn new(params: &Params, model: Model) -> Option<Self> {
-        let cfg = params.ins.clone()?;
-        let h = 1.0 / params.step_hz;
-        let earth = Earth::at(params.site);
+    pub fn new(cfg: &InsParams, site: Site, seed: u64, model: Model) -> Self {
+        let cfg = cfg.clone();
+        let h = 1.0 / cfg.rate_hz;
+        let earth = Earth::at(site);
         let fir_g = Fir::new(&cfg.fir_taps);
         let fir_a = Fir::new(&cfg.fir_taps);
         let fir_delay_s = fir_g.group_delay_samples() * h;
@@ -105,12 +122,8 @@ impl InsRun {
         let pre = cfg.fir_taps.len().saturating_sub(1).max(2 * cfg.decimation);
         let t_start = -(pre as f64) * h;
         let truth = TruthImu::new(model, earth, t_start);
-        let sensors = Sensors::new(&cfg.errors, h, params.meta.seed, t_start);
-        let algorithms: Vec<Algorithm> = if cfg.compare {
-            std::iter::once(cfg.algorithm).chain(Algorithm::ALL.into_iter().filter(|a| *a != cfg.algorithm)).collect()
-        } else {
-            vec![cfg.algorithm]
-        };
+        let sensors = Sensors::new(&cfg.errors, h, seed, t_start);
+        let algorithms = cfg.algorithms();
         let nav = cfg.navigation.map(|o| Navigator::new(&earth, o));
         let mut me = Self {
             truth,
@@ -124,7 +137,7 @@ impl InsRun {
             integrators: Vec::new(),
             history: Vec::new(),
             nav,
-            nav_start: UnitQuaternion::identity(),
+            nav_start: Rot::identity(),
             upd_g: Vec::new(),
             upd_a: Vec::new(),
             demod: Vec::new(),
@@ -148,8 +161,9 @@ impl InsRun {
         }
         // The filtered stream now stands at the truth of t = −d: start the attitude there, with the
         // alignment error φ applied as C = (I − [φ×]) C_true.
-        let start = *me.truth.eval(-fir_delay_s).n_from_s.quaternion();
-        let start = exp_small(&-me.cfg.initial_error_rad) * start;
+        let start = me.truth.eval(-fir_delay_s).n_from_s;
+        // FRAME: the alignment error is a small rotation of the navigation frame (C = (I − [φ×]) C_true).
+        let start: Rot<N, S> = Rot::<N, N>::from_quaternion(exp_small(&-me.cfg.initial_error_rad)) * start;
         me.integrators = algorithms
             .iter()
             .map(|a| {
@@ -161,12 +175,12 @@ impl InsRun {
         me.history = vec![[(-fir_delay_s, start), (-fir_delay_s, start)]; me.integrators.len()];
         me.demod = vec![DemodState::default(); me.integrators.len()];
         me.nav_start = start;
-        Some(me)
+        me
     }
 
     /// The configuration.
     #[must_use]
-    pub fn config(&self) -> &InsConfig {
+    pub fn config(&self) -> &InsParams {
         &self.cfg
     }
 
@@ -189,7 +203,7 @@ impl InsRun {
     }
 
     /// Replaces the primary attitude (position-fix and azimuth resets of later issues).
-    pub fn set_primary_attitude(&mut self, n_from_s: UnitQuaternion<f64>) {
+    pub fn set_primary_attitude(&mut self, n_from_s: Rot<N, S>) {
         if let Some(i) = self.integrators.first_mut() {
             i.n_from_s = n_from_s;
         }
@@ -208,7 +222,8 @@ impl InsRun {
     /// Turns the primary attitude about the local vertical by `angle_rad` (counter-clockwise seen from
     /// above: the heading decreases by `angle_rad`): an azimuth correction.
     pub fn rotate_azimuth(&mut self, angle_rad: f64) {
-        let r = UnitQuaternion::from_scaled_axis(Vector3::z() * angle_rad);
+        // FRAME: a rotation of the computed navigation frame about its own vertical.
+        let r: Rot<N, N> = Rot::from_quaternion(UnitQuaternion::from_scaled_axis(Vector3::z() * angle_rad));
         if let Some(i) = self.integrators.first_mut() {
             i.n_from_s = r * i.n_from_s;
         }
@@ -266,7 +281,7 @@ impl InsRun {
     /// Integrator `k`'s C_s^n as output at `t_s` (after its latest update): with the zero-order
     /// hold, the value h/2 earlier, interpolated between the two latest updates.
     #[must_use]
-    pub fn output_attitude(&self, k: usize) -> (f64, UnitQuaternion<f64>) {
+    pub fn output_attitude(&self, k: usize) -> (f64, Rot<N, S>) {
         output_attitude(&self.history[k], self.zoh_delay_s)
     }
 
@@ -277,7 +292,7 @@ impl InsRun {
         let model = self.truth.model();
         let mut errors = Vec::with_capacity(self.integrators.len());
         for k in 0..self.integrators.len() {
-            let (t_repr, q) = output_attitude(&self.history[k], self.zoh_delay_s);
+            let (t_repr, n_from_s) = output_attitude(&self.history[k], self.zoh_delay_s);
             // The output left the computer d + zoh after the instant it represents.
             let t_ref = t_repr + self.fir_delay_s + self.zoh_delay_s - self.cfg.output_compensation_s;
             // The encoders are read for the instant the IMU data represent (matched synchronisation).
@@ -285,19 +300,17 @@ impl InsRun {
             let corrected = self.demod[k].correct(model, t_repr, &encoder);
             let b_from_s_comp = model.chain.b_from_s(model.compensation_rotations(), &corrected);
             let (truth_att, _) = model.vehicle.state(t_ref);
-            // FRAME: the integrator propagates C_s^n.
-            let n_from_s: Rot<N, S> = Rot::from_quaternion(q);
             errors.push(demodulate(n_from_s, b_from_s_comp).error_from(&truth_att));
         }
         let (t_repr, imu_ins) = self.output_attitude(0);
-        let imu_true = *self.truth.eval(t_repr).n_from_s.quaternion();
+        let imu_true = self.truth.eval(t_repr).n_from_s;
         let nav = self.nav.as_ref().map(|n| {
             let s = &n.state;
             let site = self.earth.site;
             let (rm, rn) = Earth::radii(site.latitude_rad);
             let north = (s.latitude_rad - site.latitude_rad) * (rm + site.height_m);
             let east = (s.longitude_rad - site.longitude_rad) * (rn + site.height_m) * site.latitude_rad.cos();
-            (Vector3::new(east, north, north.hypot(east)), s.v_n)
+            NavError { east_m: east, north_m: north, radial_m: north.hypot(east), velocity_enu_mps: s.v_n }
         });
         InsView { t_s, t_ref_s: t_s - self.cfg.output_compensation_s, errors, imu_true, imu_ins, nav }
     }
@@ -305,7 +318,7 @@ impl InsRun {
     /// The body attitude the primary INS outputs (for tests and resets).
     #[must_use]
     pub fn body_attitude(&self, b_from_s: Rot<B, S>) -> Attitude {
-        let n_from_s: Rot<N, S> = Rot::from_quaternion(self.output_attitude(0).1);
+        let n_from_s = self.output_attitude(0).1;
         // FRAME: C_b^n = C_s^n · C_b^s.
         Attitude::from_n_from_b(&(n_from_s * b_from_s.inverse()))
     }
@@ -320,20 +333,21 @@ impl InsRun {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::units::{ARCSEC_PER_RAD, RAD_PER_DEG};
+    use crate::math::units::{ARCSEC_PER_RAD, RAD_PER_DEG};
+    use crate::scenario::Params;
 
     /// A scenario built from TOML text (the tests' one configuration mechanism, as users write it).
     pub(crate) fn params(extra: &str, table: &str) -> Params {
         let text = format!(
             "[scenario]\nname = \"t\"\ntitle = \"t\"\nseed = 5\n[simulation]\nduration_s = 100.0\nstep_hz = 200.0\n[site]\nlatitude_deg = 40.0\n{table}\n{extra}"
         );
-        crate::config::parse(&text, "test").expect("test scenario")
+        crate::scenario::parse(&text, "test").expect("test scenario")
     }
 
     const STATIC_TABLE: &str = "[turntable]\n[[turntable.axis]]\nname = \"table\"\naxis = \"z\"\n[scheme]\nkind = \"static\"\n";
 
     fn run(p: &Params, seconds: f64, mut each_update: impl FnMut(&mut InsRun, f64)) -> InsRun {
-        let mut ins = InsRun::new(p, Model::new(p)).expect("ins");
+        let mut ins = p.ins_run().expect("ins");
         let n = (seconds * p.step_hz).round() as u64;
         for _ in 0..n {
             let out = ins.step();
@@ -359,8 +373,8 @@ mod tests {
                 for e in &v.errors {
                     worst_att = worst_att.max(e.as_array().iter().fold(0.0f64, |m, x| m.max(x.abs())));
                 }
-                if let Some((pos, _)) = v.nav {
-                    worst_pos = worst_pos.max(pos.z);
+                if let Some(e) = v.nav {
+                    worst_pos = worst_pos.max(e.radial_m);
                 }
             }
         });
@@ -397,7 +411,7 @@ mod tests {
 mod bias_tests {
     use super::tests::params;
     use super::*;
-    use crate::ins::truth::{normal_gravity, EARTH_RATE};
+    use crate::model::earth::{normal_gravity, EARTH_RATE};
 
     /// The textbook linear error model of a stationary INS (Titterton & Weston ch. 12, phi-angle form,
     /// ENU, vertical channel held), integrated with RK4 — an independent computation:
@@ -456,16 +470,16 @@ mod bias_tests {
         let hours = 8.0;
         let times: Vec<f64> = (1..=32).map(|i| f64::from(i) * 900.0).collect();
         let model = linear_model(eps, p.site.latitude_rad, hours * 3600.0, &times);
-        let mut ins = InsRun::new(&p, Model::new(&p)).expect("ins");
+        let mut ins = p.ins_run().expect("ins");
         let mut got = Vec::new();
         let mut next = 0;
         while next < times.len() {
             let out = ins.step();
             if out.updated && (out.t_s - times[next]).abs() < 0.5 / p.step_hz {
                 let v = ins.view(out.t_s);
-                let (pos, _) = v.nav.expect("navigating");
+                let e = v.nav.expect("navigating");
                 // Heading error = φ_U for a level vehicle heading North (computed = (I − [φ×]) true).
-                got.push((pos.x, pos.y, v.errors[0].heading_rad));
+                got.push((e.east_m, e.north_m, v.errors[0].heading_rad));
                 next += 1;
             }
         }

@@ -43,21 +43,60 @@ impl Spec {
     }
 }
 
-/// Errors of one sensor triad, in SI (rad, rad/s, m/s, m/s², s).
+/// Errors of the gyro triad, SI.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct TriadSpec {
-    /// Constant bias (rad/s or m/s²).
-    pub bias: Spec,
+pub struct GyroSpec {
+    /// Constant bias, rad/s.
+    pub bias_rad_per_s: Spec,
     /// Scale-factor error (dimensionless).
     pub scale: Spec,
-    /// Misalignment: 1σ of each of the six small off-diagonal angles (rad).
+    /// Misalignment: 1σ of each of the six small off-diagonal angles, rad.
     pub misalignment_rad: f64,
-    /// White noise density: rad/√s (ARW) or m/s/√s (VRW).
-    pub white: f64,
-    /// Bias instability: σ of a first-order Gauss-Markov bias (rad/s or m/s²).
-    pub instability: f64,
+    /// Angle random walk (white rate noise density), rad/√s.
+    pub arw_rad_per_sqrt_s: f64,
+    /// Bias instability: σ of a first-order Gauss-Markov bias, rad/s.
+    pub instability_rad_per_s: f64,
     /// Its correlation time, s.
     pub correlation_s: f64,
+}
+
+/// Errors of the accelerometer triad, SI.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct AccelSpec {
+    /// Constant bias, m/s².
+    pub bias_mps2: Spec,
+    /// Scale-factor error (dimensionless).
+    pub scale: Spec,
+    /// Misalignment: 1σ of each of the six small off-diagonal angles, rad.
+    pub misalignment_rad: f64,
+    /// Velocity random walk (white acceleration noise density), m/s/√s.
+    pub vrw_mps_per_sqrt_s: f64,
+    /// Bias instability: σ of a first-order Gauss-Markov bias, m/s².
+    pub instability_mps2: f64,
+    /// Its correlation time, s.
+    pub correlation_s: f64,
+}
+
+/// One triad's errors in the common form (the unit is the triad's: rad/s or m/s²).
+struct TriadErrors {
+    bias: Spec,
+    scale: Spec,
+    misalignment_rad: f64,
+    white_per_sqrt_s: f64,
+    instability: f64,
+    correlation_s: f64,
+}
+
+impl From<&GyroSpec> for TriadErrors {
+    fn from(g: &GyroSpec) -> Self {
+        Self { bias: g.bias_rad_per_s, scale: g.scale, misalignment_rad: g.misalignment_rad, white_per_sqrt_s: g.arw_rad_per_sqrt_s, instability: g.instability_rad_per_s, correlation_s: g.correlation_s }
+    }
+}
+
+impl From<&AccelSpec> for TriadErrors {
+    fn from(a: &AccelSpec) -> Self {
+        Self { bias: a.bias_mps2, scale: a.scale, misalignment_rad: a.misalignment_rad, white_per_sqrt_s: a.vrw_mps_per_sqrt_s, instability: a.instability_mps2, correlation_s: a.correlation_s }
+    }
 }
 
 /// Ring-laser-gyro dither: each gyro block oscillates at its own frequency; the motion is sensed by
@@ -76,9 +115,9 @@ pub struct DitherSpec {
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct ImuErrorSpec {
     /// Gyros.
-    pub gyro: TriadSpec,
+    pub gyro: GyroSpec,
     /// Accelerometers.
-    pub accel: TriadSpec,
+    pub accel: AccelSpec,
     /// g-dependent gyro bias: rad/s per m/s² of specific force along the gyro's axis.
     pub g_sensitivity: f64,
     /// Dither.
@@ -96,7 +135,7 @@ struct Triad {
 }
 
 impl Triad {
-    fn new(spec: &TriadSpec, h: f64, rng: &mut ChaCha8Rng) -> Self {
+    fn new(spec: &TriadErrors, h: f64, rng: &mut ChaCha8Rng) -> Self {
         let bias = spec.bias.draw(rng);
         let scale = spec.scale.draw(rng);
         let mut gain = Matrix3::identity() + Matrix3::from_diagonal(&scale);
@@ -119,7 +158,7 @@ impl Triad {
             // Start in the stationary distribution.
             gm = Spec::Sigma(spec.instability).draw(rng);
         }
-        Self { bias, gain, white_per_sample: spec.white * h.sqrt(), gm, gm_decay, gm_drive }
+        Self { bias, gain, white_per_sample: spec.white_per_sqrt_s * h.sqrt(), gm, gm_decay, gm_drive }
     }
 
     #[inline]
@@ -157,8 +196,8 @@ impl Sensors {
     #[must_use]
     pub fn new(spec: &ImuErrorSpec, h: f64, seed: u64, t0: f64) -> Self {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let gyro = Triad::new(&spec.gyro, h, &mut rng);
-        let accel = Triad::new(&spec.accel, h, &mut rng);
+        let gyro = Triad::new(&TriadErrors::from(&spec.gyro), h, &mut rng);
+        let accel = Triad::new(&TriadErrors::from(&spec.accel), h, &mut rng);
         let mut dither_phase = [0.0; 3];
         for p in &mut dither_phase {
             *p = rand::Rng::random::<f64>(&mut rng) * std::f64::consts::TAU;
@@ -204,7 +243,7 @@ mod tests {
     fn white_noise_has_the_specified_density() {
         // ARW 1e-3 rad/√s at 100 Hz: per-sample σ = 1e-3·√0.01 = 1e-4 rad (sample std over 2e5 draws
         // within 1%: the standard error of a std estimate is σ/√(2n) = 0.16%).
-        let spec = ImuErrorSpec { gyro: TriadSpec { white: 1e-3, ..Default::default() }, ..Default::default() };
+        let spec = ImuErrorSpec { gyro: GyroSpec { arw_rad_per_sqrt_s: 1e-3, ..Default::default() }, ..Default::default() };
         let mut s = Sensors::new(&spec, 0.01, 7, 0.0);
         let n = 200_000;
         let mut sum_sq = 0.0;
@@ -219,7 +258,7 @@ mod tests {
     #[test]
     fn the_same_seed_gives_the_same_stream() {
         let spec = ImuErrorSpec {
-            gyro: TriadSpec { bias: Spec::Sigma(1e-6), white: 1e-5, instability: 1e-7, correlation_s: 100.0, ..Default::default() },
+            gyro: GyroSpec { bias_rad_per_s: Spec::Sigma(1e-6), arw_rad_per_sqrt_s: 1e-5, instability_rad_per_s: 1e-7, correlation_s: 100.0, ..Default::default() },
             ..Default::default()
         };
         let run = |seed| {
@@ -233,7 +272,7 @@ mod tests {
     #[test]
     fn fixed_bias_and_scale_act_as_specified() {
         let spec = ImuErrorSpec {
-            gyro: TriadSpec { bias: Spec::Fixed([1e-5, 0.0, 0.0]), scale: Spec::Fixed([1e-3, 0.0, 0.0]), ..Default::default() },
+            gyro: GyroSpec { bias_rad_per_s: Spec::Fixed([1e-5, 0.0, 0.0]), scale: Spec::Fixed([1e-3, 0.0, 0.0]), ..Default::default() },
             ..Default::default()
         };
         let mut s = Sensors::new(&spec, 0.01, 1, 0.0);

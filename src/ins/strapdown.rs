@@ -3,25 +3,12 @@
 //!
 //! `n_from_s(m) = exp(−ζ) · n_from_s(m−1) · exp(ΔΦ)`, ζ = ω_in^n·h (seed 001 eq. 1 for ΔΦ).
 
-use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use nalgebra::{UnitQuaternion, Vector3};
+
+use crate::math::frames::{Rot, N, S};
+use crate::math::rotvec::exp_small;
 
 use super::coning::{coefficients, Algorithm};
-
-/// Quaternion of a rotation vector, with a series for the small angles of one update (exact to
-/// double precision for |φ| < 0.01 rad; trigonometry above).
-#[must_use]
-#[inline]
-pub fn exp_small(phi: &Vector3<f64>) -> UnitQuaternion<f64> {
-    let x2 = phi.norm_squared();
-    let (c, s_over) = if x2 < 1e-4 {
-        // cos(x/2) and sin(x/2)/x to x^6: error < 1e-20 at x = 0.01.
-        (1.0 - x2 / 8.0 + x2 * x2 / 384.0 - x2 * x2 * x2 / 46_080.0, 0.5 - x2 / 48.0 + x2 * x2 / 3840.0 - x2 * x2 * x2 / 645_120.0)
-    } else {
-        let x = x2.sqrt();
-        ((0.5 * x).cos(), (0.5 * x).sin() / x)
-    };
-    UnitQuaternion::new_unchecked(Quaternion::new(c, phi.x * s_over, phi.y * s_over, phi.z * s_over))
-}
 
 /// One attitude integrator (one algorithm) fed gyro increments of the sensor frame s.
 #[derive(Debug, Clone)]
@@ -35,7 +22,7 @@ pub struct AttitudeIntegrator {
     prev: [Vector3<f64>; 2],
     filled: usize,
     /// The current attitude C_s^n.
-    pub n_from_s: UnitQuaternion<f64>,
+    pub n_from_s: Rot<N, S>,
     /// Number of completed updates.
     pub updates: u64,
 }
@@ -43,7 +30,7 @@ pub struct AttitudeIntegrator {
 impl AttitudeIntegrator {
     /// Starts from attitude `n_from_s`.
     #[must_use]
-    pub fn new(algorithm: Algorithm, n_from_s: UnitQuaternion<f64>) -> Self {
+    pub fn new(algorithm: Algorithm, n_from_s: Rot<N, S>) -> Self {
         let (n, p) = algorithm.n_p();
         Self { algorithm, n, p, k: coefficients(n, p), cur: [Vector3::zeros(); 3], prev: [Vector3::zeros(); 2], filled: 0, n_from_s, updates: 0 }
     }
@@ -92,9 +79,11 @@ impl AttitudeIntegrator {
             self.prev[0] = self.cur[self.n - 1];
             self.prev[1] = if self.n >= 2 { self.cur[self.n - 2] } else { self.prev[0] };
         }
-        let q = if *zeta_n == Vector3::zeros() { self.n_from_s * exp_small(&phi) } else { exp_small(&-*zeta_n) * self.n_from_s * exp_small(&phi) };
+        let n_from_s = *self.n_from_s.quaternion();
+        let q = if *zeta_n == Vector3::zeros() { n_from_s * exp_small(&phi) } else { exp_small(&-*zeta_n) * n_from_s * exp_small(&phi) };
         // Renormalise: keeps |q| = 1 to machine precision over billions of updates.
-        self.n_from_s = UnitQuaternion::new_normalize(q.into_inner());
+        // FRAME: exp(−ζ) carries n over the update, exp(ΔΦ) the sensor frame: still C_s^n, one update on.
+        self.n_from_s = Rot::from_quaternion(UnitQuaternion::new_normalize(q.into_inner()));
         self.updates += 1;
         Some(phi)
     }
@@ -103,17 +92,8 @@ impl AttitudeIntegrator {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::Quaternion;
     use crate::ins::coning::coning_drift_rate;
-
-    #[test]
-    fn exp_small_matches_nalgebra() {
-        // Independent computation: nalgebra's exponential map, small and large angles.
-        for v in [Vector3::new(1e-3, -2e-3, 5e-4), Vector3::new(0.3, 0.1, -0.2), Vector3::zeros()] {
-            let a = exp_small(&v);
-            let b = UnitQuaternion::from_scaled_axis(v);
-            assert!(a.angle_to(&b) < 1e-15, "{v:?}");
-        }
-    }
 
     /// Pure coning about z (docs/coning.md): ω_b = Ω(−sin α sin Ωt, sin α cos Ωt, −2 sin²(α/2)),
     /// true attitude q(t) = (cos α/2, sin α/2 cos Ωt, sin α/2 sin Ωt, 0). Gyro increments are the
@@ -145,7 +125,7 @@ mod tests {
             for freq in [4.0, 7.0, 10.0] {
                 let omega = std::f64::consts::TAU * freq;
                 let expected = coning_drift_rate(alg, alpha, freq, dt);
-                let mut integ = AttitudeIntegrator::new(alg, coning_truth(alpha, omega, 0.0));
+                let mut integ = AttitudeIntegrator::new(alg, Rot::from_quaternion(coning_truth(alpha, omega, 0.0)));
                 let n = integ.samples_per_update();
                 let steps = (20.0 / dt) as usize / n * n;
                 let mut first = None;
@@ -154,7 +134,7 @@ mod tests {
                     let (t0, t1) = (i as f64 * dt, (i + 1) as f64 * dt);
                     if integ.push(coning_increment(alpha, omega, t0, t1), &Vector3::zeros()).is_some() {
                         // Error rotation in the body frame; its z-component is the drift about the cone axis.
-                        let err = (coning_truth(alpha, omega, t1).inverse() * integ.n_from_s).scaled_axis();
+                        let err = (coning_truth(alpha, omega, t1).inverse() * integ.n_from_s.quaternion()).scaled_axis();
                         // Express along the cone axis: the body z axis tilted by α; for small α, z.
                         let about_axis = err.z;
                         if first.is_none() && t1 > 0.1 {

@@ -4,58 +4,12 @@
 
 use nalgebra::{UnitQuaternion, Vector3};
 
-use crate::config::Site;
-use crate::frames::{Rot, N, S};
-use crate::frames::axis_angle;
-use crate::gimbal::ShaftRotations;
-use crate::scheme::{AxisValues, MAX_AXES};
+use crate::model::earth::Earth;
+use crate::math::frames::{Rot, N, S};
+use crate::math::frames::axis_angle;
+use crate::model::gimbal::ShaftRotations;
+use crate::model::scheme::{AxisValues, MAX_AXES};
 use crate::sim::Model;
-
-/// Earth's rotation rate, rad/s (WGS84).
-pub const EARTH_RATE: f64 = 7.292_115e-5;
-/// WGS84 semi-major axis, m.
-pub const EARTH_A: f64 = 6_378_137.0;
-/// WGS84 first eccentricity squared.
-pub const EARTH_E2: f64 = 0.006_694_379_990_14;
-
-/// Normal gravity (WGS84 Somigliana, with the free-air gradient), m/s², at latitude and height.
-#[must_use]
-pub fn normal_gravity(latitude_rad: f64, height_m: f64) -> f64 {
-    let s2 = latitude_rad.sin().powi(2);
-    let g0 = 9.780_325_335_9 * (1.0 + 0.001_931_852_652_41 * s2) / (1.0 - EARTH_E2 * s2).sqrt();
-    g0 - 3.086e-6 * height_m
-}
-
-/// The Earth seen from a site: rate and gravity in the navigation frame (ENU).
-#[derive(Debug, Clone, Copy)]
-pub struct Earth {
-    /// ω_ie^n = Ω (0, cos L, sin L).
-    pub omega_ie_n: Vector3<f64>,
-    /// Gravity (with centrifugal) in n: (0, 0, −g).
-    pub gravity_n: Vector3<f64>,
-    /// Site.
-    pub site: Site,
-}
-
-impl Earth {
-    /// At `site`.
-    #[must_use]
-    pub fn at(site: Site) -> Self {
-        let (sl, cl) = site.latitude_rad.sin_cos();
-        Self {
-            omega_ie_n: Vector3::new(0.0, EARTH_RATE * cl, EARTH_RATE * sl),
-            gravity_n: Vector3::new(0.0, 0.0, -normal_gravity(site.latitude_rad, site.height_m)),
-            site,
-        }
-    }
-
-    /// Meridian and transverse radii of curvature, m.
-    #[must_use]
-    pub fn radii(latitude_rad: f64) -> (f64, f64) {
-        let w = (1.0 - EARTH_E2 * latitude_rad.sin().powi(2)).sqrt();
-        (EARTH_A * (1.0 - EARTH_E2) / (w * w * w), EARTH_A / w)
-    }
-}
 
 /// The truth at one instant.
 #[derive(Debug, Clone, Copy)]
@@ -113,7 +67,7 @@ impl ShaftCache {
         }
     }
 
-    fn rotations(&mut self, chain: &crate::gimbal::Chain, angles: &AxisValues) -> ShaftRotations {
+    fn rotations(&mut self, chain: &crate::model::gimbal::Chain, angles: &AxisValues) -> ShaftRotations {
         let n = chain.axes().len();
         let reanchor = !self.valid || self.since_anchor >= REANCHOR;
         for k in 0..n {
@@ -256,18 +210,18 @@ mod tests {
     use super::*;
     use crate::ins::coning::Algorithm;
     use crate::ins::strapdown::AttitudeIntegrator;
-    use crate::units::{ARCSEC_PER_RAD, RAD_PER_DEG};
+    use crate::math::units::ARCSEC_PER_RAD;
 
     fn model(name: &str) -> (Model, Earth) {
-        let p = crate::scenarios::load(name).expect("preset");
-        (Model::new(&p), Earth::at(p.site))
+        let p = crate::scenario::presets::load(name).expect("preset");
+        (p.table_model(), Earth::at(p.site))
     }
 
     #[test]
     fn at_rest_the_increments_are_earth_rate_and_gravity() {
         // Analytic anchor: a static table on a static vehicle senses Ω and g only.
         let (mut m, earth) = model("jiang2017-dual-axis");
-        m.scheme = crate::scheme::Scheme::continuous(vec![0.3, -0.4], vec![0.0, 0.0]);
+        m.scheme = crate::model::scheme::Scheme::continuous(vec![0.3, -0.4], vec![0.0, 0.0]);
         let mut imu = TruthImu::new(m, earth, 0.0);
         let s_from_n = imu.last().n_from_s.quaternion().inverse();
         let (dtheta, dv) = imu.increments(1.0);
@@ -283,14 +237,14 @@ mod tests {
         let (m, earth) = model(name);
         let rate = 2000.0;
         let mut imu = TruthImu::new(m, earth, 0.0);
-        let mut integ = AttitudeIntegrator::new(Algorithm::TwoSampleP1, *imu.last().n_from_s.quaternion());
+        let mut integ = AttitudeIntegrator::new(Algorithm::TwoSampleP1, imu.last().n_from_s);
         let zeta = earth.omega_ie_n * (2.0 / rate);
         let mut worst = 0.0f64;
         for i in 1..=(seconds * rate) as usize {
             let t = i as f64 / rate;
             let (dtheta, _) = imu.increments(t);
             if integ.push(dtheta, &zeta).is_some() {
-                let err = (imu.last().n_from_s.quaternion().inverse() * integ.n_from_s).angle();
+                let err = (imu.last().n_from_s.inverse() * integ.n_from_s).angle_rad();
                 worst = worst.max(err);
             }
         }
@@ -307,12 +261,5 @@ mod tests {
         // keeps the rate steps exact (without the split at breakpoints this is ~3″ per step).
         let worst = integrate_and_compare("rotary-table-2016-installation", 620.0);
         assert!(worst < 1e-3, "worst attitude difference {worst}″");
-    }
-
-    #[test]
-    fn normal_gravity_at_the_equator_and_pole() {
-        // WGS84 normal gravity: 9.7803253359 (equator), 9.8321849378 (pole).
-        assert!((normal_gravity(0.0, 0.0) - 9.780_325_335_9).abs() < 1e-9);
-        assert!((normal_gravity(90.0 * RAD_PER_DEG, 0.0) - 9.832_184_937_8).abs() < 1e-7);
     }
 }

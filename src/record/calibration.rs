@@ -7,14 +7,15 @@ use rerun::blueprint::components::ContainerKind;
 use rerun::{RecordingStream, RecordingStreamResult, TimeColumn};
 
 use super::layout::{self, Node};
-use super::{CustomLayout, Recorder, TIMELINE, albedo, cone, p3, rgb, rgba, ring_radius};
+use super::palette::{albedo, p3, rgb, rgba};
+use super::scene::{cone, ring_radius};
+use super::{CustomLayout, Recorder, TIMELINE};
 use crate::calib::report::Report;
 use crate::calib::{Calibration, Param};
-use crate::config::Params;
-use crate::frames::exp_rotation;
-use crate::run::every_n_steps;
-use crate::sim::{DemodState, ERROR_AXES, Model, step};
-use crate::units::{ARCSEC_PER_RAD, fmt_angle};
+use crate::math::rotvec::exp_rotation;
+use crate::math::units::{fmt_angle, ARCSEC_PER_RAD};
+use crate::scenario::Params;
+use crate::sim::ERROR_AXES;
 
 const GHOST: [u8; 3] = [245, 245, 245];
 const STATE_COLORS: [[u8; 3]; 5] = [[250, 200, 60], [120, 120, 120], [120, 120, 120], [90, 220, 120], [90, 160, 250]];
@@ -29,15 +30,17 @@ pub struct ErrorTraces<'a> {
     pub errors: [&'a [[f64; 3]]; 3],
 }
 
-/// Writes the calibration recording into `rec`.
-pub fn log(rec: RecordingStream, params: &Params, cal: &Calibration, report: &Report, traces: &ErrorTraces<'_>) -> RecordingStreamResult<()> {
-    let chain = &params.chain;
+/// Writes the calibration's recording into `rec`: layout, documents, the filter over time, the
+/// before/after errors and the ghost cones. Returns the table's recorder, into which the caller
+/// streams the table's motion (as in any run) and finishes.
+pub fn log(rec: RecordingStream, params: &Params, cal: &Calibration, report: &Report, traces: &ErrorTraces<'_>) -> RecordingStreamResult<Recorder> {
+    let chain = &params.table.chain;
     let set = &cal.set;
     let table: Vec<(usize, Param)> = set.params.iter().copied().enumerate().filter(|(_, p)| p.is_table()).collect();
     let plot = |name: String, origin: String| Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::whole_run_time_axis());
     // Each state's plot is framed on where the filter ends: the final estimate ± 4 × its 3σ band
     // (at least ±1″), widened to include the true value; the prior's ±3σ start falls off the top.
-    let truth = set.values(&params.truth);
+    let truth = set.values(&params.table.truth);
     let states: Vec<Node> = table
         .iter()
         .map(|(i, p)| {
@@ -54,7 +57,7 @@ pub fn log(rec: RecordingStream, params: &Params, cal: &Calibration, report: &Re
     // The table scene of the ideal demodulation; the INS is the calibration's business here.
     let mut drawing = params.clone();
     drawing.ins = None;
-    let mut recorder = Recorder::with_layout(rec, &drawing, custom)?;
+    let recorder = Recorder::with_layout(rec, &drawing, custom)?;
     let rec = recorder.stream().clone();
 
     rec.log_static(
@@ -120,7 +123,7 @@ pub fn log(rec: RecordingStream, params: &Params, cal: &Calibration, report: &Re
         }
         next = s.t_s.floor() + 1.0;
         rec.set_duration_secs(TIMELINE, s.t_s);
-        let est = set.errors(&s.theta, &params.compensation);
+        let est = set.errors(&s.theta, &params.table.compensation);
         for k in 0..n {
             let (Some(_), Some(_)) = (set.index(Param::SwingCos(k)), set.index(Param::SwingSin(k))) else {
                 continue;
@@ -133,7 +136,7 @@ pub fn log(rec: RecordingStream, params: &Params, cal: &Calibration, report: &Re
             rec.log(format!("{mount}/estimated_cone"), &rerun::Mesh3D::new(mesh.0).with_triangle_indices(mesh.1).with_albedo_factor(albedo(GHOST, 35)))?;
             rec.log(format!("{mount}/estimated_cone/rims"), &rerun::LineStrips3D::new(rims).with_colors([rgba(GHOST, 230)]).with_radii([0.003]))?;
             // The estimated rotor axis, drawn in the (truly tilted) rotor frame: W_trueᵀ W_est a.
-            let w_true = exp_rotation(&(chain.swing_vector(k, &params.truth.axes[k], 0.0) * x));
+            let w_true = exp_rotation(&(chain.swing_vector(k, &params.table.truth.axes[k], 0.0) * x));
             let w_est = exp_rotation(&(chain.swing_vector(k, &est.axes[k], 0.0) * x));
             let dir: Vector3<f64> = (w_true.inverse() * w_est) * g.axis;
             rec.log(
@@ -146,24 +149,5 @@ pub fn log(rec: RecordingStream, params: &Params, cal: &Calibration, report: &Re
         }
     }
 
-    // The table turning, and the ideal-INS error plots the standard layout keeps in its tabs.
-    let model = Model::new(&drawing);
-    let mut state = DemodState::default();
-    let steps = drawing.steps();
-    let (series_every, scene_every) = (every_n_steps(drawing.step_hz, drawing.recording.series_hz), every_n_steps(drawing.step_hz, drawing.recording.scene_hz));
-    for i in 0..=steps {
-        let t = i as f64 / drawing.step_hz;
-        let out = step(&model, &mut state, t);
-        if i % series_every == 0 {
-            recorder.push_series(&out)?;
-        }
-        if i % scene_every == 0 {
-            recorder.push_scene(&out)?;
-        }
-    }
-    recorder.event(drawing.duration_s, &format!("calibration: {} samples, {} Gauss–Newton iterations", cal.samples, cal.nls_iterations), "INFO")?;
-    for w in &report.warnings {
-        recorder.event(drawing.duration_s, w, "WARN")?;
-    }
-    recorder.finish()
+    Ok(recorder)
 }

@@ -4,13 +4,14 @@ use rerun::blueprint::components::ContainerKind;
 use rerun::{RecordingStream, RecordingStreamResult, TimeColumn};
 
 use super::layout::{self, Node};
-use super::{rgb, APPLICATION_ID, TIMELINE};
-use crate::modulation::Trace;
+use super::palette::rgb;
+use super::{APPLICATION_ID, TIMELINE};
+use crate::ins::trace::{NavSample, NavTrace};
 
 const COLORS: [[u8; 3]; 3] = [[230, 76, 60], [240, 180, 40], [46, 170, 90]];
 
 /// Logs the traces (sampled at the same instants) with their explanation and a layout.
-pub fn log(rec: &RecordingStream, traces: &[Trace], table: &str) -> RecordingStreamResult<()> {
+pub fn log(rec: &RecordingStream, traces: &[NavTrace], table: &str) -> RecordingStreamResult<()> {
     rec.send_recording_name("rinscope: rotation modulation")?;
     let names: Vec<String> = traces.iter().map(|t| t.label.clone()).collect();
     let doc = format!(
@@ -29,7 +30,7 @@ pub fn log(rec: &RecordingStream, traces: &[Trace], table: &str) -> RecordingStr
     }
     let n = traces.iter().map(|t| t.samples.len()).min().unwrap_or(0);
     let times: Vec<f64> = traces.first().map(|t| t.samples[..n].iter().map(|s| s.t_s).collect()).unwrap_or_default();
-    let column = |f: &dyn Fn(&crate::modulation::Sample) -> f64| -> Vec<f64> {
+    let column = |f: &dyn Fn(&NavSample) -> f64| -> Vec<f64> {
         let mut v = Vec::with_capacity(n * traces.len());
         for i in 0..n {
             for t in traces {

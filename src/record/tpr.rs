@@ -5,9 +5,10 @@ use rerun::blueprint::components::ContainerKind;
 use rerun::{RecordingStream, RecordingStreamResult, TimeColumn};
 
 use super::layout::{self, Node};
-use super::{rgb, APPLICATION_ID, TIMELINE};
-use crate::config::Params;
-use crate::tpr::{TprResult, BRANCHES, BRANCH_NAMES, PAPER_RADIAL_M};
+use super::palette::rgb;
+use super::{APPLICATION_ID, TIMELINE};
+use crate::scenario::Params;
+use crate::ins::reset::{TprResult, BRANCHES, BRANCH_NAMES, PAPER_RADIAL_M};
 
 const COLORS: [[u8; 3]; BRANCHES] = [[230, 76, 60], [46, 170, 90], [70, 130, 230]];
 

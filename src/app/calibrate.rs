@@ -1,0 +1,145 @@
+//! `rinscope calibrate` and `montecarlo`: simulate seed 000's static test (vehicle at rest, gimbals
+//! turning, INS and encoder noise in the loop), hand its data to the estimators of `calib`, validate
+//! the compensation on an independent run.
+
+use crate::calib::report::{build as build_report, Compensation, Report};
+use crate::calib::{attitude_errors, calibrate, AttitudeSource, CalibError, Calibration, Data, History, Measurement, Nuisance, ParamSet};
+use crate::ins::pipeline::InsRun;
+use crate::scenario::Params;
+use crate::math::timeline::decimation;
+use crate::sim::{encoder_readings, step, DemodState};
+
+/// Runs the static test of `params` with noise seed `seed` and collects one sample per INS output.
+pub fn collect(params: &Params, seed: u64) -> Result<Data, CalibError> {
+    let Some((attitude, n_from_b)) = params.table_model().fixed_state() else {
+        return Err(CalibError::VehicleMoves(params.meta.name.clone()));
+    };
+    let mut p = params.clone();
+    p.meta.seed = seed;
+    let mut model = p.table_model();
+    // The demodulation knows every error it does not estimate: the compensation's values.
+    let set = ParamSet::new(&p.table.chain, Nuisance::None);
+    model.compensation = set.without_estimated(&p.table.compensation);
+    let chain = p.table.chain.clone();
+    let steps = p.timeline().instants();
+    let duration = steps as f64 / p.step_hz;
+    let tau = |t: f64| (2.0 * t / duration - 1.0).clamp(-1.0, 1.0);
+    let mut samples = Vec::with_capacity(steps as usize);
+    let mut demod = DemodState::default();
+    let source = if p.ins.is_some() { AttitudeSource::Ins } else { AttitudeSource::Ideal };
+    match &p.ins {
+        Some(ins_params) => {
+            let mut ins = InsRun::new(ins_params, p.site, p.meta.seed, model.clone());
+            for _ in 0..steps {
+                if ins.step().updated {
+                    let (t, q) = ins.output_attitude(0);
+                    // Matched synchronisation: the encoders are read for the instant the data represent.
+                    let angles = demod.correct(&model, t, &encoder_readings(&model, t));
+                    samples.push(Measurement { t_s: t, tau: tau(t), n_from_s: q, shafts: chain.shaft_rotations(&angles) });
+                }
+            }
+        }
+        None => {
+            let truth = model.truth_rotations().clone();
+            for i in 1..=steps {
+                let t = i as f64 / p.step_hz;
+                let (lambda, _) = model.scheme.state(t - model.scheme_t0_s);
+                let n_from_s = n_from_b * chain.b_from_s(&truth, &lambda);
+                let angles = demod.correct(&model, t, &encoder_readings(&model, t));
+                samples.push(Measurement { t_s: t, tau: tau(t), n_from_s, shafts: chain.shaft_rotations(&angles) });
+            }
+        }
+    }
+    Ok(Data { samples, n_from_b, attitude, source, seed })
+}
+
+
+/// A calibration as `rinscope calibrate` runs it: the test, an independent validation run (noise
+/// seed + 1), both estimators, compensation before/after on the validation run, the report.
+pub struct Outcome {
+    /// The calibration data.
+    pub data: Data,
+    /// The validation run.
+    pub validation: Data,
+    /// The estimates.
+    pub cal: Calibration,
+    /// The report.
+    pub report: Report,
+    /// Per-sample attitude errors of the validation run: before, after KF, after LSQ.
+    pub validation_errors: [Vec<[f64; 3]>; 3],
+}
+
+/// Runs the whole calibration of a scenario (`history`: keep the filter's snapshots for a recording).
+pub fn calibrate_scenario(params: &Params, history: bool) -> Result<Outcome, CalibError> {
+    let seed = params.meta.seed;
+    let (data, validation) = std::thread::scope(|scope| {
+        let v = scope.spawn(|| collect(params, seed.wrapping_add(1)));
+        let d = collect(params, seed);
+        (d, v.join().unwrap_or(Err(CalibError::Singular)))
+    });
+    let (data, validation) = (data?, validation?);
+    let cfg = &params.calibration;
+    let cal = calibrate(&params.table.chain, &params.table.compensation, &data, cfg, if history { History::Snapshots(cfg.record_hz) } else { History::Final })?;
+    let known = &params.table.compensation;
+    let set = &cal.set;
+    let before = attitude_errors(&params.table.chain, &set.without_estimated(known), &validation);
+    let kf = attitude_errors(&params.table.chain, &set.errors(&cal.kf.theta, known), &validation);
+    let nls = attitude_errors(&params.table.chain, &set.errors(&cal.nls.theta, known), &validation);
+    let truth = attitude_errors(&params.table.chain, &set.errors(&set.values(&params.table.truth), known), &validation);
+    let compensation = Compensation { before: before.1, after_kf: kf.1, after_nls: nls.1, with_truth: truth.1 };
+    let report = build_report(&params.meta.name, &params.table.chain, &params.table.truth, &cal, &data, Some(compensation));
+    Ok(Outcome { data, validation, cal, report, validation_errors: [before.0, kf.0, nls.0] })
+}
+
+
+/// Seed 000's Monte Carlo on `params`' table: `runs` calibrations of drawn tables in parallel, each
+/// on a simulated static test (`progress` ticks once per run, `stop` ends early).
+pub fn monte_carlo(params: &Params, runs: usize, progress: &(dyn Fn() + Sync), stop: &std::sync::atomic::AtomicBool) -> Result<crate::calib::montecarlo::Summary, CalibError> {
+    let setup = crate::calib::montecarlo::Setup {
+        scenario: &params.meta.name,
+        chain: &params.table.chain,
+        truth: &params.table.truth,
+        compensation: &params.table.compensation,
+        cfg: &params.calibration,
+        seed: params.meta.seed,
+    };
+    let simulate = |truth: &crate::model::gimbal::TableErrors, seed: u64| {
+        let mut p = params.clone();
+        p.table.truth = truth.clone();
+        collect(&p, seed)
+    };
+    crate::calib::montecarlo::run(&setup, runs, &simulate, progress, stop)
+}
+
+/// Writes `outcome`'s recording into `rec`: the calibration's panels, then the table turning as in
+/// a plain run (the ideal-INS error plots the standard layout keeps in its tabs).
+pub fn record_outcome(rec: crate::record::Stream, params: &Params, outcome: &Outcome) -> anyhow::Result<()> {
+    let traces = crate::record::calibration::ErrorTraces {
+        t_s: outcome.validation.samples.iter().map(|s| s.t_s).collect(),
+        errors: [&outcome.validation_errors[0], &outcome.validation_errors[1], &outcome.validation_errors[2]],
+    };
+    let mut recorder = crate::record::calibration::log(rec, params, &outcome.cal, &outcome.report, &traces)?;
+    // The table scene of the ideal demodulation; the INS is the calibration's business here.
+    let mut drawing = params.clone();
+    drawing.ins = None;
+    let model = drawing.table_model();
+    let mut state = DemodState::default();
+    let steps = drawing.timeline().instants();
+    let (series_every, scene_every) = (decimation(drawing.step_hz, drawing.recording.series_hz), decimation(drawing.step_hz, drawing.recording.scene_hz));
+    for i in 0..=steps {
+        let t = i as f64 / drawing.step_hz;
+        let out = step(&model, &mut state, t);
+        if i % series_every == 0 {
+            recorder.push_series(&out)?;
+        }
+        if i % scene_every == 0 {
+            recorder.push_scene(&out)?;
+        }
+    }
+    recorder.event(drawing.duration_s, &format!("calibration: {} samples, {} Gauss–Newton iterations", outcome.cal.samples, outcome.cal.nls_iterations), "INFO")?;
+    for w in &outcome.report.warnings {
+        recorder.event(drawing.duration_s, w, "WARN")?;
+    }
+    recorder.finish()?;
+    Ok(())
+}

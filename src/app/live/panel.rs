@@ -1,0 +1,406 @@
+//! The terminal control panel of `rinscope live`: one slider per parameter a user would turn.
+//! Moving a slider writes the scenario file (the watcher then reloads it), so the panel and a text
+//! editor drive the same path. State and key handling are plain data, testable without a terminal.
+
+use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+use ratatui::layout::{Constraint, Layout};
+use ratatui::style::{Color, Modifier, Style};
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Block, Borders, Paragraph, Wrap};
+use ratatui::Frame;
+
+use super::edit::{KeyPath, Scalar};
+use super::Status;
+use crate::scenario::{self, RawConfig};
+
+/// One control.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Control {
+    /// A number.
+    Slider {
+        /// What the user reads.
+        label: String,
+        /// The config keys it writes (usually one; "all move rates" writes every step's).
+        keys: Vec<KeyPath>,
+        /// Unit shown after the value.
+        unit: &'static str,
+        /// Range.
+        min: f64,
+        /// Range.
+        max: f64,
+        /// Fine step (linear), or factor per step (logarithmic).
+        step: f64,
+        /// Logarithmic slider (speed, exaggeration).
+        log: bool,
+        /// Current value.
+        value: f64,
+        /// Value when the panel opened (`r` resets to it).
+        initial: f64,
+    },
+    /// On / off.
+    Toggle {
+        /// What the user reads.
+        label: String,
+        /// The config key it writes.
+        key: KeyPath,
+        /// Current value.
+        value: bool,
+        /// Value when the panel opened.
+        initial: bool,
+    },
+}
+
+/// What a key press asks for.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Action {
+    /// Nothing to write.
+    None,
+    /// Leave the session.
+    Quit,
+    /// Write these values to the config file.
+    Set(Vec<(KeyPath, Scalar)>),
+}
+
+/// The panel's state.
+#[derive(Debug, Clone)]
+pub struct Panel {
+    /// Controls in display order.
+    pub controls: Vec<Control>,
+    /// Index of the selected control.
+    pub selected: usize,
+    /// Show the long help.
+    pub show_help: bool,
+    /// First line.
+    pub title: String,
+}
+
+/// The one-line key help.
+pub const HELP: &str = "↑↓ select  ←→ adjust  Shift+←→/PgUp/PgDn ×10  Home/End min/max  0 zero  r reset  Space toggle  ? help  q quit";
+
+fn slider(label: String, key: &str, unit: &'static str, (min, max): (f64, f64), step: f64) -> Control {
+    Control::Slider { label, keys: vec![KeyPath::parse(key)], unit, min, max, step, log: false, value: 0.0, initial: 0.0 }
+}
+
+impl Panel {
+    /// The controls for a configuration.
+    #[must_use]
+    pub fn new(raw: &RawConfig, title: String) -> Self {
+        let mut controls = Vec::new();
+        for (i, a) in raw.turntable.axis.iter().enumerate() {
+            let n = &a.name;
+            let k = |f: &str| format!("turntable.axis[{i}].{f}");
+            controls.push(slider(format!("{n} swing half-angle"), &k("swing_half_angle_arcsec"), "″", (0.0, 3600.0), 10.0));
+            controls.push(slider(format!("{n} swing phase"), &k("swing_phase_deg"), "°", (-180.0, 180.0), 5.0));
+            if i > 0 {
+                controls.push(slider(format!("{n} non-orthogonality"), &k("non_orthogonality_arcsec"), "″", (-600.0, 600.0), 5.0));
+            }
+            controls.push(slider(format!("{n} encoder offset"), &k("encoder_offset_arcsec"), "″", (-600.0, 600.0), 5.0));
+            controls.push(slider(format!("{n} encoder scale"), &k("encoder_scale_ppm"), " ppm", (-1000.0, 1000.0), 10.0));
+            controls.push(slider(format!("{n} encoder delay"), &k("encoder_delay_ms"), " ms", (0.0, 50.0), 0.5));
+            controls.push(slider(format!("{n} encoder noise"), &k("encoder_noise_arcsec"), "″ 1σ", (0.0, 60.0), 1.0));
+        }
+        controls.push(slider("installation about x".into(), "turntable.installation_x_arcsec", "″", (-1800.0, 1800.0), 10.0));
+        controls.push(slider("installation about y".into(), "turntable.installation_y_arcsec", "″", (-1800.0, 1800.0), 10.0));
+        match raw.scheme.kind.as_str() {
+            "continuous" => {
+                for (j, r) in raw.scheme.rate.iter().enumerate() {
+                    controls.push(slider(format!("{} rotation rate", r.axis), &format!("scheme.rate[{j}].rate_deg_per_s"), "°/s", (-60.0, 60.0), 1.0));
+                }
+            }
+            "indexed" => controls.push(Control::Slider {
+                label: "move rate (all steps)".into(),
+                keys: (0..raw.scheme.step.len()).map(|j| KeyPath::parse(&format!("scheme.step[{j}].rate_deg_per_s"))).collect(),
+                unit: "°/s",
+                min: 1.0,
+                max: 60.0,
+                step: 1.0,
+                log: false,
+                value: 0.0,
+                initial: 0.0,
+            }),
+            _ => {}
+        }
+        let log = |label: &str, key: &str, (min, max): (f64, f64)| Control::Slider {
+            label: label.into(),
+            keys: vec![KeyPath::parse(key)],
+            unit: "×",
+            min,
+            max,
+            step: 1.25,
+            log: true,
+            value: 1.0,
+            initial: 1.0,
+        };
+        controls.push(log("speed (× real time)", "live.speed", (0.1, 1000.0)));
+        controls.push(log("3D exaggeration", "recording.exaggeration", (1.0, 10_000.0)));
+        controls.push(Control::Toggle { label: "compensation".into(), key: KeyPath::parse("compensation.enabled"), value: true, initial: true });
+        let mut panel = Self { controls, selected: 0, show_help: false, title };
+        panel.sync(raw);
+        for c in &mut panel.controls {
+            match c {
+                Control::Slider { value, initial, .. } => *initial = *value,
+                Control::Toggle { value, initial, .. } => *initial = *value,
+            }
+        }
+        panel
+    }
+
+    /// Takes the values of a configuration (after a reload: the file may have been edited elsewhere).
+    pub fn sync(&mut self, raw: &RawConfig) {
+        let flat = scenario::flatten(raw);
+        for c in &mut self.controls {
+            match c {
+                Control::Slider { keys, value, min, max, .. } => {
+                    if let Some(v) = keys.first().and_then(|k| flat.get(&k.to_string())).and_then(|s| s.parse::<f64>().ok()) {
+                        *value = v;
+                        *min = min.min(v);
+                        *max = max.max(v);
+                    }
+                }
+                Control::Toggle { key, value, .. } => {
+                    if let Some(v) = flat.get(&key.to_string()).and_then(|s| s.parse::<bool>().ok()) {
+                        *value = v;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Shows the speed actually in force (a `--speed` given on the command line wins over the file
+    /// until the file's value changes).
+    pub fn show_speed(&mut self, speed: f64) {
+        for c in &mut self.controls {
+            if let Control::Slider { keys, value, .. } = c
+                && keys.first().is_some_and(|k| k.to_string() == "live.speed")
+            {
+                *value = speed;
+            }
+        }
+    }
+
+    /// Handles one key press.
+    pub fn handle(&mut self, key: KeyEvent) -> Action {
+        let n = self.controls.len();
+        let coarse = key.modifiers.contains(KeyModifiers::SHIFT);
+        match key.code {
+            KeyCode::Char('c') if key.modifiers.contains(KeyModifiers::CONTROL) => Action::Quit,
+            KeyCode::Char('q') | KeyCode::Esc => Action::Quit,
+            KeyCode::Up | KeyCode::Char('k') => {
+                self.selected = (self.selected + n - 1) % n;
+                Action::None
+            }
+            KeyCode::Down | KeyCode::Char('j') | KeyCode::Tab => {
+                self.selected = (self.selected + 1) % n;
+                Action::None
+            }
+            KeyCode::Char('?') => {
+                self.show_help = !self.show_help;
+                Action::None
+            }
+            KeyCode::Left | KeyCode::Char('h') => self.nudge(-1.0, coarse),
+            KeyCode::Right | KeyCode::Char('l') => self.nudge(1.0, coarse),
+            KeyCode::Char('H') => self.nudge(-1.0, true),
+            KeyCode::Char('L') => self.nudge(1.0, true),
+            KeyCode::PageDown => self.nudge(-1.0, true),
+            KeyCode::PageUp => self.nudge(1.0, true),
+            KeyCode::Home => self.set_selected(|_, min, _| min),
+            KeyCode::End => self.set_selected(|_, _, max| max),
+            KeyCode::Char('0') => self.set_selected(|v, min, max| if (min..=max).contains(&0.0) { 0.0 } else { v }),
+            KeyCode::Char('r') => self.reset_selected(),
+            KeyCode::Char(' ') | KeyCode::Enter => self.toggle_selected(),
+            _ => Action::None,
+        }
+    }
+
+    fn nudge(&mut self, direction: f64, coarse: bool) -> Action {
+        let Some(Control::Slider { step, log, .. }) = self.controls.get(self.selected) else {
+            return self.toggle_selected();
+        };
+        let (step, log) = (*step, *log);
+        let times = if coarse { 10.0 } else { 1.0 };
+        self.set_selected(|v, _, _| if log { v * step.powf(direction * times / if coarse { 2.0 } else { 1.0 }) } else { v + direction * step * times })
+    }
+
+    fn set_selected(&mut self, f: impl Fn(f64, f64, f64) -> f64) -> Action {
+        let Some(Control::Slider { keys, value, min, max, step, log, .. }) = self.controls.get_mut(self.selected) else {
+            return Action::None;
+        };
+        let mut v = f(*value, *min, *max).clamp(*min, *max);
+        if !*log {
+            // Land on the step grid so repeated presses do not accumulate rounding noise.
+            v = (v / *step).round() * *step;
+        }
+        if (v - *value).abs() < 1e-12 {
+            return Action::None;
+        }
+        *value = v;
+        Action::Set(keys.iter().map(|k| (k.clone(), Scalar::Float(v))).collect())
+    }
+
+    fn reset_selected(&mut self) -> Action {
+        match self.controls.get(self.selected) {
+            Some(Control::Slider { initial, .. }) => {
+                let i = *initial;
+                self.set_selected(|_, _, _| i)
+            }
+            Some(Control::Toggle { initial, value, .. }) if initial != value => self.toggle_selected(),
+            _ => Action::None,
+        }
+    }
+
+    fn toggle_selected(&mut self) -> Action {
+        let Some(Control::Toggle { key, value, .. }) = self.controls.get_mut(self.selected) else {
+            return Action::None;
+        };
+        *value = !*value;
+        Action::Set(vec![(key.clone(), Scalar::Bool(*value))])
+    }
+
+    /// Draws the panel.
+    pub fn render(&self, frame: &mut Frame<'_>, status: &Status, config_path: &str) {
+        let [top, list, bottom] =
+            Layout::vertical([Constraint::Length(2), Constraint::Min(3), Constraint::Length(if self.show_help { 11 } else { 7 })]).areas(frame.area());
+        let head = vec![
+            Line::from(Span::styled(self.title.clone(), Style::default().add_modifier(Modifier::BOLD))),
+            Line::from(format!("sim t = {:.1} s   speed ×{}   config {config_path}", status.sim_t_s, trim(status.speed))),
+        ];
+        frame.render_widget(Paragraph::new(head), top);
+
+        let width = usize::from(list.width.saturating_sub(2));
+        let bar_width = width.saturating_sub(28 + 14 + 4).clamp(6, 40);
+        let lines: Vec<Line<'_>> = self
+            .controls
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                let selected = i == self.selected;
+                let style = if selected { Style::default().fg(Color::Yellow).add_modifier(Modifier::BOLD) } else { Style::default() };
+                let marker = if selected { "▶ " } else { "  " };
+                let (label, bar, value) = match c {
+                    Control::Slider { label, unit, min, max, value, log, .. } => {
+                        let frac = if *log { (value.ln() - min.ln()) / (max.ln() - min.ln()) } else { (value - min) / (max - min) };
+                        let filled = ((frac.clamp(0.0, 1.0)) * bar_width as f64).round() as usize;
+                        (label.as_str(), format!("[{}{}]", "█".repeat(filled), "·".repeat(bar_width - filled)), format!("{}{unit}", trim(*value)))
+                    }
+                    Control::Toggle { label, value, .. } => (label.as_str(), format!("[{}]", if *value { " on " } else { " off" }), String::new()),
+                };
+                Line::from(vec![Span::styled(format!("{marker}{label:<28}"), style), Span::raw(bar), Span::styled(format!(" {value:>12}"), style)])
+            })
+            .collect();
+        frame.render_widget(Paragraph::new(lines).block(Block::default().borders(Borders::ALL).title(" parameters (write the config file) ")), list);
+
+        let p95 = super::p95(&status.latencies_ms);
+        let mut foot = vec![
+            Line::from(format!("last: {}", if status.message.is_empty() { "—" } else { &status.message })),
+            Line::from(format!("reloads: {}   save → applied p95 {:.0} ms", status.latencies_ms.len(), p95)),
+            Line::from(Span::styled(HELP, Style::default().fg(Color::DarkGray))),
+        ];
+        if self.show_help {
+            foot.push(Line::from("Every slider writes its key into the config file (comments and layout kept);"));
+            foot.push(Line::from("the file watcher reloads it exactly as when you save from an editor. Editing the"));
+            foot.push(Line::from("file by hand moves the sliders. Bad values are reported and the old ones kept."));
+            foot.push(Line::from("q, Esc or Ctrl-C ends the session; a --save recording is completed."));
+        }
+        frame.render_widget(Paragraph::new(foot).wrap(Wrap { trim: true }), bottom);
+    }
+}
+
+/// 600 → "600", 0.5 → "0.5", 1.953125 → "1.95".
+fn trim(x: f64) -> String {
+    if x.fract().abs() < 1e-9 {
+        format!("{x:.0}")
+    } else if x.abs() >= 10.0 {
+        format!("{x:.1}")
+    } else {
+        format!("{x:.2}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ratatui::crossterm::event::KeyEventKind;
+
+    fn key(code: KeyCode) -> KeyEvent {
+        KeyEvent::new(code, KeyModifiers::NONE)
+    }
+
+    fn panel() -> Panel {
+        let p = crate::scenario::presets::load("jiang2017-dual-axis").expect("preset");
+        Panel::new(&p.resolved, "test".into())
+    }
+
+    fn value_of(p: &Panel, label: &str) -> f64 {
+        p.controls
+            .iter()
+            .find_map(|c| match c {
+                Control::Slider { label: l, value, .. } if l == label => Some(*value),
+                _ => None,
+            })
+            .expect("slider")
+    }
+
+    #[test]
+    fn the_panel_offers_what_a_teacher_turns_with_the_scenario_values() {
+        let p = panel();
+        // Seed 000 Table 2 values from the preset.
+        assert_eq!(value_of(&p, "outer swing half-angle"), 600.0);
+        assert_eq!(value_of(&p, "inner swing half-angle"), 300.0);
+        assert_eq!(value_of(&p, "inner non-orthogonality"), 20.0);
+        assert_eq!(value_of(&p, "outer rotation rate"), 10.0);
+        assert_eq!(value_of(&p, "speed (× real time)"), 1.0);
+        assert_eq!(value_of(&p, "3D exaggeration"), 100.0);
+        assert!(p.controls.iter().any(|c| matches!(c, Control::Toggle { label, value: true, .. } if label == "compensation")));
+    }
+
+    #[test]
+    fn arrows_select_and_adjust_and_write_the_right_key() {
+        let mut p = panel();
+        assert_eq!(p.selected, 0); // outer swing half-angle, 600″, step 10″
+        assert_eq!(p.handle(key(KeyCode::Right)), Action::Set(vec![(KeyPath::parse("turntable.axis[0].swing_half_angle_arcsec"), Scalar::Float(610.0))]));
+        let shift_left = KeyEvent { code: KeyCode::Left, modifiers: KeyModifiers::SHIFT, kind: KeyEventKind::Press, state: ratatui::crossterm::event::KeyEventState::NONE };
+        assert_eq!(p.handle(shift_left), Action::Set(vec![(KeyPath::parse("turntable.axis[0].swing_half_angle_arcsec"), Scalar::Float(510.0))]));
+        assert_eq!(p.handle(key(KeyCode::Char('r'))), Action::Set(vec![(KeyPath::parse("turntable.axis[0].swing_half_angle_arcsec"), Scalar::Float(600.0))]));
+        assert_eq!(p.handle(key(KeyCode::Home)), Action::Set(vec![(KeyPath::parse("turntable.axis[0].swing_half_angle_arcsec"), Scalar::Float(0.0))]));
+        // At the minimum, further presses write nothing.
+        assert_eq!(p.handle(key(KeyCode::Left)), Action::None);
+        // Down moves to the next control; Up from the top wraps to the last (the compensation toggle).
+        p.handle(key(KeyCode::Down));
+        assert_eq!(p.selected, 1);
+        p.handle(key(KeyCode::Up));
+        p.handle(key(KeyCode::Up));
+        assert_eq!(p.selected, p.controls.len() - 1);
+        assert_eq!(p.handle(key(KeyCode::Char(' '))), Action::Set(vec![(KeyPath::parse("compensation.enabled"), Scalar::Bool(false))]));
+        assert_eq!(p.handle(key(KeyCode::Char('q'))), Action::Quit);
+        assert_eq!(p.handle(KeyEvent::new(KeyCode::Char('c'), KeyModifiers::CONTROL)), Action::Quit);
+    }
+
+    #[test]
+    fn logarithmic_sliders_multiply() {
+        let mut p = panel();
+        p.selected = p.controls.iter().position(|c| matches!(c, Control::Slider { label, .. } if label.starts_with("speed"))).expect("speed");
+        assert_eq!(p.handle(key(KeyCode::Right)), Action::Set(vec![(KeyPath::parse("live.speed"), Scalar::Float(1.25))]));
+    }
+
+    #[test]
+    fn sync_follows_edits_made_elsewhere() {
+        let mut p = panel();
+        let mut raw = crate::scenario::presets::load("jiang2017-dual-axis").expect("preset").resolved;
+        raw.turntable.axis[1].swing_half_angle_arcsec = 4000.0; // beyond the slider's range: the range grows
+        p.sync(&raw);
+        assert_eq!(value_of(&p, "inner swing half-angle"), 4000.0);
+    }
+
+    #[test]
+    fn renders_without_a_terminal() {
+        let p = panel();
+        let status = super::super::new_status(&crate::scenario::presets::load("jiang2017-dual-axis").expect("preset"), 1.0);
+        let status = status.lock().expect("lock").clone();
+        let mut term = ratatui::Terminal::new(ratatui::backend::TestBackend::new(110, 40)).expect("terminal");
+        term.draw(|f| p.render(f, &status, "x.toml")).expect("draw");
+        let text: String = term.backend().buffer().content().iter().map(ratatui::buffer::Cell::symbol).collect();
+        assert!(text.contains("outer swing half-angle"));
+        assert!(text.contains("600″"));
+        assert!(text.contains("q quit"));
+    }
+}

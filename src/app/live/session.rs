@@ -1,0 +1,165 @@
+//! The simulation of a live session: the turntable step whose parameters can be replaced between
+//! two steps, and the words that say what a reload changed.
+
+use crate::model::scheme::AxisValues;
+use crate::scenario::{self, Params, RawConfig};
+use crate::sim::{step, DemodState, ErrorStats, Model, StepOutput};
+
+/// The simulation of a live session: a [`Model`] that can be replaced between two steps.
+pub struct LiveSim {
+    /// The parameters in force.
+    pub params: Params,
+    /// Their model (with the scheme re-anchored at the last scheme change).
+    pub model: Model,
+    state: DemodState,
+    step_index: u64,
+    /// RMS and peak over the session.
+    pub stats: ErrorStats,
+    last_gimbal_rad: AxisValues,
+}
+
+impl LiveSim {
+    /// Starts at t = 0.
+    #[must_use]
+    pub fn new(params: Params) -> Self {
+        let model = params.table_model();
+        let last_gimbal_rad = model.scheme.state(0.0).0;
+        Self { params, model, state: DemodState::default(), step_index: 0, stats: ErrorStats::default(), last_gimbal_rad }
+    }
+
+    /// Simulated time of the next step, s.
+    #[must_use]
+    pub fn t_s(&self) -> f64 {
+        self.step_index as f64 / self.params.step_hz
+    }
+
+    /// Number of steps taken.
+    #[must_use]
+    pub fn steps(&self) -> u64 {
+        self.step_index
+    }
+
+    /// One step.
+    pub fn step(&mut self) -> StepOutput {
+        let t = self.t_s();
+        let out = step(&self.model, &mut self.state, t);
+        self.stats.add(&out);
+        self.last_gimbal_rad = out.gimbal_rad;
+        self.step_index += 1;
+        out
+    }
+
+    /// Replaces the parameters between two steps. Returns what changed, in words (empty: nothing did);
+    /// refuses changes the running session cannot take (the old parameters stay in force).
+    pub fn apply(&mut self, new: Params) -> Result<Vec<String>, String> {
+        let old = &self.params;
+        let axes = |p: &Params| p.table.chain.axes().iter().map(|a| (a.name.clone(), a.axis)).collect::<Vec<_>>();
+        if axes(old) != axes(&new) {
+            return Err("the turntable's axes (names, number or directions) cannot change in a running session; restart `rinscope live`".into());
+        }
+        if old.step_hz != new.step_hz {
+            return Err(format!("simulation.step_hz cannot change in a running session ({} Hz -> {} Hz); restart `rinscope live`", old.step_hz, new.step_hz));
+        }
+        let changes = describe_changes(&old.written, &new.written);
+        if changes.is_empty() {
+            return Ok(changes);
+        }
+        let mut model = new.table_model();
+        let initial_changed = old.resolved.turntable.axis.iter().zip(&new.resolved.turntable.axis).any(|(a, b)| a.initial_angle_deg != b.initial_angle_deg);
+        if old.resolved.scheme == new.resolved.scheme && !initial_changed {
+            // Same motion: keep its clock, so nothing jumps.
+            model.scheme = self.model.scheme.clone();
+            model.scheme_t0_s = self.model.scheme_t0_s;
+        } else {
+            // A new motion starts from where the gimbals were at the last step, at that step's time.
+            model.scheme = new.table.scheme.with_initial(&self.last_gimbal_rad);
+            model.scheme_t0_s = self.step_index.saturating_sub(1) as f64 / self.params.step_hz;
+        }
+        self.model = model;
+        self.params = new;
+        Ok(changes)
+    }
+}
+
+/// Human-readable differences between two resolved configs, e.g. `inner swing half-angle 300″ → 600″`.
+#[must_use]
+pub fn describe_changes(old: &RawConfig, new: &RawConfig) -> Vec<String> {
+    let (a, b) = (scenario::flatten(old), scenario::flatten(new));
+    let mut keys: Vec<&String> = a.keys().chain(b.keys()).collect();
+    keys.sort();
+    keys.dedup();
+    let mut out = Vec::new();
+    for key in keys {
+        let (x, y) = (a.get(key), b.get(key));
+        if x == y {
+            continue;
+        }
+        if key.ends_with(".description") {
+            out.push("scenario description edited".to_owned());
+            continue;
+        }
+        let unit = unit_of(key);
+        let show = |v: Option<&String>| v.map_or_else(|| "(unset)".to_owned(), |v| format!("{}{unit}", pretty_value(v)));
+        out.push(format!("{} {} → {}", label_of(key, new), show(x), show(y)));
+    }
+    out
+}
+
+fn pretty_value(v: &str) -> String {
+    match v.parse::<f64>() {
+        Ok(x) if x.fract() == 0.0 && x.abs() < 1e15 => format!("{x:.0}"),
+        Ok(x) => format!("{}", (x * 1e6).round() / 1e6),
+        Err(_) => v.trim_matches('"').to_owned(),
+    }
+}
+
+fn unit_of(key: &str) -> &'static str {
+    let leaf = key.rsplit('.').next().unwrap_or(key);
+    for (suffix, unit) in [
+        ("_arcsec", "″"),
+        ("_deg_per_s2", "°/s²"),
+        ("_deg_per_s", "°/s"),
+        ("_deg", "°"),
+        ("_ppm", " ppm"),
+        ("_ms", " ms"),
+        ("_hz", " Hz"),
+        ("_s", " s"),
+        ("_m", " m"),
+    ] {
+        if leaf.ends_with(suffix) {
+            return unit;
+        }
+    }
+    if leaf == "speed" || leaf == "exaggeration" { "×" } else { "" }
+}
+
+/// `turntable.axis[1].swing_half_angle_arcsec` → `inner swing half-angle`.
+fn label_of(key: &str, raw: &RawConfig) -> String {
+    let parts: Vec<&str> = key.split('.').collect();
+    let leaf = parts.last().copied().unwrap_or(key);
+    let mut name = leaf.to_owned();
+    for suffix in ["_arcsec", "_deg_per_s2", "_deg_per_s", "_deg", "_ppm", "_ms", "_hz", "_s", "_m"] {
+        if let Some(stripped) = name.strip_suffix(suffix) {
+            name = stripped.to_owned();
+            break;
+        }
+    }
+    let name = name.replace('_', " ").replace("swing half angle", "swing half-angle").replace("non orthogonality", "non-orthogonality");
+    let index = |p: &str| p.split_once('[').and_then(|(_, r)| r.trim_end_matches(']').parse::<usize>().ok());
+    match parts.as_slice() {
+        ["turntable", ax, _] if ax.starts_with("axis[") => {
+            let axis = index(ax).and_then(|i| raw.turntable.axis.get(i)).map_or("axis", |a| a.name.as_str());
+            format!("{axis} {name}")
+        }
+        ["turntable", _] => name,
+        ["compensation", "axis", axis, _] => format!("compensation: {axis} {name}"),
+        ["compensation", _] => format!("compensation: {name}"),
+        ["scheme", r, _] if r.starts_with("rate[") => {
+            let axis = index(r).and_then(|i| raw.scheme.rate.get(i)).map_or("axis", |x| x.axis.as_str());
+            format!("{axis} rotation {name}")
+        }
+        ["scheme", s, _] if s.starts_with("step[") => format!("scheme step {} {name}", index(s).map_or(0, |i| i + 1)),
+        _ => key.to_owned(),
+    }
+}
+

@@ -1,0 +1,13 @@
+//! Layer 6, the commands' orchestration: a recorded run (simulation thread → channel → recorder),
+//! live mode, calibration and its Monte Carlo, the position-reset comparison, rotation modulation,
+//! the paper reproductions and the benchmarks. Threads, channels, progress bars and files live
+//! here, above the pure layers and the recorder.
+
+pub mod bench;
+pub mod calibrate;
+pub mod live;
+pub mod modulation;
+pub mod reproduce;
+pub mod run;
+pub mod terminate;
+pub mod tpr;

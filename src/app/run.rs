@@ -1,0 +1,419 @@
+//! A recorded run: the simulation thread steps the model and sends decimated outputs through a
+//! bounded channel to the recorder (this thread), which turns them into Rerun chunks. Memory stays
+//! flat: nothing holds more than one chunk of rows.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::ins::pipeline::{InsRun, InsView, SampleOut};
+use crate::math::stats::RunningStat;
+use crate::math::timeline::decimation;
+use crate::math::units::ARCSEC_PER_RAD;
+use crate::record::sink::OpenSinks;
+use crate::record::Recorder;
+use crate::scenario::Params;
+use crate::sim::{step, DemodState, ErrorStats, Model, StepOutput, DEMODULATIONS, ERROR_AXES};
+
+/// Summary row of the closed form minus the exact (uncompensated) error.
+pub const CLOSED_FORM_DEVIATION: &str = "closed_form_minus_exact";
+
+/// Rows per message from the simulation thread to the recorder.
+const BATCH_ROWS: usize = 2048;
+
+/// One output instant: the turntable-only demodulations and, with an IMU in the loop, the INS's view.
+#[derive(Debug, Clone)]
+pub struct OutputRow {
+    /// Ideal-INS step (truth, encoders, the three demodulations).
+    pub core: StepOutput,
+    /// The INS in the loop, if any.
+    pub ins: Option<InsView>,
+}
+
+/// What the simulation thread sends.
+enum Batch {
+    Series(Vec<OutputRow>),
+    Scene(Vec<OutputRow>),
+    Signal(Vec<SampleOut>),
+}
+
+/// Statistics of the INS in the loop.
+#[derive(Debug, Clone, Default)]
+pub struct InsStats {
+    /// Algorithm names, in integrator order.
+    pub algorithms: Vec<String>,
+    /// `[algorithm][axis]`, radians.
+    pub stats: Vec<[RunningStat; 3]>,
+    /// Navigation errors, when navigating.
+    pub nav: Option<NavSummary>,
+}
+
+impl InsStats {
+    fn add(&mut self, v: &InsView) {
+        if self.stats.len() < v.errors.len() {
+            self.stats.resize(v.errors.len(), [RunningStat::default(); 3]);
+        }
+        for (k, e) in v.errors.iter().enumerate() {
+            for (a, x) in e.as_array().into_iter().enumerate() {
+                self.stats[k][a].add(x);
+            }
+        }
+        if let Some(e) = v.nav {
+            let peak = self.nav.map_or(0.0, |n| n.peak_radial_m).max(e.radial_m);
+            self.nav = Some(NavSummary { peak_radial_m: peak, final_radial_m: e.radial_m, final_east_m: e.east_m, final_north_m: e.north_m });
+        }
+    }
+}
+
+/// RMS and peak of one component, arcsec.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct RmsPeak {
+    /// Root mean square, arcsec.
+    pub rms_arcsec: f64,
+    /// Largest absolute value, arcsec.
+    pub peak_arcsec: f64,
+}
+
+/// The result of a run, as printed and as written by `--summary-json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct RunSummary {
+    /// Scenario name.
+    pub scenario: String,
+    /// Seed of the run.
+    pub seed: u64,
+    /// Simulated time, s.
+    pub duration_s: f64,
+    /// Simulation rate, Hz.
+    pub step_hz: f64,
+    /// Steps simulated.
+    pub steps: u64,
+    /// True if Ctrl-C stopped the run early (the recording holds what was simulated).
+    pub interrupted: bool,
+    /// Wall-clock time of the whole run, s.
+    pub wall_time_s: f64,
+    /// Simulation steps per wall-clock second (including recording).
+    pub steps_per_second: f64,
+    /// Saved recording, if any.
+    pub recording_path: Option<String>,
+    /// Its size, bytes.
+    pub recording_bytes: Option<u64>,
+    /// `[variant][axis]`: "uncompensated" / "compensated" / "closed_form" / "closed_form_minus_exact"
+    /// x "pitch" / "roll" / "heading" (with an IMU in the loop: at the output instants).
+    pub attitude_error_arcsec: std::collections::BTreeMap<String, std::collections::BTreeMap<String, RmsPeak>>,
+    /// With an IMU in the loop: the INS body-attitude error `[algorithm][axis]`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ins_attitude_error_arcsec: Option<std::collections::BTreeMap<String, std::collections::BTreeMap<String, RmsPeak>>>,
+    /// With navigation: radial position error, m (peak and final) and the final east/north error.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub navigation: Option<NavSummary>,
+}
+
+/// Navigation errors of a run.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct NavSummary {
+    /// Largest radial position error, m.
+    pub peak_radial_m: f64,
+    /// Radial position error at the end, m.
+    pub final_radial_m: f64,
+    /// East position error at the end, m.
+    pub final_east_m: f64,
+    /// North position error at the end, m.
+    pub final_north_m: f64,
+}
+
+impl RunSummary {
+    fn new(p: &Params, stats: &ErrorStats, steps: u64, wall_time_s: f64, interrupted: bool) -> Self {
+        let mut table = std::collections::BTreeMap::new();
+        for (v, variant) in DEMODULATIONS.iter().enumerate() {
+            let mut row = std::collections::BTreeMap::new();
+            for (a, axis) in ERROR_AXES.iter().enumerate() {
+                let s = &stats.stats[v][a];
+                row.insert((*axis).to_owned(), RmsPeak { rms_arcsec: s.rms() * ARCSEC_PER_RAD, peak_arcsec: s.peak() * ARCSEC_PER_RAD });
+            }
+            table.insert((*variant).to_owned(), row);
+        }
+        let mut row = std::collections::BTreeMap::new();
+        for (a, axis) in ERROR_AXES.iter().enumerate() {
+            let s = &stats.closed_form_deviation[a];
+            row.insert((*axis).to_owned(), RmsPeak { rms_arcsec: s.rms() * ARCSEC_PER_RAD, peak_arcsec: s.peak() * ARCSEC_PER_RAD });
+        }
+        table.insert(CLOSED_FORM_DEVIATION.to_owned(), row);
+        Self {
+            scenario: p.meta.name.clone(),
+            seed: p.meta.seed,
+            duration_s: steps.saturating_sub(1) as f64 / p.step_hz,
+            step_hz: p.step_hz,
+            steps,
+            interrupted,
+            wall_time_s,
+            steps_per_second: steps as f64 / wall_time_s.max(1e-9),
+            recording_path: None,
+            recording_bytes: None,
+            attitude_error_arcsec: table,
+            ins_attitude_error_arcsec: None,
+            navigation: None,
+        }
+    }
+
+    fn with_ins(mut self, ins: &InsStats) -> Self {
+        if ins.algorithms.is_empty() {
+            return self;
+        }
+        let mut table = std::collections::BTreeMap::new();
+        for (k, name) in ins.algorithms.iter().enumerate() {
+            let mut row = std::collections::BTreeMap::new();
+            for (a, axis) in ERROR_AXES.iter().enumerate() {
+                let s = ins.stats.get(k).map_or(RunningStat::default(), |s| s[a]);
+                row.insert((*axis).to_owned(), RmsPeak { rms_arcsec: s.rms() * ARCSEC_PER_RAD, peak_arcsec: s.peak() * ARCSEC_PER_RAD });
+            }
+            table.insert(name.clone(), row);
+        }
+        self.ins_attitude_error_arcsec = Some(table);
+        self.navigation = ins.nav;
+        self
+    }
+
+    /// RMS and peak of one variant and axis.
+    #[must_use]
+    pub fn get(&self, variant: &str, axis: &str) -> RmsPeak {
+        self.attitude_error_arcsec[variant][axis]
+    }
+
+    /// The end-of-run table.
+    #[must_use]
+    pub fn table(&self) -> String {
+        let mut s = String::new();
+        s.push_str(&format!(
+            "{} — {:.1} s simulated, {} steps at {} Hz, {:.2} s wall ({:.2} M steps/s){}\n",
+            self.scenario,
+            self.duration_s,
+            self.steps,
+            self.step_hz,
+            self.wall_time_s,
+            self.steps_per_second / 1e6,
+            if self.interrupted { " — INTERRUPTED" } else { "" }
+        ));
+        s.push_str("attitude error, arcsec     pitch rms  pitch peak    roll rms   roll peak  heading rms heading peak\n");
+        for variant in DEMODULATIONS.iter().chain([&CLOSED_FORM_DEVIATION]) {
+            s.push_str(&format!("{:<24}", variant.replace('_', " ")));
+            for axis in ERROR_AXES {
+                let v = self.get(variant, axis);
+                s.push_str(&format!(" {:>11.3} {:>11.3}", v.rms_arcsec, v.peak_arcsec));
+            }
+            s.push('\n');
+        }
+        if let Some(ins) = &self.ins_attitude_error_arcsec {
+            s.push_str("INS attitude error, arcsec\n");
+            for (name, row) in ins {
+                s.push_str(&format!("{:<24}", format!("  {name}")));
+                for axis in ERROR_AXES {
+                    let v = row[axis];
+                    s.push_str(&format!(" {:>11.3} {:>11.3}", v.rms_arcsec, v.peak_arcsec));
+                }
+                s.push('\n');
+            }
+        }
+        if let Some(n) = &self.navigation {
+            s.push_str(&format!(
+                "navigation: radial position error peak {:.1} m, final {:.1} m (east {:.1} m, north {:.1} m)\n",
+                n.peak_radial_m, n.final_radial_m, n.final_east_m, n.final_north_m
+            ));
+        }
+        if let (Some(p), Some(b)) = (&self.recording_path, self.recording_bytes) {
+            s.push_str(&format!("recording: {p} ({:.2} MB)\n", b as f64 / 1e6));
+        }
+        s
+    }
+}
+
+/// Simulates `params`, streaming to `sinks`; Ctrl-C (`stop`) ends the run early and keeps what was
+/// simulated. Returns the summary and the still-open sinks (the caller finishes or abandons them).
+pub fn run_recorded(params: &Params, sinks: &OpenSinks, stop: &AtomicBool, progress: bool) -> anyhow::Result<RunSummary> {
+    let started = Instant::now();
+    let model = params.table_model();
+    let mut recorder = Recorder::new(sinks.rec.clone(), params)?;
+    let steps = params.timeline().instants();
+    let series_every = decimation(params.step_hz, params.recording.series_hz);
+    let scene_every = decimation(params.step_hz, params.recording.scene_hz);
+    let step_hz = params.step_hz;
+
+    let bar = if progress && steps > 2_000_000 {
+        let bar = indicatif::ProgressBar::new(steps);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{spinner} simulating [{bar:40}] {percent}% ({eta} left)")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        Some(bar)
+    } else {
+        None
+    };
+
+    let (tx, rx) = crossbeam_channel::bounded::<Batch>(8);
+    let (stats, ins_stats, done, interrupted) = std::thread::scope(|scope| -> anyhow::Result<(ErrorStats, InsStats, u64, bool)> {
+        let sim = scope.spawn(|| {
+            let ctx = Producer { model: &model, params, stop, bar: bar.as_ref(), tx: &tx, series_every, scene_every };
+            let r = if params.ins.is_some() { ctx.run_ins(steps) } else { ctx.run_ideal(steps) };
+            drop(tx);
+            r
+        });
+        let mut result = Ok(());
+        for batch in &rx {
+            let r = match batch {
+                Batch::Series(rows) => rows.iter().try_for_each(|o| recorder.push_row(&o.core, o.ins.as_ref())),
+                Batch::Scene(rows) => rows.iter().try_for_each(|o| recorder.push_scene_row(&o.core, o.ins.as_ref())),
+                Batch::Signal(samples) => samples.iter().try_for_each(|o| recorder.push_signal(o)),
+            };
+            if let Err(e) = r {
+                result = Err(e);
+                break;
+            }
+        }
+        drop(rx);
+        let r = sim.join().map_err(|_| anyhow::anyhow!("simulation thread panicked"))?;
+        result?;
+        Ok(r)
+    })?;
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+
+    let summary = RunSummary::new(params, &stats, done, started.elapsed().as_secs_f64(), interrupted).with_ins(&ins_stats);
+    let t_end = done.saturating_sub(1) as f64 / step_hz;
+    let end_text = if interrupted {
+        format!("run interrupted by the user at {t_end:.3} s; the recording holds everything simulated until then")
+    } else {
+        format!("run finished at {t_end:.3} s")
+    };
+    recorder.event(t_end, &end_text, if interrupted { "WARN" } else { "INFO" })?;
+    recorder.event(t_end, &format!("summary:\n{}", summary.table()), "INFO")?;
+    recorder.finish()?;
+    Ok(summary)
+}
+
+/// The simulation thread's side of a recorded run.
+struct Producer<'a> {
+    model: &'a Model,
+    params: &'a Params,
+    stop: &'a AtomicBool,
+    bar: Option<&'a indicatif::ProgressBar>,
+    tx: &'a crossbeam_channel::Sender<Batch>,
+    series_every: u64,
+    scene_every: u64,
+}
+
+/// Buffers rows and sends them in batches; `false` when the recorder has gone away.
+struct Outbox<'a> {
+    tx: &'a crossbeam_channel::Sender<Batch>,
+    series: Vec<OutputRow>,
+    scene: Vec<OutputRow>,
+    signal: Vec<SampleOut>,
+}
+
+impl Outbox<'_> {
+    fn series(&mut self, r: OutputRow) -> bool {
+        self.series.push(r);
+        self.series.len() < BATCH_ROWS || self.tx.send(Batch::Series(std::mem::take(&mut self.series))).is_ok()
+    }
+    fn scene(&mut self, r: OutputRow) -> bool {
+        self.scene.push(r);
+        self.scene.len() < BATCH_ROWS || self.tx.send(Batch::Scene(std::mem::take(&mut self.scene))).is_ok()
+    }
+    fn signal(&mut self, s: SampleOut) -> bool {
+        self.signal.push(s);
+        self.signal.len() < BATCH_ROWS || self.tx.send(Batch::Signal(std::mem::take(&mut self.signal))).is_ok()
+    }
+    fn close(self) {
+        // A closed receiver means the recorder failed; it reports the error itself.
+        let _ = self.tx.send(Batch::Signal(self.signal));
+        let _ = self.tx.send(Batch::Series(self.series));
+        let _ = self.tx.send(Batch::Scene(self.scene));
+    }
+}
+
+impl Producer<'_> {
+    fn check(&self, i: u64) -> bool {
+        if let Some(b) = self.bar {
+            b.set_position(i);
+        }
+        self.stop.load(Ordering::Relaxed)
+    }
+
+    /// The IMU attitude is exact: one core step per simulation step.
+    fn run_ideal(&self, steps: u64) -> (ErrorStats, InsStats, u64, bool) {
+        let mut state = DemodState::default();
+        let mut stats = ErrorStats::default();
+        let mut out = Outbox { tx: self.tx, series: Vec::new(), scene: Vec::new(), signal: Vec::new() };
+        let (mut done, mut interrupted) = (0, false);
+        for i in 0..steps {
+            if i % 65_536 == 0 && self.check(i) {
+                interrupted = true;
+                break;
+            }
+            let o = step(self.model, &mut state, i as f64 / self.params.step_hz);
+            stats.add(&o);
+            if i % self.series_every == 0 && !out.series(OutputRow { core: o, ins: None }) {
+                break;
+            }
+            if i % self.scene_every == 0 && !out.scene(OutputRow { core: o, ins: None }) {
+                break;
+            }
+            done = i + 1;
+        }
+        out.close();
+        (stats, InsStats::default(), done, interrupted)
+    }
+
+    /// An IMU in the loop: one IMU sample per step; outputs at the attitude updates closest to the
+    /// recording rates (statistics at the series outputs).
+    fn run_ins(&self, steps: u64) -> (ErrorStats, InsStats, u64, bool) {
+        let Some(ins_params) = &self.params.ins else {
+            return self.run_ideal(steps);
+        };
+        let mut ins = InsRun::new(ins_params, self.params.site, self.params.meta.seed, self.model.clone());
+        let mut state = DemodState::default();
+        let mut stats = ErrorStats::default();
+        let mut ins_stats = InsStats { algorithms: ins.algorithms().iter().map(|a| a.name().to_owned()).collect(), ..InsStats::default() };
+        let mut out = Outbox { tx: self.tx, series: Vec::new(), scene: Vec::new(), signal: Vec::new() };
+        let window = ins.config().signal_window_s;
+        let (mut done, mut interrupted) = (1, false);
+        let (mut next_series, mut next_scene) = (0u64, 0u64);
+        for i in 1..steps {
+            if i % 65_536 == 0 && self.check(i) {
+                interrupted = true;
+                break;
+            }
+            let s = ins.step();
+            if s.t_s <= window && !out.signal(s) {
+                break;
+            }
+            done = i + 1;
+            if !s.updated {
+                continue;
+            }
+            let want_series = i >= next_series;
+            let want_scene = i >= next_scene;
+            if !(want_series || want_scene) {
+                continue;
+            }
+            let core = step(self.model, &mut state, s.t_s);
+            let view = ins.view(s.t_s);
+            if want_series {
+                next_series = i + self.series_every;
+                stats.add(&core);
+                ins_stats.add(&view);
+                if !out.series(OutputRow { core, ins: Some(view.clone()) }) {
+                    break;
+                }
+            }
+            if want_scene {
+                next_scene = i + self.scene_every;
+                if !out.scene(OutputRow { core, ins: Some(view) }) {
+                    break;
+                }
+            }
+        }
+        out.close();
+        (stats, ins_stats, done, interrupted)
+    }
+}

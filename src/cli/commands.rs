@@ -1,0 +1,370 @@
+//! The commands: each turns its arguments into parameters and sinks, runs the orchestration in
+//! `app`, prints what a user reads and maps failures to exit codes.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::Ordering;
+
+use super::{CalibrateArgs, Failure, LiveArgs, ModulationArgs, MonteCarloArgs, RunArgs, TprArgs};
+use crate::app::calibrate::{calibrate_scenario, monte_carlo, record_outcome};
+use crate::app::run::run_recorded;
+use crate::app::terminate::stop_flag;
+use crate::app::{live, modulation, reproduce, tpr};
+use crate::calib::CalibError;
+use crate::ins::reset::sweep_text;
+use crate::io::files::write_atomically;
+use crate::math::units::RAD_PER_ARCSEC;
+use crate::record::sink::{self, SinkRequest};
+use crate::record::APPLICATION_ID;
+use crate::scenario::{self, presets, Params};
+
+fn load(args: &RunArgs) -> Result<Params, Failure> {
+    let mut params = args.source.load(presets::DEFAULT_SCENARIO)?;
+    if let Some(d) = args.duration_s {
+        if !(d.is_finite() && d > 0.0 && d * params.step_hz <= 2.0e9) {
+            return Err(Failure::input(format!("--duration-s {d} s: must be > 0 and at most 2e9 steps at {} Hz", params.step_hz)));
+        }
+        params.duration_s = d;
+    }
+    Ok(params)
+}
+
+/// `rinscope run`.
+pub(super) fn run(args: &RunArgs) -> Result<(), Failure> {
+    let params = load(args)?;
+    // The summary file is checked before anything runs, so a typo costs nothing.
+    check_output_dir("--summary-json", args.summary_json.as_deref())?;
+    let sinks = open_sinks(args.sinks.request(default_recording(&params.meta.name)), &format!("{}-seed{}", params.meta.name, params.meta.seed))?;
+    let stop = stop_flag();
+    let mut summary = match run_recorded(&params, &sinks, &stop, true) {
+        Ok(s) => s,
+        Err(e) => {
+            sinks.abandon();
+            return Err(e.into());
+        }
+    };
+    if let Some((path, bytes)) = sinks.finish()? {
+        summary.recording_path = Some(path.display().to_string());
+        summary.recording_bytes = Some(bytes);
+    }
+    print!("{}", summary.table());
+    if let Some(path) = &args.summary_json {
+        write_json("--summary-json", path, &summary)?;
+    }
+    if let Some(p) = &summary.recording_path {
+        println!("open it with:  rerun {p}     (viewer: {})", sink::VIEWER_INSTALL_HINT);
+    }
+    if summary.interrupted {
+        return Err(Failure::interrupted("interrupted: the recording is complete up to the moment of Ctrl-C"));
+    }
+    Ok(())
+}
+
+/// `rinscope live`.
+pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
+    use std::io::IsTerminal;
+    let path = match (&args.config, &args.scenario) {
+        (Some(p), _) => p.clone(),
+        (None, name) => {
+            let name = name.as_deref().unwrap_or(presets::DEFAULT_SCENARIO);
+            presets::load(name)?; // a clear error for an unknown name
+            let (path, created) = live::ensure_preset_copy(name).map_err(|e| Failure::input(format!("{e:#}")))?;
+            eprintln!("rinscope live: {} {} — edit it, or move the sliders", if created { "wrote" } else { "using your edited" }, path.display());
+            path
+        }
+    };
+    let params = scenario::load_file(&path)?;
+    if let Some(s) = args.speed
+        && !(s.is_finite() && s > 0.0 && s <= 10_000.0)
+    {
+        return Err(Failure::input(format!("--speed {s}: must be > 0 and <= 10000 (x real time)")));
+    }
+    if let Some(d) = args.duration_s
+        && !(d.is_finite() && d > 0.0)
+    {
+        return Err(Failure::input(format!("--duration-s {d} s: must be > 0")));
+    }
+    let viewer_given = args.sinks.viewer_asked();
+    if args.no_viewer && args.sinks.save.is_none() {
+        return Err(Failure::input("--no-viewer needs --save FILE (otherwise nothing would be kept)"));
+    }
+    // Two streams: small chunks for viewers, full-size chunks for the saved file (see live::Outputs).
+    let viewer_request = SinkRequest {
+        spawn: args.sinks.spawn || (!viewer_given && !args.no_viewer),
+        connect: args.sinks.connect.clone(),
+        serve: args.sinks.serve,
+        ..Default::default()
+    };
+    let recording_id = format!("{}-seed{}-live", params.meta.name, params.meta.seed);
+    let viewer_sinks = if viewer_request.spawn || viewer_request.connect.is_some() || viewer_request.serve.is_some() {
+        Some(sink::open(&viewer_request, APPLICATION_ID, &recording_id)?)
+    } else {
+        None
+    };
+    let file_sinks = match &args.sinks.save {
+        Some(p) => Some(sink::open(&SinkRequest { save: Some(p.clone()), ..Default::default() }, APPLICATION_ID, &recording_id)?),
+        None => None,
+    };
+    for d in viewer_sinks.iter().chain(file_sinks.iter()).flat_map(|s| &s.description) {
+        eprintln!("rinscope live: {d}");
+    }
+    let panel = !args.no_panel && std::io::stdout().is_terminal() && std::io::stdin().is_terminal();
+    let stop = stop_flag();
+    if !panel {
+        eprintln!("rinscope live: running; edit {} to change parameters, Ctrl-C to stop", path.display());
+    }
+    let options = live::LiveOptions { config_path: path, speed: args.speed, duration_s: args.duration_s, panel, log_to_stderr: true };
+    let outputs = live::Outputs { viewer: viewer_sinks.as_ref().map(|s| s.rec.clone()), file: file_sinks.as_ref().map(|s| s.rec.clone()) };
+    let result = live::run_session(&options, params, outputs, &stop);
+    // Whatever happened, complete the saved file: it holds everything simulated so far.
+    if let Some(v) = viewer_sinks {
+        v.finish().ok();
+    }
+    let saved = match file_sinks {
+        Some(f) => f.finish()?,
+        None => None,
+    };
+    let summary = result?;
+    println!(
+        "live session: {:.1} s simulated ({} steps), {} reloads applied, save -> applied p95 {:.1} ms",
+        summary.sim_t_s,
+        summary.steps,
+        summary.latencies_ms.len(),
+        live::p95(&summary.latencies_ms)
+    );
+    if let Some((p, bytes)) = saved {
+        println!("recording: {} ({:.2} MB) — open with `rerun {}`, list its events with `rinscope events {}`", p.display(), bytes as f64 / 1e6, p.display(), p.display());
+    }
+    Ok(())
+}
+
+/// `rinscope modulation`.
+pub(super) fn modulation(args: &ModulationArgs) -> Result<(), Failure> {
+    let hours = args.hours;
+    if !(hours.is_finite() && hours > 0.0 && hours <= 24.0 * 30.0) {
+        return Err(Failure::input(format!("--hours {hours}: must be > 0 and at most 720 h")));
+    }
+    let sinks = open_sinks(args.sinks.request(default_recording("rotation-modulation")), "rotation-modulation")?;
+    let stop = stop_flag();
+    let started = std::time::Instant::now();
+    eprintln!("rinscope: simulating {hours} h three times in parallel (no rotation, continuous azimuth, 16-position)...");
+    let traces = match modulation::simulate_variants(hours, &stop) {
+        Ok(t) => t,
+        Err(e) => {
+            sinks.abandon();
+            return Err(e.into());
+        }
+    };
+    let table = modulation::table(&traces, started.elapsed().as_secs_f64());
+    if let Err(e) = crate::record::modulation::log(&sinks.rec, &traces, &table) {
+        sinks.abandon();
+        return Err(Failure::run(format!("rerun: {e}")));
+    }
+    let saved = sinks.finish()?;
+    print!("{table}");
+    print_saved(saved);
+    Ok(())
+}
+
+fn check_output_dir(flag: &str, path: Option<&std::path::Path>) -> Result<(), Failure> {
+    if let Some(dir) = path.and_then(|p| p.parent()).filter(|d| !d.as_os_str().is_empty() && !d.is_dir()) {
+        return Err(Failure::input(format!("{flag}: directory {} does not exist", dir.display())));
+    }
+    Ok(())
+}
+
+/// The file a command saves to when no sink is asked for.
+fn default_recording(name: &str) -> PathBuf {
+    PathBuf::from("recordings").join(format!("{name}.rrd"))
+}
+
+/// Opens the sinks a command asked for.
+fn open_sinks(request: SinkRequest, recording_id: &str) -> Result<sink::OpenSinks, Failure> {
+    let sinks = sink::open(&request, APPLICATION_ID, recording_id)?;
+    for d in &sinks.description {
+        eprintln!("rinscope: {d}");
+    }
+    Ok(sinks)
+}
+
+/// Writes `value` as pretty JSON to the file given with `flag`, atomically.
+fn write_json(flag: &str, path: &std::path::Path, value: &impl serde::Serialize) -> Result<(), Failure> {
+    let json = serde_json::to_string_pretty(value).map_err(|e| Failure::run(e.to_string()))?;
+    write_atomically(path, json.as_bytes()).map_err(|e| Failure::input(format!("{flag} {}: {e}", path.display())))
+}
+
+/// The line that tells where a saved recording is and how to open it.
+fn print_saved(saved: Option<(PathBuf, u64)>) {
+    if let Some((p, bytes)) = saved {
+        println!("recording: {} ({:.2} MB) — open with `rerun {}`", p.display(), bytes as f64 / 1e6, p.display());
+    }
+}
+
+/// `rinscope calibrate`.
+pub(super) fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
+    let params = args.source.load("jiang2017-calibration")?;
+    check_output_dir("--json", args.json.as_deref())?;
+    let sinks = if args.no_recording {
+        None
+    } else {
+        let request = args.sinks.request(default_recording(&format!("{}-calibration", params.meta.name)));
+        Some(open_sinks(request, &format!("{}-calibration-seed{}", params.meta.name, params.meta.seed))?)
+    };
+    let started = std::time::Instant::now();
+    let outcome = match calibrate_scenario(&params, sinks.is_some()) {
+        Ok(o) => o,
+        Err(e) => {
+            if let Some(s) = sinks {
+                s.abandon();
+            }
+            let code = if matches!(e, CalibError::VehicleMoves(_)) { 2 } else { 1 };
+            return Err(Failure { code, message: format!("calibrate: {e}") });
+        }
+    };
+    let wall = started.elapsed().as_secs_f64();
+    print!("{}", outcome.report.text());
+    println!("({wall:.2} s wall: two {:.0}-s runs simulated, filter and least squares)", params.duration_s);
+    if let Some(path) = &args.json {
+        write_json("--json", path, &outcome.report)?;
+    }
+    if let Some(sinks) = sinks {
+        if let Err(e) = record_outcome(sinks.rec.clone(), &params, &outcome) {
+            sinks.abandon();
+            return Err(Failure::run(format!("rerun: {e}")));
+        }
+        print_saved(sinks.finish()?);
+    }
+    Ok(())
+}
+
+/// `rinscope montecarlo`.
+pub(super) fn montecarlo(args: &MonteCarloArgs) -> Result<(), Failure> {
+    let mut params = args.source.load("jiang2017-calibration")?;
+    check_output_dir("--json", args.json.as_deref())?;
+    let runs = args.runs.unwrap_or(params.calibration.montecarlo.runs as usize);
+    if runs == 0 || runs > 1_000_000 {
+        return Err(Failure::input(format!("--runs {runs}: must be 1 ..= 1000000")));
+    }
+    if let Some(s) = args.eta_measured_sigma_arcsec {
+        if !(s.is_finite() && s > 0.0 && s <= 3600.0) {
+            return Err(Failure::input(format!("--eta-measured-sigma-arcsec {s}: must be > 0 and <= 3600 arcsec")));
+        }
+        params.calibration.montecarlo.eta_measured_sigma_rad = Some(s * RAD_PER_ARCSEC);
+    }
+    let stop = stop_flag();
+    let bar = indicatif::ProgressBar::new(runs as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} {pos}/{len} calibrations [{bar:40}] {elapsed_precise} (eta {eta})")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    let tick = || bar.inc(1);
+    let result = monte_carlo(&params, runs, &tick, &stop);
+    bar.finish_and_clear();
+    let summary = result.map_err(|e| Failure::run(format!("montecarlo: {e}")))?;
+    print!("{}", summary.text());
+    if let Some(path) = &args.json {
+        write_json("--json", path, &summary)?;
+    }
+    if summary.runs < summary.runs_requested {
+        return Err(Failure::interrupted(format!("interrupted after {} runs (statistics above are over those)", summary.runs)));
+    }
+    Ok(())
+}
+
+/// `rinscope tpr`.
+pub(super) fn tpr(args: &TprArgs) -> Result<(), Failure> {
+    let params = args.source.load("zheng2016-tpr")?;
+    check_output_dir("--json", args.json.as_deref())?;
+    tpr::check(&params).map_err(|e| Failure::input(format!("tpr: {e}")))?;
+    let sinks = open_sinks(args.sinks.request(default_recording(&params.meta.name)), &format!("{}-seed{}", params.meta.name, params.meta.seed))?;
+    let stop = stop_flag();
+    eprintln!("rinscope: navigating {:.1} h (forking at the second fix)...", params.duration_s / 3600.0);
+    let result = match tpr::compare_resets(&params, 60.0, &stop) {
+        Ok(r) => r,
+        Err(e) => {
+            sinks.abandon();
+            return Err(Failure::input(format!("tpr: {e}")));
+        }
+    };
+    let text = result.text();
+    if let Err(e) = crate::record::tpr::log(&sinks.rec, &params, &result, &text) {
+        sinks.abandon();
+        return Err(Failure::run(format!("rerun: {e}")));
+    }
+    let saved = sinks.finish()?;
+    print!("{text}");
+    if let Some(path) = &args.json {
+        write_json("--json", path, &result)?;
+    }
+    print_saved(saved);
+    if !result.complete {
+        return Err(Failure::interrupted("interrupted: the recording holds what was simulated"));
+    }
+    if let Some(n) = args.seeds {
+        eprintln!("rinscope: {n} seeds from {} in parallel...", params.meta.seed);
+        let started = std::time::Instant::now();
+        let rows = tpr::sweep(&params, n, &stop).map_err(|e| Failure::input(format!("tpr: {e}")))?;
+        if stop.load(Ordering::SeqCst) {
+            return Err(Failure::interrupted("interrupted"));
+        }
+        print!("{}", sweep_text(&rows));
+        println!("  {n} runs of {:.1} h in {:.1} s", params.duration_s / 3600.0, started.elapsed().as_secs_f64());
+    }
+    Ok(())
+}
+
+/// `rinscope events`.
+pub(super) fn events(file: &Path) -> Result<(), Failure> {
+    let events = crate::record::read::events(file).map_err(|e| Failure::input(format!("{e:#}")))?;
+    for e in events {
+        match e.t_s {
+            Some(t) => println!("{t:>10.3} s  {:<5} {}", e.level, e.text),
+            None => println!("{:>12}  {:<5} {}", "static", e.level, e.text),
+        }
+    }
+    Ok(())
+}
+
+/// `rinscope scenarios`.
+pub(super) fn list_scenarios() {
+    for (name, _) in presets::PRESETS {
+        match presets::load(name) {
+            Ok(p) => {
+                let mark = if *name == presets::DEFAULT_SCENARIO { " (default)" } else { "" };
+                println!("{name}{mark}\n    {}", p.meta.title);
+            }
+            Err(e) => println!("{name}\n    BROKEN: {e}"),
+        }
+    }
+}
+
+/// `rinscope check-config`.
+pub(super) fn check_config(file: &Path) -> Result<(), Failure> {
+    let p = scenario::load_file(file)?;
+    let axes: Vec<String> = p.table.chain.axes().iter().map(|a| a.name.clone()).collect();
+    println!(
+        "{}: ok — scenario \"{}\", {} s at {} Hz ({} steps), axes {:?}, seed {}",
+        file.display(),
+        p.meta.name,
+        p.duration_s,
+        p.step_hz,
+        p.timeline().instants(),
+        axes,
+        p.meta.seed
+    );
+    Ok(())
+}
+
+/// `rinscope reproduce`.
+pub(super) fn reproduce(markdown: Option<&Path>) -> Result<(), Failure> {
+    let table = reproduce::run_all()?;
+    print!("{}", table.text());
+    if let Some(path) = markdown {
+        write_atomically(path, table.markdown().as_bytes()).map_err(|e| Failure::input(format!("--markdown {}: {e}", path.display())))?;
+    }
+    if table.all_agree() {
+        Ok(())
+    } else {
+        Err(Failure::run("some reproductions fall outside their tolerance (see the table)"))
+    }
+}

@@ -1,0 +1,295 @@
+//! Layer 7, the command line: clap's view of every command, the sink flags declared once and
+//! flattened into each command that records, exit codes. `main` parses and dispatches; the
+//! commands' work is in [`commands`] and the layers below.
+//!
+//! ```text
+//! rinscope                                   # embedded default scenario -> recordings/<scenario>.rrd
+//! rinscope run --scenario NAME --spawn       # stream to a new viewer (pip install rerun-sdk==0.36.3)
+//! rinscope run --config my.toml --save out.rrd --summary-json out.json
+//! rinscope scenarios | check-config FILE | reproduce | bench
+//! ```
+//!
+//! Exit codes: 0 success, 1 a failure while running (or a reproduction outside tolerance),
+//! 2 bad input (config, path, viewer), 130 interrupted by Ctrl-C (what was simulated is saved).
+
+mod commands;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Args, Parser, Subcommand};
+
+use crate::record::sink::{self, SinkError, SinkRequest};
+use crate::scenario::{self, presets, ConfigError, Params};
+
+#[derive(Parser)]
+#[command(name = "rinscope", version, about = "See the errors of a rotational inertial navigation system (RINS) in the Rerun viewer")]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Simulate a scenario and record it (the default command).
+    Run(RunArgs),
+    /// Run in real time, streaming to a viewer, with the config file watched and a slider panel.
+    Live(LiveArgs),
+    /// Rotation modulation: static INS with constant biases, no rotation vs continuous vs 16-position,
+    /// simulated together and recorded side by side.
+    Modulation(ModulationArgs),
+    /// Static calibration of the swing cones and non-orthogonality (seed 000 §5): static Kalman
+    /// filter and exact least squares, compensation before/after, a recording with ghost cones
+    /// (default scenario: jiang2017-calibration).
+    Calibrate(CalibrateArgs),
+    /// Seed 000's Monte Carlo (Tables 2-3): many calibrations with drawn parameters, in parallel
+    /// (default scenario: jiang2017-calibration).
+    Montecarlo(MonteCarloArgs),
+    /// Seed 003's Twice Position-fix Reset against the conventional reset, from one IMU stream
+    /// (default scenario: zheng2016-tpr; needs [imu], [navigation] and two [position_fix] times).
+    Tpr(TprArgs),
+    /// Print the event log (reloads, errors, summary) of a saved recording.
+    Events {
+        /// The .rrd file.
+        file: PathBuf,
+    },
+    /// List the scenario presets.
+    Scenarios,
+    /// Parse and validate a scenario file without running it.
+    CheckConfig {
+        /// The TOML file.
+        file: PathBuf,
+    },
+    /// Run every scenario that reproduces a paper's number and compare (exit 1 on disagreement).
+    Reproduce {
+        /// Also write the table as markdown to this file (e.g. docs/reproduce.md).
+        #[arg(long)]
+        markdown: Option<PathBuf>,
+    },
+    /// Measure speed and recording size.
+    Bench {
+        /// Steps of each pure-simulation repetition.
+        #[arg(long, default_value_t = 2_000_000)]
+        steps: u64,
+    },
+}
+
+/// Where a recording goes, as Rerun's tools spell it; several at once are allowed. With none, a
+/// command saves to its default file (`recordings/<scenario>.rrd`).
+#[derive(Args, Default, Clone)]
+struct SinkArgs {
+    /// Save the recording to this .rrd file (default: recordings/<name>.rrd when no viewer is asked for).
+    #[arg(long)]
+    save: Option<PathBuf>,
+    /// Start a new Rerun viewer and stream to it.
+    #[arg(long)]
+    spawn: bool,
+    /// Stream to a running viewer (default URL rerun+http://127.0.0.1:9876/proxy).
+    #[arg(long, num_args = 0..=1, default_missing_value = sink::DEFAULT_CONNECT_URL)]
+    connect: Option<String>,
+    /// Serve the stream over gRPC on this port (default 9876) for native or web viewers.
+    #[arg(long, num_args = 0..=1, default_missing_value = "9876")]
+    serve: Option<u16>,
+}
+
+impl SinkArgs {
+    /// True if a viewer (spawned, connected or served) was asked for.
+    fn viewer_asked(&self) -> bool {
+        self.spawn || self.connect.is_some() || self.serve.is_some()
+    }
+
+    /// The request, with `default_save` when nothing at all was asked for.
+    fn request(&self, default_save: PathBuf) -> SinkRequest {
+        let save = self.save.clone().or_else(|| (!self.viewer_asked()).then_some(default_save));
+        SinkRequest { save, spawn: self.spawn, connect: self.connect.clone(), serve: self.serve }
+    }
+}
+
+/// Where a command's scenario comes from (each command has its own default preset).
+#[derive(Args, Default)]
+struct ScenarioSource {
+    /// A preset from assets/scenarios (see `rinscope scenarios`).
+    #[arg(long, conflicts_with = "config")]
+    scenario: Option<String>,
+    /// A scenario file.
+    #[arg(long)]
+    config: Option<PathBuf>,
+}
+
+impl ScenarioSource {
+    /// The scenario file if given, else the named preset, else `default`.
+    fn load(&self, default: &str) -> Result<Params, ConfigError> {
+        match &self.config {
+            Some(path) => scenario::load_file(path),
+            None => presets::load(self.scenario.as_deref().unwrap_or(default)),
+        }
+    }
+}
+
+#[derive(Args, Default)]
+struct RunArgs {
+    #[command(flatten)]
+    source: ScenarioSource,
+    #[command(flatten)]
+    sinks: SinkArgs,
+    /// Write RMS and peak errors, duration, steps and wall time as JSON.
+    #[arg(long)]
+    summary_json: Option<PathBuf>,
+    /// Override the scenario's simulated duration, s.
+    #[arg(long)]
+    duration_s: Option<f64>,
+}
+
+#[derive(Args)]
+struct LiveArgs {
+    /// A preset: an editable copy is written to rinscope-live/<name>.toml (kept if it exists).
+    #[arg(long, conflicts_with = "config")]
+    scenario: Option<String>,
+    /// The scenario file to run and watch.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    #[command(flatten)]
+    sinks: SinkArgs,
+    /// Simulated seconds per wall-clock second (default: the file's [live] speed, else 1).
+    #[arg(long)]
+    speed: Option<f64>,
+    /// Stop after this much simulated time, s (default: run until you quit).
+    #[arg(long)]
+    duration_s: Option<f64>,
+    /// No viewer: only --save (for headless sessions and tests).
+    #[arg(long, conflicts_with_all = ["spawn", "connect", "serve"])]
+    no_viewer: bool,
+    /// No terminal panel (edit the file by hand; Ctrl-C ends the session).
+    #[arg(long)]
+    no_panel: bool,
+}
+
+#[derive(Args)]
+struct ModulationArgs {
+    /// Simulated hours.
+    #[arg(long, default_value_t = 24.0)]
+    hours: f64,
+    #[command(flatten)]
+    sinks: SinkArgs,
+}
+
+#[derive(Args)]
+struct CalibrateArgs {
+    // Default jiang2017-calibration: a static vehicle; its [calibration] section, or the defaults.
+    #[command(flatten)]
+    source: ScenarioSource,
+    #[command(flatten)]
+    sinks: SinkArgs,
+    /// Write the estimates, 1σ, observability and compensation as JSON.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// No recording (print and JSON only).
+    #[arg(long, conflicts_with_all = ["save", "spawn", "connect", "serve"])]
+    no_recording: bool,
+}
+
+#[derive(Args)]
+struct MonteCarloArgs {
+    // Default jiang2017-calibration.
+    #[command(flatten)]
+    source: ScenarioSource,
+    /// Number of runs (default: [calibration.montecarlo] runs).
+    #[arg(long)]
+    runs: Option<usize>,
+    /// Give the filter an independent measurement of η with this 1σ, arcsec.
+    #[arg(long)]
+    eta_measured_sigma_arcsec: Option<f64>,
+    /// Write the statistics as JSON.
+    #[arg(long)]
+    json: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct TprArgs {
+    // Default zheng2016-tpr.
+    #[command(flatten)]
+    source: ScenarioSource,
+    #[command(flatten)]
+    sinks: SinkArgs,
+    /// Write the comparison (and the sampled traces) as JSON.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Also run this many seeds (the scenario's and the following ones) in parallel and print the
+    /// distribution: one realisation of the random walk says little.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=10_000))]
+    seeds: Option<u64>,
+}
+
+/// A failure with the exit code it deserves.
+struct Failure {
+    code: u8,
+    message: String,
+}
+
+impl Failure {
+    /// Bad input (exit 2).
+    fn input(message: impl Into<String>) -> Self {
+        Self { code: 2, message: message.into() }
+    }
+
+    /// A failure while running (exit 1).
+    fn run(message: impl Into<String>) -> Self {
+        Self { code: 1, message: message.into() }
+    }
+
+    /// Stopped by the user before the end (exit 130).
+    fn interrupted(message: impl Into<String>) -> Self {
+        Self { code: 130, message: message.into() }
+    }
+}
+
+impl From<ConfigError> for Failure {
+    fn from(e: ConfigError) -> Self {
+        Self::input(format!("config error: {e}"))
+    }
+}
+
+impl From<SinkError> for Failure {
+    fn from(e: SinkError) -> Self {
+        let code = match e {
+            SinkError::Rerun(_) | SinkError::Spawn(_) => 1,
+            _ => 2,
+        };
+        Self { code, message: e.to_string() }
+    }
+}
+
+impl From<anyhow::Error> for Failure {
+    fn from(e: anyhow::Error) -> Self {
+        Self::run(format!("{e:#}"))
+    }
+}
+
+/// Parses the command line, runs the command, maps its outcome to an exit code.
+#[must_use]
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command.unwrap_or(Command::Run(RunArgs::default())) {
+        Command::Run(args) => commands::run(&args),
+        Command::Live(args) => commands::live(&args),
+        Command::Calibrate(args) => commands::calibrate(&args),
+        Command::Montecarlo(args) => commands::montecarlo(&args),
+        Command::Tpr(args) => commands::tpr(&args),
+        Command::Events { file } => commands::events(&file),
+        Command::Modulation(args) => commands::modulation(&args),
+        Command::Scenarios => {
+            commands::list_scenarios();
+            Ok(())
+        }
+        Command::CheckConfig { file } => commands::check_config(&file),
+        Command::Reproduce { markdown } => commands::reproduce(markdown.as_deref()),
+        Command::Bench { steps } => crate::app::bench::run_benchmarks(steps).map_err(Failure::from),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(f) => {
+            eprintln!("rinscope: {}", f.message);
+            ExitCode::from(f.code)
+        }
+    }
+}

@@ -1,0 +1,7 @@
+//! Layer 1, the world model: the gimbal chain with its exact errors, the rotation schemes, the
+//! vehicle's motion and the Earth. Pure functions of time and parameters; imports only `math`.
+
+pub mod earth;
+pub mod gimbal;
+pub mod motion;
+pub mod scheme;

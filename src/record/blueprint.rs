@@ -1,0 +1,70 @@
+//! The layout a run's recording opens with: the 3D scene and its documents on the left, the error
+//! plots on the right (the INS's when it is in the loop, the table-only ones in tabs).
+
+use rerun::blueprint::components::ContainerKind;
+use rerun::RecordingStreamResult;
+
+use super::layout::{self, Node};
+use super::{CustomLayout, Recorder, APPLICATION_ID, TIMELINE};
+use crate::scenario::Params;
+use crate::sim::ERROR_AXES;
+
+impl Recorder {
+    pub(crate) fn send_blueprint(&self, p: &Params, custom: Option<CustomLayout>) -> RecordingStreamResult<()> {
+        let plot = |name: String, origin: &str| Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::whole_run_time_axis());
+        let error_view = |axis: &str| plot(format!("{axis} error (arcsec)"), &format!("attitude_error_arcsec/{axis}"));
+        let scene = Node::view("3D", format!("3D: gimbal chain (errors ×{})", p.recording.exaggeration), "world")
+            .with_property(
+                "EyeControls3D",
+                // With an INS, the trace stands beside the table: step back to frame both.
+                &if self.ins.is_some() { layout::eye([3.6, -1.7, 1.5], [0.7, 0.7, -0.3]) } else { layout::eye([2.6, -1.1, 0.95], [0.0, 0.1, -0.2]) },
+            );
+        let (custom_right, mut doc_tabs) = match custom {
+            Some(c) => (Some(c.right), c.docs),
+            None => (None, Vec::new()),
+        };
+        doc_tabs.extend([
+            Node::view("TextDocument", "scenario", "docs/scenario"),
+            Node::view("TextDocument", "config", "docs/config"),
+            Node::view("TextLog", "events", "events"),
+        ]);
+        let docs = Node::container(ContainerKind::Tabs, doc_tabs, &[]);
+        let left = Node::container(ContainerKind::Vertical, vec![scene, docs], &[3.0, 1.3]);
+        let mut more = vec![
+            plot("gimbal angles (deg)".into(), "gimbal_angle_deg"),
+            plot("vehicle attitude (deg)".into(), "vehicle_attitude_deg"),
+            plot("swing angles (arcsec)".into(), "swing_arcsec"),
+        ];
+        let right = match (&self.ins, custom_right) {
+            (_, Some(right)) => right,
+            (None, None) => {
+                let more = Node::container(ContainerKind::Tabs, more, &[]);
+                Node::container(ContainerKind::Vertical, vec![error_view("pitch"), error_view("roll"), error_view("heading"), more], &[])
+            }
+            (Some(layout), None) => {
+                // The INS in the loop leads; the turntable-only (ideal-INS) plots go into the tabs.
+                let ins_view = |axis: &str| plot(format!("INS {axis} error (arcsec)"), &format!("ins/attitude_error_arcsec/{axis}"));
+                let mut tabs = Vec::new();
+                if layout.nav {
+                    tabs.push(plot("position error (m)".into(), "ins/position_error_m"));
+                    tabs.push(plot("velocity error (m/s)".into(), "ins/velocity_error_mps"));
+                }
+                let window = |name: &str, origin: &str| Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::window_time_axis(layout.signal_window_s));
+                tabs.push(window("gyro raw (deg/s)", "ins/gyro_raw_deg_per_s"));
+                tabs.push(window("gyro after FIR (deg/s)", "ins/gyro_filtered_deg_per_s"));
+                if layout.fir_taps.len() > 1 {
+                    tabs.push(Node::view("2D", "FIR response (x: Hz, y: −5·dB)", "ins/fir_response"));
+                }
+                for axis in ERROR_AXES {
+                    tabs.push(plot(format!("table only: {axis} (arcsec)"), &format!("attitude_error_arcsec/{axis}")));
+                }
+                tabs.append(&mut more);
+                Node::container(ContainerKind::Vertical, vec![ins_view("pitch"), ins_view("roll"), ins_view("heading"), Node::container(ContainerKind::Tabs, tabs, &[])], &[])
+            }
+        };
+        let root = Node::container(ContainerKind::Horizontal, vec![left, right], &[1.1, 1.0]);
+        // Play a whole run in about a minute; a live session follows the newest data.
+        let speed = if self.live { 1.0 } else { (p.duration_s / 60.0).max(1.0).round() };
+        layout::send(&self.rec, APPLICATION_ID, &root, &layout::Playback { timeline: TIMELINE, speed, follow: self.live })
+    }
+}

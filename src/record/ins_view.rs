@@ -1,0 +1,115 @@
+//! What a run with the INS in the loop adds to a recording: the INS error plots' styles, the raw and
+//! filtered gyro signals of the first moments, the FIR's amplitude response and the trace of the
+//! true and computed IMU axes beside the table.
+
+use rerun::{RecordingStreamResult, TimeColumn};
+
+use super::palette::{colors, rgb, rgba};
+use super::{Recorder, SERIES_CHUNK_ROWS, TIMELINE};
+use crate::ins::pipeline::SampleOut;
+use crate::math::units::DEG_PER_RAD;
+use crate::sim::ERROR_AXES;
+
+/// What a run with an IMU in the loop adds to the recording.
+pub(crate) struct InsLayout {
+    pub(crate) algorithms: Vec<String>,
+    pub(crate) nav: bool,
+    /// Index in `Recorder::series` of the first INS entity.
+    pub(crate) first_series: usize,
+    pub(crate) signal_t: Vec<f64>,
+    pub(crate) raw: Vec<f64>,
+    pub(crate) filtered: Vec<f64>,
+    pub(crate) trace_true: Vec<rerun::Quaternion>,
+    pub(crate) trace_ins: Vec<rerun::Quaternion>,
+    pub(crate) exaggeration: f64,
+    pub(crate) fir_taps: Vec<f64>,
+    pub(crate) rate_hz: f64,
+    pub(crate) signal_window_s: f64,
+}
+
+/// Where the INS trace (true and computed IMU axes) is drawn, beside the table.
+pub(crate) const TRACE_OFFSET: [f32; 3] = [1.3, 1.3, -0.5];
+
+impl Recorder {
+    /// Buffers one raw and filtered gyro sample (the signal window at the IMU rate).
+    pub fn push_signal(&mut self, s: &SampleOut) -> RecordingStreamResult<()> {
+        let Some(layout) = self.ins.as_mut() else { return Ok(()) };
+        layout.signal_t.push(s.t_s);
+        layout.raw.extend(s.raw_rate_s.iter().map(|x| x * DEG_PER_RAD));
+        layout.filtered.extend(s.filtered_rate_s.iter().map(|x| x * DEG_PER_RAD));
+        if layout.signal_t.len() >= SERIES_CHUNK_ROWS {
+            self.flush_signal()?;
+        }
+        Ok(())
+    }
+
+    pub(crate) fn flush_signal(&mut self) -> RecordingStreamResult<()> {
+        let Some(layout) = self.ins.as_mut() else { return Ok(()) };
+        if layout.signal_t.is_empty() {
+            return Ok(());
+        }
+        let times = std::mem::take(&mut layout.signal_t);
+        for (path, values) in [("ins/gyro_raw_deg_per_s", std::mem::take(&mut layout.raw)), ("ins/gyro_filtered_deg_per_s", std::mem::take(&mut layout.filtered))] {
+            let time = TimeColumn::new_duration_secs(TIMELINE, times.iter().copied());
+            self.rec.send_columns(path, [time], rerun::Scalars::new(values).columns(std::iter::repeat_n(3, times.len()))?)?;
+        }
+        Ok(())
+    }
+
+    /// Static parts of an INS run: series styles, the FIR's amplitude response, the trace's axes.
+    pub(crate) fn log_ins_once(&self) -> RecordingStreamResult<()> {
+        let Some(layout) = &self.ins else { return Ok(()) };
+        let rec = &self.rec;
+        let algo_colors: Vec<rerun::Color> = (0..layout.algorithms.len()).map(|k| rgb(colors::ALGORITHMS[k % colors::ALGORITHMS.len()])).collect();
+        for axis in ERROR_AXES {
+            rec.log_static(
+                format!("ins/attitude_error_arcsec/{axis}"),
+                &rerun::SeriesLines::new().with_colors(algo_colors.clone()).with_names(layout.algorithms.clone()),
+            )?;
+        }
+        let enu = ["east", "north"];
+        rec.log_static("ins/position_error_m", &rerun::SeriesLines::new().with_colors(colors::EULER.map(rgb)).with_names([enu[0], enu[1], "radial"]))?;
+        rec.log_static("ins/velocity_error_mps", &rerun::SeriesLines::new().with_colors(colors::EULER.map(rgb)).with_names([enu[0], enu[1], "up"]))?;
+        for path in ["ins/gyro_raw_deg_per_s", "ins/gyro_filtered_deg_per_s"] {
+            rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors::SENSOR.map(rgb)).with_names(["gyro x", "gyro y", "gyro z"]))?;
+        }
+        // FIR amplitude response, dB, drawn in a 2D view: x = frequency (Hz), y = 5 × dB (so that
+        // 0..-150 dB spans a readable height next to 0..1000 Hz).
+        if layout.fir_taps.len() > 1 {
+            let fir = crate::ins::fir::Fir::new(&layout.fir_taps);
+            let nyquist = 0.5 * layout.rate_hz;
+            let curve: Vec<[f32; 2]> = (0..=1000)
+                .map(|i| {
+                    let f = nyquist * f64::from(i) / 1000.0;
+                    let db = (20.0 * fir.amplitude(f, layout.rate_hz).log10()).max(-160.0);
+                    [f as f32, (-5.0 * db) as f32]
+                })
+                .collect();
+            rec.log_static("ins/fir_response/curve", &rerun::LineStrips2D::new([curve]).with_colors([rgb([90, 200, 250])]).with_radii([1.5]))?;
+            let mut grid = Vec::new();
+            for db in [0.0f32, -50.0, -100.0, -150.0] {
+                grid.push(vec![[0.0, -5.0 * db], [nyquist as f32, -5.0 * db]]);
+            }
+            rec.log_static("ins/fir_response/grid", &rerun::LineStrips2D::new(grid).with_colors([rgba([120, 120, 120], 120)]).with_radii([0.8]).with_labels(["0 dB", "-50 dB", "-100 dB", "-150 dB"]))?;
+            let tones: Vec<[f32; 2]> = [335.4f64, 375.5, 425.7]
+                .iter()
+                .filter(|f| **f < nyquist)
+                .map(|f| [*f as f32, (-5.0 * (20.0 * fir.amplitude(*f, layout.rate_hz).log10()).max(-160.0)) as f32])
+                .collect();
+            let labels: Vec<String> = [335.4f64, 375.5, 425.7].iter().filter(|f| **f < nyquist).map(|f| format!("{f} Hz dither")).collect();
+            rec.log_static("ins/fir_response/dither", &rerun::Points2D::new(tones).with_labels(labels).with_radii([6.0]).with_colors([rgb([240, 90, 90])]))?;
+        }
+        // The INS trace: true IMU axes (grey) and computed (coloured, error ×N), beside the table.
+        let ins_label = format!("INS IMU axes (error ×{})", layout.exaggeration);
+        for (path, colors, label) in [("world/ins_trace/true", [[170, 170, 170]; 3], "true IMU axes"), ("world/ins_trace/ins", colors::SENSOR, ins_label.as_str())] {
+            rec.log_static(path, &rerun::Transform3D::from_translation(TRACE_OFFSET))?;
+            rec.log_static(
+                format!("{path}/axes"),
+                &rerun::Arrows3D::from_vectors([[0.6, 0.0, 0.0], [0.0, 0.6, 0.0], [0.0, 0.0, 0.6]]).with_colors(colors.map(rgb)).with_radii([0.012]),
+            )?;
+            let at = if path.ends_with("true") { [0.0f32, 0.0, -0.2] } else { [0.0f32, 0.0, 0.75] };
+            rec.log_static(format!("{path}/label"), &rerun::Points3D::new([at]).with_labels([label]).with_radii([0.002]))?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,31 @@
+//! One palette for every recording, and the small conversions Rerun's types need.
+
+use nalgebra::Vector3;
+
+/// Display colours, one place.
+pub(crate) mod colors {
+
+    pub const VARIANT: [[u8; 3]; 3] = [[230, 76, 60], [46, 170, 90], [70, 130, 240]];
+    pub const AXES: [[u8; 3]; 3] = [[240, 160, 40], [200, 90, 230], [60, 200, 200]];
+    pub const EULER: [[u8; 3]; 3] = [[230, 90, 90], [90, 200, 90], [90, 140, 240]];
+    pub const NOMINAL: [u8; 3] = [150, 150, 150];
+    pub const SENSOR: [[u8; 3]; 3] = [[235, 50, 50], [50, 200, 50], [60, 110, 255]];
+    pub const ALGORITHMS: [[u8; 3]; 5] = [[250, 200, 60], [230, 76, 60], [46, 170, 90], [70, 130, 240], [200, 90, 230]];
+}
+
+/// A point or vector as Rerun's f32 triple.
+pub(crate) fn p3(v: Vector3<f64>) -> [f32; 3] {
+    [v.x as f32, v.y as f32, v.z as f32]
+}
+
+pub(crate) fn rgb(c: [u8; 3]) -> rerun::Color {
+    rerun::Color::from_rgb(c[0], c[1], c[2])
+}
+
+pub(crate) fn rgba(c: [u8; 3], a: u8) -> rerun::Color {
+    rerun::Color::from_unmultiplied_rgba(c[0], c[1], c[2], a)
+}
+
+pub(crate) fn albedo(c: [u8; 3], a: u8) -> rerun::datatypes::Rgba32 {
+    rerun::datatypes::Rgba32::from_unmultiplied_rgba(c[0], c[1], c[2], a)
+}

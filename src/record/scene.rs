@@ -1,0 +1,342 @@
+//! The 3D scene of a run: the gimbal chain as an entity tree of transforms, rings and axes, the
+//! exaggerated error geometry (swing cones, non-orthogonality and installation wedges) with labels,
+//! the vehicle's deck and compass.
+
+use nalgebra::{UnitQuaternion, Vector3};
+use rerun::RecordingStreamResult;
+
+use super::palette::{albedo, colors, p3, rgb, rgba};
+use super::{to_rerun_quaternion, Recorder, TIMELINE};
+use crate::math::units::{fmt_angle, ARCSEC_PER_RAD, DEG_PER_RAD};
+use crate::model::gimbal::AxisGeometry;
+use crate::scenario::Params;
+use crate::sim::{DEMODULATIONS, ERROR_AXES};
+
+/// Entity paths of the chain.
+#[derive(Debug, Clone)]
+pub(crate) struct ChainPaths {
+    pub(crate) vehicle: String,
+    pub(crate) base: String,
+    /// `<axis>_mount` per axis.
+    pub(crate) mounts: Vec<String>,
+    /// `<axis>` per axis (the rotor).
+    pub(crate) gimbals: Vec<String>,
+    pub(crate) imu: String,
+}
+
+impl ChainPaths {
+    pub(crate) fn new(names: &[String]) -> Self {
+        let vehicle = "world/vehicle".to_owned();
+        let base = format!("{vehicle}/base");
+        let mut parent = base.clone();
+        let (mut mounts, mut gimbals) = (Vec::new(), Vec::new());
+        for name in names {
+            let mount = format!("{parent}/{name}_mount");
+            let gimbal = format!("{mount}/{name}");
+            mounts.push(mount);
+            gimbals.push(gimbal.clone());
+            parent = gimbal;
+        }
+        let imu = format!("{parent}/imu");
+        Self { vehicle, base, mounts, gimbals, imu }
+    }
+}
+
+impl Recorder {
+    /// Logs what never changes during a run: names, properties, series styles and the fixed geometry.
+    pub(crate) fn log_once(&self, p: &Params) -> RecordingStreamResult<()> {
+        let rec = &self.rec;
+        rec.send_recording_name(format!("rinscope: {}", p.meta.name))?;
+        rec.send_property(
+            "rinscope",
+            &rerun::AnyValues::default()
+                .with_component::<rerun::components::Text>("scenario", [p.meta.name.clone()])
+                .with_component::<rerun::components::Text>("seed", [p.meta.seed.to_string()])
+                .with_component::<rerun::components::Text>("version", [env!("CARGO_PKG_VERSION").to_owned()]),
+        )?;
+
+        // Series styles, once.
+        let variant_names: Vec<String> = DEMODULATIONS.iter().map(|v| v.replace('_', " ")).collect();
+        for axis in ERROR_AXES {
+            rec.log_static(
+                format!("attitude_error_arcsec/{axis}"),
+                &rerun::SeriesLines::new()
+                    .with_colors(colors::VARIANT.map(rgb))
+                    .with_names(variant_names.clone())
+                    .with_widths([3.0, 1.5, 1.0]),
+            )?;
+        }
+        rec.log_static(
+            "vehicle_attitude_deg",
+            &rerun::SeriesLines::new().with_colors(colors::EULER.map(rgb)).with_names(ERROR_AXES),
+        )?;
+        let n = self.axis_names.len();
+        rec.log_static(
+            "gimbal_angle_deg",
+            &rerun::SeriesLines::new().with_colors(colors::AXES[..n].iter().map(|c| rgb(*c))).with_names(self.axis_names.clone()),
+        )?;
+        for (k, name) in self.axis_names.iter().enumerate() {
+            let g = &self.chain.axes()[k];
+            let light = colors::AXES[k].map(|c| c / 2 + 60);
+            rec.log_static(
+                format!("swing_arcsec/{name}"),
+                &rerun::SeriesLines::new()
+                    .with_colors([rgb(colors::AXES[k]), rgb(light)])
+                    .with_names([format!("{name} swing about {}", axis_letter(&g.e1)), format!("{name} swing about {}", axis_letter(&g.e2))]),
+            )?;
+        }
+
+        rec.log_static("world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
+        rec.log_static(
+            "world/compass",
+            &rerun::Arrows3D::from_vectors([[1.6, 0.0, 0.0], [0.0, 1.6, 0.0]])
+                .with_origins([[0.0, 0.0, -1.4]; 2])
+                .with_colors([rgba([120, 120, 120], 160); 2])
+                .with_radii([0.006]),
+        )?;
+        self.label(None, "world/compass/labels", &[([1.7, 0.0, -1.4], "E"), ([0.0, 1.7, -1.4], "N")])?;
+        // Vehicle: a deck plate under the table and the body axes.
+        rec.log_static(
+            format!("{}/deck", self.paths.vehicle),
+            &rerun::Boxes3D::from_centers_and_half_sizes([[0.0, 0.0, -1.35]], [[0.9, 1.2, 0.03]])
+                .with_colors([rgba([110, 110, 120], 200)])
+                .with_fill_mode(rerun::FillMode::Solid),
+        )?;
+        rec.log_static(
+            format!("{}/body_axes", self.paths.vehicle),
+            &rerun::Arrows3D::from_vectors([[0.5, 0.0, 0.0], [0.0, 0.9, 0.0], [0.0, 0.0, 0.4]])
+                .with_origins([[0.0, 0.0, -1.3]; 3])
+                .with_colors([rgba([200, 200, 200], 200); 3])
+                .with_radii([0.01]),
+        )?;
+        let n = self.axis_names.len();
+        let axes = self.chain.axes();
+        for k in 0..n {
+            let g = &axes[k];
+            let radius = ring_radius(k, n);
+            let half = radius * 1.25;
+            let color = colors::AXES[k];
+            // Nominal axis (grey) in the mount frame; the rotor's own axis (coloured) in the rotor frame.
+            rec.log_static(
+                format!("{}/nominal_axis", self.paths.mounts[k]),
+                &rerun::LineStrips3D::new([[p3(-g.axis * half), p3(g.axis * half)]]).with_colors([rgb(colors::NOMINAL)]).with_radii([0.006]),
+            )?;
+            rec.log_static(
+                format!("{}/actual_axis", self.paths.gimbals[k]),
+                &rerun::LineStrips3D::new([[p3(-g.axis * half * 1.05), p3(g.axis * half * 1.05)]]).with_colors([rgb(color)]).with_radii([0.012]),
+            )?;
+            // Ring of this gimbal: through its own axis and the next one; the last is a platform.
+            rec.log_static(
+                format!("{}/ring", self.paths.gimbals[k]),
+                &rerun::LineStrips3D::new(ring(axes, k, radius)).with_colors([rgb(color)]).with_radii([0.02]),
+            )?;
+        }
+        // The IMU: a box and its three sensor axes.
+        rec.log_static(
+            format!("{}/case", self.paths.imu),
+            &rerun::Boxes3D::from_half_sizes([[0.22, 0.22, 0.16]]).with_colors([rgba([200, 200, 210], 90)]).with_fill_mode(rerun::FillMode::Solid),
+        )?;
+        rec.log_static(
+            format!("{}/sensor_axes", self.paths.imu),
+            &rerun::Arrows3D::from_vectors([[0.45, 0.0, 0.0], [0.0, 0.45, 0.0], [0.0, 0.0, 0.45]])
+                .with_colors(colors::SENSOR.map(rgb))
+                .with_labels(["x_s", "y_s", "z_s"])
+                .with_radii([0.015]),
+        )?;
+        Ok(())
+    }
+
+    /// Logs `arch` at `path`: static in a plain run (`at = None`), at simulated time `at` in live mode,
+    /// where a reload can change it and the saved session must show the history.
+    pub(crate) fn put(&self, at: Option<f64>, path: impl Into<rerun::EntityPath>, arch: &dyn rerun::AsComponents) -> RecordingStreamResult<()> {
+        match at {
+            None => self.rec.log_static(path, arch),
+            Some(t) => {
+                self.rec.set_duration_secs(TIMELINE, t);
+                self.rec.log(path, arch)
+            }
+        }
+    }
+
+    /// Removes what `put` drew at `path` (live mode: an error set back to zero).
+    pub(crate) fn clear(&self, at: Option<f64>, path: impl Into<rerun::EntityPath>) -> RecordingStreamResult<()> {
+        match at {
+            None => Ok(()),
+            Some(t) => {
+                self.rec.set_duration_secs(TIMELINE, t);
+                self.rec.log(path, &rerun::Clear::recursive())
+            }
+        }
+    }
+
+    /// Text labels at points (Points3D with tiny dots): labels sit exactly where they belong.
+    pub(crate) fn label(&self, at: Option<f64>, path: &str, items: &[([f32; 3], &str)]) -> RecordingStreamResult<()> {
+        self.put(
+            at,
+            path,
+            &rerun::Points3D::new(items.iter().map(|(p, _)| *p))
+                .with_labels(items.iter().map(|(_, t)| *t))
+                .with_radii([0.002])
+                .with_colors([rgb([230, 230, 230])]),
+        )
+    }
+
+    /// Everything that depends on the error values: the documents, the exaggerated base, mount and
+    /// IMU transforms, the swing cones and the wedges.
+    pub(crate) fn log_error_geometry(&self, p: &Params, at: Option<f64>) -> RecordingStreamResult<()> {
+        // Documents: the scenario explains itself; the resolved config makes the run reproducible.
+        let mut doc = format!("# {}\n\n*{}*\n\n{}\n", p.meta.name, p.meta.title, p.meta.description.trim());
+        doc.push_str(&format!(
+            "\n---\nError angles in the 3D view are drawn **×{}**. Plots: red = uncompensated (nominal table model), \
+             green = compensated (`[compensation]` parameters), blue = closed form (first-order theory, docs/closed-form.md). \
+             Seed {}.\n",
+            p.recording.exaggeration, p.meta.seed
+        ));
+        self.put(at, "docs/scenario", &rerun::TextDocument::from_markdown(doc))?;
+        self.put(at, "docs/config", &rerun::TextDocument::from_markdown(format!("```toml\n{}\n```\n", p.resolved_toml)))?;
+
+        let x = p.recording.exaggeration;
+        self.label(at, "world/legend", &[([0.0, 0.0, 1.45], format!("error angles drawn ×{x}").as_str())])?;
+        // The base, mount and IMU links do not depend on the gimbal angles.
+        let draw = self.chain.link_rotations(&self.drawing, &[0.0; crate::model::scheme::MAX_AXES]);
+        let t = |q: &UnitQuaternion<f64>| rerun::Transform3D::from_rotation(to_rerun_quaternion(q));
+        self.put(at, self.paths.base.as_str(), &t(&draw.base))?;
+        for k in 0..self.axis_names.len() {
+            self.put(at, self.paths.mounts[k].as_str(), &t(&draw.mount[k]))?;
+        }
+        self.put(at, self.paths.imu.as_str(), &t(&draw.imu))?;
+
+        let n = self.axis_names.len();
+        let axes = self.chain.axes();
+        let drawing = p.table.truth.exaggerated(x);
+        // Installation: a wedge in the body between the ideal first axis and the tilted one.
+        let first_tilted = draw.base * axes[0].axis;
+        let installation = p.table.truth.installation_rad.norm() * ARCSEC_PER_RAD;
+        self.log_wedge(at, &format!("{}/installation", self.paths.vehicle), axes[0].axis, first_tilted, 1.5, installation, x, "installation")?;
+        for (k, g) in axes.iter().enumerate() {
+            let half = ring_radius(k, n) * 1.25;
+            let color = colors::AXES[k];
+            // Swing cone: a translucent double cone of half-angle α·x around the nominal axis, with rims.
+            let alpha = drawing.axes[k].swing_half_angle_rad;
+            let cone_path = format!("{}/swing_cone", self.paths.mounts[k]);
+            if alpha > 0.0 {
+                let (mesh, rims) = cone(g.axis, g.e1, g.e2, alpha, half);
+                self.put(at, cone_path.as_str(), &rerun::Mesh3D::new(mesh.0).with_triangle_indices(mesh.1).with_albedo_factor(albedo(color, 60)))?;
+                self.put(at, format!("{cone_path}/rims"), &rerun::LineStrips3D::new(rims).with_colors([rgba(color, 200)]).with_radii([0.004]))?;
+                let tip = -g.axis * half - g.e1 * (half * alpha.tan());
+                let text = format!(
+                    "{} swing α = {}, φ = {:.1}°",
+                    g.name,
+                    fmt_angle(p.table.truth.axes[k].swing_half_angle_rad),
+                    p.table.truth.axes[k].swing_phase_rad * DEG_PER_RAD
+                );
+                self.label(at, &format!("{cone_path}/label"), &[(p3(tip), text.as_str())])?;
+            } else {
+                self.clear(at, cone_path.as_str())?;
+            }
+            // Non-orthogonality: a wedge, in the previous rotor, between the normal to the previous
+            // axis and this axis.
+            if k > 0 {
+                let tilted = draw.mount[k] * g.axis;
+                let eta_arcsec = p.table.truth.axes[k].non_orthogonality_rad * ARCSEC_PER_RAD;
+                self.log_wedge(at, &format!("{}/non_orthogonality", self.paths.gimbals[k - 1]), g.axis, tilted, half, eta_arcsec, x, "η non-orthogonality")?;
+            }
+        }
+        Ok(())
+    }
+
+    /// A translucent wedge from `ideal` to `tilted` (both unit, same frame) with a label.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn log_wedge(&self, at: Option<f64>, path: &str, ideal: Vector3<f64>, tilted: Vector3<f64>, length: f64, true_arcsec: f64, x: f64, what: &str) -> RecordingStreamResult<()> {
+        if true_arcsec == 0.0 {
+            return self.clear(at, path);
+        }
+        let mut positions = vec![[0.0f32; 3]];
+        let steps = 16;
+        for i in 0..=steps {
+            let s = i as f64 / steps as f64;
+            positions.push(p3(((1.0 - s) * ideal + s * tilted).normalize() * length));
+        }
+        let triangles: Vec<[u32; 3]> = (1..=steps as u32).map(|i| [0, i, i + 1]).collect();
+        self.put(at, format!("{path}/wedge"), &rerun::Mesh3D::new(positions).with_triangle_indices(triangles).with_albedo_factor(albedo([255, 200, 60], 110)))?;
+        self.put(
+            at,
+            format!("{path}/edges"),
+            &rerun::LineStrips3D::new([[[0.0, 0.0, 0.0], p3(ideal * length)], [[0.0, 0.0, 0.0], p3(tilted * length)]])
+                .with_colors([rgb([255, 255, 255]), rgb([255, 200, 60])])
+                .with_radii([0.004]),
+        )?;
+        let text = format!("{what} {} (drawn ×{x})", fmt_angle(true_arcsec / ARCSEC_PER_RAD));
+        self.label(at, &format!("{path}/label"), &[(p3(tilted * length * 1.08), text.as_str())])
+    }
+}
+
+/// "x", "y" or "z" for a coordinate unit vector.
+pub(crate) fn axis_letter(v: &Vector3<f64>) -> &'static str {
+    let a = v.abs();
+    if a.x >= a.y && a.x >= a.z {
+        "x"
+    } else if a.y >= a.z {
+        "y"
+    } else {
+        "z"
+    }
+}
+
+/// Ring radius of gimbal k of n: nested, outer first.
+pub(crate) fn ring_radius(k: usize, n: usize) -> f64 {
+    let radii: [f64; 3] = [1.0, 0.75, 0.52];
+    radii[3 - n + k].max(0.5)
+}
+
+/// Polylines of gimbal k's ring: a circle through its axis and the next axis (with bearing stubs),
+/// or, for the last gimbal, a platform circle with spokes so that its rotation shows.
+pub(crate) fn ring(axes: &[AxisGeometry], k: usize, radius: f64) -> Vec<Vec<[f32; 3]>> {
+    let g = &axes[k];
+    let (u, w) = if k + 1 < axes.len() { (g.axis, axes[k + 1].axis) } else { (g.e1, g.e2) };
+    let circle: Vec<[f32; 3]> = (0..=96)
+        .map(|i| {
+            let t = std::f64::consts::TAU * i as f64 / 96.0;
+            p3((u * t.cos() + w * t.sin()) * radius)
+        })
+        .collect();
+    let mut strips = vec![circle];
+    if k + 1 == axes.len() {
+        for j in 0..4 {
+            let t = std::f64::consts::FRAC_PI_2 * j as f64;
+            strips.push(vec![[0.0; 3], p3((u * t.cos() + w * t.sin()) * radius)]);
+        }
+        // A marker notch at e1 so the sense of rotation reads at a glance.
+        strips.push(vec![p3(u * radius * 1.12 + w * 0.05), p3(u * radius * 1.12 - w * 0.05), p3(u * radius * 0.95), p3(u * radius * 1.12 + w * 0.05)]);
+    }
+    strips
+}
+
+/// A double cone of half-angle `alpha` around `axis` (length `half` each way): mesh and rim circles.
+#[allow(clippy::type_complexity)]
+pub(crate) fn cone(axis: Vector3<f64>, e1: Vector3<f64>, e2: Vector3<f64>, alpha: f64, half: f64) -> ((Vec<[f32; 3]>, Vec<[u32; 3]>), Vec<Vec<[f32; 3]>>) {
+    let segments = 48u32;
+    let r = half * alpha.tan();
+    let mut positions = vec![[0.0f32; 3]];
+    let mut rims = Vec::new();
+    for sign in [1.0, -1.0] {
+        let mut rim = Vec::new();
+        for i in 0..=segments {
+            let t = std::f64::consts::TAU * f64::from(i) / f64::from(segments);
+            let p = p3(axis * half * sign + (e1 * t.cos() + e2 * t.sin()) * r);
+            if i < segments {
+                positions.push(p);
+            }
+            rim.push(p);
+        }
+        rims.push(rim);
+    }
+    let mut triangles = Vec::new();
+    for nappe in 0..2u32 {
+        let base = 1 + nappe * segments;
+        for i in 0..segments {
+            triangles.push([0, base + i, base + (i + 1) % segments]);
+        }
+    }
+    ((positions, triangles), rims)
+}

@@ -1,0 +1,203 @@
+//! Layer 4, the scenario: the only code that knows the TOML. The file is parsed strictly
+//! ([`raw`]), validated once and converted once into SI [`Params`] made of the lower layers' own
+//! parameter structs ([`validate`], [`instruments`]); [`presets`] embeds the shipped scenarios.
+//!
+//! Every error names the key, the value and the unit (and the allowed range where there is one).
+
+pub mod instruments;
+pub mod presets;
+pub mod raw;
+pub mod validate;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use crate::calib::CalibConfig;
+use crate::ins::pipeline::InsRun;
+use crate::ins::InsParams;
+use crate::math::timeline::Timeline;
+use crate::model::earth::Site;
+use crate::sim::{Model, TableParams};
+pub use raw::RawConfig;
+
+/// A configuration problem a user can fix. Displayed as one line naming key, value and unit.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    /// The file could not be read.
+    #[error("cannot read config file {path}: {source}")]
+    Read {
+        /// The path as given.
+        path: String,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// TOML syntax, an unknown key or a wrong type (the toml crate's message shows the line).
+    #[error("{origin}: {message}")]
+    Parse {
+        /// The file or scenario name.
+        origin: String,
+        /// toml's message, with the offending line and key.
+        message: String,
+    },
+    /// A number that is not finite (nan, inf).
+    #[error("{origin}: `{key}` = {value} {unit} is not a finite number")]
+    NotFinite {
+        /// The file or scenario name.
+        origin: String,
+        /// Dotted key path.
+        key: String,
+        /// The value as read.
+        value: f64,
+        /// The unit of the key.
+        unit: &'static str,
+    },
+    /// A number outside its allowed range.
+    #[error("{origin}: `{key}` = {value} {unit} is out of range: {range}")]
+    OutOfRange {
+        /// The file or scenario name.
+        origin: String,
+        /// Dotted key path.
+        key: String,
+        /// The value as read.
+        value: f64,
+        /// The unit of the key.
+        unit: &'static str,
+        /// The allowed range and a hint.
+        range: String,
+    },
+    /// Any other inconsistency (duplicate axis names, an unknown axis referenced, ...).
+    #[error("{origin}: `{key}`: {message}")]
+    Invalid {
+        /// The file or scenario name.
+        origin: String,
+        /// Dotted key path.
+        key: String,
+        /// What is wrong and how to fix it.
+        message: String,
+    },
+}
+
+/// What the scenario is, for people.
+#[derive(Debug, Clone)]
+pub struct ScenarioMeta {
+    /// Identifier.
+    pub name: String,
+    /// One line.
+    pub title: String,
+    /// Markdown.
+    pub description: String,
+    /// Seed of every random draw.
+    pub seed: u64,
+}
+
+/// Output rates and drawing.
+#[derive(Debug, Clone, Copy)]
+pub struct RecordingParams {
+    /// Time-series output rate, Hz.
+    pub series_hz: f64,
+    /// Scene output rate, Hz.
+    pub scene_hz: f64,
+    /// Drawing factor for error angles.
+    pub exaggeration: f64,
+}
+
+/// A validated scenario in SI units.
+#[derive(Debug, Clone)]
+pub struct Params {
+    /// Name, title, description, seed.
+    pub meta: ScenarioMeta,
+    /// Simulated time, s.
+    pub duration_s: f64,
+    /// Simulation rate, Hz.
+    pub step_hz: f64,
+    /// Output rates and drawing.
+    pub recording: RecordingParams,
+    /// Site.
+    pub site: Site,
+    /// The turntable: chain, vehicle motion, scheme, true and assumed errors.
+    pub table: TableParams,
+    /// The configuration as resolved (defaults and compensation filled in), as TOML.
+    pub resolved_toml: String,
+    /// The same, as data.
+    pub resolved: RawConfig,
+    /// The configuration as written (defaults of optional keys not filled in): live mode describes
+    /// reloads as its differences.
+    pub written: RawConfig,
+    /// `[live] speed`: simulated seconds per wall-clock second.
+    pub live_speed: f64,
+    /// The INS in the loop, if any.
+    pub ins: Option<InsParams>,
+    /// `[calibration]` (its defaults when the section is absent).
+    pub calibration: CalibConfig,
+    /// Times of the position fixes, s (`[position_fix]`).
+    pub position_fix_s: Vec<f64>,
+}
+
+impl Params {
+    /// The run's instants at the simulation rate (the one sampling rule, `math::timeline`).
+    #[must_use]
+    pub fn timeline(&self) -> Timeline {
+        Timeline::new(self.duration_s, self.step_hz)
+    }
+
+    /// The turntable step's model (encoder noise seeded with the scenario's seed).
+    #[must_use]
+    pub fn table_model(&self) -> Model {
+        Model::new(&self.table, self.meta.seed)
+    }
+
+    /// The INS in the loop on this scenario's table, if it has an `[imu]` section.
+    #[must_use]
+    pub fn ins_run(&self) -> Option<InsRun> {
+        let ins = self.ins.as_ref()?;
+        Some(InsRun::new(ins, self.site, self.meta.seed, self.table_model()))
+    }
+}
+
+/// Reads and validates a scenario file.
+pub fn load_file(path: &Path) -> Result<Params, ConfigError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+        path: path.display().to_string(),
+        source,
+    })?;
+    parse(&text, &path.display().to_string())
+}
+
+/// Parses and validates scenario text; `origin` names the file or the embedded scenario in errors.
+pub fn parse(text: &str, origin: &str) -> Result<Params, ConfigError> {
+    let raw: RawConfig = toml::from_str(text).map_err(|e| ConfigError::Parse {
+        origin: origin.to_owned(),
+        message: e.to_string().trim_end().to_owned(),
+    })?;
+    validate::validate(raw, origin)
+}
+
+/// Every leaf of a resolved config as `dotted.key -> value text` (arrays of tables indexed `[i]`),
+/// for describing what changed between two versions.
+#[must_use]
+pub fn flatten(raw: &RawConfig) -> BTreeMap<String, String> {
+    fn walk(prefix: &str, v: &toml::Value, out: &mut BTreeMap<String, String>) {
+        match v {
+            toml::Value::Table(t) => {
+                for (k, x) in t {
+                    let key = if prefix.is_empty() { k.clone() } else { format!("{prefix}.{k}") };
+                    walk(&key, x, out);
+                }
+            }
+            toml::Value::Array(a) if a.iter().all(toml::Value::is_table) && !a.is_empty() => {
+                for (i, x) in a.iter().enumerate() {
+                    walk(&format!("{prefix}[{i}]"), x, out);
+                }
+            }
+            other => {
+                out.insert(prefix.to_owned(), other.to_string());
+            }
+        }
+    }
+    let mut out = BTreeMap::new();
+    if let Ok(v) = toml::Value::try_from(raw) {
+        walk("", &v, &mut out);
+    }
+    out
+}
+

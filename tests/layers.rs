@@ -1,0 +1,129 @@
+//! The crate's structure, kept honest: every module imports only the layers below it (the order in
+//! `src/lib.rs`), only `record` names Rerun, and no source file grows past `MAX_LINES`.
+//!
+//! Test code (`#[cfg(test)]` blocks and `tests.rs` files) may use higher layers to build fixtures
+//! the way users write them (a scenario's TOML); the rules apply to what ships.
+
+use std::path::{Path, PathBuf};
+
+/// Layers, lowest first; modules of one rank are peers and may not import each other.
+const LAYERS: &[(&str, u32)] = &[
+    ("math", 0),
+    ("io", 0),
+    ("model", 1),
+    ("sim", 2),
+    ("ins", 3),
+    ("calib", 3),
+    ("scenario", 4),
+    ("record", 5),
+    ("app", 6),
+    ("cli", 7),
+];
+
+/// A source file longer than this is a god file in the making: split it by responsibility.
+const MAX_LINES: usize = 700;
+
+fn rank(module: &str) -> Option<u32> {
+    LAYERS.iter().find(|(m, _)| *m == module).map(|(_, r)| *r)
+}
+
+/// The shipped part of a file: everything before its first `#[cfg(test)]`.
+fn shipped(text: &str) -> &str {
+    text.find("#[cfg(test)]").map_or(text, |i| &text[..i])
+}
+
+/// The violations in one file of top-level module `module` (None: the crate root or the binary).
+fn violations(file: &str, module: Option<&str>, text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let code = shipped(text);
+    let lines = text.lines().count();
+    if lines > MAX_LINES {
+        out.push(format!("{file}: {lines} lines (at most {MAX_LINES}); split it by responsibility"));
+    }
+    if module != Some("record") {
+        for (n, line) in code.lines().enumerate() {
+            let l = line.trim_start();
+            if l.starts_with("//") {
+                continue;
+            }
+            if l.contains("rerun::") || l.starts_with("use rerun") {
+                out.push(format!("{file}:{}: names Rerun outside `record`: {l}", n + 1));
+            }
+        }
+    }
+    let Some(module) = module else { return out };
+    let Some(own) = rank(module) else {
+        out.push(format!("{file}: top-level module `{module}` has no layer in tests/layers.rs"));
+        return out;
+    };
+    for (n, line) in code.lines().enumerate() {
+        let l = line.trim_start();
+        if l.starts_with("//") {
+            continue;
+        }
+        let mut rest = l;
+        while let Some(i) = rest.find("crate::") {
+            rest = &rest[i + "crate::".len()..];
+            let target: String = rest.chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
+            if target == module || target.is_empty() {
+                continue;
+            }
+            match rank(&target) {
+                Some(r) if r < own => {}
+                Some(r) => out.push(format!("{file}:{}: `{module}` (layer {own}) imports `{target}` (layer {r}): {l}", n + 1)),
+                None => out.push(format!("{file}:{}: unknown module `{target}`", n + 1)),
+            }
+        }
+    }
+    out
+}
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for e in entries.flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            rust_files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push(p);
+        }
+    }
+}
+
+#[test]
+fn every_module_imports_only_the_layers_below_it() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    files.sort();
+    assert!(files.len() > 30, "found the sources: {}", files.len());
+    let mut all = Vec::new();
+    for path in &files {
+        let rel = path.strip_prefix(&src).expect("under src").to_string_lossy().replace('\\', "/");
+        let text = std::fs::read_to_string(path).expect("readable");
+        // Whole test files only build fixtures; their length still counts.
+        let is_test_file = rel.ends_with("/tests.rs");
+        let module = rel.split_once('/').map(|(m, _)| m);
+        let checked = if is_test_file { "" } else { text.as_str() };
+        let mut v = violations(&rel, module, checked);
+        if is_test_file && text.lines().count() > MAX_LINES {
+            v.push(format!("{rel}: {} lines (at most {MAX_LINES})", text.lines().count()));
+        }
+        all.extend(v);
+    }
+    assert!(all.is_empty(), "layering violations:\n{}", all.join("\n"));
+}
+
+#[test]
+fn the_checker_sees_what_it_must_refuse() {
+    // The rules above are only evidence if they can fail: an import upward, a peer import, Rerun
+    // outside `record` and a long file are each reported; test code and comments are not.
+    assert_eq!(violations("model/x.rs", Some("model"), "use crate::sim::Model;\n").len(), 1);
+    assert_eq!(violations("ins/x.rs", Some("ins"), "use crate::calib::Data;\n").len(), 1, "peers");
+    assert_eq!(violations("app/x.rs", Some("app"), "use crate::record::Recorder;\nuse crate::math::units;\n").len(), 0);
+    assert_eq!(violations("app/x.rs", Some("app"), "let s: rerun::RecordingStream;\n").len(), 1);
+    assert_eq!(violations("record/x.rs", Some("record"), "use rerun::Color;\n").len(), 0);
+    assert_eq!(violations("sim/x.rs", Some("sim"), "// crate::app is above\n#[cfg(test)]\nuse crate::scenario::presets;\n").len(), 0);
+    let long = "let x = 1;\n".repeat(MAX_LINES + 1);
+    assert_eq!(violations("math/x.rs", Some("math"), &long).len(), 1);
+}
