@@ -6,8 +6,10 @@ use crate::calib::report::{build as build_report, Compensation, Report};
 use crate::calib::{attitude_errors, calibrate, AttitudeSource, CalibError, Calibration, Data, History, Measurement, Nuisance, ParamSet};
 use crate::ins::pipeline::InsRun;
 use crate::scenario::Params;
-use crate::math::timeline::decimation;
-use crate::sim::{encoder_readings, step, DemodState};
+use std::sync::atomic::AtomicBool;
+
+use crate::app::run::record_run;
+use crate::sim::{encoder_readings, DemodState};
 
 /// Runs the static test of `params` with noise seed `seed` and collects one sample per INS output.
 pub fn collect(params: &Params, seed: u64) -> Result<Data, CalibError> {
@@ -21,16 +23,16 @@ pub fn collect(params: &Params, seed: u64) -> Result<Data, CalibError> {
     let set = ParamSet::new(&p.table.chain, Nuisance::None);
     model.compensation = set.without_estimated(&p.table.compensation);
     let chain = p.table.chain.clone();
-    let steps = p.timeline().instants();
-    let duration = steps as f64 / p.step_hz;
+    let timeline = p.timeline();
+    let duration = timeline.end_s();
     let tau = |t: f64| (2.0 * t / duration - 1.0).clamp(-1.0, 1.0);
-    let mut samples = Vec::with_capacity(steps as usize);
+    let mut samples = Vec::with_capacity(timeline.intervals() as usize);
     let mut demod = DemodState::default();
     let source = if p.ins.is_some() { AttitudeSource::Ins } else { AttitudeSource::Ideal };
     match &p.ins {
         Some(ins_params) => {
             let mut ins = InsRun::new(ins_params, p.site, p.meta.seed, model.clone());
-            for _ in 0..steps {
+            for _ in 0..timeline.intervals() {
                 if ins.step().updated {
                     let (t, q) = ins.output_attitude(0);
                     // Matched synchronisation: the encoders are read for the instant the data represent.
@@ -41,8 +43,9 @@ pub fn collect(params: &Params, seed: u64) -> Result<Data, CalibError> {
         }
         None => {
             let truth = model.truth_rotations().clone();
-            for i in 1..=steps {
-                let t = i as f64 / p.step_hz;
+            // The same instants as the INS's samples: t_1 ..= t_n.
+            for k in 1..=timeline.intervals() {
+                let t = timeline.t_s(k);
                 let (lambda, _) = model.scheme.state(t - model.scheme_t0_s);
                 let n_from_s = n_from_b * chain.b_from_s(&truth, &lambda);
                 let angles = demod.correct(&model, t, &encoder_readings(&model, t));
@@ -94,7 +97,7 @@ pub fn calibrate_scenario(params: &Params, history: bool) -> Result<Outcome, Cal
 
 /// Seed 000's Monte Carlo on `params`' table: `runs` calibrations of drawn tables in parallel, each
 /// on a simulated static test (`progress` ticks once per run, `stop` ends early).
-pub fn monte_carlo(params: &Params, runs: usize, progress: &(dyn Fn() + Sync), stop: &std::sync::atomic::AtomicBool) -> Result<crate::calib::montecarlo::Summary, CalibError> {
+pub fn monte_carlo(params: &Params, runs: usize, progress: &(dyn Fn() + Sync), stop: &AtomicBool) -> Result<crate::calib::montecarlo::Summary, CalibError> {
     let setup = crate::calib::montecarlo::Setup {
         scenario: &params.meta.name,
         chain: &params.table.chain,
@@ -112,34 +115,20 @@ pub fn monte_carlo(params: &Params, runs: usize, progress: &(dyn Fn() + Sync), s
 }
 
 /// Writes `outcome`'s recording into `rec`: the calibration's panels, then the table turning as in
-/// a plain run (the ideal-INS error plots the standard layout keeps in its tabs).
-pub fn record_outcome(rec: crate::record::Stream, params: &Params, outcome: &Outcome) -> anyhow::Result<()> {
+/// a plain run of the ideal demodulation (the INS is the calibration's business here), whose error
+/// plots the layout keeps in its tabs.
+pub fn record_outcome(rec: crate::record::Stream, params: &Params, outcome: &Outcome, stop: &AtomicBool) -> anyhow::Result<()> {
     let traces = crate::record::calibration::ErrorTraces {
         t_s: outcome.validation.samples.iter().map(|s| s.t_s).collect(),
         errors: [&outcome.validation_errors[0], &outcome.validation_errors[1], &outcome.validation_errors[2]],
     };
-    let mut recorder = crate::record::calibration::log(rec, params, &outcome.cal, &outcome.report, &traces)?;
-    // The table scene of the ideal demodulation; the INS is the calibration's business here.
-    let mut drawing = params.clone();
-    drawing.ins = None;
-    let model = drawing.table_model();
-    let mut state = DemodState::default();
-    let steps = drawing.timeline().instants();
-    let (series_every, scene_every) = (decimation(drawing.step_hz, drawing.recording.series_hz), decimation(drawing.step_hz, drawing.recording.scene_hz));
-    for i in 0..=steps {
-        let t = i as f64 / drawing.step_hz;
-        let out = step(&model, &mut state, t);
-        if i % series_every == 0 {
-            recorder.push_series(&out)?;
-        }
-        if i % scene_every == 0 {
-            recorder.push_scene(&out)?;
-        }
-    }
-    recorder.event(drawing.duration_s, &format!("calibration: {} samples, {} Gauss–Newton iterations", outcome.cal.samples, outcome.cal.nls_iterations), "INFO")?;
+    let recorder = crate::record::calibration::log(rec, params, &outcome.cal, &outcome.report, &traces)?;
+    recorder.event(params.duration_s, &format!("calibration: {} samples, {} Gauss–Newton iterations", outcome.cal.samples, outcome.cal.nls_iterations), "INFO")?;
     for w in &outcome.report.warnings {
-        recorder.event(drawing.duration_s, w, "WARN")?;
+        recorder.event(params.duration_s, w, "WARN")?;
     }
-    recorder.finish()?;
+    let mut table = params.clone();
+    table.ins = None;
+    record_run(recorder, &table, stop, false)?;
     Ok(())
 }

@@ -15,7 +15,7 @@ pub const MODULATION_PRESETS: [(&str, &str); 3] =
 fn simulate(p: &Params, label: &str, sample_s: f64, stop: &AtomicBool) -> NavTrace {
     let mut trace = NavTrace { label: label.to_owned(), samples: Vec::new() };
     let Some(mut ins) = p.ins_run() else { return trace };
-    let steps = (p.duration_s * p.step_hz).round() as u64;
+    let steps = p.timeline().intervals();
     let mut next = 0.0;
     for i in 0..steps {
         if i % 100_000 == 0 && stop.load(Ordering::Relaxed) {

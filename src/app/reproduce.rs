@@ -13,7 +13,7 @@ use crate::math::units::{ARCSEC_PER_RAD, DEG_PER_RAD};
 /// attitude error at every attitude update after `settle_s` (the FIR and the alignment settle).
 fn ins_stats(p: &Params, settle_s: f64) -> Vec<[RunningStat; 3]> {
     let Some(mut ins) = p.ins_run() else { return Vec::new() };
-    let steps = (p.duration_s * p.step_hz).round() as u64;
+    let steps = p.timeline().intervals();
     let mut stats = vec![[RunningStat::default(); 3]; ins.algorithms().len()];
     for _ in 0..steps {
         let s = ins.step();

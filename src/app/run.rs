@@ -9,7 +9,7 @@ use serde::Serialize;
 
 use crate::ins::pipeline::{InsRun, InsView, SampleOut};
 use crate::math::stats::RunningStat;
-use crate::math::timeline::decimation;
+use crate::math::timeline::{decimation, Timeline};
 use crate::math::units::ARCSEC_PER_RAD;
 use crate::record::sink::OpenSinks;
 use crate::record::Recorder;
@@ -228,15 +228,20 @@ impl RunSummary {
 }
 
 /// Simulates `params`, streaming to `sinks`; Ctrl-C (`stop`) ends the run early and keeps what was
-/// simulated. Returns the summary and the still-open sinks (the caller finishes or abandons them).
+/// simulated. Returns the summary; the sinks stay open (the caller finishes or abandons them).
 pub fn run_recorded(params: &Params, sinks: &OpenSinks, stop: &AtomicBool, progress: bool) -> anyhow::Result<RunSummary> {
+    record_run(Recorder::new(sinks.rec.clone(), params)?, params, stop, progress)
+}
+
+/// Simulates `params` into `recorder` (whose layout the caller chose), ends it with the run's
+/// events and flushes it.
+pub fn record_run(mut recorder: Recorder, params: &Params, stop: &AtomicBool, progress: bool) -> anyhow::Result<RunSummary> {
     let started = Instant::now();
     let model = params.table_model();
-    let mut recorder = Recorder::new(sinks.rec.clone(), params)?;
-    let steps = params.timeline().instants();
+    let timeline = params.timeline();
+    let steps = timeline.instants();
     let series_every = decimation(params.step_hz, params.recording.series_hz);
     let scene_every = decimation(params.step_hz, params.recording.scene_hz);
-    let step_hz = params.step_hz;
 
     let bar = if progress && steps > 2_000_000 {
         let bar = indicatif::ProgressBar::new(steps);
@@ -253,7 +258,7 @@ pub fn run_recorded(params: &Params, sinks: &OpenSinks, stop: &AtomicBool, progr
     let (stats, ins_stats, done, interrupted) = std::thread::scope(|scope| -> anyhow::Result<(ErrorStats, InsStats, u64, bool)> {
         let sim = scope.spawn(|| {
             let ctx = Producer { model: &model, params, stop, bar: bar.as_ref(), tx: &tx, series_every, scene_every };
-            let r = if params.ins.is_some() { ctx.run_ins(steps) } else { ctx.run_ideal(steps) };
+            let r = if params.ins.is_some() { ctx.run_ins(&timeline) } else { ctx.run_ideal(&timeline) };
             drop(tx);
             r
         });
@@ -279,7 +284,7 @@ pub fn run_recorded(params: &Params, sinks: &OpenSinks, stop: &AtomicBool, progr
     }
 
     let summary = RunSummary::new(params, &stats, done, started.elapsed().as_secs_f64(), interrupted).with_ins(&ins_stats);
-    let t_end = done.saturating_sub(1) as f64 / step_hz;
+    let t_end = timeline.t_s(done.saturating_sub(1));
     let end_text = if interrupted {
         format!("run interrupted by the user at {t_end:.3} s; the recording holds everything simulated until then")
     } else {
@@ -339,18 +344,18 @@ impl Producer<'_> {
         self.stop.load(Ordering::Relaxed)
     }
 
-    /// The IMU attitude is exact: one core step per simulation step.
-    fn run_ideal(&self, steps: u64) -> (ErrorStats, InsStats, u64, bool) {
+    /// The IMU attitude is exact: one core step per instant.
+    fn run_ideal(&self, timeline: &Timeline) -> (ErrorStats, InsStats, u64, bool) {
         let mut state = DemodState::default();
         let mut stats = ErrorStats::default();
         let mut out = Outbox { tx: self.tx, series: Vec::new(), scene: Vec::new(), signal: Vec::new() };
         let (mut done, mut interrupted) = (0, false);
-        for i in 0..steps {
+        for i in 0..timeline.instants() {
             if i % 65_536 == 0 && self.check(i) {
                 interrupted = true;
                 break;
             }
-            let o = step(self.model, &mut state, i as f64 / self.params.step_hz);
+            let o = step(self.model, &mut state, timeline.t_s(i));
             stats.add(&o);
             if i % self.series_every == 0 && !out.series(OutputRow { core: o, ins: None }) {
                 break;
@@ -366,9 +371,9 @@ impl Producer<'_> {
 
     /// An IMU in the loop: one IMU sample per step; outputs at the attitude updates closest to the
     /// recording rates (statistics at the series outputs).
-    fn run_ins(&self, steps: u64) -> (ErrorStats, InsStats, u64, bool) {
+    fn run_ins(&self, timeline: &Timeline) -> (ErrorStats, InsStats, u64, bool) {
         let Some(ins_params) = &self.params.ins else {
-            return self.run_ideal(steps);
+            return self.run_ideal(timeline);
         };
         let mut ins = InsRun::new(ins_params, self.params.site, self.params.meta.seed, self.model.clone());
         let mut state = DemodState::default();
@@ -378,7 +383,7 @@ impl Producer<'_> {
         let window = ins.config().signal_window_s;
         let (mut done, mut interrupted) = (1, false);
         let (mut next_series, mut next_scene) = (0u64, 0u64);
-        for i in 1..steps {
+        for i in 1..=timeline.intervals() {
             if i % 65_536 == 0 && self.check(i) {
                 interrupted = true;
                 break;

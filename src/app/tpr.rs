@@ -64,7 +64,8 @@ pub fn compare_resets(params: &Params, sample_s: f64, stop: &AtomicBool) -> Resu
     };
     let mut v_before = [[0.0; 2]; 2];
     let mut v_before_taken = [false; 2];
-    let steps = params.timeline().instants();
+    // One INS sample per interval of the run.
+    let steps = params.timeline().intervals();
     let mut samples = Vec::new();
     let mut next = 0.0;
     let mut i = 0u64;
@@ -106,7 +107,7 @@ pub fn compare_resets(params: &Params, sample_s: f64, stop: &AtomicBool) -> Resu
         }
     }
     // The second fix: every branch resets the position; TPR also corrects the azimuth.
-    let t_fix2 = i as f64 / params.step_hz;
+    let t_fix2 = params.timeline().t_s(i);
     let (heading2, [_, lat2]) = errors(&mut ins, t_fix2);
     dlat[1] = lat2;
     let phi2 = level(&ins, v_before[1]);

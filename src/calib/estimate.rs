@@ -5,7 +5,7 @@ use nalgebra::{DMatrix, DVector, Vector3};
 
 use super::{CalibConfig, CalibError, Data, Measurement, Param, ParamSet, MAX_PARAMS, MAX_TABLE};
 use crate::math::frames::{Rot, B, N};
-use crate::math::rotvec::rotation_vector;
+use crate::math::rotvec;
 use crate::model::gimbal::{Chain, ErrorRotations, TableErrors};
 
 /// Which of the filter's intermediate results a calibration keeps.
@@ -159,7 +159,7 @@ pub struct Calibration {
 pub(crate) fn exact_residual(chain: &Chain, err: &ErrorRotations, s: &Measurement, ref_inv: &Rot<B, N>) -> Vector3<f64> {
     let b_from_s = chain.b_from_s_with(err, &s.shafts);
     let computed: Rot<N, B> = s.n_from_s * b_from_s.inverse();
-    rotation_vector((computed * *ref_inv).quaternion())
+    rotvec::log((computed * *ref_inv).quaternion())
 }
 
 fn solve(a: &DMatrix<f64>, b: &DVector<f64>) -> Result<(DVector<f64>, DMatrix<f64>), CalibError> {

@@ -69,7 +69,7 @@ pub struct Unobservable {
     pub resolved_by_prior: bool,
 }
 
-/// Attitude error of the validation run for one demodulation, arcsec.
+/// Attitude error of the validation run for each demodulation (the summaries hold radians).
 #[derive(Debug, Clone, Copy, Serialize)]
 pub struct Compensation {
     /// Table model with the estimated parameters at zero.

@@ -227,7 +227,7 @@ pub(super) fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
         write_json("--json", path, &outcome.report)?;
     }
     if let Some(sinks) = sinks {
-        if let Err(e) = record_outcome(sinks.rec.clone(), &params, &outcome) {
+        if let Err(e) = record_outcome(sinks.rec.clone(), &params, &outcome, &stop_flag()) {
             sinks.abandon();
             return Err(Failure::run(format!("rerun: {e}")));
         }

@@ -6,7 +6,7 @@
 //! are taken at the same instant (matched synchronisation); outputs are compared with the truth
 //! `output_compensation` earlier (seed 001 §3.2's Δt).
 
-use nalgebra::{UnitQuaternion, Vector3};
+use nalgebra::Vector3;
 
 use super::coning::Algorithm;
 use super::fir::Fir;
@@ -14,7 +14,7 @@ use super::nav::{NavState, Navigator};
 use super::sensor::Sensors;
 use super::strapdown::AttitudeIntegrator;
 use super::truth::TruthImu;
-use crate::math::rotvec::exp_small;
+use crate::math::rotvec;
 use crate::model::earth::Earth;
 use super::InsParams;
 use crate::math::attitude::{Attitude, AttitudeError};
@@ -163,7 +163,7 @@ impl InsRun {
         // alignment error φ applied as C = (I − [φ×]) C_true.
         let start = me.truth.eval(-fir_delay_s).n_from_s;
         // FRAME: the alignment error is a small rotation of the navigation frame (C = (I − [φ×]) C_true).
-        let start: Rot<N, S> = Rot::<N, N>::from_quaternion(exp_small(&-me.cfg.initial_error_rad)) * start;
+        let start: Rot<N, S> = Rot::<N, N>::from_quaternion(rotvec::exp(&-me.cfg.initial_error_rad)) * start;
         me.integrators = algorithms
             .iter()
             .map(|a| {
@@ -223,7 +223,7 @@ impl InsRun {
     /// above: the heading decreases by `angle_rad`): an azimuth correction.
     pub fn rotate_azimuth(&mut self, angle_rad: f64) {
         // FRAME: a rotation of the computed navigation frame about its own vertical.
-        let r: Rot<N, N> = Rot::from_quaternion(UnitQuaternion::from_scaled_axis(Vector3::z() * angle_rad));
+        let r: Rot<N, N> = Rot::from_quaternion(rotvec::exp(&(Vector3::z() * angle_rad)));
         if let Some(i) = self.integrators.first_mut() {
             i.n_from_s = r * i.n_from_s;
         }

@@ -6,7 +6,7 @@
 use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::math::frames::{Rot, N, S};
-use crate::math::rotvec::exp_small;
+use crate::math::rotvec;
 
 use super::coning::{coefficients, Algorithm};
 
@@ -80,7 +80,7 @@ impl AttitudeIntegrator {
             self.prev[1] = if self.n >= 2 { self.cur[self.n - 2] } else { self.prev[0] };
         }
         let n_from_s = *self.n_from_s.quaternion();
-        let q = if *zeta_n == Vector3::zeros() { n_from_s * exp_small(&phi) } else { exp_small(&-*zeta_n) * n_from_s * exp_small(&phi) };
+        let q = if *zeta_n == Vector3::zeros() { n_from_s * rotvec::exp(&phi) } else { rotvec::exp(&-*zeta_n) * n_from_s * rotvec::exp(&phi) };
         // Renormalise: keeps |q| = 1 to machine precision over billions of updates.
         // FRAME: exp(−ζ) carries n over the update, exp(ΔΦ) the sensor frame: still C_s^n, one update on.
         self.n_from_s = Rot::from_quaternion(UnitQuaternion::new_normalize(q.into_inner()));

@@ -107,7 +107,7 @@ pub fn quaternion_of(att: &Attitude) -> UnitQuaternion<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::rotvec::exp_rotation;
+    use crate::math::rotvec;
     use crate::math::units::RAD_PER_DEG;
 
     fn att(pitch_deg: f64, roll_deg: f64, heading_deg: f64) -> Attitude {
@@ -162,7 +162,7 @@ mod tests {
         for axis in [Vector3::x(), Vector3::y(), Vector3::z(), Vector3::new(0.3, -0.5, 0.8).normalize()] {
             let phi = axis * eps;
             // FRAME: a small rotation applied on the navigation side of C_b^n.
-            let perturbed: Rot<N, N> = Rot::from_quaternion(exp_rotation(&phi));
+            let perturbed: Rot<N, N> = Rot::from_quaternion(rotvec::exp(&phi));
             let computed = Attitude::from_n_from_b(&(perturbed * truth.n_from_b()));
             let exact = computed.error_from(&truth).as_array();
             let linear = AttitudeError::first_order(&truth.n_from_b(), V3::new(phi)).as_array();

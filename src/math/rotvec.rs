@@ -3,17 +3,12 @@
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
-/// Rotation whose rotation vector is `phi` (exact exponential map, any size).
-#[must_use]
-pub fn exp_rotation(phi: &Vector3<f64>) -> UnitQuaternion<f64> {
-    UnitQuaternion::from_scaled_axis(*phi)
-}
-
-/// Quaternion of a rotation vector, with a series for the small angles of one update (exact to
-/// double precision for |φ| < 0.01 rad; trigonometry above).
+/// The rotation whose rotation vector is `phi` (the exponential map, any size): a series for the
+/// small angles of one update or one error (exact to double precision for |φ| < 0.01 rad),
+/// trigonometry above.
 #[must_use]
 #[inline]
-pub fn exp_small(phi: &Vector3<f64>) -> UnitQuaternion<f64> {
+pub fn exp(phi: &Vector3<f64>) -> UnitQuaternion<f64> {
     let x2 = phi.norm_squared();
     let (c, s_over) = if x2 < 1e-4 {
         // cos(x/2) and sin(x/2)/x to x^6: error < 1e-20 at x = 0.01.
@@ -30,7 +25,7 @@ pub fn exp_small(phi: &Vector3<f64>) -> UnitQuaternion<f64> {
 /// the vector part's norm s; the first omitted term, 35s⁸/1152, is below 1e-17 for s < 0.01
 /// (rotations under 1.1°); larger ones the library's atan2 form.
 #[must_use]
-pub fn rotation_vector(q: &UnitQuaternion<f64>) -> Vector3<f64> {
+pub fn log(q: &UnitQuaternion<f64>) -> Vector3<f64> {
     let v = if q.w < 0.0 { -q.imag() } else { q.imag() };
     let s2 = v.norm_squared();
     if s2 < 1e-4 { v * (2.0 * (1.0 + s2 * (1.0 / 6.0 + s2 * (3.0 / 40.0 + s2 * (5.0 / 112.0))))) } else { q.scaled_axis() }
@@ -47,12 +42,11 @@ mod tests {
         for angle in [0.0, 1e-9, 1e-5, 1e-3, 0.0099, 0.0101, 0.019, 0.021, 0.5, 3.0] {
             let v = Vector3::new(0.3, -0.5, 0.81).normalize() * angle;
             let q = UnitQuaternion::from_scaled_axis(v);
-            assert!(exp_small(&v).angle_to(&q) < 1e-15, "exp_small, angle {angle}");
-            assert!(exp_rotation(&v).angle_to(&q) < 1e-15, "exp_rotation, angle {angle}");
-            assert!((rotation_vector(&q) - v).norm() <= 1e-15 * angle.max(1e-3), "log, angle {angle}");
+            assert!(exp(&v).angle_to(&q) < 1e-15, "exp, angle {angle}");
+            assert!((log(&q) - v).norm() <= 1e-15 * angle.max(1e-3), "log, angle {angle}");
             // The same rotation with the quaternion's other sign.
             let neg = UnitQuaternion::new_unchecked(-q.into_inner());
-            assert!((rotation_vector(&neg) - v).norm() <= 1e-15 * angle.max(1e-3), "log, angle {angle} (−q)");
+            assert!((log(&neg) - v).norm() <= 1e-15 * angle.max(1e-3), "log, angle {angle} (−q)");
         }
     }
 }

@@ -20,7 +20,7 @@
 use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::math::frames::{axis_angle, Rot, B, S, V3};
-use crate::math::rotvec::exp_rotation;
+use crate::math::rotvec;
 use crate::model::scheme::{AxisValues, MAX_AXES};
 
 /// Nominal geometry of one gimbal axis.
@@ -226,11 +226,11 @@ impl Chain {
         let mut tilt = [UnitQuaternion::identity(); MAX_AXES];
         let mut swing_rotor = [UnitQuaternion::identity(); MAX_AXES];
         for (k, e) in errors.axes.iter().enumerate() {
-            tilt[k] = exp_rotation(&self.tilt_vector(k, e));
-            swing_rotor[k] = exp_rotation(&self.swing_vector(k, e, 0.0));
+            tilt[k] = rotvec::exp(&self.tilt_vector(k, e));
+            swing_rotor[k] = rotvec::exp(&self.swing_vector(k, e, 0.0));
         }
-        let installation = exp_rotation(&errors.installation_rad);
-        let mount = exp_rotation(&errors.imu_mount_rad);
+        let installation = rotvec::exp(&errors.installation_rad);
+        let mount = rotvec::exp(&errors.imu_mount_rad);
         let n = self.axes.len();
         let mut between = [UnitQuaternion::identity(); MAX_AXES + 1];
         between[0] = installation * tilt[0];

@@ -12,7 +12,7 @@ use super::scene::{cone, ring_radius};
 use super::{CustomLayout, Recorder, TIMELINE};
 use crate::calib::report::Report;
 use crate::calib::{Calibration, Param};
-use crate::math::rotvec::exp_rotation;
+use crate::math::rotvec;
 use crate::math::units::{fmt_angle, ARCSEC_PER_RAD};
 use crate::scenario::Params;
 use crate::sim::ERROR_AXES;
@@ -136,8 +136,8 @@ pub fn log(rec: RecordingStream, params: &Params, cal: &Calibration, report: &Re
             rec.log(format!("{mount}/estimated_cone"), &rerun::Mesh3D::new(mesh.0).with_triangle_indices(mesh.1).with_albedo_factor(albedo(GHOST, 35)))?;
             rec.log(format!("{mount}/estimated_cone/rims"), &rerun::LineStrips3D::new(rims).with_colors([rgba(GHOST, 230)]).with_radii([0.003]))?;
             // The estimated rotor axis, drawn in the (truly tilted) rotor frame: W_trueᵀ W_est a.
-            let w_true = exp_rotation(&(chain.swing_vector(k, &params.table.truth.axes[k], 0.0) * x));
-            let w_est = exp_rotation(&(chain.swing_vector(k, &est.axes[k], 0.0) * x));
+            let w_true = rotvec::exp(&(chain.swing_vector(k, &params.table.truth.axes[k], 0.0) * x));
+            let w_est = rotvec::exp(&(chain.swing_vector(k, &est.axes[k], 0.0) * x));
             let dir: Vector3<f64> = (w_true.inverse() * w_est) * g.axis;
             rec.log(
                 format!("{}/estimated_axis", recorder.paths.gimbals[k]),

@@ -28,6 +28,7 @@ pub mod sink;
 pub mod tpr;
 
 use crate::ins::pipeline::{InsView, NavError};
+use crate::math::rotvec;
 use crate::math::units::{ARCSEC_PER_RAD, DEG_PER_RAD};
 use crate::model::gimbal::{Chain, ErrorRotations, TableErrors};
 use crate::scenario::Params;
@@ -261,15 +262,15 @@ impl Recorder {
     pub fn push_scene_row(&mut self, out: &StepOutput, ins: Option<&InsView>) -> RecordingStreamResult<()> {
         let links = self.chain.link_rotations(&self.drawing, &out.gimbal_rad);
         self.scene_t.push(out.t_s);
-        self.scene_vehicle.push(to_rerun_quaternion(&out.n_from_b));
+        self.scene_vehicle.push(to_rerun_quaternion(out.n_from_b.quaternion()));
         for (k, col) in self.scene_gimbals.iter_mut().enumerate() {
             col.push(to_rerun_quaternion(&links.gimbal[k]));
         }
         if let Some(layout) = self.ins.as_mut() {
             let (t, c) = ins.map_or((UnitQuaternion::identity(), UnitQuaternion::identity()), |v| (*v.imu_true.quaternion(), *v.imu_ins.quaternion()));
-            let err = (c * t.inverse()).scaled_axis() * layout.exaggeration;
+            let err = rotvec::log(&(c * t.inverse())) * layout.exaggeration;
             layout.trace_true.push(to_rerun_quaternion(&t));
-            layout.trace_ins.push(to_rerun_quaternion(&(UnitQuaternion::from_scaled_axis(err) * t)));
+            layout.trace_ins.push(to_rerun_quaternion(&(rotvec::exp(&err) * t)));
         }
         if self.scene_t.len() >= SERIES_CHUNK_ROWS {
             self.flush_scene()?;

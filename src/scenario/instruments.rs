@@ -11,7 +11,7 @@ use crate::ins::coning::Algorithm;
 use crate::ins::nav::{NavOptions, Vertical};
 use crate::ins::sensor::{AccelSpec, DitherSpec, GyroSpec, Spec};
 use crate::ins::{fir, InsParams};
-use crate::math::units::{MPS2_PER_UG, RAD_PER_ARCSEC, RAD_PER_DEG, RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H, RAD_PER_S_PER_DEG_PER_H, STANDARD_GRAVITY_MPS2};
+use crate::math::units::{MPS2_PER_UG, RAD_PER_ARCMIN, RAD_PER_ARCSEC, RAD_PER_DEG, RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H, RAD_PER_S_PER_DEG_PER_H, STANDARD_GRAVITY_MPS2};
 use crate::model::gimbal::TableErrors;
 
 /// Starting values of the `[imu]` section; keys in the file override them.
@@ -146,7 +146,7 @@ pub(super) fn validate_imu(c: &Checker<'_>, raw: &RawImu, nav: Option<&RawNaviga
         e.gyro.misalignment_rad = c.range("imu.gyro.misalignment_arcsec", v, "arcsec", 0.0, MAX_ERROR_ANGLE_ARCSEC, ERROR_HINT)? * RAD_PER_ARCSEC;
     }
     if let Some(v) = g.arw_deg_per_sqrt_h {
-        e.gyro.arw_rad_per_sqrt_s = c.range("imu.gyro.arw_deg_per_sqrt_h", v, "deg/√h", 0.0, 100.0, "")? * RAD_PER_DEG / 60.0;
+        e.gyro.arw_rad_per_sqrt_s = c.range("imu.gyro.arw_deg_per_sqrt_h", v, "deg/√h", 0.0, 100.0, "")? * RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H;
     }
     if let Some(v) = g.bias_instability_deg_per_h {
         e.gyro.instability_rad_per_s = c.range("imu.gyro.bias_instability_deg_per_h", v, "deg/h", 0.0, 3600.0, "")? * DEG_PER_H;
@@ -198,7 +198,7 @@ pub(super) fn validate_imu(c: &Checker<'_>, raw: &RawImu, nav: Option<&RawNaviga
         };
         let mut err = [0.0; 3];
         for (i, x) in n.initial_attitude_error_arcmin.iter().enumerate() {
-            err[i] = c.range(&format!("navigation.initial_attitude_error_arcmin[{i}]"), *x, "arcmin", -600.0, 600.0, "")? * RAD_PER_DEG / 60.0;
+            err[i] = c.range(&format!("navigation.initial_attitude_error_arcmin[{i}]"), *x, "arcmin", -600.0, 600.0, "")? * RAD_PER_ARCMIN;
         }
         cfg.navigation = Some(NavOptions { vertical, damping_per_s: if n.velocity_damping { crate::model::earth::schuler_rate() } else { 0.0 } });
         cfg.initial_error_rad = Vector3::from(err);

@@ -4,8 +4,6 @@
 //! Pure: `step(&Model, &mut DemodState, t)` knows nothing of Rerun, files or threads.
 //! The IMU attitude is exact here (an ideal INS), so every error is the turntable's.
 
-use nalgebra::UnitQuaternion;
-
 use crate::math::attitude::{Attitude, AttitudeError};
 use crate::math::frames::{Rot, B, N, S};
 use crate::math::stats::RunningStat;
@@ -153,7 +151,7 @@ pub struct StepOutput {
     /// True vehicle attitude.
     pub attitude: Attitude,
     /// True C_b^n.
-    pub n_from_b: UnitQuaternion<f64>,
+    pub n_from_b: Rot<N, B>,
     /// True gimbal angles, rad.
     pub gimbal_rad: AxisValues,
     /// Encoder readings, rad.
@@ -196,7 +194,7 @@ pub fn step(model: &Model, state: &mut DemodState, t_s: f64) -> StepOutput {
     StepOutput {
         t_s,
         attitude,
-        n_from_b: *n_from_b.quaternion(),
+        n_from_b,
         gimbal_rad,
         encoder_rad,
         errors: [uncompensated.error_from(&attitude), compensated.error_from(&attitude), closed_form],
