@@ -36,7 +36,7 @@ pub fn collect(params: &Params, seed: u64) -> Result<Data, CalibError> {
                 if ins.step().updated {
                     let (t, q) = ins.output_attitude(0);
                     // Matched synchronisation: the encoders are read for the instant the data represent.
-                    let angles = demod.correct(&model, t, &encoder_readings(&model, t));
+                    let angles = demod.correct(&model.compensation, t, &encoder_readings(&model, t));
                     samples.push(Measurement { t_s: t, tau: tau(t), n_from_s: q, shafts: chain.shaft_rotations(&angles) });
                 }
             }
@@ -48,7 +48,7 @@ pub fn collect(params: &Params, seed: u64) -> Result<Data, CalibError> {
                 let t = timeline.t_s(k);
                 let (lambda, _) = model.scheme.state(t - model.scheme_t0_s);
                 let n_from_s = n_from_b * chain.b_from_s(&truth, &lambda);
-                let angles = demod.correct(&model, t, &encoder_readings(&model, t));
+                let angles = demod.correct(&model.compensation, t, &encoder_readings(&model, t));
                 samples.push(Measurement { t_s: t, tau: tau(t), n_from_s, shafts: chain.shaft_rotations(&angles) });
             }
         }

@@ -7,7 +7,8 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::ins::pipeline::{InsRun, InsView, SampleOut};
+use crate::ins::core::SampleOut;
+use crate::ins::pipeline::{InsRun, InsView};
 use crate::math::stats::RunningStat;
 use crate::math::timeline::{decimation, Timeline};
 use crate::math::units::ARCSEC_PER_RAD;

@@ -89,7 +89,7 @@ pub fn compare_resets(params: &Params, sample_s: f64, stop: &AtomicBool) -> Resu
         if !fix1_done && s.t_s >= t1 {
             dlat[0] = errors(&mut ins, s.t_s).1[1];
             phi1 = level(&ins, v_before[0]);
-            ins.reset_position();
+            ins.core_mut().reset_position();
             fix1_done = true;
         }
         if s.t_s >= t2 {
@@ -116,10 +116,10 @@ pub fn compare_resets(params: &Params, sample_s: f64, stop: &AtomicBool) -> Resu
     let phi_u_level = azimuth_error_level_corrected(phi1, phi2, dlat2, t2 - t1, lat);
     let mut branches: [InsRun; BRANCHES] = [ins.clone(), ins.clone(), ins];
     for b in &mut branches {
-        b.reset_position();
+        b.core_mut().reset_position();
     }
-    branches[1].rotate_azimuth(-phi_u);
-    branches[2].rotate_azimuth(-phi_u_level);
+    branches[1].core_mut().rotate_azimuth(-phi_u);
+    branches[2].core_mut().rotate_azimuth(-phi_u_level);
     let remaining = steps.saturating_sub(i);
     let branch = |mut ins: InsRun| -> Vec<(f64, f64, [f64; 2])> {
         let mut out = Vec::new();

@@ -2,6 +2,7 @@
 //! FIR, coning-compensated attitude algorithms, strapdown navigation, position resets.
 
 pub mod coning;
+pub mod core;
 pub mod fir;
 pub mod nav;
 pub mod pipeline;

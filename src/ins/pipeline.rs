@@ -1,39 +1,20 @@
-//! One IMU sample at a time: truth increments → sensor errors and dither → FIR → decimation →
-//! attitude algorithm(s) → navigation; and, on demand, the INS body attitude and its error.
-//!
-//! Timing (docs/ins.md): after the FIR, sample k represents the truth at k·h − d (d = group delay);
-//! the navigation computer's zero-order hold is a further h/2 (seed 001 §3.1); the encoder angles
-//! are taken at the same instant (matched synchronisation); outputs are compared with the truth
-//! `output_compensation` earlier (seed 001 §3.2's Δt).
+//! The INS in the loop on a simulated table: exact IMU truth → sensor errors and dither → the
+//! navigation computer (`core`); and, on demand, the INS body attitude and its error against the
+//! truth.
 
 use nalgebra::Vector3;
 
 use super::coning::Algorithm;
-use super::fir::Fir;
-use super::nav::{NavState, Navigator};
+use super::core::{InsCore, NavError, SampleOut};
+use super::nav::NavState;
 use super::sensor::Sensors;
-use super::strapdown::AttitudeIntegrator;
 use super::truth::TruthImu;
-use crate::math::rotvec;
-use crate::model::earth::Earth;
 use super::InsParams;
 use crate::math::attitude::{Attitude, AttitudeError};
 use crate::math::frames::{Rot, B, N, S};
-use crate::model::earth::Site;
+use crate::math::rotvec;
+use crate::model::earth::{Earth, Site};
 use crate::sim::{demodulate, encoder_readings, DemodState, Model};
-
-/// What one IMU sample produced.
-#[derive(Debug, Clone, Copy)]
-pub struct SampleOut {
-    /// End of the sample, s.
-    pub t_s: f64,
-    /// True if the primary algorithm completed an attitude update with this sample.
-    pub updated: bool,
-    /// Measured gyro rate (raw, with dither), rad/s.
-    pub raw_rate_s: Vector3<f64>,
-    /// After the FIR, rad/s.
-    pub filtered_rate_s: Vector3<f64>,
-}
 
 /// The INS's view of the body at one output instant.
 #[derive(Debug, Clone)]
@@ -52,142 +33,67 @@ pub struct InsView {
     pub nav: Option<NavError>,
 }
 
-/// Navigation errors (computed − true) at one output instant.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct NavError {
-    /// East position error, m.
-    pub east_m: f64,
-    /// North position error, m.
-    pub north_m: f64,
-    /// Horizontal (radial) position error, m.
-    pub radial_m: f64,
-    /// Velocity error (East, North, Up), m/s (the vehicle is at rest: this is the velocity).
-    pub velocity_enu_mps: Vector3<f64>,
-}
-
-/// The attitude output `zoh` after the latest of two (time, attitude) updates, interpolated.
-fn output_attitude(history: &[(f64, Rot<N, S>); 2], zoh: f64) -> (f64, Rot<N, S>) {
-    let [(t0, q0), (t1, q1)] = *history;
-    let t = t1 - zoh;
-    if t1 > t0 && t < t1 {
-        let f = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
-        // FRAME: between two C_s^n the interpolated rotation is C_s^n at the instant in between.
-        (t, Rot::from_quaternion(q0.quaternion().slerp(q1.quaternion(), f)))
-    } else {
-        (t1, q1)
-    }
-}
-
 /// The INS in the loop (cloned to fork one IMU stream into two navigation strategies).
 #[derive(Clone)]
 pub struct InsRun {
-    cfg: InsParams,
     truth: TruthImu,
-    earth: Earth,
     sensors: Sensors,
-    fir_g: Fir,
-    fir_a: Fir,
+    core: InsCore,
     h: f64,
     index: u64,
-    acc: (Vector3<f64>, Vector3<f64>, usize),
-    /// The integrators; `[0]` is the configured algorithm (the navigation's).
-    integrators: Vec<AttitudeIntegrator>,
-    /// (time, attitude) of each integrator's previous and latest update.
-    history: Vec<[(f64, Rot<N, S>); 2]>,
-    nav: Option<Navigator>,
-    nav_start: Rot<N, S>,
-    upd_g: Vec<Vector3<f64>>,
-    upd_a: Vec<Vector3<f64>>,
     demod: Vec<DemodState>,
-    /// FIR group delay, s.
-    pub fir_delay_s: f64,
-    /// Zero-order-hold delay, s.
-    pub zoh_delay_s: f64,
 }
 
 impl InsRun {
     /// Builds the INS `cfg` at `site` on the table `model` (sensor noise seeded with `seed`) and
-    /// pre-rolls the FIR.
+    /// pre-rolls the FIR: the filter has been running before t = 0 on the same motion, and the
+    /// algorithms that use previous samples have them.
     #[must_use]
     pub fn new(cfg: &InsParams, site: Site, seed: u64, model: Model) -> Self {
-        let cfg = cfg.clone();
         let h = 1.0 / cfg.rate_hz;
-        let earth = Earth::at(site);
-        let fir_g = Fir::new(&cfg.fir_taps);
-        let fir_a = Fir::new(&cfg.fir_taps);
-        let fir_delay_s = fir_g.group_delay_samples() * h;
-        let zoh_delay_s = if cfg.zero_order_hold { 0.5 * h } else { 0.0 };
-        // Pre-roll: the filter has been running before t = 0 on the same motion, and the algorithms
-        // that use previous samples have them.
-        let pre = cfg.fir_taps.len().saturating_sub(1).max(2 * cfg.decimation);
+        let pre = InsCore::pre_roll_samples(cfg);
         let t_start = -(pre as f64) * h;
-        let truth = TruthImu::new(model, earth, t_start);
-        let sensors = Sensors::new(&cfg.errors, h, seed, t_start);
-        let algorithms = cfg.algorithms();
-        let nav = cfg.navigation.map(|o| Navigator::new(&earth, o));
-        let mut me = Self {
-            truth,
-            earth,
-            sensors,
-            fir_g,
-            fir_a,
-            h,
-            index: 0,
-            acc: (Vector3::zeros(), Vector3::zeros(), 0),
-            integrators: Vec::new(),
-            history: Vec::new(),
-            nav,
-            nav_start: Rot::identity(),
-            upd_g: Vec::new(),
-            upd_a: Vec::new(),
-            demod: Vec::new(),
-            fir_delay_s,
-            zoh_delay_s,
-            cfg,
-        };
-        let mut primed = Vec::new();
-        let mut acc = (Vector3::zeros(), 0);
-        for i in 0..pre {
-            let t1 = t_start + (i + 1) as f64 * h;
-            let (g, a) = me.truth.increments(t1);
-            let (g, a) = me.sensors.measure(&g, &a, t1);
-            acc.0 += me.fir_g.push(g);
-            acc.1 += 1;
-            me.fir_a.push(a);
-            if acc.1 == me.cfg.decimation {
-                primed.push(acc.0);
-                acc = (Vector3::zeros(), 0);
-            }
-        }
-        // The filtered stream now stands at the truth of t = −d: start the attitude there, with the
-        // alignment error φ applied as C = (I − [φ×]) C_true.
-        let start = me.truth.eval(-fir_delay_s).n_from_s;
-        // FRAME: the alignment error is a small rotation of the navigation frame (C = (I − [φ×]) C_true).
-        let start: Rot<N, S> = Rot::<N, N>::from_quaternion(rotvec::exp(&-me.cfg.initial_error_rad)) * start;
-        me.integrators = algorithms
-            .iter()
-            .map(|a| {
-                let mut i = AttitudeIntegrator::new(*a, start);
-                i.prime(&primed);
-                i
+        let mut truth = TruthImu::new(model, Earth::at(site), t_start);
+        let mut sensors = Sensors::new(&cfg.errors, h, seed, t_start);
+        let pre_roll: Vec<(Vector3<f64>, Vector3<f64>)> = (0..pre)
+            .map(|i| {
+                let t1 = t_start + (i + 1) as f64 * h;
+                let (g, a) = truth.increments(t1);
+                sensors.measure(&g, &a, t1)
             })
             .collect();
-        me.history = vec![[(-fir_delay_s, start), (-fir_delay_s, start)]; me.integrators.len()];
-        me.demod = vec![DemodState::default(); me.integrators.len()];
-        me.nav_start = start;
-        me
+        // The filtered stream now stands at the truth of t = −d: start the attitude there, with the
+        // alignment error φ applied as C = (I − [φ×]) C_true.
+        let fir_delay_s = super::fir::Fir::new(&cfg.fir_taps).group_delay_samples() * h;
+        let start = truth.eval(-fir_delay_s).n_from_s;
+        // FRAME: the alignment error is a small rotation of the navigation frame (C = (I − [φ×]) C_true).
+        let start: Rot<N, S> = Rot::<N, N>::from_quaternion(rotvec::exp(&-cfg.initial_error_rad)) * start;
+        let core = InsCore::new(cfg, site, start, &pre_roll);
+        let demod = vec![DemodState::default(); core.algorithms().len()];
+        Self { truth, sensors, core, h, index: 0, demod }
+    }
+
+    /// The navigation computer.
+    #[must_use]
+    pub fn core(&self) -> &InsCore {
+        &self.core
+    }
+
+    /// The navigation computer, for resets.
+    pub fn core_mut(&mut self) -> &mut InsCore {
+        &mut self.core
     }
 
     /// The configuration.
     #[must_use]
     pub fn config(&self) -> &InsParams {
-        &self.cfg
+        self.core.config()
     }
 
     /// The algorithms run, in order.
     #[must_use]
     pub fn algorithms(&self) -> Vec<Algorithm> {
-        self.integrators.iter().map(|i| i.algorithm).collect()
+        self.core.algorithms()
     }
 
     /// The model (truth).
@@ -199,90 +105,29 @@ impl InsRun {
     /// Navigation solution, if navigating.
     #[must_use]
     pub fn nav_state(&self) -> Option<&NavState> {
-        self.nav.as_ref().map(|n| &n.state)
+        self.core.nav_state()
     }
 
-    /// Replaces the primary attitude (position-fix and azimuth resets of later issues).
-    pub fn set_primary_attitude(&mut self, n_from_s: Rot<N, S>) {
-        if let Some(i) = self.integrators.first_mut() {
-            i.n_from_s = n_from_s;
-        }
-    }
-
-    /// Position fix: the navigation's latitude and longitude set to the truth (the site), velocity
-    /// and the attitude relative to local level kept (the usual reset; docs/tpr.md).
-    pub fn reset_position(&mut self) {
-        let site = self.earth.site;
-        if let Some(nav) = self.nav.as_mut() {
-            nav.state.latitude_rad = site.latitude_rad;
-            nav.state.longitude_rad = site.longitude_rad;
-        }
-    }
-
-    /// Turns the primary attitude about the local vertical by `angle_rad` (counter-clockwise seen from
-    /// above: the heading decreases by `angle_rad`): an azimuth correction.
-    pub fn rotate_azimuth(&mut self, angle_rad: f64) {
-        // FRAME: a rotation of the computed navigation frame about its own vertical.
-        let r: Rot<N, N> = Rot::from_quaternion(rotvec::exp(&(Vector3::z() * angle_rad)));
-        if let Some(i) = self.integrators.first_mut() {
-            i.n_from_s = r * i.n_from_s;
-        }
-        if let Some(h) = self.history.first_mut() {
-            for (_, q) in h.iter_mut() {
-                *q = r * *q;
-            }
-        }
+    /// The measured increments (Δθ, Δv) of the next IMU sample and its end time, without feeding
+    /// them to the computer (for writing a log).
+    pub fn next_measurement(&mut self) -> (f64, Vector3<f64>, Vector3<f64>) {
+        self.index += 1;
+        let t1 = self.index as f64 * self.h;
+        let (g_true, a_true) = self.truth.increments(t1);
+        let (g, a) = self.sensors.measure(&g_true, &a_true, t1);
+        (t1, g, a)
     }
 
     /// One IMU sample.
     pub fn step(&mut self) -> SampleOut {
-        self.index += 1;
-        let t1 = self.index as f64 * self.h;
-        let (g_true, a_true) = self.truth.increments(t1);
-        let (g_meas, a_meas) = self.sensors.measure(&g_true, &a_true, t1);
-        let g_filt = self.fir_g.push(g_meas);
-        let a_filt = self.fir_a.push(a_meas);
-        let mut out = SampleOut { t_s: t1, updated: false, raw_rate_s: g_meas / self.h, filtered_rate_s: g_filt / self.h };
-        self.acc.0 += g_filt;
-        self.acc.1 += a_filt;
-        self.acc.2 += 1;
-        if self.acc.2 < self.cfg.decimation {
-            return out;
-        }
-        let (dg, da) = (self.acc.0, self.acc.1);
-        self.acc = (Vector3::zeros(), Vector3::zeros(), 0);
-        let h_alg = self.h * self.cfg.decimation as f64;
-        // The attitude at the start of the primary update, for the velocity update.
-        if self.upd_g.is_empty() {
-            self.nav_start = self.integrators[0].n_from_s;
-        }
-        self.upd_g.push(dg);
-        self.upd_a.push(da);
-        let w_in = self.nav.as_ref().map_or(self.earth.omega_ie_n, Navigator::omega_in_n);
-        let t_repr = t1 - self.fir_delay_s;
-        for (k, integ) in self.integrators.iter_mut().enumerate() {
-            let zeta = w_in * (h_alg * integ.samples_per_update() as f64);
-            if integ.push(dg, &zeta).is_some() {
-                self.history[k] = [self.history[k][1], (t_repr, integ.n_from_s)];
-                if k == 0 {
-                    out.updated = true;
-                    let h_upd = h_alg * self.upd_g.len() as f64;
-                    if let Some(nav) = self.nav.as_mut() {
-                        nav.update(&self.nav_start, &self.upd_g, &self.upd_a, &zeta, h_upd);
-                    }
-                    self.upd_g.clear();
-                    self.upd_a.clear();
-                }
-            }
-        }
-        out
+        let (t1, g, a) = self.next_measurement();
+        self.core.push(t1, g, a)
     }
 
-    /// Integrator `k`'s C_s^n as output at `t_s` (after its latest update): with the zero-order
-    /// hold, the value h/2 earlier, interpolated between the two latest updates.
+    /// Integrator `k`'s C_s^n as output after its latest update, and the instant it represents.
     #[must_use]
     pub fn output_attitude(&self, k: usize) -> (f64, Rot<N, S>) {
-        output_attitude(&self.history[k], self.zoh_delay_s)
+        self.core.output_attitude(k)
     }
 
     /// The INS body attitude errors (call right after a primary update at `t_s`). Each algorithm is
@@ -290,37 +135,27 @@ impl InsRun {
     /// update update less often), against the truth `output_compensation` earlier.
     pub fn view(&mut self, t_s: f64) -> InsView {
         let model = self.truth.model();
-        let mut errors = Vec::with_capacity(self.integrators.len());
-        for k in 0..self.integrators.len() {
-            let (t_repr, n_from_s) = output_attitude(&self.history[k], self.zoh_delay_s);
-            // The output left the computer d + zoh after the instant it represents.
-            let t_ref = t_repr + self.fir_delay_s + self.zoh_delay_s - self.cfg.output_compensation_s;
+        let mut errors = Vec::with_capacity(self.demod.len());
+        for k in 0..self.demod.len() {
+            let (t_repr, n_from_s) = self.core.output_attitude(k);
+            let t_ref = self.core.reference_instant(t_repr);
             // The encoders are read for the instant the IMU data represent (matched synchronisation).
             let encoder = encoder_readings(model, t_repr);
-            let corrected = self.demod[k].correct(model, t_repr, &encoder);
+            let corrected = self.demod[k].correct(&model.compensation, t_repr, &encoder);
             let b_from_s_comp = model.chain.b_from_s(model.compensation_rotations(), &corrected);
             let (truth_att, _) = model.vehicle.state(t_ref);
             errors.push(demodulate(n_from_s, b_from_s_comp).error_from(&truth_att));
         }
-        let (t_repr, imu_ins) = self.output_attitude(0);
+        let (t_repr, imu_ins) = self.core.output_attitude(0);
         let imu_true = self.truth.eval(t_repr).n_from_s;
-        let nav = self.nav.as_ref().map(|n| {
-            let s = &n.state;
-            let site = self.earth.site;
-            let (rm, rn) = Earth::radii(site.latitude_rad);
-            let north = (s.latitude_rad - site.latitude_rad) * (rm + site.height_m);
-            let east = (s.longitude_rad - site.longitude_rad) * (rn + site.height_m) * site.latitude_rad.cos();
-            NavError { east_m: east, north_m: north, radial_m: north.hypot(east), velocity_enu_mps: s.v_n }
-        });
-        InsView { t_s, t_ref_s: t_s - self.cfg.output_compensation_s, errors, imu_true, imu_ins, nav }
+        let nav: Option<NavError> = self.core.nav_error();
+        InsView { t_s, t_ref_s: t_s - self.core.config().output_compensation_s, errors, imu_true, imu_ins, nav }
     }
 
     /// The body attitude the primary INS outputs (for tests and resets).
     #[must_use]
     pub fn body_attitude(&self, b_from_s: Rot<B, S>) -> Attitude {
-        let n_from_s = self.output_attitude(0).1;
-        // FRAME: C_b^n = C_s^n · C_b^s.
-        Attitude::from_n_from_b(&(n_from_s * b_from_s.inverse()))
+        self.core.body_attitude(b_from_s)
     }
 
     /// IMU sample period, s.

@@ -6,7 +6,7 @@ use rerun::{RecordingStreamResult, TimeColumn};
 
 use super::palette::{colors, rgb, rgba};
 use super::{Recorder, SERIES_CHUNK_ROWS, TIMELINE};
-use crate::ins::pipeline::SampleOut;
+use crate::ins::core::SampleOut;
 use crate::math::units::DEG_PER_RAD;
 use crate::sim::ERROR_AXES;
 

@@ -27,7 +27,8 @@ mod scene;
 pub mod sink;
 pub mod tpr;
 
-use crate::ins::pipeline::{InsView, NavError};
+use crate::ins::core::NavError;
+use crate::ins::pipeline::InsView;
 use crate::math::rotvec;
 use crate::math::units::{ARCSEC_PER_RAD, DEG_PER_RAD};
 use crate::model::gimbal::{Chain, ErrorRotations, TableErrors};

@@ -87,7 +87,17 @@ fn spec(c: &Checker<'_>, key: &str, v: RawSpec, unit: &'static str, max: f64, to
     })
 }
 
-pub(super) fn validate_imu(c: &Checker<'_>, raw: &RawImu, nav: Option<&RawNavigation>, step_hz: f64) -> Result<InsParams, ConfigError> {
+/// `[imu]` with `[navigation]` at the IMU rate `step_hz` (None without `[imu]`; `[navigation]`
+/// alone is refused).
+pub(super) fn validate_ins(c: &Checker<'_>, imu: Option<&RawImu>, nav: Option<&RawNavigation>, step_hz: f64) -> Result<Option<InsParams>, ConfigError> {
+    match imu {
+        None if nav.is_some() => Err(c.invalid("navigation", "needs an [imu] section (navigation runs on the IMU's increments)")),
+        None => Ok(None),
+        Some(imu) => validate_imu(c, imu, nav, step_hz).map(Some),
+    }
+}
+
+fn validate_imu(c: &Checker<'_>, raw: &RawImu, nav: Option<&RawNavigation>, step_hz: f64) -> Result<InsParams, ConfigError> {
     const DEG_PER_H: f64 = RAD_PER_S_PER_DEG_PER_H;
     const UG: f64 = MPS2_PER_UG;
     let preset_name = raw.preset.as_deref().unwrap_or("none");

@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 
 use nalgebra::Vector3;
 
-use super::raw::{RawAxisCompensation, RawCompensation, RawConfig, RawScheme, RawTurntable};
+use super::raw::{RawAxisCompensation, RawCompensation, RawConfig, RawRecording, RawScheme, RawSite, RawTurntable};
 use super::{instruments, ConfigError, Params, RecordingParams, ScenarioMeta};
 use crate::math::attitude::Attitude;
 use crate::math::units::{RAD_PER_ARCSEC, RAD_PER_DEG};
@@ -101,17 +101,8 @@ pub(super) fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigErr
         ));
     }
 
-    // [recording]
-    let series_hz = c.positive("recording.series_hz", raw.recording.series_hz, "Hz", step_hz)?;
-    let scene_hz = c.positive("recording.scene_hz", raw.recording.scene_hz, "Hz", step_hz)?;
-    let exaggeration = c.range("recording.exaggeration", raw.recording.exaggeration, "x", 1.0, 100_000.0, "")?;
-
-    // [site]
-    let site = Site {
-        latitude_rad: c.range("site.latitude_deg", raw.site.latitude_deg, "deg", -90.0, 90.0, "")? * RAD_PER_DEG,
-        longitude_rad: c.range("site.longitude_deg", raw.site.longitude_deg, "deg", -180.0, 360.0, "")? * RAD_PER_DEG,
-        height_m: c.range("site.height_m", raw.site.height_m, "m", -1000.0, 100_000.0, "")?,
-    };
+    let recording = recording(&c, &raw.recording, step_hz)?;
+    let site = site(&c, &raw.site)?;
 
     // [vehicle]
     let pitch_hint = "Euler angles are singular at +-90 deg pitch";
@@ -162,61 +153,7 @@ pub(super) fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigErr
         ));
     }
 
-    // [turntable]
-    let t = &raw.turntable;
-    if t.axis.is_empty() || t.axis.len() > 3 {
-        return Err(c.invalid("turntable.axis", format!("{} axes given; a table has 1, 2 or 3", t.axis.len())));
-    }
-    let mut geometry = Vec::new();
-    let mut axis_errors = Vec::new();
-    for (i, a) in t.axis.iter().enumerate() {
-        let k = |f: &str| format!("turntable.axis[{i}] (\"{}\").{f}", a.name);
-        if a.name.trim().is_empty() || geometry.iter().any(|g: &AxisGeometry| g.name == a.name) {
-            return Err(c.invalid(&k("name"), format!("\"{}\" must be non-empty and unique", a.name)));
-        }
-        let dir = match a.axis.as_str() {
-            "x" => Vector3::x(),
-            "y" => Vector3::y(),
-            "z" => Vector3::z(),
-            other => return Err(c.invalid(&k("axis"), format!("\"{other}\" is not an axis; use \"x\", \"y\" or \"z\""))),
-        };
-        if let Some(prev) = geometry.last() {
-            let prev: &AxisGeometry = prev;
-            if prev.axis.dot(&dir).abs() > 0.5 {
-                return Err(c.invalid(
-                    &k("axis"),
-                    format!("\"{}\" is parallel to the previous axis \"{}\"; consecutive gimbal axes must be perpendicular", a.axis, prev.name),
-                ));
-            }
-        }
-        if i == 0 && a.non_orthogonality_arcsec != 0.0 {
-            return Err(c.invalid(
-                &k("non_orthogonality_arcsec"),
-                format!(
-                    "{} arcsec given on the first axis; its tilt against the body is the installation error (turntable.installation_*_arcsec)",
-                    a.non_orthogonality_arcsec
-                ),
-            ));
-        }
-        geometry.push(AxisGeometry::new(a.name.clone(), dir, c.finite(&k("initial_angle_deg"), a.initial_angle_deg, "deg")? * RAD_PER_DEG));
-        let values = AxisErrorKeys {
-            swing_half_angle_arcsec: a.swing_half_angle_arcsec,
-            swing_phase_deg: a.swing_phase_deg,
-            non_orthogonality_arcsec: a.non_orthogonality_arcsec,
-            encoder_offset_arcsec: a.encoder_offset_arcsec,
-            encoder_scale_ppm: a.encoder_scale_ppm,
-            encoder_delay_ms: a.encoder_delay_ms,
-        };
-        let mut errors = axis_errors_of(&c, &k, &values)?;
-        errors.encoder_noise_rad = c.range(&k("encoder_noise_arcsec"), a.encoder_noise_arcsec, "arcsec", 0.0, 3600.0, "1σ per reading, 1° at most")? * RAD_PER_ARCSEC;
-        axis_errors.push(errors);
-    }
-    let chain = Chain::new(geometry);
-    let truth = TableErrors {
-        installation_rad: rotation_arcsec(&c, "turntable.installation", [t.installation_x_arcsec, t.installation_y_arcsec, t.installation_z_arcsec])?,
-        imu_mount_rad: rotation_arcsec(&c, "turntable.imu_mount", [t.imu_mount_x_arcsec, t.imu_mount_y_arcsec, t.imu_mount_z_arcsec])?,
-        axes: axis_errors,
-    };
+    let (chain, truth) = turntable(&c, &raw.turntable)?;
 
     // [scheme]
     let scheme = validate_scheme(&c, &raw.scheme, &chain)?;
@@ -231,15 +168,7 @@ pub(super) fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigErr
         seed: raw.scenario.seed,
     };
     let live_speed = c.range("live.speed", raw.live.speed, "x real time", 0.01, 10_000.0, "")?;
-    let ins = match &raw.imu {
-        None => {
-            if raw.navigation.is_some() {
-                return Err(c.invalid("navigation", "needs an [imu] section (navigation runs on the simulated IMU)"));
-            }
-            None
-        }
-        Some(imu) => Some(instruments::validate_imu(&c, imu, raw.navigation.as_ref(), step_hz)?),
-    };
+    let ins = instruments::validate_ins(&c, raw.imu.as_ref(), raw.navigation.as_ref(), step_hz)?;
     let calibration = instruments::validate_calibration(&c, &raw.calibration.clone().unwrap_or_default(), &truth)?;
     let mut position_fix_s = Vec::new();
     if let Some(fix) = &raw.position_fix {
@@ -264,7 +193,7 @@ pub(super) fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigErr
         meta,
         duration_s,
         step_hz,
-        recording: RecordingParams { series_hz, scene_hz, exaggeration },
+        recording,
         site,
         table: TableParams { chain, vehicle, scheme, truth, compensation },
         resolved_toml,
@@ -457,4 +386,81 @@ fn axis_errors_of(c: &Checker<'_>, key: &dyn Fn(&str) -> String, v: &AxisErrorKe
         encoder_delay_s: c.range(&key("encoder_delay_ms"), v.encoder_delay_ms, "ms", -1000.0, 1000.0, "")? * 1e-3,
         encoder_noise_rad: 0.0,
     })
+}
+
+/// `[recording]`: output rates (at most the simulation rate `step_hz`) and the drawing factor.
+pub(super) fn recording(c: &Checker<'_>, raw: &RawRecording, step_hz: f64) -> Result<RecordingParams, ConfigError> {
+    Ok(RecordingParams {
+        series_hz: c.positive("recording.series_hz", raw.series_hz, "Hz", step_hz)?,
+        scene_hz: c.positive("recording.scene_hz", raw.scene_hz, "Hz", step_hz)?,
+        exaggeration: c.range("recording.exaggeration", raw.exaggeration, "x", 1.0, 100_000.0, "")?,
+    })
+}
+
+/// `[site]`.
+pub(super) fn site(c: &Checker<'_>, raw: &RawSite) -> Result<Site, ConfigError> {
+    Ok(Site {
+        latitude_rad: c.range("site.latitude_deg", raw.latitude_deg, "deg", -90.0, 90.0, "")? * RAD_PER_DEG,
+        longitude_rad: c.range("site.longitude_deg", raw.longitude_deg, "deg", -180.0, 360.0, "")? * RAD_PER_DEG,
+        height_m: c.range("site.height_m", raw.height_m, "m", -1000.0, 100_000.0, "")?,
+    })
+}
+
+/// `[turntable]`: the nominal chain and the table's errors as written.
+pub(super) fn turntable(c: &Checker<'_>, raw: &RawTurntable) -> Result<(Chain, TableErrors), ConfigError> {
+    let t = raw;
+    if t.axis.is_empty() || t.axis.len() > 3 {
+        return Err(c.invalid("turntable.axis", format!("{} axes given; a table has 1, 2 or 3", t.axis.len())));
+    }
+    let mut geometry = Vec::new();
+    let mut axis_errors = Vec::new();
+    for (i, a) in t.axis.iter().enumerate() {
+        let k = |f: &str| format!("turntable.axis[{i}] (\"{}\").{f}", a.name);
+        if a.name.trim().is_empty() || geometry.iter().any(|g: &AxisGeometry| g.name == a.name) {
+            return Err(c.invalid(&k("name"), format!("\"{}\" must be non-empty and unique", a.name)));
+        }
+        let dir = match a.axis.as_str() {
+            "x" => Vector3::x(),
+            "y" => Vector3::y(),
+            "z" => Vector3::z(),
+            other => return Err(c.invalid(&k("axis"), format!("\"{other}\" is not an axis; use \"x\", \"y\" or \"z\""))),
+        };
+        if let Some(prev) = geometry.last() {
+            let prev: &AxisGeometry = prev;
+            if prev.axis.dot(&dir).abs() > 0.5 {
+                return Err(c.invalid(
+                    &k("axis"),
+                    format!("\"{}\" is parallel to the previous axis \"{}\"; consecutive gimbal axes must be perpendicular", a.axis, prev.name),
+                ));
+            }
+        }
+        if i == 0 && a.non_orthogonality_arcsec != 0.0 {
+            return Err(c.invalid(
+                &k("non_orthogonality_arcsec"),
+                format!(
+                    "{} arcsec given on the first axis; its tilt against the body is the installation error (turntable.installation_*_arcsec)",
+                    a.non_orthogonality_arcsec
+                ),
+            ));
+        }
+        geometry.push(AxisGeometry::new(a.name.clone(), dir, c.finite(&k("initial_angle_deg"), a.initial_angle_deg, "deg")? * RAD_PER_DEG));
+        let values = AxisErrorKeys {
+            swing_half_angle_arcsec: a.swing_half_angle_arcsec,
+            swing_phase_deg: a.swing_phase_deg,
+            non_orthogonality_arcsec: a.non_orthogonality_arcsec,
+            encoder_offset_arcsec: a.encoder_offset_arcsec,
+            encoder_scale_ppm: a.encoder_scale_ppm,
+            encoder_delay_ms: a.encoder_delay_ms,
+        };
+        let mut errors = axis_errors_of(c, &k, &values)?;
+        errors.encoder_noise_rad = c.range(&k("encoder_noise_arcsec"), a.encoder_noise_arcsec, "arcsec", 0.0, 3600.0, "1σ per reading, 1° at most")? * RAD_PER_ARCSEC;
+        axis_errors.push(errors);
+    }
+    let chain = Chain::new(geometry);
+    let truth = TableErrors {
+        installation_rad: rotation_arcsec(c, "turntable.installation", [t.installation_x_arcsec, t.installation_y_arcsec, t.installation_z_arcsec])?,
+        imu_mount_rad: rotation_arcsec(c, "turntable.imu_mount", [t.imu_mount_x_arcsec, t.imu_mount_y_arcsec, t.imu_mount_z_arcsec])?,
+        axes: axis_errors,
+    };
+    Ok((chain, truth))
 }

@@ -118,20 +118,20 @@ pub fn encoder_readings(model: &Model, t_s: f64) -> AxisValues {
 }
 
 impl DemodState {
-    /// Encoder angles corrected with the assumed parameters: offset and scale removed, then
-    /// extrapolated over the assumed delay with the rate seen in successive corrected readings.
-    pub fn correct(&mut self, model: &Model, t_s: f64, encoder_rad: &AxisValues) -> AxisValues {
-        let n = model.n_axes();
+    /// Encoder angles corrected with the assumed parameters `assumed`: offset and scale removed,
+    /// then extrapolated over the assumed delay with the rate seen in successive corrected readings.
+    pub fn correct(&mut self, assumed: &TableErrors, t_s: f64, encoder_rad: &AxisValues) -> AxisValues {
+        let n = assumed.axes.len();
         let mut corrected = [0.0; MAX_AXES];
         for k in 0..n {
-            corrected[k] = model.compensation.axes[k].encoder_correct(encoder_rad[k]);
+            corrected[k] = assumed.axes[k].encoder_correct(encoder_rad[k]);
         }
         let raw_corrected = corrected;
         if let Some((t_prev, prev)) = self.previous {
             let dt = t_s - t_prev;
             if dt > 0.0 {
                 for k in 0..n {
-                    let delay = model.compensation.axes[k].encoder_delay_s;
+                    let delay = assumed.axes[k].encoder_delay_s;
                     if delay != 0.0 {
                         corrected[k] += (raw_corrected[k] - prev[k]) / dt * delay;
                     }
@@ -184,7 +184,7 @@ pub fn step(model: &Model, state: &mut DemodState, t_s: f64) -> StepOutput {
     let uncompensated = demodulate(n_from_s, model.chain.b_from_s_nominal_with(&shafts_of(&encoder_rad)));
 
     // 2. Compensated: the exact chain with the assumed errors and corrected encoder angles.
-    let corrected = state.correct(model, t_s, &encoder_rad);
+    let corrected = state.correct(&model.compensation, t_s, &encoder_rad);
     let compensated = demodulate(n_from_s, model.chain.b_from_s_with(&model.compensation_rot, &shafts_of(&corrected)));
 
     // 3. Closed form: first-order error model (docs/closed-form.md).

@@ -1,0 +1,278 @@
+//! The navigation computer: measured IMU increments in, attitude and navigation out. One sample at
+//! a time: FIR → decimation → attitude algorithm(s) → navigation. The simulation (`pipeline`) and
+//! the replay of a log feed it the same way.
+//!
+//! Timing (docs/ins.md): after the FIR, sample k represents the truth at k·h − d (d = group delay);
+//! the navigation computer's zero-order hold is a further h/2 (seed 001 §3.1); outputs are compared
+//! with the truth `output_compensation` earlier (seed 001 §3.2's Δt).
+
+use nalgebra::Vector3;
+
+use super::coning::Algorithm;
+use super::fir::Fir;
+use super::nav::{NavState, Navigator};
+use super::strapdown::AttitudeIntegrator;
+use super::InsParams;
+use crate::math::attitude::Attitude;
+use crate::math::frames::{Rot, B, N, S};
+use crate::math::rotvec;
+use crate::model::earth::{Earth, Site};
+
+/// What one IMU sample produced.
+#[derive(Debug, Clone, Copy)]
+pub struct SampleOut {
+    /// End of the sample, s.
+    pub t_s: f64,
+    /// True if the primary algorithm completed an attitude update with this sample.
+    pub updated: bool,
+    /// Measured gyro rate (raw, with dither), rad/s.
+    pub raw_rate_s: Vector3<f64>,
+    /// After the FIR, rad/s.
+    pub filtered_rate_s: Vector3<f64>,
+}
+
+/// Navigation errors (computed − true) at one output instant.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct NavError {
+    /// East position error, m.
+    pub east_m: f64,
+    /// North position error, m.
+    pub north_m: f64,
+    /// Horizontal (radial) position error, m.
+    pub radial_m: f64,
+    /// Velocity error (East, North, Up), m/s (the vehicle is at rest: this is the velocity).
+    pub velocity_enu_mps: Vector3<f64>,
+}
+
+/// The attitude output `zoh` after the latest of two (time, attitude) updates, interpolated.
+fn output_attitude(history: &[(f64, Rot<N, S>); 2], zoh: f64) -> (f64, Rot<N, S>) {
+    let [(t0, q0), (t1, q1)] = *history;
+    let t = t1 - zoh;
+    if t1 > t0 && t < t1 {
+        let f = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
+        // FRAME: between two C_s^n the interpolated rotation is C_s^n at the instant in between.
+        (t, Rot::from_quaternion(q0.quaternion().slerp(q1.quaternion(), f)))
+    } else {
+        (t1, q1)
+    }
+}
+
+/// The navigation computer's state (cloned to fork one IMU stream into two navigation strategies).
+#[derive(Debug, Clone)]
+pub struct InsCore {
+    cfg: InsParams,
+    earth: Earth,
+    fir_g: Fir,
+    fir_a: Fir,
+    h: f64,
+    acc: (Vector3<f64>, Vector3<f64>, usize),
+    /// The integrators; `[0]` is the configured algorithm (the navigation's).
+    integrators: Vec<AttitudeIntegrator>,
+    /// (time, attitude) of each integrator's previous and latest update.
+    history: Vec<[(f64, Rot<N, S>); 2]>,
+    nav: Option<Navigator>,
+    nav_start: Rot<N, S>,
+    upd_g: Vec<Vector3<f64>>,
+    upd_a: Vec<Vector3<f64>>,
+    /// FIR group delay, s.
+    pub fir_delay_s: f64,
+    /// Zero-order-hold delay, s.
+    pub zoh_delay_s: f64,
+}
+
+impl InsCore {
+    /// IMU samples that fill the FIR and give the algorithms their previous samples before the
+    /// first update (the first samples of a log, the samples before t = 0 of a simulation).
+    #[must_use]
+    pub fn pre_roll_samples(cfg: &InsParams) -> usize {
+        cfg.fir_taps.len().saturating_sub(1).max(2 * cfg.decimation)
+    }
+
+    /// The computer at `site`, pre-rolled with `pre_roll` measured (Δθ, Δv) samples, its attitude
+    /// C_s^n starting at `start` (the filtered stream's instant, −d).
+    #[must_use]
+    pub fn new(cfg: &InsParams, site: Site, start: Rot<N, S>, pre_roll: &[(Vector3<f64>, Vector3<f64>)]) -> Self {
+        let cfg = cfg.clone();
+        let h = 1.0 / cfg.rate_hz;
+        let earth = Earth::at(site);
+        let mut fir_g = Fir::new(&cfg.fir_taps);
+        let mut fir_a = Fir::new(&cfg.fir_taps);
+        let fir_delay_s = fir_g.group_delay_samples() * h;
+        let zoh_delay_s = if cfg.zero_order_hold { 0.5 * h } else { 0.0 };
+        let mut primed = Vec::new();
+        let mut acc = (Vector3::zeros(), 0);
+        for (g, a) in pre_roll {
+            acc.0 += fir_g.push(*g);
+            acc.1 += 1;
+            fir_a.push(*a);
+            if acc.1 == cfg.decimation {
+                primed.push(acc.0);
+                acc = (Vector3::zeros(), 0);
+            }
+        }
+        let integrators: Vec<AttitudeIntegrator> = cfg
+            .algorithms()
+            .iter()
+            .map(|a| {
+                let mut i = AttitudeIntegrator::new(*a, start);
+                i.prime(&primed);
+                i
+            })
+            .collect();
+        let history = vec![[(-fir_delay_s, start), (-fir_delay_s, start)]; integrators.len()];
+        let nav = cfg.navigation.map(|o| Navigator::new(&earth, o));
+        Self {
+            earth,
+            fir_g,
+            fir_a,
+            h,
+            acc: (Vector3::zeros(), Vector3::zeros(), 0),
+            integrators,
+            history,
+            nav,
+            nav_start: start,
+            upd_g: Vec::new(),
+            upd_a: Vec::new(),
+            fir_delay_s,
+            zoh_delay_s,
+            cfg,
+        }
+    }
+
+    /// The configuration.
+    #[must_use]
+    pub fn config(&self) -> &InsParams {
+        &self.cfg
+    }
+
+    /// The algorithms run, in order.
+    #[must_use]
+    pub fn algorithms(&self) -> Vec<Algorithm> {
+        self.integrators.iter().map(|i| i.algorithm).collect()
+    }
+
+    /// Navigation solution, if navigating.
+    #[must_use]
+    pub fn nav_state(&self) -> Option<&NavState> {
+        self.nav.as_ref().map(|n| &n.state)
+    }
+
+    /// The site the navigation started from.
+    #[must_use]
+    pub fn site(&self) -> Site {
+        self.earth.site
+    }
+
+    /// Replaces the primary attitude.
+    pub fn set_primary_attitude(&mut self, n_from_s: Rot<N, S>) {
+        if let Some(i) = self.integrators.first_mut() {
+            i.n_from_s = n_from_s;
+        }
+    }
+
+    /// Position fix: the navigation's latitude and longitude set to the truth (the site), velocity
+    /// and the attitude relative to local level kept (the usual reset; docs/tpr.md).
+    pub fn reset_position(&mut self) {
+        let site = self.earth.site;
+        if let Some(nav) = self.nav.as_mut() {
+            nav.state.latitude_rad = site.latitude_rad;
+            nav.state.longitude_rad = site.longitude_rad;
+        }
+    }
+
+    /// Turns the primary attitude about the local vertical by `angle_rad` (counter-clockwise seen from
+    /// above: the heading decreases by `angle_rad`): an azimuth correction.
+    pub fn rotate_azimuth(&mut self, angle_rad: f64) {
+        // FRAME: a rotation of the computed navigation frame about its own vertical.
+        let r: Rot<N, N> = Rot::from_quaternion(rotvec::exp(&(Vector3::z() * angle_rad)));
+        if let Some(i) = self.integrators.first_mut() {
+            i.n_from_s = r * i.n_from_s;
+        }
+        if let Some(h) = self.history.first_mut() {
+            for (_, q) in h.iter_mut() {
+                *q = r * *q;
+            }
+        }
+    }
+
+    /// One measured IMU sample (Δθ, Δv in s) ending at `t1`.
+    pub fn push(&mut self, t1: f64, g_meas: Vector3<f64>, a_meas: Vector3<f64>) -> SampleOut {
+        let g_filt = self.fir_g.push(g_meas);
+        let a_filt = self.fir_a.push(a_meas);
+        let mut out = SampleOut { t_s: t1, updated: false, raw_rate_s: g_meas / self.h, filtered_rate_s: g_filt / self.h };
+        self.acc.0 += g_filt;
+        self.acc.1 += a_filt;
+        self.acc.2 += 1;
+        if self.acc.2 < self.cfg.decimation {
+            return out;
+        }
+        let (dg, da) = (self.acc.0, self.acc.1);
+        self.acc = (Vector3::zeros(), Vector3::zeros(), 0);
+        let h_alg = self.h * self.cfg.decimation as f64;
+        // The attitude at the start of the primary update, for the velocity update.
+        if self.upd_g.is_empty() {
+            self.nav_start = self.integrators[0].n_from_s;
+        }
+        self.upd_g.push(dg);
+        self.upd_a.push(da);
+        let w_in = self.nav.as_ref().map_or(self.earth.omega_ie_n, Navigator::omega_in_n);
+        let t_repr = t1 - self.fir_delay_s;
+        for (k, integ) in self.integrators.iter_mut().enumerate() {
+            let zeta = w_in * (h_alg * integ.samples_per_update() as f64);
+            if integ.push(dg, &zeta).is_some() {
+                self.history[k] = [self.history[k][1], (t_repr, integ.n_from_s)];
+                if k == 0 {
+                    out.updated = true;
+                    let h_upd = h_alg * self.upd_g.len() as f64;
+                    if let Some(nav) = self.nav.as_mut() {
+                        nav.update(&self.nav_start, &self.upd_g, &self.upd_a, &zeta, h_upd);
+                    }
+                    self.upd_g.clear();
+                    self.upd_a.clear();
+                }
+            }
+        }
+        out
+    }
+
+    /// Integrator `k`'s C_s^n as output after its latest update, and the instant it represents:
+    /// with the zero-order hold, the value h/2 earlier, interpolated between the two latest updates.
+    #[must_use]
+    pub fn output_attitude(&self, k: usize) -> (f64, Rot<N, S>) {
+        output_attitude(&self.history[k], self.zoh_delay_s)
+    }
+
+    /// The instant the truth is taken at for an output representing `t_repr`: the output left the
+    /// computer d + zoh after the instant it represents, and is compared `output_compensation` earlier.
+    #[must_use]
+    pub fn reference_instant(&self, t_repr: f64) -> f64 {
+        t_repr + self.fir_delay_s + self.zoh_delay_s - self.cfg.output_compensation_s
+    }
+
+    /// The navigation errors relative to the start site (the vehicle rests there), if navigating.
+    #[must_use]
+    pub fn nav_error(&self) -> Option<NavError> {
+        self.nav.as_ref().map(|n| {
+            let s = &n.state;
+            let site = self.earth.site;
+            let (rm, rn) = Earth::radii(site.latitude_rad);
+            let north = (s.latitude_rad - site.latitude_rad) * (rm + site.height_m);
+            let east = (s.longitude_rad - site.longitude_rad) * (rn + site.height_m) * site.latitude_rad.cos();
+            NavError { east_m: east, north_m: north, radial_m: north.hypot(east), velocity_enu_mps: s.v_n }
+        })
+    }
+
+    /// The body attitude the primary INS outputs through the table rotation `b_from_s`.
+    #[must_use]
+    pub fn body_attitude(&self, b_from_s: Rot<B, S>) -> Attitude {
+        let n_from_s = self.output_attitude(0).1;
+        // FRAME: C_b^n = C_s^n · C_b^s.
+        Attitude::from_n_from_b(&(n_from_s * b_from_s.inverse()))
+    }
+
+    /// IMU sample period, s.
+    #[must_use]
+    pub fn sample_s(&self) -> f64 {
+        self.h
+    }
+}
