@@ -3,8 +3,10 @@
 //! the compensation on an independent run.
 
 use crate::calib::report::{build as build_report, Compensation, Report};
+use crate::calib::montecarlo::{self, RunErrors, Setup, Shard, Summary};
 use crate::calib::{attitude_errors, calibrate, AttitudeSource, CalibError, Calibration, Data, History, Measurement, Nuisance, ParamSet};
 use crate::ins::pipeline::InsRun;
+use crate::model::gimbal::TableErrors;
 use crate::scenario::Params;
 use std::sync::atomic::AtomicBool;
 
@@ -95,23 +97,36 @@ pub fn calibrate_scenario(params: &Params, history: bool) -> Result<Outcome, Cal
 }
 
 
-/// Seed 000's Monte Carlo on `params`' table: `runs` calibrations of drawn tables in parallel, each
-/// on a simulated static test (`progress` ticks once per run, `stop` ends early).
-pub fn monte_carlo(params: &Params, runs: usize, progress: &(dyn Fn() + Sync), stop: &AtomicBool) -> Result<crate::calib::montecarlo::Summary, CalibError> {
-    let setup = crate::calib::montecarlo::Setup {
+/// The Monte Carlo's fixed part for `params`: its table, what the calibration knows, the seed.
+#[must_use]
+pub fn monte_carlo_setup(params: &Params) -> Setup<'_> {
+    Setup {
         scenario: &params.meta.name,
         chain: &params.table.chain,
         truth: &params.table.truth,
         compensation: &params.table.compensation,
         cfg: &params.calibration,
         seed: params.meta.seed,
-    };
-    let simulate = |truth: &crate::model::gimbal::TableErrors, seed: u64| {
+    }
+}
+
+/// Seed 000's Monte Carlo on `params`' table, the runs of `shard` out of `runs`: each run a
+/// calibration of a drawn table on its simulated static test, in parallel (`progress` ticks once
+/// per run, `stop` ends early). Returns the runs' errors; `montecarlo::summarize` makes the table.
+pub fn monte_carlo_runs(params: &Params, runs: usize, shard: Shard, progress: &(dyn Fn() + Sync), stop: &AtomicBool) -> Result<Vec<RunErrors>, CalibError> {
+    let simulate = |truth: &TableErrors, seed: u64| {
         let mut p = params.clone();
         p.table.truth = truth.clone();
         collect(&p, seed)
     };
-    crate::calib::montecarlo::run(&setup, runs, &simulate, progress, stop)
+    montecarlo::run_indices(&monte_carlo_setup(params), &shard.indices(runs as u64), &simulate, progress, stop)
+}
+
+/// The whole Monte Carlo of `params` (`runs` runs), summarised.
+pub fn monte_carlo(params: &Params, runs: usize, progress: &(dyn Fn() + Sync), stop: &AtomicBool) -> Result<Summary, CalibError> {
+    let started = std::time::Instant::now();
+    let done = monte_carlo_runs(params, runs, Shard::WHOLE, progress, stop)?;
+    Ok(montecarlo::summarize(&monte_carlo_setup(params), runs, &done, started.elapsed().as_secs_f64()))
 }
 
 /// Writes `outcome`'s recording into `rec`: the calibration's panels, then the table turning as in

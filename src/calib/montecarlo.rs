@@ -8,7 +8,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::{CalibConfig, CalibError, Data, History, Param, ParamSet, calibrate};
 use crate::model::gimbal::{Chain, TableErrors};
@@ -18,7 +18,7 @@ use crate::math::units::{ARCSEC_PER_RAD, wrap_pi};
 pub const PAPER_TABLE3: [(&str, f64, f64); 5] = [("α1", 0.98, 0.0238), ("φ1", 1.14, 0.6103), ("α2", 0.78, 0.0078), ("φ2", 0.65, 0.0317), ("η", 1.05, 0.0091)];
 
 /// One quantity's error statistics, arcsec.
-#[derive(Debug, Clone, Copy, Default, Serialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct ErrorSpread {
     /// Mean of the signed errors.
     pub mean: f64,
@@ -40,7 +40,7 @@ impl ErrorSpread {
 }
 
 /// One quantity's row.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct QuantityRow {
     /// What.
     pub label: String,
@@ -55,10 +55,12 @@ pub struct QuantityRow {
 }
 
 /// The Monte Carlo's result.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Summary {
     /// Scenario.
     pub scenario: String,
+    /// Base seed of the draws and the noise.
+    pub seed: u64,
     /// Runs completed.
     pub runs: usize,
     /// Runs asked for.
@@ -81,9 +83,6 @@ struct Quantities {
 }
 
 type Quantity = (String, Option<(f64, f64)>, bool);
-
-/// One run's errors: (filter, least squares), in the order of the quantities.
-type RunErrors = (Vec<f64>, Vec<f64>);
 
 fn quantities(chain: &Chain, set: &ParamSet, eta_known: bool) -> Quantities {
     let n = chain.axes().len();
@@ -167,18 +166,57 @@ pub struct Setup<'a> {
 /// Simulates one static test for true errors `truth` with noise seed `seed`.
 pub type Collect<'a> = dyn Fn(&TableErrors, u64) -> Result<Data, CalibError> + Sync + 'a;
 
-/// Runs `runs` calibrations in parallel, each on the data `collect` simulates for a drawn table
-/// (`progress` ticks once per run; `stop` ends early).
-pub fn run(setup: &Setup<'_>, runs: usize, collect: &Collect<'_>, progress: &(dyn Fn() + Sync), stop: &AtomicBool) -> Result<Summary, CalibError> {
-    let started = std::time::Instant::now();
+/// One slice of a Monte Carlo: the runs `i` with `i mod count == index`, seeded exactly as in the
+/// whole run (`--shard index/count`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Shard {
+    /// This slice, `0 ..count`.
+    pub index: u64,
+    /// Number of slices.
+    pub count: u64,
+}
+
+impl Shard {
+    /// The whole run.
+    pub const WHOLE: Self = Self { index: 0, count: 1 };
+
+    /// Parses `K/M` (0 ≤ K < M).
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let (k, m) = text.split_once('/').ok_or_else(|| format!("`{text}` is not K/M (e.g. 3/8: slice 3 of 8, counted from 0)"))?;
+        let (k, m): (u64, u64) = (k.trim().parse().map_err(|_| format!("`{k}` in `{text}` is not a whole number"))?, m.trim().parse().map_err(|_| format!("`{m}` in `{text}` is not a whole number"))?);
+        if m == 0 || k >= m {
+            return Err(format!("`{text}`: the slice K must be in 0 ..= M−1 and M ≥ 1"));
+        }
+        Ok(Self { index: k, count: m })
+    }
+
+    /// The run indices of this slice of `runs`.
+    #[must_use]
+    pub fn indices(&self, runs: u64) -> Vec<u64> {
+        (self.index..runs).step_by(self.count as usize).collect()
+    }
+}
+
+/// One run's errors (″), in the order of the summary's quantities: the filter's and the least
+/// squares'. Kept so that shards can be merged into the statistics of the whole run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunErrors {
+    /// The run's index (its seed and draw).
+    pub index: u64,
+    /// Static Kalman filter.
+    pub kf: Vec<f64>,
+    /// Exact least squares.
+    pub nls: Vec<f64>,
+}
+
+/// Runs calibrations `indices` in parallel, each on the data `collect` simulates for a drawn table
+/// (`progress` ticks once per run; `stop` ends early: the runs not started are left out).
+pub fn run_indices(setup: &Setup<'_>, indices: &[u64], collect: &Collect<'_>, progress: &(dyn Fn() + Sync), stop: &AtomicBool) -> Result<Vec<RunErrors>, CalibError> {
     let mc = &setup.cfg.montecarlo;
-    let eta_known = mc.eta_measured_sigma_rad.is_some();
-    let set = ParamSet::new(setup.chain, setup.cfg.nuisance);
-    let q = quantities(setup.chain, &set, eta_known);
     let base_seed = setup.seed;
-    let results: Vec<Result<Option<RunErrors>, CalibError>> = (0..runs as u64)
-        .into_par_iter()
-        .map(|i| {
+    let results: Vec<Result<Option<RunErrors>, CalibError>> = indices
+        .par_iter()
+        .map(|&i| {
             if stop.load(Ordering::Relaxed) {
                 return Ok(None);
             }
@@ -201,7 +239,7 @@ pub fn run(setup: &Setup<'_>, runs: usize, collect: &Collect<'_>, progress: &(dy
             let data = collect(&truth, base_seed.wrapping_add(1000).wrapping_add(i))?;
             let cal = calibrate(setup.chain, setup.compensation, &data, &cfg, History::Lean)?;
             let truth_v = cal.set.values(&truth);
-            let out = (errors(setup.chain, &cal.set, &cal.kf.theta, &truth_v), errors(setup.chain, &cal.set, &cal.nls.theta, &truth_v));
+            let out = RunErrors { index: i, kf: errors(setup.chain, &cal.set, &cal.kf.theta, &truth_v), nls: errors(setup.chain, &cal.set, &cal.nls.theta, &truth_v) };
             progress();
             Ok(Some(out))
         })
@@ -212,13 +250,31 @@ pub fn run(setup: &Setup<'_>, runs: usize, collect: &Collect<'_>, progress: &(dy
             done.push(x);
         }
     }
+    Ok(done)
+}
+
+/// Runs `runs` calibrations in parallel (see [`run_indices`]) and summarises them.
+pub fn run(setup: &Setup<'_>, runs: usize, collect: &Collect<'_>, progress: &(dyn Fn() + Sync), stop: &AtomicBool) -> Result<Summary, CalibError> {
+    let started = std::time::Instant::now();
+    let done = run_indices(setup, &Shard::WHOLE.indices(runs as u64), collect, progress, stop)?;
+    Ok(summarize(setup, runs, &done, started.elapsed().as_secs_f64()))
+}
+
+/// The statistics of `done` (in index order, as a whole run or a merge of shards produces them)
+/// out of `runs_requested`.
+#[must_use]
+pub fn summarize(setup: &Setup<'_>, runs_requested: usize, done: &[RunErrors], wall_s: f64) -> Summary {
+    let mc = &setup.cfg.montecarlo;
+    let eta_known = mc.eta_measured_sigma_rad.is_some();
+    let set = ParamSet::new(setup.chain, setup.cfg.nuisance);
+    let q = quantities(setup.chain, &set, eta_known);
     let rows = q
         .labels
         .iter()
         .enumerate()
         .map(|(j, (label, paper, identifiable))| {
-            let kf: Vec<f64> = done.iter().map(|(k, _)| k[j]).collect();
-            let nls: Vec<f64> = done.iter().map(|(_, n)| n[j]).collect();
+            let kf: Vec<f64> = done.iter().map(|r| r.kf[j]).collect();
+            let nls: Vec<f64> = done.iter().map(|r| r.nls[j]).collect();
             QuantityRow { label: label.clone(), kf: ErrorSpread::of(&kf), nls: ErrorSpread::of(&nls), paper: *paper, identifiable: *identifiable }
         })
         .collect();
@@ -236,15 +292,75 @@ pub fn run(setup: &Setup<'_>, runs: usize, collect: &Collect<'_>, progress: &(dy
             None => "the distribution only (no independent measurement)".into(),
         }
     );
-    Ok(Summary {
+    Summary {
         scenario: setup.scenario.to_owned(),
+        seed: setup.seed,
         runs: done.len(),
-        runs_requested: runs,
-        wall_s: started.elapsed().as_secs_f64(),
+        runs_requested,
+        wall_s,
         threads: rayon::current_num_threads(),
         setup: described,
         rows,
-    })
+    }
+}
+
+/// What a shard writes: its runs' errors (for the merge) and its own summary.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ShardFile {
+    /// Which slice.
+    pub shard: Shard,
+    /// The slice's summary (its own runs only).
+    pub summary: Summary,
+    /// Every run's errors, in index order.
+    pub runs: Vec<RunErrors>,
+}
+
+/// Why shard files cannot be merged.
+#[derive(Debug, thiserror::Error)]
+pub enum MergeError {
+    /// Files of different Monte Carlos.
+    #[error("{0}")]
+    Mismatch(String),
+}
+
+/// Merges shard files into the summary of the whole run: the same statistics, bit for bit, as the
+/// unsharded run (the runs are put back in index order; only wall time and threads differ).
+pub fn merge(setup: &Setup<'_>, files: &[ShardFile]) -> Result<Summary, MergeError> {
+    let Some(first) = files.first() else {
+        return Err(MergeError::Mismatch("no shard files given".into()));
+    };
+    let count = first.shard.count;
+    let runs_requested = first.summary.runs_requested;
+    let mut seen = vec![false; count as usize];
+    let mut wall_s = 0.0f64;
+    let mut done: Vec<RunErrors> = Vec::new();
+    for f in files {
+        let s = &f.summary;
+        if f.shard.count != count || s.runs_requested != runs_requested || s.scenario != first.summary.scenario || s.seed != first.summary.seed || s.setup != first.summary.setup {
+            return Err(MergeError::Mismatch(format!(
+                "shard {}/{} of {} (seed {}, {} runs) does not belong with shard {}/{} of {} (seed {}, {} runs)",
+                f.shard.index, f.shard.count, s.scenario, s.seed, s.runs_requested, first.shard.index, count, first.summary.scenario, first.summary.seed, runs_requested
+            )));
+        }
+        if s.scenario != setup.scenario || s.seed != setup.seed {
+            return Err(MergeError::Mismatch(format!("the shards are of {} (seed {}), the scenario given is {} (seed {})", s.scenario, s.seed, setup.scenario, setup.seed)));
+        }
+        let slot = &mut seen[f.shard.index as usize];
+        if *slot {
+            return Err(MergeError::Mismatch(format!("shard {}/{count} is given twice", f.shard.index)));
+        }
+        *slot = true;
+        if f.runs.len() != f.shard.indices(runs_requested as u64).len() {
+            return Err(MergeError::Mismatch(format!("shard {}/{count} holds {} of its {} runs (interrupted?)", f.shard.index, f.runs.len(), f.shard.indices(runs_requested as u64).len())));
+        }
+        wall_s = wall_s.max(s.wall_s);
+        done.extend(f.runs.iter().cloned());
+    }
+    if let Some(missing) = seen.iter().position(|s| !s) {
+        return Err(MergeError::Mismatch(format!("shard {missing}/{count} is missing")));
+    }
+    done.sort_by_key(|r| r.index);
+    Ok(summarize(setup, runs_requested, &done, wall_s))
 }
 
 impl Summary {

@@ -4,8 +4,9 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 
-use super::{CalibrateArgs, Failure, LiveArgs, ModulationArgs, MonteCarloArgs, RunArgs, TprArgs};
-use crate::app::calibrate::{calibrate_scenario, monte_carlo, record_outcome};
+use super::{CalibrateArgs, Failure, LiveArgs, ModulationArgs, MonteCarloAction, MonteCarloArgs, RunArgs, ScenarioSource, TprArgs};
+use crate::app::calibrate::{calibrate_scenario, monte_carlo_runs, monte_carlo_setup, record_outcome};
+use crate::calib::montecarlo::{self, Shard, ShardFile};
 use crate::app::run::run_recorded;
 use crate::app::terminate::stop_flag;
 use crate::app::{live, modulation, reproduce, tpr};
@@ -236,39 +237,98 @@ pub(super) fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-/// `rinscope montecarlo`.
-pub(super) fn montecarlo(args: &MonteCarloArgs) -> Result<(), Failure> {
-    let mut params = args.source.load("jiang2017-calibration")?;
-    check_output_dir("--json", args.json.as_deref())?;
-    let runs = args.runs.unwrap_or(params.calibration.montecarlo.runs as usize);
-    if runs == 0 || runs > 1_000_000 {
-        return Err(Failure::input(format!("--runs {runs}: must be 1 ..= 1000000")));
-    }
-    if let Some(s) = args.eta_measured_sigma_arcsec {
+/// The calibration preset with `--eta-measured-sigma-arcsec` applied.
+fn monte_carlo_params(source: &ScenarioSource, eta_measured_sigma_arcsec: Option<f64>) -> Result<Params, Failure> {
+    let mut params = source.load("jiang2017-calibration")?;
+    if let Some(s) = eta_measured_sigma_arcsec {
         if !(s.is_finite() && s > 0.0 && s <= 3600.0) {
             return Err(Failure::input(format!("--eta-measured-sigma-arcsec {s}: must be > 0 and <= 3600 arcsec")));
         }
         params.calibration.montecarlo.eta_measured_sigma_rad = Some(s * RAD_PER_ARCSEC);
     }
+    Ok(params)
+}
+
+/// `rinscope montecarlo`.
+pub(super) fn montecarlo(args: &MonteCarloArgs) -> Result<(), Failure> {
+    if let Some(MonteCarloAction::Merge { files, source, eta_measured_sigma_arcsec, json }) = &args.action {
+        return montecarlo_merge(files, source, *eta_measured_sigma_arcsec, json.as_deref());
+    }
+    let params = monte_carlo_params(&args.source, args.eta_measured_sigma_arcsec)?;
+    check_output_dir("--json", args.json.as_deref())?;
+    let runs = args.runs.unwrap_or(params.calibration.montecarlo.runs as usize);
+    if runs == 0 || runs > 1_000_000 {
+        return Err(Failure::input(format!("--runs {runs}: must be 1 ..= 1000000")));
+    }
+    let shard = match &args.shard {
+        Some(text) => Shard::parse(text).map_err(|e| Failure::input(format!("--shard {e}")))?,
+        None => Shard::WHOLE,
+    };
+    let mine = shard.indices(runs as u64).len();
     let stop = stop_flag();
-    let bar = indicatif::ProgressBar::new(runs as u64);
+    let bar = indicatif::ProgressBar::new(mine as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{spinner} {pos}/{len} calibrations [{bar:40}] {elapsed_precise} (eta {eta})")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
             .progress_chars("=> "),
     );
     let tick = || bar.inc(1);
-    let result = monte_carlo(&params, runs, &tick, &stop);
+    let started = std::time::Instant::now();
+    let result = monte_carlo_runs(&params, runs, shard, &tick, &stop);
     bar.finish_and_clear();
-    let summary = result.map_err(|e| Failure::run(format!("montecarlo: {e}")))?;
+    let done = result.map_err(|e| Failure::run(format!("montecarlo: {e}")))?;
+    let summary = montecarlo::summarize(&monte_carlo_setup(&params), runs, &done, started.elapsed().as_secs_f64());
+    if shard != Shard::WHOLE {
+        println!("shard {}/{}: {} of the {runs} runs (i mod {} == {})", shard.index, shard.count, mine, shard.count, shard.index);
+    }
     print!("{}", summary.text());
     if let Some(path) = &args.json {
-        write_json("--json", path, &summary)?;
+        if shard == Shard::WHOLE {
+            write_json("--json", path, &summary)?;
+        } else {
+            write_json("--json", path, &ShardFile { shard, summary: summary.clone(), runs: done.clone() })?;
+        }
     }
-    if summary.runs < summary.runs_requested {
-        return Err(Failure::interrupted(format!("interrupted after {} runs (statistics above are over those)", summary.runs)));
+    if done.len() < mine {
+        return Err(Failure::interrupted(format!("interrupted after {} of {mine} runs (statistics above are over those)", done.len())));
     }
     Ok(())
+}
+
+/// `rinscope montecarlo merge`.
+fn montecarlo_merge(files: &[PathBuf], source: &ScenarioSource, eta_measured_sigma_arcsec: Option<f64>, json: Option<&Path>) -> Result<(), Failure> {
+    let params = monte_carlo_params(source, eta_measured_sigma_arcsec)?;
+    check_output_dir("--json", json)?;
+    let mut shards = Vec::new();
+    for f in files {
+        let text = read_small_file(f, "shard file")?;
+        let shard: ShardFile = serde_json::from_str(&text).map_err(|e| Failure::input(format!("{}: not a shard file of `rinscope montecarlo --shard K/M --json` ({e})", f.display())))?;
+        shards.push(shard);
+    }
+    let setup = monte_carlo_setup(&params);
+    let summary = montecarlo::merge(&setup, &shards).map_err(|e| Failure::input(format!("montecarlo merge: {e}")))?;
+    if let Some(first) = shards.first()
+        && first.summary.setup != summary.setup
+    {
+        return Err(Failure::input(format!(
+            "montecarlo merge: the shards ran with \"{}\", this merge with \"{}\" (give the same --scenario/--config and --eta-measured-sigma-arcsec)",
+            first.summary.setup, summary.setup
+        )));
+    }
+    print!("{}", summary.text());
+    if let Some(path) = json {
+        write_json("--json", path, &summary)?;
+    }
+    Ok(())
+}
+
+/// Reads a text file of at most 1 GB (a FIFO or a device is refused).
+fn read_small_file(path: &Path, what: &str) -> Result<String, Failure> {
+    let meta = std::fs::metadata(path).map_err(|e| Failure::input(format!("{what} {}: {e}", path.display())))?;
+    if !meta.is_file() || meta.len() > 1 << 30 {
+        return Err(Failure::input(format!("{what} {}: not a regular file of at most 1 GB", path.display())));
+    }
+    std::fs::read_to_string(path).map_err(|e| Failure::input(format!("{what} {}: {e}", path.display())))
 }
 
 /// `rinscope tpr`.

@@ -189,7 +189,10 @@ struct CalibrateArgs {
 }
 
 #[derive(Args)]
+#[command(args_conflicts_with_subcommands = true)]
 struct MonteCarloArgs {
+    #[command(subcommand)]
+    action: Option<MonteCarloAction>,
     // Default jiang2017-calibration.
     #[command(flatten)]
     source: ScenarioSource,
@@ -199,9 +202,33 @@ struct MonteCarloArgs {
     /// Give the filter an independent measurement of η with this 1σ, arcsec.
     #[arg(long)]
     eta_measured_sigma_arcsec: Option<f64>,
-    /// Write the statistics as JSON.
+    /// Run only the runs i with i mod M == K (K/M, K from 0), seeded as in the whole run; --json
+    /// then writes the shard file that `montecarlo merge` combines (cluster array jobs).
+    #[arg(long, value_name = "K/M")]
+    shard: Option<String>,
+    /// Write the statistics (with --shard: the shard file) as JSON.
     #[arg(long)]
     json: Option<PathBuf>,
+}
+
+#[derive(Subcommand)]
+enum MonteCarloAction {
+    /// Combine shard files into the statistics of the whole run (identical to running it unsharded,
+    /// but for wall time).
+    Merge {
+        /// The shard files (`--shard K/M --json FILE` of every K).
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        // The scenario the shards ran (default jiang2017-calibration).
+        #[command(flatten)]
+        source: ScenarioSource,
+        /// The η measurement the shards were given, arcsec.
+        #[arg(long)]
+        eta_measured_sigma_arcsec: Option<f64>,
+        /// Write the merged statistics as JSON.
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
 }
 
 #[derive(Args)]
