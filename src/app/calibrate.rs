@@ -5,7 +5,9 @@
 use crate::calib::report::{build as build_report, Compensation, Report};
 use crate::calib::montecarlo::{self, RunErrors, Setup, Shard, Summary};
 use crate::calib::{attitude_errors, calibrate, AttitudeSource, CalibError, Calibration, Data, History, Measurement, Nuisance, ParamSet};
+use crate::app::playback::{Playback, PlaybackError};
 use crate::ins::pipeline::InsRun;
+use crate::scenario::logset::LogSet;
 use crate::model::gimbal::TableErrors;
 use crate::scenario::Params;
 use std::sync::atomic::AtomicBool;
@@ -146,4 +148,104 @@ pub fn record_outcome(rec: crate::record::Stream, params: &Params, outcome: &Out
     table.ins = None;
     record_run(recorder, &table, stop, false)?;
     Ok(())
+}
+
+/// The static test of a log set as calibration data: one measurement per primary update (the INS
+/// output and the encoder angles corrected with what the calibration knows, `known`), the known
+/// body attitude from the log's reference (it must be constant: the vehicle at rest).
+pub fn collect_from_log(log: &LogSet, known: &TableErrors, stop: &AtomicBool) -> Result<Data, LogCalibrationError> {
+    let mut pb = Playback::open(log, &log.table.compensation)?;
+    let mut demod = DemodState::default();
+    let mut times = Vec::new();
+    let mut samples = Vec::new();
+    let mut attitude = None;
+    let chain = &log.table.chain;
+    while let Some(s) = pb.step()? {
+        if pb.samples % 65_536 == 0 && stop.load(std::sync::atomic::Ordering::Relaxed) {
+            return Err(LogCalibrationError::Interrupted);
+        }
+        if !s.updated {
+            continue;
+        }
+        let (t, n_from_s) = pb.core.output_attitude(0);
+        let reference = pb.reference_at(t)?.ok_or(LogCalibrationError::NoReference)?;
+        let first = *attitude.get_or_insert(reference);
+        let moved = (reference.pitch_rad - first.pitch_rad).abs().max(crate::math::units::wrap_pi(reference.roll_rad - first.roll_rad).abs()).max(crate::math::units::wrap_pi(reference.heading_rad - first.heading_rad).abs());
+        if moved > 1e-9 {
+            return Err(LogCalibrationError::Moves { t_s: t, arcsec: moved * crate::math::units::ARCSEC_PER_RAD });
+        }
+        // Matched synchronisation: the encoders are read for the instant the data represent.
+        let angles = demod.correct(known, t, &pb.encoders_at(t)?);
+        times.push(t);
+        samples.push(Measurement { t_s: t, tau: 0.0, n_from_s, shafts: chain.shaft_rotations(&angles) });
+    }
+    let attitude = attitude.ok_or(LogCalibrationError::NoReference)?;
+    // τ ∈ [−1, 1] over the test, as the simulation's calibration has it.
+    let duration = times.last().copied().unwrap_or(1.0).max(1e-9);
+    for s in &mut samples {
+        s.tau = (2.0 * s.t_s / duration - 1.0).clamp(-1.0, 1.0);
+    }
+    Ok(Data { samples, n_from_b: attitude.n_from_b(), attitude, source: AttitudeSource::Log, seed: log.seed.unwrap_or(0) })
+}
+
+/// Why a log cannot be calibrated.
+#[derive(Debug, thiserror::Error)]
+pub enum LogCalibrationError {
+    /// The log's data.
+    #[error("{0}")]
+    Playback(#[from] PlaybackError),
+    /// No known body attitude.
+    #[error("calibration needs the body's attitude at rest: give the log set a [reference] (attitude_deg = [pitch, roll, heading], or a file)")]
+    NoReference,
+    /// The reference attitude changes.
+    #[error("the reference attitude changes by {arcsec:.3}″ at {t_s:.3} s: a static calibration needs the vehicle at rest")]
+    Moves {
+        /// When, s.
+        t_s: f64,
+        /// By how much, arcsec.
+        arcsec: f64,
+    },
+    /// The estimators failed.
+    #[error("{0}")]
+    Calibration(#[from] CalibError),
+    /// Stopped by the user.
+    #[error("interrupted")]
+    Interrupted,
+}
+
+/// `calibrate --log`: seed 000's filter and the exact least squares on a log set, the compensation
+/// before/after on the same data (a log has no independent second run).
+pub fn calibrate_log(log: &LogSet, history: bool, stop: &AtomicBool) -> Result<(Calibration, Report, Data), LogCalibrationError> {
+    let cfg = &log.table.calibration;
+    let set = ParamSet::new(&log.table.chain, Nuisance::None);
+    let known = set.without_estimated(&log.table.compensation);
+    let data = collect_from_log(log, &known, stop)?;
+    let chain = &log.table.chain;
+    let cal = calibrate(chain, &log.table.compensation, &data, cfg, if history { History::Snapshots(cfg.record_hz) } else { History::Final })?;
+    let comp = &log.table.compensation;
+    let set = &cal.set;
+    let before = attitude_errors(chain, &set.without_estimated(comp), &data);
+    let kf = attitude_errors(chain, &set.errors(&cal.kf.theta, comp), &data);
+    let nls = attitude_errors(chain, &set.errors(&cal.nls.theta, comp), &data);
+    let stated = attitude_errors(chain, &set.errors(&set.values(&log.table.stated), comp), &data);
+    let compensation = Compensation { before: before.1, after_kf: kf.1, after_nls: nls.1, with_truth: stated.1 };
+    let report = build_report(&log.name, chain, &log.table.stated, &cal, &data, Some(compensation));
+    Ok((cal, report, data))
+}
+
+/// What `calibrate --json` writes: the report, and the estimates as `[compensation]` keys that
+/// `replay --compensation FILE` and a scenario's `[compensation] from_calibration` read.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct CalibrationOutput<'a> {
+    /// The report.
+    #[serde(flatten)]
+    pub report: &'a Report,
+    /// The least-squares estimates over the known errors, as `[compensation]` keys.
+    pub estimated_compensation: crate::scenario::raw::RawCompensation,
+}
+
+/// The `[compensation]` keys of a calibration's least-squares estimates over `known`.
+#[must_use]
+pub fn estimated_compensation(chain: &crate::model::gimbal::Chain, cal: &Calibration, known: &TableErrors) -> crate::scenario::raw::RawCompensation {
+    crate::scenario::compensation_keys(chain, &cal.set.errors(&cal.nls.theta, known))
 }

@@ -5,8 +5,11 @@
 
 pub mod bench;
 pub mod calibrate;
+pub mod export_log;
 pub mod live;
 pub mod modulation;
+pub mod playback;
+pub mod replay;
 pub mod reproduce;
 pub mod run;
 pub mod terminate;

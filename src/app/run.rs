@@ -231,7 +231,7 @@ impl RunSummary {
 /// Simulates `params`, streaming to `sinks`; Ctrl-C (`stop`) ends the run early and keeps what was
 /// simulated. Returns the summary; the sinks stay open (the caller finishes or abandons them).
 pub fn run_recorded(params: &Params, sinks: &OpenSinks, stop: &AtomicBool, progress: bool) -> anyhow::Result<RunSummary> {
-    record_run(Recorder::new(sinks.rec.clone(), params)?, params, stop, progress)
+    record_run(Recorder::new(sinks.stream(), params)?, params, stop, progress)
 }
 
 /// Simulates `params` into `recorder` (whose layout the caller chose), ends it with the run's

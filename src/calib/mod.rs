@@ -313,6 +313,8 @@ pub enum AttitudeSource {
     Ins,
     /// No `[imu]`: the exact IMU attitude (only the encoder noise remains).
     Ideal,
+    /// A replayed log set's INS output.
+    Log,
 }
 
 /// The data of one static test.

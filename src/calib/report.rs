@@ -389,6 +389,7 @@ pub fn build(scenario: &str, chain: &Chain, truth: &TableErrors, cal: &Calibrati
         source: match data.source {
             super::AttitudeSource::Ins => "INS in the loop ([imu])".into(),
             super::AttitudeSource::Ideal => "exact IMU attitude (no [imu])".into(),
+            super::AttitudeSource::Log => "a log set's INS output (replayed)".into(),
         },
         samples: cal.samples,
         duration_s: data.samples.last().map_or(0.0, |s| s.t_s),

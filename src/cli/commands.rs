@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 
 use super::{CalibrateArgs, Failure, LiveArgs, ModulationArgs, MonteCarloAction, MonteCarloArgs, RunArgs, ScenarioSource, TprArgs};
-use crate::app::calibrate::{calibrate_scenario, monte_carlo_runs, monte_carlo_setup, record_outcome};
+use crate::app::calibrate::{calibrate_scenario, estimated_compensation, monte_carlo_runs, monte_carlo_setup, record_outcome, CalibrationOutput};
 use crate::calib::montecarlo::{self, Shard, ShardFile};
 use crate::app::run::run_recorded;
 use crate::app::terminate::stop_flag;
@@ -34,7 +34,7 @@ pub(super) fn run(args: &RunArgs) -> Result<(), Failure> {
     let params = load(args)?;
     // The summary file is checked before anything runs, so a typo costs nothing.
     check_output_dir("--summary-json", args.summary_json.as_deref())?;
-    let sinks = open_sinks(args.sinks.request(default_recording(&params.meta.name)), &format!("{}-seed{}", params.meta.name, params.meta.seed))?;
+    let sinks = open_sinks(args.sinks.request(default_recording(&params.meta.name))?, &format!("{}-seed{}", params.meta.name, params.meta.seed))?;
     let stop = stop_flag();
     let mut summary = match run_recorded(&params, &sinks, &stop, true) {
         Ok(s) => s,
@@ -43,11 +43,13 @@ pub(super) fn run(args: &RunArgs) -> Result<(), Failure> {
             return Err(e.into());
         }
     };
-    if let Some((path, bytes)) = sinks.finish()? {
+    let saved = sinks.finish()?;
+    if let Some((path, bytes)) = &saved.recording {
         summary.recording_path = Some(path.display().to_string());
-        summary.recording_bytes = Some(bytes);
+        summary.recording_bytes = Some(*bytes);
     }
     print!("{}", summary.table());
+    print_exported(&saved);
     if let Some(path) = &args.summary_json {
         write_json("--summary-json", path, &summary)?;
     }
@@ -63,6 +65,9 @@ pub(super) fn run(args: &RunArgs) -> Result<(), Failure> {
 /// `rinscope live`.
 pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
     use std::io::IsTerminal;
+    if args.sinks.export.is_some() {
+        return Err(Failure::input("--export is for runs that end (run, replay, calibrate, tpr, modulation); save the live session with --save and export a run of its file"));
+    }
     let path = match (&args.config, &args.scenario) {
         (Some(p), _) => p.clone(),
         (None, name) => {
@@ -114,14 +119,14 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
         eprintln!("rinscope live: running; edit {} to change parameters, Ctrl-C to stop", path.display());
     }
     let options = live::LiveOptions { config_path: path, speed: args.speed, duration_s: args.duration_s, panel, log_to_stderr: true };
-    let outputs = live::Outputs { viewer: viewer_sinks.as_ref().map(|s| s.rec.clone()), file: file_sinks.as_ref().map(|s| s.rec.clone()) };
+    let outputs = live::Outputs { viewer: viewer_sinks.as_ref().map(sink::OpenSinks::stream), file: file_sinks.as_ref().map(sink::OpenSinks::stream) };
     let result = live::run_session(&options, params, outputs, &stop);
     // Whatever happened, complete the saved file: it holds everything simulated so far.
     if let Some(v) = viewer_sinks {
         v.finish().ok();
     }
     let saved = match file_sinks {
-        Some(f) => f.finish()?,
+        Some(f) => f.finish()?.recording,
         None => None,
     };
     let summary = result?;
@@ -144,7 +149,7 @@ pub(super) fn modulation(args: &ModulationArgs) -> Result<(), Failure> {
     if !(hours.is_finite() && hours > 0.0 && hours <= 24.0 * 30.0) {
         return Err(Failure::input(format!("--hours {hours}: must be > 0 and at most 720 h")));
     }
-    let sinks = open_sinks(args.sinks.request(default_recording("rotation-modulation")), "rotation-modulation")?;
+    let sinks = open_sinks(args.sinks.request(default_recording("rotation-modulation"))?, "rotation-modulation")?;
     let stop = stop_flag();
     let started = std::time::Instant::now();
     eprintln!("rinscope: simulating {hours} h three times in parallel (no rotation, continuous azimuth, 16-position)...");
@@ -156,17 +161,17 @@ pub(super) fn modulation(args: &ModulationArgs) -> Result<(), Failure> {
         }
     };
     let table = modulation::table(&traces, started.elapsed().as_secs_f64());
-    if let Err(e) = crate::record::modulation::log(&sinks.rec, &traces, &table) {
+    if let Err(e) = crate::record::modulation::log(&sinks.stream(), &traces, &table) {
         sinks.abandon();
         return Err(Failure::run(format!("rerun: {e}")));
     }
     let saved = sinks.finish()?;
     print!("{table}");
-    print_saved(saved);
+    print_saved(&saved);
     Ok(())
 }
 
-fn check_output_dir(flag: &str, path: Option<&std::path::Path>) -> Result<(), Failure> {
+pub(super) fn check_output_dir(flag: &str, path: Option<&std::path::Path>) -> Result<(), Failure> {
     if let Some(dir) = path.and_then(|p| p.parent()).filter(|d| !d.as_os_str().is_empty() && !d.is_dir()) {
         return Err(Failure::input(format!("{flag}: directory {} does not exist", dir.display())));
     }
@@ -174,12 +179,12 @@ fn check_output_dir(flag: &str, path: Option<&std::path::Path>) -> Result<(), Fa
 }
 
 /// The file a command saves to when no sink is asked for.
-fn default_recording(name: &str) -> PathBuf {
+pub(super) fn default_recording(name: &str) -> PathBuf {
     PathBuf::from("recordings").join(format!("{name}.rrd"))
 }
 
 /// Opens the sinks a command asked for.
-fn open_sinks(request: SinkRequest, recording_id: &str) -> Result<sink::OpenSinks, Failure> {
+pub(super) fn open_sinks(request: SinkRequest, recording_id: &str) -> Result<sink::OpenSinks, Failure> {
     let sinks = sink::open(&request, APPLICATION_ID, recording_id)?;
     for d in &sinks.description {
         eprintln!("rinscope: {d}");
@@ -188,26 +193,38 @@ fn open_sinks(request: SinkRequest, recording_id: &str) -> Result<sink::OpenSink
 }
 
 /// Writes `value` as pretty JSON to the file given with `flag`, atomically.
-fn write_json(flag: &str, path: &std::path::Path, value: &impl serde::Serialize) -> Result<(), Failure> {
+pub(super) fn write_json(flag: &str, path: &std::path::Path, value: &impl serde::Serialize) -> Result<(), Failure> {
     let json = serde_json::to_string_pretty(value).map_err(|e| Failure::run(e.to_string()))?;
     write_atomically(path, json.as_bytes()).map_err(|e| Failure::input(format!("{flag} {}: {e}", path.display())))
 }
 
 /// The line that tells where a saved recording is and how to open it.
-fn print_saved(saved: Option<(PathBuf, u64)>) {
-    if let Some((p, bytes)) = saved {
-        println!("recording: {} ({:.2} MB) — open with `rerun {}`", p.display(), bytes as f64 / 1e6, p.display());
+pub(super) fn print_saved(saved: &sink::Saved) {
+    if let Some((p, bytes)) = &saved.recording {
+        println!("recording: {} ({:.2} MB) — open with `rerun {}`", p.display(), *bytes as f64 / 1e6, p.display());
+    }
+    print_exported(saved);
+}
+
+/// The line that tells where the export tables are.
+pub(super) fn print_exported(saved: &sink::Saved) {
+    if let Some(first) = saved.exported.first() {
+        let dir = first.parent().map_or_else(|| ".".into(), |d| d.display().to_string());
+        println!("exported {} tables to {dir} (pandas: pd.read_parquet(path); MATLAB: parquetread(path); docs/export.md)", saved.exported.len());
     }
 }
 
 /// `rinscope calibrate`.
 pub(super) fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
+    if let Some(dir) = &args.log {
+        return super::logs::calibrate_log(args, dir);
+    }
     let params = args.source.load("jiang2017-calibration")?;
     check_output_dir("--json", args.json.as_deref())?;
     let sinks = if args.no_recording {
         None
     } else {
-        let request = args.sinks.request(default_recording(&format!("{}-calibration", params.meta.name)));
+        let request = args.sinks.request(default_recording(&format!("{}-calibration", params.meta.name)))?;
         Some(open_sinks(request, &format!("{}-calibration-seed{}", params.meta.name, params.meta.seed))?)
     };
     let started = std::time::Instant::now();
@@ -225,14 +242,15 @@ pub(super) fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
     print!("{}", outcome.report.text());
     println!("({wall:.2} s wall: two {:.0}-s runs simulated, filter and least squares)", params.duration_s);
     if let Some(path) = &args.json {
-        write_json("--json", path, &outcome.report)?;
+        let compensation = estimated_compensation(&params.table.chain, &outcome.cal, &params.table.compensation);
+        write_json("--json", path, &CalibrationOutput { report: &outcome.report, estimated_compensation: compensation })?;
     }
     if let Some(sinks) = sinks {
-        if let Err(e) = record_outcome(sinks.rec.clone(), &params, &outcome, &stop_flag()) {
+        if let Err(e) = record_outcome(sinks.stream(), &params, &outcome, &stop_flag()) {
             sinks.abandon();
             return Err(Failure::run(format!("rerun: {e}")));
         }
-        print_saved(sinks.finish()?);
+        print_saved(&sinks.finish()?);
     }
     Ok(())
 }
@@ -323,7 +341,7 @@ fn montecarlo_merge(files: &[PathBuf], source: &ScenarioSource, eta_measured_sig
 }
 
 /// Reads a text file of at most 1 GB (a FIFO or a device is refused).
-fn read_small_file(path: &Path, what: &str) -> Result<String, Failure> {
+pub(super) fn read_small_file(path: &Path, what: &str) -> Result<String, Failure> {
     let meta = std::fs::metadata(path).map_err(|e| Failure::input(format!("{what} {}: {e}", path.display())))?;
     if !meta.is_file() || meta.len() > 1 << 30 {
         return Err(Failure::input(format!("{what} {}: not a regular file of at most 1 GB", path.display())));
@@ -336,7 +354,7 @@ pub(super) fn tpr(args: &TprArgs) -> Result<(), Failure> {
     let params = args.source.load("zheng2016-tpr")?;
     check_output_dir("--json", args.json.as_deref())?;
     tpr::check(&params).map_err(|e| Failure::input(format!("tpr: {e}")))?;
-    let sinks = open_sinks(args.sinks.request(default_recording(&params.meta.name)), &format!("{}-seed{}", params.meta.name, params.meta.seed))?;
+    let sinks = open_sinks(args.sinks.request(default_recording(&params.meta.name))?, &format!("{}-seed{}", params.meta.name, params.meta.seed))?;
     let stop = stop_flag();
     eprintln!("rinscope: navigating {:.1} h (forking at the second fix)...", params.duration_s / 3600.0);
     let result = match tpr::compare_resets(&params, 60.0, &stop) {
@@ -347,7 +365,7 @@ pub(super) fn tpr(args: &TprArgs) -> Result<(), Failure> {
         }
     };
     let text = result.text();
-    if let Err(e) = crate::record::tpr::log(&sinks.rec, &params, &result, &text) {
+    if let Err(e) = crate::record::tpr::log(&sinks.stream(), &params, &result, &text) {
         sinks.abandon();
         return Err(Failure::run(format!("rerun: {e}")));
     }
@@ -356,7 +374,7 @@ pub(super) fn tpr(args: &TprArgs) -> Result<(), Failure> {
     if let Some(path) = &args.json {
         write_json("--json", path, &result)?;
     }
-    print_saved(saved);
+    print_saved(&saved);
     if !result.complete {
         return Err(Failure::interrupted("interrupted: the recording holds what was simulated"));
     }
@@ -427,4 +445,15 @@ pub(super) fn reproduce(markdown: Option<&Path>) -> Result<(), Failure> {
     } else {
         Err(Failure::run("some reproductions fall outside their tolerance (see the table)"))
     }
+}
+
+/// `bench --peer pyins`.
+pub(super) fn bench_peer(python: PathBuf, rounds: usize, samples: u64, json: Option<&std::path::Path>) -> Result<(), Failure> {
+    use crate::app::bench::peer;
+    let reports = peer::compare(&peer::PeerOptions { python, rounds, samples }).map_err(|e| Failure::run(format!("{e:#}")))?;
+    print!("{}", peer::text(&reports));
+    if let Some(path) = json {
+        write_json("--json", path, &reports)?;
+    }
+    Ok(())
 }

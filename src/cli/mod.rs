@@ -13,12 +13,14 @@
 //! 2 bad input (config, path, viewer), 130 interrupted by Ctrl-C (what was simulated is saved).
 
 mod commands;
+mod logs;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
 
+use crate::record::export::ExportFormat;
 use crate::record::sink::{self, SinkError, SinkRequest};
 use crate::scenario::{self, presets, ConfigError, Params};
 
@@ -48,6 +50,12 @@ enum Command {
     /// Seed 003's Twice Position-fix Reset against the conventional reset, from one IMU stream
     /// (default scenario: zheng2016-tpr; needs [imu], [navigation] and two [position_fix] times).
     Tpr(TprArgs),
+    /// Write a scenario as a log set (docs/logs.md): the IMU's measured increments, the encoder
+    /// readings and the true attitude at every sample, the table description and the manifest.
+    ExportLog(ExportLogArgs),
+    /// Replay a log set (or an IMU file with --imu) through the INS and the table models: the same
+    /// scene and plots as a simulation, from the files.
+    Replay(ReplayArgs),
     /// Print the event log (reloads, errors, summary) of a saved recording.
     Events {
         /// The .rrd file.
@@ -71,6 +79,22 @@ enum Command {
         /// Steps of each pure-simulation repetition.
         #[arg(long, default_value_t = 2_000_000)]
         steps: u64,
+        /// Instead: measure `rinscope replay` against a peer INS on the same streams, whole processes
+        /// alternated (`pyins`: python-ins 1.0.1; docs/benchmarks.md).
+        #[arg(long, value_parser = ["pyins"])]
+        peer: Option<String>,
+        /// --peer: the Python interpreter that has the peer installed.
+        #[arg(long, default_value = "python3")]
+        python: PathBuf,
+        /// --peer: alternated rounds per stream.
+        #[arg(long, default_value_t = 5)]
+        rounds: usize,
+        /// --peer: samples per stream (2 kHz).
+        #[arg(long, default_value_t = 2_000_000)]
+        samples: u64,
+        /// --peer: also write every round's numbers as JSON.
+        #[arg(long)]
+        json: Option<PathBuf>,
     },
 }
 
@@ -90,6 +114,13 @@ struct SinkArgs {
     /// Serve the stream over gRPC on this port (default 9876) for native or web viewers.
     #[arg(long, num_args = 0..=1, default_missing_value = "9876")]
     serve: Option<u16>,
+    /// Also write every recorded time series as tables into this folder (one file per plot, a
+    /// t_s column, units in the column names; docs/export.md).
+    #[arg(long, value_name = "DIR")]
+    export: Option<PathBuf>,
+    /// Table format of --export: parquet or csv.
+    #[arg(long, default_value = "parquet", value_name = "FORMAT")]
+    export_format: String,
 }
 
 impl SinkArgs {
@@ -98,10 +129,14 @@ impl SinkArgs {
         self.spawn || self.connect.is_some() || self.serve.is_some()
     }
 
-    /// The request, with `default_save` when nothing at all was asked for.
-    fn request(&self, default_save: PathBuf) -> SinkRequest {
+    /// The request, with `default_save` when no viewer was asked for.
+    fn request(&self, default_save: PathBuf) -> Result<SinkRequest, Failure> {
         let save = self.save.clone().or_else(|| (!self.viewer_asked()).then_some(default_save));
-        SinkRequest { save, spawn: self.spawn, connect: self.connect.clone(), serve: self.serve }
+        let export = match &self.export {
+            None => None,
+            Some(dir) => Some((dir.clone(), ExportFormat::parse(&self.export_format).map_err(|e| Failure::input(format!("--export-format {e}")))?)),
+        };
+        Ok(SinkRequest { save, spawn: self.spawn, connect: self.connect.clone(), serve: self.serve, export })
     }
 }
 
@@ -180,12 +215,70 @@ struct CalibrateArgs {
     source: ScenarioSource,
     #[command(flatten)]
     sinks: SinkArgs,
-    /// Write the estimates, 1σ, observability and compensation as JSON.
+    /// Calibrate a log set's static test instead of simulating one (its [reference] gives the
+    /// known attitude).
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["scenario", "config"])]
+    log: Option<PathBuf>,
+    /// Write the estimates, 1σ, observability, compensation and the estimates as [compensation]
+    /// keys (for replay --compensation) as JSON.
     #[arg(long)]
     json: Option<PathBuf>,
     /// No recording (print and JSON only).
     #[arg(long, conflicts_with_all = ["save", "spawn", "connect", "serve"])]
     no_recording: bool,
+}
+
+#[derive(Args)]
+struct ExportLogArgs {
+    #[command(flatten)]
+    source: ScenarioSource,
+    /// The new folder to write (refused if it exists).
+    #[arg(long)]
+    out: PathBuf,
+    /// File format: csv, npy or parquet.
+    #[arg(long, default_value = "csv")]
+    format: String,
+}
+
+#[derive(Args)]
+struct ReplayArgs {
+    /// The log set's folder (with log.toml).
+    #[arg(conflicts_with = "imu")]
+    dir: Option<PathBuf>,
+    #[command(flatten)]
+    sinks: SinkArgs,
+    /// Write the errors' RMS and peak, navigation, gaps and wall time as JSON.
+    #[arg(long)]
+    summary_json: Option<PathBuf>,
+    /// Compensate with a calibration's estimates (`calibrate --json FILE`) instead of the table
+    /// description's [compensation].
+    #[arg(long, value_name = "FILE")]
+    compensation: Option<PathBuf>,
+    /// Without a log set: an IMU file (.csv, .txt, .npy, .parquet, .mcap).
+    #[arg(long, requires_all = ["rate_hz", "table"])]
+    imu: Option<PathBuf>,
+    /// --imu: its layout: rinscope, psins, kf-gins, kalibr, npy7, ros2 (default from the extension).
+    #[arg(long, requires = "imu")]
+    imu_layout: Option<String>,
+    /// --imu: increments or rates.
+    #[arg(long, requires = "imu")]
+    imu_kind: Option<String>,
+    /// --imu: the file's axes (rfu, frd, flu, ...).
+    #[arg(long, requires = "imu")]
+    imu_frame: Option<String>,
+    /// --imu: the sample rate, Hz.
+    #[arg(long, requires = "imu")]
+    rate_hz: Option<f64>,
+    /// --imu: the table description (the [site], [turntable], [imu], ... sections of a scenario).
+    #[arg(long, requires = "imu")]
+    table: Option<PathBuf>,
+    /// --imu: an encoder file (t_s and <axis>_deg columns).
+    #[arg(long, requires = "imu")]
+    encoders: Option<PathBuf>,
+    /// --imu: the body attitude at rest [pitch, roll, heading], deg, as reference and start (else a
+    /// 60 s coarse alignment).
+    #[arg(long, requires = "imu", num_args = 3, value_names = ["PITCH", "ROLL", "HEADING"], allow_negative_numbers = true)]
+    attitude_deg: Option<Vec<f64>>,
 }
 
 #[derive(Args)]
@@ -303,6 +396,8 @@ pub fn main() -> ExitCode {
         Command::Montecarlo(args) => commands::montecarlo(&args),
         Command::Tpr(args) => commands::tpr(&args),
         Command::Events { file } => commands::events(&file),
+        Command::ExportLog(args) => logs::export_log(&args),
+        Command::Replay(args) => logs::replay(&args),
         Command::Modulation(args) => commands::modulation(&args),
         Command::Scenarios => {
             commands::list_scenarios();
@@ -310,7 +405,8 @@ pub fn main() -> ExitCode {
         }
         Command::CheckConfig { file } => commands::check_config(&file),
         Command::Reproduce { markdown } => commands::reproduce(markdown.as_deref()),
-        Command::Bench { steps } => crate::app::bench::run_benchmarks(steps).map_err(Failure::from),
+        Command::Bench { steps, peer: None, .. } => crate::app::bench::run_benchmarks(steps).map_err(Failure::from),
+        Command::Bench { peer: Some(_), python, rounds, samples, json, .. } => commands::bench_peer(python, rounds, samples, json.as_deref()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -175,8 +175,7 @@ impl InsCore {
     pub fn reset_position(&mut self) {
         let site = self.earth.site;
         if let Some(nav) = self.nav.as_mut() {
-            nav.state.latitude_rad = site.latitude_rad;
-            nav.state.longitude_rad = site.longitude_rad;
+            nav.fix_position(&site);
         }
     }
 
@@ -240,6 +239,13 @@ impl InsCore {
     #[must_use]
     pub fn output_attitude(&self, k: usize) -> (f64, Rot<N, S>) {
         output_attitude(&self.history[k], self.zoh_delay_s)
+    }
+
+    /// Algorithm `k`'s latest attitude update, without the output's hold: (the instant it stands
+    /// for, C_s^n) — the state to compare with another navigator run on the same samples.
+    #[must_use]
+    pub fn latest_attitude(&self, k: usize) -> (f64, Rot<N, S>) {
+        self.history[k][1]
     }
 
     /// The instant the truth is taken at for an output representing `t_repr`: the output left the

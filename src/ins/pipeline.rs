@@ -42,6 +42,10 @@ pub struct InsRun {
     h: f64,
     index: u64,
     demod: Vec<DemodState>,
+    /// The measured (end time, Δθ, Δv) before t = 0 that pre-rolled the computer.
+    pre_roll: Vec<(f64, Vector3<f64>, Vector3<f64>)>,
+    /// The computer's initial C_s^n (at −d, with the alignment error).
+    start: Rot<N, S>,
 }
 
 impl InsRun {
@@ -55,11 +59,12 @@ impl InsRun {
         let t_start = -(pre as f64) * h;
         let mut truth = TruthImu::new(model, Earth::at(site), t_start);
         let mut sensors = Sensors::new(&cfg.errors, h, seed, t_start);
-        let pre_roll: Vec<(Vector3<f64>, Vector3<f64>)> = (0..pre)
+        let pre_roll: Vec<(f64, Vector3<f64>, Vector3<f64>)> = (0..pre)
             .map(|i| {
                 let t1 = t_start + (i + 1) as f64 * h;
                 let (g, a) = truth.increments(t1);
-                sensors.measure(&g, &a, t1)
+                let (g, a) = sensors.measure(&g, &a, t1);
+                (t1, g, a)
             })
             .collect();
         // The filtered stream now stands at the truth of t = −d: start the attitude there, with the
@@ -68,9 +73,23 @@ impl InsRun {
         let start = truth.eval(-fir_delay_s).n_from_s;
         // FRAME: the alignment error is a small rotation of the navigation frame (C = (I − [φ×]) C_true).
         let start: Rot<N, S> = Rot::<N, N>::from_quaternion(rotvec::exp(&-cfg.initial_error_rad)) * start;
-        let core = InsCore::new(cfg, site, start, &pre_roll);
+        let samples: Vec<(Vector3<f64>, Vector3<f64>)> = pre_roll.iter().map(|(_, g, a)| (*g, *a)).collect();
+        let core = InsCore::new(cfg, site, start, &samples);
         let demod = vec![DemodState::default(); core.algorithms().len()];
-        Self { truth, sensors, core, h, index: 0, demod }
+        Self { truth, sensors, core, h, index: 0, demod, pre_roll, start }
+    }
+
+    /// The measured (end time, Δθ, Δv) samples before t = 0 that pre-rolled the computer (what a log
+    /// of this run starts with).
+    #[must_use]
+    pub fn pre_roll(&self) -> &[(f64, Vector3<f64>, Vector3<f64>)] {
+        &self.pre_roll
+    }
+
+    /// The computer's initial C_s^n (the truth at −d with the alignment error applied).
+    #[must_use]
+    pub fn start_attitude(&self) -> Rot<N, S> {
+        self.start
     }
 
     /// The navigation computer.

@@ -4,12 +4,12 @@
 
 use nalgebra::Vector3;
 use rerun::blueprint::components::ContainerKind;
-use rerun::{RecordingStream, RecordingStreamResult, TimeColumn};
+use rerun::RecordingStreamResult;
 
 use super::layout::{self, Node};
 use super::palette::{albedo, p3, rgb, rgba};
 use super::scene::{cone, ring_radius};
-use super::{CustomLayout, Recorder, TIMELINE};
+use super::{CustomLayout, Recorder, Stream, TIMELINE};
 use crate::calib::report::Report;
 use crate::calib::{Calibration, Param};
 use crate::math::rotvec;
@@ -20,6 +20,8 @@ use crate::sim::ERROR_AXES;
 const GHOST: [u8; 3] = [245, 245, 245];
 const STATE_COLORS: [[u8; 3]; 5] = [[250, 200, 60], [120, 120, 120], [120, 120, 120], [90, 220, 120], [90, 160, 250]];
 const ERROR_COLORS: [[u8; 3]; 3] = [[230, 76, 60], [250, 200, 60], [90, 160, 250]];
+const STATE_NAMES: [&str; 5] = ["static KF", "+3σ", "−3σ", "true", "exact LSQ (final)"];
+const ERROR_NAMES: [&str; 3] = ["before (no swing/η model)", "after: static KF", "after: exact LSQ"];
 
 /// Per-sample attitude errors (pitch, roll, heading, rad) of the validation run: before, after the
 /// filter's compensation, after the least squares'.
@@ -33,7 +35,7 @@ pub struct ErrorTraces<'a> {
 /// Writes the calibration's recording into `rec`: layout, documents, the filter over time, the
 /// before/after errors and the ghost cones. Returns the table's recorder, into which the caller
 /// streams the table's motion (as in any run) and finishes.
-pub fn log(rec: RecordingStream, params: &Params, cal: &Calibration, report: &Report, traces: &ErrorTraces<'_>) -> RecordingStreamResult<Recorder> {
+pub fn log(stream: Stream, params: &Params, cal: &Calibration, report: &Report, traces: &ErrorTraces<'_>) -> RecordingStreamResult<Recorder> {
     let chain = &params.table.chain;
     let set = &cal.set;
     let table: Vec<(usize, Param)> = set.params.iter().copied().enumerate().filter(|(_, p)| p.is_table()).collect();
@@ -46,7 +48,7 @@ pub fn log(rec: RecordingStream, params: &Params, cal: &Calibration, report: &Re
         .map(|(i, p)| {
             let (x, sd, t) = (cal.kf.theta[*i] * ARCSEC_PER_RAD, cal.kf.sigma(*i) * ARCSEC_PER_RAD, truth[*i] * ARCSEC_PER_RAD);
             let half = (12.0 * sd).max(1.0).max(1.5 * (x - t).abs());
-            plot(format!("{} (″)", p.label(chain)), format!("calibration/state/{}", p.key(chain)))
+            plot(format!("{} (″)", p.label(chain)), format!("calibration/state_arcsec/{}", p.key(chain)))
                 .with_property("ScalarAxis", &layout::scalar_range(x - half, x + half))
                 .with_property("PlotLegend", &layout::no_legend())
         })
@@ -57,8 +59,9 @@ pub fn log(rec: RecordingStream, params: &Params, cal: &Calibration, report: &Re
     // The table scene of the ideal demodulation; the INS is the calibration's business here.
     let mut drawing = params.clone();
     drawing.ins = None;
-    let recorder = Recorder::with_layout(rec, &drawing, custom)?;
-    let rec = recorder.stream().clone();
+    let recorder = Recorder::with_layout(stream, &drawing, custom)?;
+    let stream = recorder.stream().clone();
+    let rec = stream.rec().clone();
 
     rec.log_static(
         "docs/calibration",
@@ -74,17 +77,17 @@ pub fn log(rec: RecordingStream, params: &Params, cal: &Calibration, report: &Re
     // Styles.
     for (_, p) in &table {
         rec.log_static(
-            format!("calibration/state/{}", p.key(chain)),
+            format!("calibration/state_arcsec/{}", p.key(chain)),
             &rerun::SeriesLines::new()
                 .with_colors(STATE_COLORS.map(rgb))
-                .with_names(["static KF", "+3σ", "−3σ", "true", "exact LSQ (final)"])
+                .with_names(STATE_NAMES)
                 .with_widths([2.5, 1.0, 1.0, 1.5, 1.5]),
         )?;
     }
     for a in ERROR_AXES {
         rec.log_static(
             format!("calibration/error_arcsec/{a}"),
-            &rerun::SeriesLines::new().with_colors(ERROR_COLORS.map(rgb)).with_names(["before (no swing/η model)", "after: static KF", "after: exact LSQ"]),
+            &rerun::SeriesLines::new().with_colors(ERROR_COLORS.map(rgb)).with_names(ERROR_NAMES),
         )?;
     }
 
@@ -96,8 +99,7 @@ pub fn log(rec: RecordingStream, params: &Params, cal: &Calibration, report: &Re
             let (x, sd) = (s.theta[*i] * ARCSEC_PER_RAD, s.sigma[*i] * ARCSEC_PER_RAD);
             values.extend([x, x + 3.0 * sd, x - 3.0 * sd, truth[*i] * ARCSEC_PER_RAD, cal.nls.theta[*i] * ARCSEC_PER_RAD]);
         }
-        let time = TimeColumn::new_duration_secs(TIMELINE, times.iter().copied());
-        rec.send_columns(format!("calibration/state/{}", p.key(chain)), [time], rerun::Scalars::new(values).columns(std::iter::repeat_n(5, times.len()))?)?;
+        stream.send_series(&format!("calibration/state_arcsec/{}", p.key(chain)), &STATE_NAMES.map(String::from), &times, values, 5)?;
     }
 
     // Before / after, decimated to the series rate.
@@ -108,8 +110,8 @@ pub fn log(rec: RecordingStream, params: &Params, cal: &Calibration, report: &Re
         for &i in &idx {
             values.extend(traces.errors.iter().map(|e| e[i][a] * ARCSEC_PER_RAD));
         }
-        let time = TimeColumn::new_duration_secs(TIMELINE, idx.iter().map(|&i| traces.t_s[i]));
-        rec.send_columns(format!("calibration/error_arcsec/{name}"), [time], rerun::Scalars::new(values).columns(std::iter::repeat_n(3, idx.len()))?)?;
+        let times: Vec<f64> = idx.iter().map(|&i| traces.t_s[i]).collect();
+        stream.send_series(&format!("calibration/error_arcsec/{name}"), &ERROR_NAMES.map(String::from), &times, values, 3)?;
     }
 
     // Ghost cones and estimated rotor axes, once per second of the test.

@@ -2,10 +2,10 @@
 //! filtered gyro signals of the first moments, the FIR's amplitude response and the trace of the
 //! true and computed IMU axes beside the table.
 
-use rerun::{RecordingStreamResult, TimeColumn};
+use rerun::RecordingStreamResult;
 
 use super::palette::{colors, rgb, rgba};
-use super::{Recorder, SERIES_CHUNK_ROWS, TIMELINE};
+use super::{Recorder, SERIES_CHUNK_ROWS};
 use crate::ins::core::SampleOut;
 use crate::math::units::DEG_PER_RAD;
 use crate::sim::ERROR_AXES;
@@ -26,6 +26,9 @@ pub(crate) struct InsLayout {
     pub(crate) rate_hz: f64,
     pub(crate) signal_window_s: f64,
 }
+
+/// The gyro signals' lines.
+const GYRO_NAMES: [&str; 3] = ["gyro x", "gyro y", "gyro z"];
 
 /// Where the INS trace (true and computed IMU axes) is drawn, beside the table.
 pub(crate) const TRACE_OFFSET: [f32; 3] = [1.3, 1.3, -0.5];
@@ -49,9 +52,9 @@ impl Recorder {
             return Ok(());
         }
         let times = std::mem::take(&mut layout.signal_t);
+        let names = GYRO_NAMES.map(String::from);
         for (path, values) in [("ins/gyro_raw_deg_per_s", std::mem::take(&mut layout.raw)), ("ins/gyro_filtered_deg_per_s", std::mem::take(&mut layout.filtered))] {
-            let time = TimeColumn::new_duration_secs(TIMELINE, times.iter().copied());
-            self.rec.send_columns(path, [time], rerun::Scalars::new(values).columns(std::iter::repeat_n(3, times.len()))?)?;
+            self.stream.send_series(path, &names, &times, values, 3)?;
         }
         Ok(())
     }
@@ -62,16 +65,14 @@ impl Recorder {
         let rec = &self.rec;
         let algo_colors: Vec<rerun::Color> = (0..layout.algorithms.len()).map(|k| rgb(colors::ALGORITHMS[k % colors::ALGORITHMS.len()])).collect();
         for axis in ERROR_AXES {
-            rec.log_static(
-                format!("ins/attitude_error_arcsec/{axis}"),
-                &rerun::SeriesLines::new().with_colors(algo_colors.clone()).with_names(layout.algorithms.clone()),
-            )?;
+            let path = format!("ins/attitude_error_arcsec/{axis}");
+            rec.log_static(path.as_str(), &rerun::SeriesLines::new().with_colors(algo_colors.clone()).with_names(self.series_names(&path)))?;
         }
-        let enu = ["east", "north"];
-        rec.log_static("ins/position_error_m", &rerun::SeriesLines::new().with_colors(colors::EULER.map(rgb)).with_names([enu[0], enu[1], "radial"]))?;
-        rec.log_static("ins/velocity_error_mps", &rerun::SeriesLines::new().with_colors(colors::EULER.map(rgb)).with_names([enu[0], enu[1], "up"]))?;
+        for path in ["ins/position_error_m", "ins/velocity_error_mps"] {
+            rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors::EULER.map(rgb)).with_names(self.series_names(path)))?;
+        }
         for path in ["ins/gyro_raw_deg_per_s", "ins/gyro_filtered_deg_per_s"] {
-            rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors::SENSOR.map(rgb)).with_names(["gyro x", "gyro y", "gyro z"]))?;
+            rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors::SENSOR.map(rgb)).with_names(GYRO_NAMES))?;
         }
         // FIR amplitude response, dB, drawn in a 2D view: x = frequency (Hz), y = 5 × dB (so that
         // 0..-150 dB spans a readable height next to 0..1000 Hz).

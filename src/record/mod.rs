@@ -18,6 +18,7 @@ use layout::Node;
 
 mod blueprint;
 pub mod calibration;
+pub mod export;
 mod ins_view;
 mod layout;
 pub mod modulation;
@@ -35,11 +36,45 @@ use crate::model::gimbal::{Chain, ErrorRotations, TableErrors};
 use crate::scenario::Params;
 use crate::sim::{StepOutput, DEMODULATIONS, ERROR_AXES};
 use ins_view::{InsLayout, TRACE_OFFSET};
+use export::SharedExporter;
 use scene::ChainPaths;
 
-/// A recording stream: what the commands hand from the sinks to a [`Recorder`] (the rest of the
-/// crate names Rerun's types only through this module).
-pub type Stream = RecordingStream;
+/// A recording stream and, with `--export`, the tables its series also go to: what the commands
+/// hand from the sinks to the recorders (the rest of the crate names Rerun's types only here).
+#[derive(Clone)]
+pub struct Stream {
+    rec: RecordingStream,
+    export: Option<SharedExporter>,
+}
+
+impl Stream {
+    /// A stream into `rec`, its series also into `export`.
+    #[must_use]
+    pub(crate) fn new(rec: RecordingStream, export: Option<SharedExporter>) -> Self {
+        Self { rec, export }
+    }
+
+    /// The Rerun stream.
+    pub(crate) fn rec(&self) -> &RecordingStream {
+        &self.rec
+    }
+
+    /// Sends `width` series of `path` (values row-major, one row per time) to Rerun, and to the
+    /// export tables with the series' `names` and the unit `path` states.
+    pub(crate) fn send_series(&self, path: &str, names: &[String], times: &[f64], values: Vec<f64>, width: usize) -> RecordingStreamResult<()> {
+        if let Some(export) = &self.export {
+            let unit = export::unit_of(path).unwrap_or("1");
+            let mut e = export.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+            e.write(path, unit, names, times, &values);
+        }
+        let time = TimeColumn::new_duration_secs(TIMELINE, times.iter().copied());
+        self.rec.send_columns(path, [time], rerun::Scalars::new(values).columns(std::iter::repeat_n(width, times.len()))?)?;
+        Ok(())
+    }
+}
+
+/// What a failed Rerun call returns.
+pub type RecordError = rerun::RecordingStreamError;
 
 /// Application id of every rinscope recording (the viewer keys layouts by it).
 pub const APPLICATION_ID: &str = "rinscope";
@@ -62,19 +97,26 @@ pub fn to_rerun_quaternion(q: &UnitQuaternion<f64>) -> rerun::Quaternion {
 /// One entity of `width` plotted series, buffered row-major.
 struct Series {
     path: String,
-    width: usize,
+    /// The names of its lines (the legend, and the export's columns).
+    names: Vec<String>,
     values: Vec<f64>,
 }
 
 impl Series {
-    fn new(path: String, width: usize) -> Self {
-        Self { path, width, values: Vec::new() }
+    fn new(path: String, names: Vec<String>) -> Self {
+        Self { path, names, values: Vec::new() }
+    }
+
+    fn width(&self) -> usize {
+        self.names.len()
     }
 }
 
 /// Streams a run into a Rerun recording.
 pub struct Recorder {
     rec: RecordingStream,
+    /// The same stream, with the export tables.
+    stream: Stream,
     chain: Chain,
     /// The true errors (the swing plots, the labels).
     truth: TableErrors,
@@ -92,6 +134,8 @@ pub struct Recorder {
     chunks_in_flight: usize,
     /// Live mode: geometry on the timeline instead of static.
     live: bool,
+    /// A replayed log: the demodulations are the nominal and the compensated table (no closed form).
+    replay: bool,
     /// With an IMU in the loop.
     ins: Option<InsLayout>,
 }
@@ -106,37 +150,47 @@ pub(crate) struct CustomLayout {
 
 impl Recorder {
     /// Logs everything static (documents, styles, geometry, blueprint) and prepares the buffers.
-    pub fn new(rec: RecordingStream, params: &Params) -> RecordingStreamResult<Self> {
-        Self::build(rec, params, false, None)
+    pub fn new(stream: Stream, params: &Params) -> RecordingStreamResult<Self> {
+        Self::build(stream, params, false, None)
     }
 
     /// A recorder whose layout has `custom.right` as its right column and `custom.docs` as extra
     /// document tabs (commands that add their own panels to the table's 3D scene).
-    pub(crate) fn with_layout(rec: RecordingStream, params: &Params, custom: CustomLayout) -> RecordingStreamResult<Self> {
-        Self::build(rec, params, false, Some(custom))
+    pub(crate) fn with_layout(stream: Stream, params: &Params, custom: CustomLayout) -> RecordingStreamResult<Self> {
+        Self::build(stream, params, false, Some(custom))
     }
 
-    fn build(rec: RecordingStream, params: &Params, live: bool, custom: Option<CustomLayout>) -> RecordingStreamResult<Self> {
+    fn build(stream: Stream, params: &Params, live: bool, custom: Option<CustomLayout>) -> RecordingStreamResult<Self> {
+        Self::build_with(stream, params, live, false, custom)
+    }
+
+    fn build_with(stream: Stream, params: &Params, live: bool, replay: bool, custom: Option<CustomLayout>) -> RecordingStreamResult<Self> {
+        let rec = stream.rec.clone();
         let chain = params.table.chain.clone();
         let drawing = chain.error_rotations(&params.table.truth.exaggerated(params.recording.exaggeration));
         let axis_names: Vec<String> = params.table.chain.axes().iter().map(|a| a.name.clone()).collect();
         let paths = ChainPaths::new(&axis_names);
-        let n = axis_names.len();
-        let mut series: Vec<Series> = ERROR_AXES.iter().map(|axis| Series::new(format!("attitude_error_arcsec/{axis}"), DEMODULATIONS.len())).collect();
-        series.push(Series::new("gimbal_angle_deg".into(), n));
-        series.push(Series::new("vehicle_attitude_deg".into(), 3));
-        for name in &axis_names {
-            series.push(Series::new(format!("swing_arcsec/{name}"), 2));
+        let demodulations: Vec<String> = if replay {
+            vec!["nominal table".into(), "compensated table".into(), "(no closed form in a replay)".into()]
+        } else {
+            DEMODULATIONS.iter().map(|v| v.replace('_', " ")).collect()
+        };
+        let mut series: Vec<Series> = ERROR_AXES.iter().map(|axis| Series::new(format!("attitude_error_arcsec/{axis}"), demodulations.clone())).collect();
+        series.push(Series::new("gimbal_angle_deg".into(), axis_names.clone()));
+        series.push(Series::new("vehicle_attitude_deg".into(), ERROR_AXES.map(String::from).to_vec()));
+        for (name, g) in axis_names.iter().zip(chain.axes()) {
+            let about = |v: &nalgebra::Vector3<f64>| format!("{name} swing about {}", scene::axis_letter(v));
+            series.push(Series::new(format!("swing_arcsec/{name}"), vec![about(&g.e1), about(&g.e2)]));
         }
         let ins = params.ins.as_ref().map(|cfg| {
             let algorithms: Vec<String> = cfg.algorithms().iter().map(|a| a.name().to_owned()).collect();
             let first_series = series.len();
             for axis in ERROR_AXES {
-                series.push(Series::new(format!("ins/attitude_error_arcsec/{axis}"), algorithms.len()));
+                series.push(Series::new(format!("ins/attitude_error_arcsec/{axis}"), algorithms.clone()));
             }
             if cfg.navigation.is_some() {
-                series.push(Series::new("ins/position_error_m".into(), 3));
-                series.push(Series::new("ins/velocity_error_mps".into(), 3));
+                series.push(Series::new("ins/position_error_m".into(), ["east", "north", "radial"].map(String::from).to_vec()));
+                series.push(Series::new("ins/velocity_error_mps".into(), ["east", "north", "up"].map(String::from).to_vec()));
             }
             InsLayout {
                 algorithms,
@@ -153,8 +207,10 @@ impl Recorder {
                 signal_window_s: cfg.signal_window_s.max(0.01),
             }
         });
+        let n = axis_names.len();
         let me = Self {
             rec,
+            stream,
             chain,
             truth: params.table.truth.clone(),
             drawing,
@@ -168,6 +224,7 @@ impl Recorder {
             scene_gimbals: vec![Vec::new(); n],
             chunks_in_flight: 0,
             live,
+            replay,
             ins,
         };
         me.log_once(params)?;
@@ -178,13 +235,24 @@ impl Recorder {
         Ok(me)
     }
 
+    /// A recorder for a replayed log: the same scene and plots, the demodulations named for what they
+    /// are (the nominal and the compensated table, against the log's reference).
+    pub fn new_replay(stream: Stream, params: &Params) -> RecordingStreamResult<Self> {
+        Self::build_with(stream, params, false, true, None)
+    }
+
     /// A recorder for live mode: everything that a reload can change is logged on the timeline.
-    pub fn new_live(rec: RecordingStream, params: &Params) -> RecordingStreamResult<Self> {
-        Self::build(rec, params, true, None)
+    pub fn new_live(stream: Stream, params: &Params) -> RecordingStreamResult<Self> {
+        Self::build(stream, params, true, None)
     }
 
     fn geometry_at(&self, t_s: f64) -> Option<f64> {
         self.live.then_some(t_s)
+    }
+
+    /// Sends the layout again for `params` (a replay knows its length only at the end).
+    pub fn resend_layout(&self, params: &Params) -> RecordingStreamResult<()> {
+        self.send_blueprint(params, None)
     }
 
     /// Live mode: new parameters apply from simulated time `t_s` on (buffered rows go out first).
@@ -204,8 +272,13 @@ impl Recorder {
 
     /// The underlying stream (for flushing and sinks).
     #[must_use]
-    pub fn stream(&self) -> &RecordingStream {
-        &self.rec
+    pub fn stream(&self) -> &Stream {
+        &self.stream
+    }
+
+    /// The line names of the series at `path` (its legend).
+    pub(crate) fn series_names(&self, path: &str) -> Vec<String> {
+        self.series.iter().find(|s| s.path == path).map(|s| s.names.clone()).unwrap_or_default()
     }
 
     /// Buffers one time-series row; sends a chunk when the buffer is full.
@@ -301,9 +374,8 @@ impl Recorder {
         let times = std::mem::take(&mut self.series_t);
         for s in &mut self.series {
             let values = std::mem::take(&mut s.values);
-            debug_assert_eq!(values.len(), s.width * times.len());
-            let time = TimeColumn::new_duration_secs(TIMELINE, times.iter().copied());
-            self.rec.send_columns(s.path.as_str(), [time], rerun::Scalars::new(values).columns(std::iter::repeat_n(s.width, times.len()))?)?;
+            debug_assert_eq!(values.len(), s.width() * times.len());
+            self.stream.send_series(&s.path, &s.names, &times, values, s.width())?;
         }
         Ok(())
     }

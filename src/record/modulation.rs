@@ -1,17 +1,18 @@
 //! The recording of `rinscope modulation`: the three variants' position and heading errors overlaid.
 
 use rerun::blueprint::components::ContainerKind;
-use rerun::{RecordingStream, RecordingStreamResult, TimeColumn};
+use rerun::RecordingStreamResult;
 
 use super::layout::{self, Node};
 use super::palette::rgb;
-use super::{APPLICATION_ID, TIMELINE};
+use super::{Stream, APPLICATION_ID, TIMELINE};
 use crate::ins::trace::{NavSample, NavTrace};
 
 const COLORS: [[u8; 3]; 3] = [[230, 76, 60], [240, 180, 40], [46, 170, 90]];
 
 /// Logs the traces (sampled at the same instants) with their explanation and a layout.
-pub fn log(rec: &RecordingStream, traces: &[NavTrace], table: &str) -> RecordingStreamResult<()> {
+pub fn log(stream: &Stream, traces: &[NavTrace], table: &str) -> RecordingStreamResult<()> {
+    let rec = stream.rec();
     rec.send_recording_name("rinscope: rotation modulation")?;
     let names: Vec<String> = traces.iter().map(|t| t.label.clone()).collect();
     let doc = format!(
@@ -46,8 +47,7 @@ pub fn log(rec: &RecordingStream, traces: &[NavTrace], table: &str) -> Recording
         ("modulation/north_error_m", column(&|s| s.position_m[1])),
         ("modulation/heading_error_arcsec", column(&|s| s.heading_arcsec)),
     ] {
-        let time = TimeColumn::new_duration_secs(TIMELINE, times.iter().copied());
-        rec.send_columns(path, [time], rerun::Scalars::new(values).columns(std::iter::repeat_n(width, n))?)?;
+        stream.send_series(path, &names, &times, values, width)?;
     }
     let plot = |name: &str, origin: &str| Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::whole_run_time_axis());
     let root = Node::container(

@@ -10,7 +10,7 @@ use super::{to_rerun_quaternion, Recorder, TIMELINE};
 use crate::math::units::{fmt_angle, ARCSEC_PER_RAD, DEG_PER_RAD};
 use crate::model::gimbal::AxisGeometry;
 use crate::scenario::Params;
-use crate::sim::{DEMODULATIONS, ERROR_AXES};
+use crate::sim::ERROR_AXES;
 
 /// Entity paths of the chain.
 #[derive(Debug, Clone)]
@@ -56,33 +56,28 @@ impl Recorder {
         )?;
 
         // Series styles, once.
-        let variant_names: Vec<String> = DEMODULATIONS.iter().map(|v| v.replace('_', " ")).collect();
         for axis in ERROR_AXES {
+            let path = format!("attitude_error_arcsec/{axis}");
             rec.log_static(
-                format!("attitude_error_arcsec/{axis}"),
-                &rerun::SeriesLines::new()
-                    .with_colors(colors::VARIANT.map(rgb))
-                    .with_names(variant_names.clone())
-                    .with_widths([3.0, 1.5, 1.0]),
+                path.as_str(),
+                &rerun::SeriesLines::new().with_colors(colors::VARIANT.map(rgb)).with_names(self.series_names(&path)).with_widths([3.0, 1.5, 1.0]),
             )?;
         }
         rec.log_static(
             "vehicle_attitude_deg",
-            &rerun::SeriesLines::new().with_colors(colors::EULER.map(rgb)).with_names(ERROR_AXES),
+            &rerun::SeriesLines::new().with_colors(colors::EULER.map(rgb)).with_names(self.series_names("vehicle_attitude_deg")),
         )?;
         let n = self.axis_names.len();
         rec.log_static(
             "gimbal_angle_deg",
-            &rerun::SeriesLines::new().with_colors(colors::AXES[..n].iter().map(|c| rgb(*c))).with_names(self.axis_names.clone()),
+            &rerun::SeriesLines::new().with_colors(colors::AXES[..n].iter().map(|c| rgb(*c))).with_names(self.series_names("gimbal_angle_deg")),
         )?;
         for (k, name) in self.axis_names.iter().enumerate() {
-            let g = &self.chain.axes()[k];
             let light = colors::AXES[k].map(|c| c / 2 + 60);
+            let path = format!("swing_arcsec/{name}");
             rec.log_static(
-                format!("swing_arcsec/{name}"),
-                &rerun::SeriesLines::new()
-                    .with_colors([rgb(colors::AXES[k]), rgb(light)])
-                    .with_names([format!("{name} swing about {}", axis_letter(&g.e1)), format!("{name} swing about {}", axis_letter(&g.e2))]),
+                path.as_str(),
+                &rerun::SeriesLines::new().with_colors([rgb(colors::AXES[k]), rgb(light)]).with_names(self.series_names(&path)),
             )?;
         }
 
@@ -186,10 +181,15 @@ impl Recorder {
     pub(crate) fn log_error_geometry(&self, p: &Params, at: Option<f64>) -> RecordingStreamResult<()> {
         // Documents: the scenario explains itself; the resolved config makes the run reproducible.
         let mut doc = format!("# {}\n\n*{}*\n\n{}\n", p.meta.name, p.meta.title, p.meta.description.trim());
+        let plots = if self.replay {
+            "Plots (a replayed log): red = the INS attitude demodulated through the nominal table, green = through the compensated table, \
+             each against the log's reference attitude (without one, the compensated demodulation is the reference)."
+        } else {
+            "Plots: red = uncompensated (nominal table model), green = compensated (`[compensation]` parameters), \
+             blue = closed form (first-order theory, docs/closed-form.md)."
+        };
         doc.push_str(&format!(
-            "\n---\nError angles in the 3D view are drawn **×{}**. Plots: red = uncompensated (nominal table model), \
-             green = compensated (`[compensation]` parameters), blue = closed form (first-order theory, docs/closed-form.md). \
-             Seed {}.\n",
+            "\n---\nError angles in the 3D view are drawn **×{}**. {plots} Seed {}.\n",
             p.recording.exaggeration, p.meta.seed
         ));
         self.put(at, "docs/scenario", &rerun::TextDocument::from_markdown(doc))?;

@@ -11,6 +11,10 @@ use rerun::{RecordingStream, RecordingStreamBuilder};
 
 pub use crate::io::files::partial_path;
 
+use super::export::{ExportFormat, Exporter, SharedExporter};
+use super::Stream;
+use std::sync::{Arc, Mutex};
+
 /// The viewer version that matches the SDK this binary is built with.
 pub const VIEWER_INSTALL_HINT: &str = "pip install rerun-sdk==0.36.3";
 
@@ -56,6 +60,9 @@ pub enum SinkError {
     /// Spawning the viewer failed.
     #[error("--spawn: {0}")]
     Spawn(String),
+    /// The export tables could not be written.
+    #[error("--export: {0}")]
+    Export(String),
     /// Any other Rerun SDK error.
     #[error("rerun: {0}")]
     Rerun(String),
@@ -72,12 +79,16 @@ pub struct SinkRequest {
     pub connect: Option<String>,
     /// Serve the stream on this gRPC port for viewers (native or web) to connect to.
     pub serve: Option<u16>,
+    /// Also write every time series as tables into this folder.
+    pub export: Option<(PathBuf, ExportFormat)>,
 }
 
 /// An open recording and the file it will become.
 pub struct OpenSinks {
     /// The stream to log into.
-    pub rec: RecordingStream,
+    rec: RecordingStream,
+    /// The export tables, if asked for.
+    export: Option<SharedExporter>,
     /// (partial path, final path) of the saved file, if any.
     pub file: Option<(PathBuf, PathBuf)>,
     /// Human-readable description of where the data goes.
@@ -155,32 +166,60 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
         ));
     }
 
+    let export = match &req.export {
+        None => None,
+        Some((dir, format)) => {
+            let e = Exporter::new(dir, *format).map_err(|e| SinkError::Export(format!("{}: {e}", dir.display())))?;
+            description.push(format!("exporting every time series as {format:?} tables to {}", dir.display()));
+            Some(Arc::new(Mutex::new(e)))
+        }
+    };
     let rec = RecordingStreamBuilder::new(application_id)
         .recording_id(recording_id.to_owned())
         .set_sinks(sinks)
         .map_err(|e| SinkError::Rerun(e.to_string()))?;
-    Ok(OpenSinks { rec, file, description })
+    Ok(OpenSinks { rec, export, file, description })
+}
+
+/// What a finished run left.
+#[derive(Debug, Clone, Default)]
+pub struct Saved {
+    /// The recording file and its size, bytes.
+    pub recording: Option<(PathBuf, u64)>,
+    /// The export tables.
+    pub exported: Vec<PathBuf>,
 }
 
 impl OpenSinks {
-    /// Flushes, closes every sink and moves the saved file to its final name.
-    /// Returns the final path and its size in bytes.
-    pub fn finish(self) -> Result<Option<(PathBuf, u64)>, SinkError> {
-        let Self { rec, file, .. } = self;
+    /// The stream (and export tables) the recorders log into.
+    #[must_use]
+    pub fn stream(&self) -> Stream {
+        Stream::new(self.rec.clone(), self.export.clone())
+    }
+
+    /// Flushes, closes every sink, moves the saved file to its final name and finishes the export
+    /// tables.
+    pub fn finish(self) -> Result<Saved, SinkError> {
+        let Self { rec, file, export, .. } = self;
         // A viewer that went away fails the flush; the file must still be completed and kept.
         if let Err(e) = rec.flush_with_timeout(std::time::Duration::from_secs(10)) {
             eprintln!("rinscope: not every sink received the whole stream ({e}); the saved file is complete");
         }
         // Dropping the last handle joins the batcher and the file writer, which writes the footer.
         drop(rec);
-        match file {
-            None => Ok(None),
+        let recording = match file {
+            None => None,
             Some((partial, path)) => {
                 std::fs::rename(&partial, &path).map_err(|e| SinkError::File { path: path.display().to_string(), reason: e.to_string() })?;
                 let bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
-                Ok(Some((path, bytes)))
+                Some((path, bytes))
             }
-        }
+        };
+        let exported = match export {
+            None => Vec::new(),
+            Some(e) => e.lock().unwrap_or_else(std::sync::PoisonError::into_inner).finish().map_err(|e| SinkError::Export(e.to_string()))?,
+        };
+        Ok(Saved { recording, exported })
     }
 
     /// Closes every sink and deletes the partial file (the run failed).

@@ -2,18 +2,19 @@
 //! of TPR overlaid, the fixes marked, the comparison with seed 003 as a document.
 
 use rerun::blueprint::components::ContainerKind;
-use rerun::{RecordingStream, RecordingStreamResult, TimeColumn};
+use rerun::RecordingStreamResult;
 
 use super::layout::{self, Node};
 use super::palette::rgb;
-use super::{APPLICATION_ID, TIMELINE};
+use super::{Stream, APPLICATION_ID, TIMELINE};
 use crate::scenario::Params;
 use crate::ins::reset::{TprResult, BRANCHES, BRANCH_NAMES, PAPER_RADIAL_M};
 
 const COLORS: [[u8; 3]; BRANCHES] = [[230, 76, 60], [46, 170, 90], [70, 130, 230]];
 
 /// Logs the comparison.
-pub fn log(rec: &RecordingStream, params: &Params, r: &TprResult, table: &str) -> RecordingStreamResult<()> {
+pub fn log(stream: &Stream, params: &Params, r: &TprResult, table: &str) -> RecordingStreamResult<()> {
+    let rec = stream.rec();
     rec.send_recording_name(format!("rinscope: {}", params.meta.name))?;
     rec.send_property(
         "rinscope",
@@ -38,7 +39,6 @@ pub fn log(rec: &RecordingStream, params: &Params, r: &TprResult, table: &str) -
     for path in paths {
         rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors.clone()).with_names(BRANCH_NAMES))?;
     }
-    let n = r.samples.len();
     let times: Vec<f64> = r.samples.iter().map(|s| s.t_s).collect();
     let columns: [Vec<f64>; 4] = [
         r.samples.iter().flat_map(|s| s.heading_arcsec).collect(),
@@ -46,9 +46,9 @@ pub fn log(rec: &RecordingStream, params: &Params, r: &TprResult, table: &str) -
         r.samples.iter().flat_map(|s| s.east_north_m[0]).collect(),
         r.samples.iter().flat_map(|s| s.east_north_m[1]).collect(),
     ];
+    let names = BRANCH_NAMES.map(String::from);
     for (path, values) in paths.iter().zip(columns) {
-        let time = TimeColumn::new_duration_secs(TIMELINE, times.iter().copied());
-        rec.send_columns(*path, [time], rerun::Scalars::new(values).columns(std::iter::repeat_n(BRANCHES, n))?)?;
+        stream.send_series(path, &names, &times, values, BRANCHES)?;
     }
     for (k, t) in r.fixes_s.iter().enumerate() {
         rec.set_duration_secs(TIMELINE, *t);

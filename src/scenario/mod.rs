@@ -5,6 +5,7 @@
 //! Every error names the key, the value and the unit (and the allowed range where there is one).
 
 pub mod instruments;
+pub mod logset;
 pub mod presets;
 pub mod raw;
 pub mod validate;
@@ -154,13 +155,26 @@ impl Params {
     }
 }
 
+/// Largest configuration file read, bytes: a scenario is a few kB; anything this big is not one.
+const MAX_CONFIG_BYTES: u64 = 16 << 20;
+
+/// Reads a configuration file: a regular file of at most [`MAX_CONFIG_BYTES`] (a FIFO, a device
+/// or `/dev/zero` would block or never end).
+pub fn read_text(path: &Path) -> Result<String, ConfigError> {
+    let err = |source: std::io::Error| ConfigError::Read { path: path.display().to_string(), source };
+    let meta = std::fs::metadata(path).map_err(err)?;
+    if !meta.is_file() {
+        return Err(err(std::io::Error::other("not a regular file (a directory, FIFO or device is not a configuration)")));
+    }
+    if meta.len() > MAX_CONFIG_BYTES {
+        return Err(err(std::io::Error::other(format!("{} bytes: larger than any configuration ({} MB at most)", meta.len(), MAX_CONFIG_BYTES >> 20))));
+    }
+    std::fs::read_to_string(path).map_err(err)
+}
+
 /// Reads and validates a scenario file.
 pub fn load_file(path: &Path) -> Result<Params, ConfigError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
-        path: path.display().to_string(),
-        source,
-    })?;
-    parse(&text, &path.display().to_string())
+    parse(&read_text(path)?, &path.display().to_string())
 }
 
 /// Parses and validates scenario text; `origin` names the file or the embedded scenario in errors.
@@ -201,3 +215,35 @@ pub fn flatten(raw: &RawConfig) -> BTreeMap<String, String> {
     out
 }
 
+
+/// The `[compensation]` keys that state `errors` on `chain` (every key given): what a calibration
+/// writes for `replay --compensation` and a scenario's `[compensation]`.
+#[must_use]
+pub fn compensation_keys(chain: &crate::model::gimbal::Chain, errors: &crate::model::gimbal::TableErrors) -> raw::RawCompensation {
+    use crate::math::units::{ARCSEC_PER_RAD, DEG_PER_RAD};
+    let arcsec = |x: f64| Some(x * ARCSEC_PER_RAD);
+    let mut axis = BTreeMap::new();
+    for (g, e) in chain.axes().iter().zip(&errors.axes) {
+        axis.insert(
+            g.name.clone(),
+            raw::RawAxisCompensation {
+                swing_half_angle_arcsec: arcsec(e.swing_half_angle_rad),
+                swing_phase_deg: Some(e.swing_phase_rad * DEG_PER_RAD),
+                non_orthogonality_arcsec: arcsec(e.non_orthogonality_rad),
+                encoder_offset_arcsec: arcsec(e.encoder_offset_rad),
+                encoder_scale_ppm: Some(e.encoder_scale * 1e6),
+                encoder_delay_ms: Some(e.encoder_delay_s * 1e3),
+            },
+        );
+    }
+    raw::RawCompensation {
+        enabled: Some(true),
+        installation_x_arcsec: arcsec(errors.installation_rad.x),
+        installation_y_arcsec: arcsec(errors.installation_rad.y),
+        installation_z_arcsec: arcsec(errors.installation_rad.z),
+        imu_mount_x_arcsec: arcsec(errors.imu_mount_rad.x),
+        imu_mount_y_arcsec: arcsec(errors.imu_mount_rad.y),
+        imu_mount_z_arcsec: arcsec(errors.imu_mount_rad.z),
+        axis,
+    }
+}

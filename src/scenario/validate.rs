@@ -282,7 +282,7 @@ fn validate_scheme(c: &Checker<'_>, s: &RawScheme, chain: &Chain) -> Result<Sche
     }
 }
 
-fn validate_compensation(
+pub(super) fn validate_compensation(
     c: &Checker<'_>,
     comp: &RawCompensation,
     table: &RawTurntable,

@@ -1,4 +1,7 @@
-//! `rinscope bench`: simulation speed without recording, and a full recorded run's speed and size.
+//! `rinscope bench`: simulation speed without recording, and a full recorded run's speed and size;
+//! `bench --peer pyins` (peer.rs) against another INS.
+
+pub mod peer;
 
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
@@ -57,7 +60,7 @@ pub fn run_benchmarks(steps: u64) -> anyhow::Result<()> {
         let sinks = sink::open(&SinkRequest { save: Some(path.clone()), ..Default::default() }, "rinscope-bench", name)?;
         let started = Instant::now();
         let summary = crate::app::run::run_recorded(&p, &sinks, &AtomicBool::new(false), false)?;
-        let (_, bytes) = sinks.finish()?.ok_or_else(|| anyhow::anyhow!("no file written"))?;
+        let (_, bytes) = sinks.finish()?.recording.ok_or_else(|| anyhow::anyhow!("no file written"))?;
         let secs = started.elapsed().as_secs_f64();
         println!(
             "recorded run      {name:<28} 3600 s at {} Hz (series {} Hz, scene {} Hz): {} steps in {secs:.2} s, {:.2} MB per simulated hour",
@@ -74,7 +77,7 @@ pub fn run_benchmarks(steps: u64) -> anyhow::Result<()> {
     let sinks = sink::open(&SinkRequest { save: Some(path), ..Default::default() }, "rinscope-bench", "ins24h")?;
     let started = Instant::now();
     let summary = crate::app::run::run_recorded(&p, &sinks, &AtomicBool::new(false), false)?;
-    let (_, bytes) = sinks.finish()?.ok_or_else(|| anyhow::anyhow!("no file written"))?;
+    let (_, bytes) = sinks.finish()?.recording.ok_or_else(|| anyhow::anyhow!("no file written"))?;
     println!(
         "INS 24 h          rotation-modulation-16-position: {} IMU samples at 200 Hz with navigation and recording in {:.2} s ({:.2} MB)",
         summary.steps,
@@ -167,7 +170,7 @@ fn live_latency(dir: &std::path::Path) -> anyhow::Result<()> {
     let sinks = sink::open(&SinkRequest { save: Some(rec_path), ..Default::default() }, "rinscope-bench", "live")?;
     let session = {
         let (status, stop) = (status.clone(), stop.clone());
-        let outputs = live::Outputs { viewer: None, file: Some(sinks.rec.clone()) };
+        let outputs = live::Outputs { viewer: None, file: Some(sinks.stream()) };
         std::thread::spawn(move || live::run_session_with_status(&opts, params, outputs, &stop, &status))
     };
     std::thread::sleep(std::time::Duration::from_millis(300));

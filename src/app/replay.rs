@@ -1,0 +1,298 @@
+//! `rinscope replay`: a recorded RINS through the same pipeline as a simulation — the navigation
+//! computer on the logged IMU samples, the body attitude demodulated through the nominal and the
+//! compensated table models at the logged encoder angles, the same 3D scene and plots. With a
+//! reference attitude the plots are errors against it; without, the compensated demodulation is the
+//! reference (the "uncompensated" plot then shows what the compensation changes).
+
+use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use serde::Serialize;
+
+use super::playback::{Gap, Playback, PlaybackError};
+use super::run::{NavSummary, RmsPeak};
+use crate::ins::pipeline::InsView;
+use crate::math::attitude::{Attitude, AttitudeError};
+use crate::math::frames::Rot;
+use crate::math::stats::RunningStat;
+use crate::math::timeline::decimation;
+use crate::math::units::ARCSEC_PER_RAD;
+use crate::model::gimbal::TableErrors;
+use crate::record::Recorder;
+use crate::scenario::logset::{LogSet, Reference};
+use crate::sim::{DemodState, StepOutput, ERROR_AXES};
+
+/// The result of a replay, as printed and as written by `--summary-json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct ReplaySummary {
+    /// The log set's name.
+    pub log: String,
+    /// What the errors are measured against.
+    pub reference: String,
+    /// IMU samples replayed (after the pre-roll / alignment).
+    pub samples: u64,
+    /// Replayed time, s.
+    pub duration_s: f64,
+    /// Wall time, s.
+    pub wall_time_s: f64,
+    /// IMU samples per wall-clock second.
+    pub samples_per_second: f64,
+    /// True if stopped before the end of the log.
+    pub interrupted: bool,
+    /// `[demodulation][axis]`: "nominal" and "compensated" table, against the reference (the primary
+    /// algorithm at the output instants); without a reference, "nominal" is nominal − compensated.
+    pub attitude_error_arcsec: BTreeMap<String, BTreeMap<String, RmsPeak>>,
+    /// `[algorithm][axis]`: each algorithm's compensated body attitude against the reference.
+    pub ins_attitude_error_arcsec: BTreeMap<String, BTreeMap<String, RmsPeak>>,
+    /// Navigation errors relative to the start site (a resting log), when navigating.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub navigation: Option<NavSummary>,
+    /// Gaps in the IMU data the replay carried the attitude across.
+    pub gaps: Vec<Gap>,
+    /// The navigation computer's state after the last sample (to compare with another INS).
+    pub final_state: FinalState,
+    /// Peak resident memory of the process at the end of the replay, MB.
+    pub peak_rss_mb: f64,
+    /// Saved recording, if any.
+    pub recording_path: Option<String>,
+    /// Its size, bytes.
+    pub recording_bytes: Option<u64>,
+}
+
+/// The primary algorithm's state after the last replayed sample.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct FinalState {
+    /// The instant the attitude stands for, s (the last update, less the FIR's delay).
+    pub t_s: f64,
+    /// Attitude of the IMU's sensor axes in the local level frame, deg (heading clockwise from North).
+    pub imu_pitch_deg: f64,
+    /// Roll, deg.
+    pub imu_roll_deg: f64,
+    /// Heading, deg.
+    pub imu_heading_deg: f64,
+    /// Latitude, deg (navigating only).
+    pub latitude_deg: Option<f64>,
+    /// Longitude, deg.
+    pub longitude_deg: Option<f64>,
+    /// Height, m.
+    pub height_m: Option<f64>,
+    /// Velocity (East, North, Up), m/s.
+    pub velocity_enu_mps: Option<[f64; 3]>,
+}
+
+fn table(names: &[String], stats: &[[RunningStat; 3]]) -> BTreeMap<String, BTreeMap<String, RmsPeak>> {
+    names
+        .iter()
+        .zip(stats)
+        .map(|(name, s)| {
+            let row = ERROR_AXES.iter().zip(s).map(|(axis, st)| ((*axis).to_owned(), RmsPeak { rms_arcsec: st.rms() * ARCSEC_PER_RAD, peak_arcsec: st.peak() * ARCSEC_PER_RAD })).collect();
+            (name.clone(), row)
+        })
+        .collect()
+}
+
+impl ReplaySummary {
+    /// The end-of-replay table.
+    #[must_use]
+    pub fn text(&self) -> String {
+        let mut s = format!(
+            "replay of {} — {:.1} s, {} IMU samples, {:.2} s wall ({:.2} M samples/s){}\nreference: {}\n",
+            self.log,
+            self.duration_s,
+            self.samples,
+            self.wall_time_s,
+            self.samples_per_second / 1e6,
+            if self.interrupted { " — INTERRUPTED" } else { "" },
+            self.reference
+        );
+        s.push_str("attitude error, arcsec     pitch rms  pitch peak    roll rms   roll peak  heading rms heading peak\n");
+        let rows = |s: &mut String, label: &str, t: &BTreeMap<String, BTreeMap<String, RmsPeak>>| {
+            for (name, row) in t {
+                s.push_str(&format!("{:<24}", format!("{label}{name}")));
+                for axis in ERROR_AXES {
+                    let v = row[axis];
+                    s.push_str(&format!(" {:>11.3} {:>11.3}", v.rms_arcsec, v.peak_arcsec));
+                }
+                s.push('\n');
+            }
+        };
+        rows(&mut s, "", &self.attitude_error_arcsec);
+        if self.ins_attitude_error_arcsec.len() > 1 {
+            s.push_str("by algorithm (compensated)\n");
+            rows(&mut s, "  ", &self.ins_attitude_error_arcsec);
+        }
+        if let Some(n) = &self.navigation {
+            s.push_str(&format!(
+                "navigation: radial position error peak {:.1} m, final {:.1} m (east {:.1} m, north {:.1} m)\n",
+                n.peak_radial_m, n.final_radial_m, n.final_east_m, n.final_north_m
+            ));
+        }
+        for g in &self.gaps {
+            s.push_str(&format!("gap in the IMU data: {:.3} s → {:.3} s ({:.3} s), attitude carried across\n", g.from_s, g.to_s, g.to_s - g.from_s));
+        }
+        s
+    }
+}
+
+fn final_state(pb: &Playback) -> FinalState {
+    let (t_s, n_from_s) = pb.core.latest_attitude(0);
+    // The sensor frame read as a body frame: the same matrix, its Euler angles.
+    let a = Attitude::from_n_from_b(&Rot::from_quaternion(*n_from_s.quaternion()));
+    let nav = pb.core.nav_state();
+    FinalState {
+        t_s,
+        imu_pitch_deg: a.pitch_rad.to_degrees(),
+        imu_roll_deg: a.roll_rad.to_degrees(),
+        imu_heading_deg: a.heading_rad.to_degrees(),
+        latitude_deg: nav.map(|n| n.latitude_rad.to_degrees()),
+        longitude_deg: nav.map(|n| n.longitude_rad.to_degrees()),
+        height_m: nav.map(|n| n.height_m),
+        velocity_enu_mps: nav.map(|n| [n.v_n.x, n.v_n.y, n.v_n.z]),
+    }
+}
+
+/// Replays `log` with the compensation `compensation` (the table description's, or a calibration's)
+/// into `recorder` if given; `stop` ends it early (the summary says so); `bar`, if given, shows the
+/// replayed time.
+pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mut Recorder>, stop: &AtomicBool, bar: Option<&indicatif::ProgressBar>) -> Result<ReplaySummary, PlaybackError> {
+    let started = Instant::now();
+    let mut pb = Playback::open(log, compensation)?;
+    let chain = &log.table.chain;
+    let nominal = TableErrors::zero(chain.axes().len());
+    let (nominal_rot, comp_rot) = (chain.error_rotations(&nominal), chain.error_rotations(compensation));
+    let algorithms: Vec<String> = pb.core.algorithms().iter().map(|a| a.name().to_owned()).collect();
+    let rate = log.table.ins.rate_hz;
+    let series_every = decimation(rate, log.table.recording.series_hz);
+    let scene_every = decimation(rate, log.table.recording.scene_hz);
+    let window = log.table.ins.signal_window_s;
+    let mut demod = vec![DemodState::default(); algorithms.len()];
+    let mut demod_nominal = DemodState::default();
+    let mut stats = [[RunningStat::default(); 3]; 2];
+    let mut ins_stats = vec![[RunningStat::default(); 3]; algorithms.len()];
+    let mut nav: Option<NavSummary> = None;
+    let (mut next_series, mut next_scene) = (0u64, 0u64);
+    let mut interrupted = false;
+    let mut t_end = 0.0;
+    let mut i = 0u64;
+    let nan = AttitudeError { pitch_rad: f64::NAN, roll_rad: f64::NAN, heading_rad: f64::NAN };
+    while let Some(s) = pb.step()? {
+        i += 1;
+        t_end = s.t_s;
+        if i.is_multiple_of(65_536) {
+            if stop.load(Ordering::Relaxed) {
+                interrupted = true;
+                break;
+            }
+            if let Some(bar) = bar {
+                bar.set_message(format!("{:.0} s of the log replayed ({:.1} M samples/s)", s.t_s, i as f64 / started.elapsed().as_secs_f64().max(1e-9) / 1e6));
+            }
+        }
+        if s.t_s <= window
+            && let Some(r) = recorder.as_deref_mut()
+        {
+            r.push_signal(&s).map_err(|e| PlaybackError::Data(format!("rerun: {e}")))?;
+        }
+        if !s.updated {
+            continue;
+        }
+        let (want_series, want_scene) = (i >= next_series, i >= next_scene);
+        if !(want_series || want_scene) {
+            continue;
+        }
+        // Each algorithm at the instant its own output stands for, as the simulation compares them.
+        let mut errors = Vec::with_capacity(algorithms.len());
+        let mut primary = None;
+        for (k, state) in demod.iter_mut().enumerate() {
+            let (t_repr, _) = pb.core.output_attitude(k);
+            let t_ref = pb.core.reference_instant(t_repr);
+            let encoder = pb.encoders_at(t_repr)?;
+            let corrected = state.correct(compensation, t_repr, &encoder);
+            let body = pb.body_attitude(k, chain, &comp_rot, &corrected);
+            let reference = pb.reference_at(t_ref)?;
+            errors.push(body.error_from(&reference.unwrap_or(body)));
+            if k == 0 {
+                let raw = demod_nominal.correct(&nominal, t_repr, &encoder);
+                let body_nominal = pb.body_attitude(0, chain, &nominal_rot, &raw);
+                primary = Some((t_repr, encoder, corrected, body, body_nominal, reference));
+            }
+        }
+        let Some((t_repr, encoder, corrected, body, body_nominal, reference)) = primary else { continue };
+        let truth = reference.unwrap_or(body);
+        let out = StepOutput {
+            t_s: s.t_s,
+            attitude: truth,
+            n_from_b: truth.n_from_b(),
+            gimbal_rad: corrected,
+            encoder_rad: encoder,
+            errors: [body_nominal.error_from(&truth), body.error_from(&truth), nan],
+        };
+        let (_, imu_ins) = pb.core.output_attitude(0);
+        // The best estimate of the true IMU attitude: the reference through the compensated table.
+        let imu_true = match reference {
+            Some(r) => r.n_from_b() * chain.b_from_s(&comp_rot, &corrected),
+            None => imu_ins,
+        };
+        let view = InsView { t_s: s.t_s, t_ref_s: pb.core.reference_instant(t_repr), errors, imu_true, imu_ins, nav: pb.core.nav_error() };
+        if want_series {
+            next_series = i + series_every;
+            for (v, e) in out.errors[..2].iter().enumerate() {
+                for (a, x) in e.as_array().into_iter().enumerate() {
+                    stats[v][a].add(x);
+                }
+            }
+            for (k, e) in view.errors.iter().enumerate() {
+                for (a, x) in e.as_array().into_iter().enumerate() {
+                    ins_stats[k][a].add(x);
+                }
+            }
+            if let Some(e) = view.nav {
+                let peak = nav.map_or(0.0, |n| n.peak_radial_m).max(e.radial_m);
+                nav = Some(NavSummary { peak_radial_m: peak, final_radial_m: e.radial_m, final_east_m: e.east_m, final_north_m: e.north_m });
+            }
+            if let Some(r) = recorder.as_deref_mut() {
+                r.push_row(&out, Some(&view)).map_err(|e| PlaybackError::Data(format!("rerun: {e}")))?;
+            }
+        }
+        if want_scene {
+            next_scene = i + scene_every;
+            if let Some(r) = recorder.as_deref_mut() {
+                r.push_scene_row(&out, Some(&view)).map_err(|e| PlaybackError::Data(format!("rerun: {e}")))?;
+            }
+        }
+    }
+    let reference = match &log.reference {
+        Reference::None => "none: the compensated demodulation (the \"nominal\" row is nominal − compensated)".to_owned(),
+        Reference::Static(a) => format!("a static attitude (pitch {:.4}°, roll {:.4}°, heading {:.4}°)", a.pitch_rad.to_degrees(), a.roll_rad.to_degrees(), a.heading_rad.to_degrees()),
+        Reference::File(p) => format!("the attitude in {}", p.display()),
+    };
+    let wall = started.elapsed().as_secs_f64();
+    let summary = ReplaySummary {
+        log: log.name.clone(),
+        reference,
+        samples: pb.samples,
+        duration_s: t_end,
+        wall_time_s: wall,
+        samples_per_second: pb.samples as f64 / wall.max(1e-9),
+        interrupted,
+        attitude_error_arcsec: table(&["nominal".to_owned(), "compensated".to_owned()], &stats),
+        ins_attitude_error_arcsec: table(&algorithms, &ins_stats),
+        navigation: nav,
+        gaps: pb.gaps.clone(),
+        final_state: final_state(&pb),
+        peak_rss_mb: crate::app::bench::peak_rss_bytes() as f64 / 1e6,
+        recording_path: None,
+        recording_bytes: None,
+    };
+    if let Some(r) = recorder {
+        let rerun = |e: crate::record::RecordError| PlaybackError::Data(format!("rerun: {e}"));
+        for g in &summary.gaps {
+            r.event(g.to_s, &format!("gap in the IMU data from {:.3} s to {:.3} s: the attitude was carried across", g.from_s, g.to_s), "WARN").map_err(rerun)?;
+        }
+        let end = if interrupted { format!("replay interrupted by the user at {t_end:.3} s; the recording holds everything replayed until then") } else { format!("replay finished at {t_end:.3} s") };
+        r.event(t_end, &end, if interrupted { "WARN" } else { "INFO" }).map_err(rerun)?;
+        r.event(t_end, &format!("summary:\n{}", summary.text()), "INFO").map_err(rerun)?;
+        r.finish().map_err(rerun)?;
+    }
+    Ok(summary)
+}

@@ -1,0 +1,179 @@
+//! The commands on recorded data: `export-log`, `replay` and `calibrate --log`.
+
+use std::path::{Path, PathBuf};
+
+use super::commands::{check_output_dir, open_sinks, print_saved, read_small_file, write_json};
+use super::{CalibrateArgs, ExportLogArgs, Failure, ReplayArgs};
+use crate::app::calibrate::{self as calibration, estimated_compensation, CalibrationOutput, LogCalibrationError};
+use crate::app::export_log::{export_log as write_log_set, LogFormat};
+use crate::app::replay::replay as replay_log;
+use crate::app::terminate::stop_flag;
+use crate::record::Recorder;
+use crate::scenario::logset::{self, RawImuFile, RawInitial, RawLogInfo, RawManifest, RawReference, RawTable};
+use crate::scenario::{presets, ConfigError};
+
+impl From<crate::app::playback::PlaybackError> for Failure {
+    fn from(e: crate::app::playback::PlaybackError) -> Self {
+        Self::input(format!("replay: {e}"))
+    }
+}
+
+/// `rinscope export-log`.
+pub(super) fn export_log(args: &ExportLogArgs) -> Result<(), Failure> {
+    let params = args.source.load(presets::DEFAULT_SCENARIO)?;
+    let format = LogFormat::parse(&args.format).map_err(|e| Failure::input(format!("--format {e}")))?;
+    let stop = stop_flag();
+    let written = write_log_set(&params, &args.out, format, &stop).map_err(|e| match e {
+        crate::app::export_log::ExportError::Interrupted => Failure::interrupted(format!("export-log: {e}")),
+        other => Failure::input(format!("export-log: {other}")),
+    })?;
+    println!(
+        "log set {}: {} IMU samples of {} ({:.1} s at {} Hz), encoders, reference attitude, table.toml, log.toml ({:.2} MB)",
+        written.dir.display(),
+        written.samples,
+        params.meta.name,
+        params.duration_s,
+        params.step_hz,
+        written.bytes as f64 / 1e6
+    );
+    println!("replay it with:  rinscope replay {}", written.dir.display());
+    Ok(())
+}
+
+/// The log set of `args`: a folder with a manifest, or one IMU file described by the flags.
+fn load_log(args: &ReplayArgs) -> Result<logset::LogSet, Failure> {
+    if let Some(dir) = &args.dir {
+        return Ok(logset::load(dir)?);
+    }
+    let (Some(imu), Some(rate_hz), Some(table)) = (&args.imu, args.rate_hz, &args.table) else {
+        return Err(Failure::input("replay: give a log set's folder, or --imu FILE with --rate-hz and --table"));
+    };
+    let ext = imu.extension().and_then(|e| e.to_str()).unwrap_or("");
+    let layout = args.imu_layout.clone().unwrap_or_else(|| match ext {
+        "npy" => "npy7".into(),
+        "mcap" => "ros2".into(),
+        _ => "rinscope".into(),
+    });
+    let name: String = imu.file_stem().and_then(|s| s.to_str()).unwrap_or("replay").chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '_' }).collect();
+    let attitude = match &args.attitude_deg {
+        Some(v) if v.len() == 3 => Some([v[0], v[1], v[2]]),
+        _ => None,
+    };
+    let manifest = RawManifest {
+        log: RawLogInfo { name, description: format!("`{}` replayed with the table {}", imu.display(), table.display()), table: table.display().to_string(), seed: None },
+        imu: RawImuFile {
+            file: std::path::absolute(imu).unwrap_or_else(|_| imu.clone()).display().to_string(),
+            layout,
+            kind: args.imu_kind.clone(),
+            rate_hz,
+            frame: args.imu_frame.clone().map(logset::RawFrame::Named),
+            time: None,
+            topic: None,
+            gap_policy: "refuse".into(),
+            gap_factor: 3.0,
+        },
+        encoders: args.encoders.as_ref().map(|e| logset::RawEncoderFile { file: std::path::absolute(e).unwrap_or_else(|_| e.clone()).display().to_string(), latch_delay_ms: 0.0, gap_policy: "interpolate".into() }),
+        reference: attitude.map(|a| RawReference { source: Some("--attitude-deg".into()), file: None, attitude_deg: Some(a) }),
+        initial: RawInitial { alignment_s: attitude.is_none().then_some(60.0), ..RawInitial::default() },
+    };
+    let text = crate::scenario::read_text(table)?;
+    let raw_table: RawTable = toml::from_str(&text).map_err(|e| ConfigError::Parse { origin: table.display().to_string(), message: e.to_string().trim_end().to_owned() })?;
+    let cwd = PathBuf::from(".");
+    Ok(logset::validate_manifest(&cwd, &manifest, "the command line (--imu ...)", &raw_table, &table.display().to_string())?)
+}
+
+/// `rinscope replay`.
+pub(super) fn replay(args: &ReplayArgs) -> Result<(), Failure> {
+    let log = load_log(args)?;
+    check_output_dir("--summary-json", args.summary_json.as_deref())?;
+    let compensation = match &args.compensation {
+        None => log.table.compensation.clone(),
+        Some(path) => {
+            let text = read_small_file(path, "--compensation")?;
+            logset::compensation_from_calibration(&log.raw_table, &text, &path.display().to_string())?
+        }
+    };
+    let params = log.recording_params(1.0)?;
+    let default_save = PathBuf::from("recordings").join(format!("{}-replay.rrd", log.name));
+    let sinks = open_sinks(args.sinks.request(default_save)?, &format!("{}-replay", log.name))?;
+    let stop = stop_flag();
+    let mut recorder = match Recorder::new_replay(sinks.stream(), &params) {
+        Ok(r) => r,
+        Err(e) => {
+            sinks.abandon();
+            return Err(Failure::run(format!("rerun: {e}")));
+        }
+    };
+    let bar = std::io::IsTerminal::is_terminal(&std::io::stderr()).then(|| {
+        let bar = indicatif::ProgressBar::new_spinner();
+        bar.enable_steady_tick(std::time::Duration::from_millis(200));
+        bar.set_message("opening the log");
+        bar
+    });
+    let result = replay_log(&log, &compensation, Some(&mut recorder), &stop, bar.as_ref());
+    if let Some(bar) = &bar {
+        bar.finish_and_clear();
+    }
+    let mut summary = match result {
+        Ok(s) => s,
+        Err(e) => {
+            drop(recorder);
+            sinks.abandon();
+            return Err(e.into());
+        }
+    };
+    // The layout again, now that the length is known: a whole replay plays in about a minute.
+    if let Ok(p) = log.recording_params(summary.duration_s) {
+        recorder.resend_layout(&p).map_err(|e| Failure::run(format!("rerun: {e}")))?;
+    }
+    drop(recorder);
+    let saved = sinks.finish()?;
+    if let Some((p, bytes)) = &saved.recording {
+        summary.recording_path = Some(p.display().to_string());
+        summary.recording_bytes = Some(*bytes);
+    }
+    print!("{}", summary.text());
+    if let Some(path) = &args.summary_json {
+        write_json("--summary-json", path, &summary)?;
+    }
+    print_saved(&saved);
+    if summary.interrupted {
+        return Err(Failure::interrupted("interrupted: the recording is complete up to the moment of Ctrl-C"));
+    }
+    Ok(())
+}
+
+/// `rinscope calibrate --log DIR`.
+pub(super) fn calibrate_log(args: &CalibrateArgs, dir: &Path) -> Result<(), Failure> {
+    let log = logset::load(dir)?;
+    check_output_dir("--json", args.json.as_deref())?;
+    let stop = stop_flag();
+    let started = std::time::Instant::now();
+    let (cal, report, data) = calibration::calibrate_log(&log, !args.no_recording, &stop).map_err(|e| match e {
+        LogCalibrationError::Interrupted => Failure::interrupted("calibrate --log: interrupted"),
+        LogCalibrationError::Calibration(c) => Failure::run(format!("calibrate --log: {c}")),
+        other => Failure::input(format!("calibrate --log: {other}")),
+    })?;
+    print!("{}", report.text());
+    println!("({:.2} s wall: {} measurements of {}, filter and least squares; before/after on the same data)", started.elapsed().as_secs_f64(), data.samples.len(), dir.display());
+    if let Some(path) = &args.json {
+        let compensation = estimated_compensation(&log.table.chain, &cal, &log.table.compensation);
+        write_json("--json", path, &CalibrationOutput { report: &report, estimated_compensation: compensation })?;
+    }
+    if !args.no_recording {
+        let params = log.recording_params(data.samples.last().map_or(1.0, |s| s.t_s))?;
+        let default_save = PathBuf::from("recordings").join(format!("{}-calibration.rrd", log.name));
+        let sinks = open_sinks(args.sinks.request(default_save)?, &format!("{}-calibration", log.name))?;
+        let errs = |e: &crate::model::gimbal::TableErrors| crate::calib::attitude_errors(&log.table.chain, e, &data).0;
+        let comp = &log.table.compensation;
+        let traces_owned = [errs(&cal.set.without_estimated(comp)), errs(&cal.set.errors(&cal.kf.theta, comp)), errs(&cal.set.errors(&cal.nls.theta, comp))];
+        let traces = crate::record::calibration::ErrorTraces { t_s: data.samples.iter().map(|s| s.t_s).collect(), errors: [&traces_owned[0], &traces_owned[1], &traces_owned[2]] };
+        let logged = crate::record::calibration::log(sinks.stream(), &params, &cal, &report, &traces).and_then(|mut r| r.finish());
+        if let Err(e) = logged {
+            sinks.abandon();
+            return Err(Failure::run(format!("rerun: {e}")));
+        }
+        print_saved(&sinks.finish()?);
+    }
+    Ok(())
+}

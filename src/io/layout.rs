@@ -1,0 +1,254 @@
+//! Resolving a [`Layout`] to the columns, units, kind and default frame of a file.
+
+use crate::io::error::{LogError, Result};
+use crate::io::imu::{ImuOptions, Layout, SampleKind, TimeUnit};
+use crate::io::table::{Col, ColumnReader, HeaderMode, ReadOptions};
+use crate::io::units::{Quantity, split_unit, suffixes_for};
+use std::path::Path;
+
+/// The resolved columns of a layout.
+pub(crate) struct Plan {
+    /// Time, gyro x/y/z, accel x/y/z.
+    pub cols: [Col; 7],
+    pub time: TimeUnit,
+    /// Factors to SI of the six sensor columns.
+    pub scale: [f64; 6],
+    pub kind: SampleKind,
+    /// The layout's documented body frame, if it has one.
+    pub frame: Option<&'static str>,
+    pub header: HeaderMode,
+}
+
+fn fixed(
+    time: TimeUnit,
+    kind: SampleKind,
+    order: [usize; 7],
+    frame: Option<&'static str>,
+    header: HeaderMode,
+) -> Plan {
+    Plan {
+        cols: order.map(Col::Index),
+        time,
+        scale: [1.0; 6],
+        kind,
+        frame,
+        header,
+    }
+}
+
+pub(crate) fn plan_for(path: &Path, options: &ImuOptions) -> Result<Plan> {
+    use HeaderMode::{Absent, Auto};
+    use SampleKind::{Increments, Rates};
+    Ok(match &options.layout {
+        Layout::Psins => fixed(
+            TimeUnit::Seconds,
+            Increments,
+            [6, 0, 1, 2, 3, 4, 5],
+            Some("rfu"),
+            Auto,
+        ),
+        Layout::KfGins => fixed(
+            TimeUnit::GpsSecondsOfWeek,
+            Increments,
+            [0, 1, 2, 3, 4, 5, 6],
+            Some("frd"),
+            Absent,
+        ),
+        Layout::Kalibr => fixed(
+            TimeUnit::Nanoseconds,
+            Rates,
+            [0, 1, 2, 3, 4, 5, 6],
+            None,
+            Auto,
+        ),
+        Layout::Npy7 { time } => fixed(*time, Increments, [0, 1, 2, 3, 4, 5, 6], None, Auto),
+        Layout::Rinscope | Layout::Ros2 => {
+            let probe = ColumnReader::open(path, &[], &read_options(options, Auto))?;
+            let is_mcap = probe.format() == crate::io::sniff::Format::Mcap;
+            if options.layout == Layout::Ros2 && !is_mcap {
+                return Err(LogError::Layout {
+                    file: path.to_path_buf(),
+                    problem: "the Ros2 layout reads MCAP files only".into(),
+                });
+            }
+            let mut plan = rinscope_plan(path, probe.all_columns())?;
+            if is_mcap {
+                // ROS REP 103: body frames are x forward, y left, z up.
+                plan.frame = Some("flu");
+            }
+            plan
+        }
+    })
+}
+
+pub(crate) fn read_options(options: &ImuOptions, header: HeaderMode) -> ReadOptions {
+    ReadOptions {
+        header,
+        topic: options.topic.clone(),
+        allow_non_finite: false,
+    }
+}
+
+/// Finds `<base>_<unit>` among `names`; the unit must measure `quantity`.
+fn find_unit_column(
+    path: &Path,
+    names: &[String],
+    base: &str,
+    quantity: Quantity,
+) -> Result<Option<(String, f64)>> {
+    let prefix = format!("{base}_");
+    let hits: Vec<&String> = names.iter().filter(|n| n.starts_with(&prefix)).collect();
+    let [name] = hits[..] else {
+        if hits.len() > 1 {
+            return Err(LogError::Layout {
+                file: path.to_path_buf(),
+                problem: format!("several {base}_* columns: {hits:?}"),
+            });
+        }
+        return Ok(None);
+    };
+    let unit_error = |problem: String| LogError::Unit {
+        file: path.to_path_buf(),
+        column: name.clone(),
+        problem,
+    };
+    match split_unit(name) {
+        Some((b, unit)) if b == base && unit.quantity == quantity => {
+            Ok(Some((name.clone(), unit.to_si)))
+        }
+        Some((b, unit)) if b == base => Err(unit_error(format!(
+            "{base} is {}, but _{} is a unit of {}; use one of {}",
+            quantity_phrase(quantity),
+            unit.suffix,
+            quantity_phrase(unit.quantity),
+            suffixes_for(quantity)
+        ))),
+        _ => Err(unit_error(format!(
+            "unknown unit {:?}; a {base} column takes one of {}",
+            name.get(prefix.len()..).unwrap_or(""),
+            suffixes_for(quantity)
+        ))),
+    }
+}
+
+fn quantity_phrase(q: Quantity) -> &'static str {
+    match q {
+        Quantity::Angle => "an angle (increment)",
+        Quantity::AngularRate => "an angular rate",
+        Quantity::Velocity => "a velocity (increment)",
+        Quantity::Acceleration => "an acceleration",
+        Quantity::Time => "a time",
+        Quantity::Length => "a length",
+        Quantity::Dimensionless => "a pure number",
+    }
+}
+
+fn rinscope_plan(path: &Path, names: &[String]) -> Result<Plan> {
+    let times: Vec<(&String, TimeUnit)> = names
+        .iter()
+        .filter_map(|n| {
+            let unit = match n.as_str() {
+                "t_s" => TimeUnit::Seconds,
+                "t_ms" => TimeUnit::Milliseconds,
+                "t_us" => TimeUnit::Microseconds,
+                "t_ns" => TimeUnit::Nanoseconds,
+                "gps_sow_s" => TimeUnit::GpsSecondsOfWeek,
+                _ => return None,
+            };
+            Some((n, unit))
+        })
+        .collect();
+    let layout_error = |problem: String| LogError::Layout {
+        file: path.to_path_buf(),
+        problem,
+    };
+    let (time_name, time) = match times[..] {
+        [(n, u)] => (n.clone(), u),
+        [] => {
+            return Err(LogError::MissingColumn {
+                file: path.to_path_buf(),
+                column:
+                    "t_s, t_ms, t_us, t_ns or gps_sow_s (the time column of the rinscope layout)"
+                        .into(),
+                available: names.to_vec(),
+            });
+        }
+        _ => {
+            return Err(layout_error(format!(
+                "several time columns: {:?}",
+                times.iter().map(|t| t.0).collect::<Vec<_>>()
+            )));
+        }
+    };
+    let mut families = Vec::new();
+    for (gyro, q_gyro, accel, q_accel, kind) in [
+        (
+            "gyro",
+            Quantity::AngularRate,
+            "accel",
+            Quantity::Acceleration,
+            SampleKind::Rates,
+        ),
+        (
+            "dtheta",
+            Quantity::Angle,
+            "dv",
+            Quantity::Velocity,
+            SampleKind::Increments,
+        ),
+    ] {
+        let mut found = Vec::new();
+        for (family, q) in [(gyro, q_gyro), (accel, q_accel)] {
+            for axis in ["x", "y", "z"] {
+                found.push((
+                    format!("{family}_{axis}"),
+                    find_unit_column(path, names, &format!("{family}_{axis}"), q)?,
+                ));
+            }
+        }
+        if found.iter().any(|(_, c)| c.is_some()) {
+            families.push((kind, found));
+        }
+    }
+    let (kind, found) = match families.len() {
+        1 => families.remove(0),
+        0 => {
+            return Err(layout_error(format!(
+                "no IMU columns: the rinscope layout needs gyro_{{x,y,z}}_<rate unit> and accel_{{x,y,z}}_<acceleration unit> (rates) or dtheta_{{x,y,z}}_<angle unit> and dv_{{x,y,z}}_<velocity unit> (increments); the file has {}",
+                names.join(", ")
+            )));
+        }
+        _ => {
+            return Err(layout_error(
+                "both rate (gyro_*/accel_*) and increment (dtheta_*/dv_*) columns: keep one kind"
+                    .into(),
+            ));
+        }
+    };
+    let mut cols: Vec<Col> = vec![Col::Name(time_name)];
+    let mut scale = [1.0; 6];
+    for (i, (base, column)) in found.into_iter().enumerate() {
+        let Some((name, to_si)) = column else {
+            return Err(LogError::MissingColumn {
+                file: path.to_path_buf(),
+                column: format!("{base}_<unit> ({kind:?})"),
+                available: names.to_vec(),
+            });
+        };
+        if let Some(s) = scale.get_mut(i) {
+            *s = to_si;
+        }
+        cols.push(Col::Name(name));
+    }
+    let cols: [Col; 7] = cols
+        .try_into()
+        .map_err(|_| layout_error("internal: column plan".into()))?;
+    Ok(Plan {
+        cols,
+        time,
+        scale,
+        kind,
+        frame: Some("rfu"),
+        header: HeaderMode::Auto,
+    })
+}

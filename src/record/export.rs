@@ -1,0 +1,154 @@
+//! `--export DIR`: every time series a recording holds, also written as tables — one Parquet (or
+//! CSV) file per entity, a `t_s` column and one column per series, the unit in each column's name
+//! — for notebooks, MATLAB and spreadsheets (Rerun's own reader needs a server for .rrd files).
+//! The files go through `FILE.partial` and appear when the run finishes.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+use crate::io::{LogError, TableWriter};
+
+/// The table format.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExportFormat {
+    /// Apache Parquet (pandas `read_parquet`, MATLAB `parquetread`).
+    Parquet,
+    /// CSV with a header.
+    Csv,
+}
+
+impl ExportFormat {
+    /// Parses "parquet" or "csv".
+    pub fn parse(text: &str) -> Result<Self, String> {
+        match text {
+            "parquet" => Ok(Self::Parquet),
+            "csv" => Ok(Self::Csv),
+            other => Err(format!("\"{other}\" is not an export format; use parquet or csv")),
+        }
+    }
+
+    fn extension(self) -> &'static str {
+        match self {
+            Self::Parquet => "parquet",
+            Self::Csv => "csv",
+        }
+    }
+}
+
+/// The tables of one recording.
+pub struct Exporter {
+    dir: PathBuf,
+    format: ExportFormat,
+    tables: BTreeMap<String, TableWriter>,
+    /// The first write that failed: the recording goes on, the run reports it at the end.
+    failed: Option<LogError>,
+}
+
+/// An exporter shared by the recorders of one run.
+pub type SharedExporter = Arc<Mutex<Exporter>>;
+
+/// The unit an entity path states: the unit suffix of its last segment that has one
+/// (`attitude_error_arcsec/pitch` → arcsec).
+#[must_use]
+pub fn unit_of(entity: &str) -> Option<&'static str> {
+    entity.rsplit('/').find_map(|seg| crate::io::units::split_unit(seg).map(|(_, u)| u.suffix))
+}
+
+/// A series name as a column name: lower-case letters, digits and `_` (`+3σ` → `plus_3_sigma`).
+#[must_use]
+pub fn column_base(name: &str) -> String {
+    let mut out = String::new();
+    for ch in name.chars() {
+        let piece = match ch {
+            '+' => "_plus_".to_owned(),
+            '−' | '-' => "_minus_".to_owned(),
+            'σ' => "_sigma_".to_owned(),
+            'α' => "_alpha_".to_owned(),
+            'φ' => "_phi_".to_owned(),
+            'η' => "_eta_".to_owned(),
+            c if c.is_ascii_alphanumeric() => c.to_ascii_lowercase().to_string(),
+            _ => "_".to_owned(),
+        };
+        out.push_str(&piece);
+    }
+    let parts: Vec<&str> = out.split('_').filter(|p| !p.is_empty()).collect();
+    if parts.is_empty() { "value".to_owned() } else { parts.join("_") }
+}
+
+impl Exporter {
+    /// Tables into `dir` (created if needed).
+    pub fn new(dir: &Path, format: ExportFormat) -> std::io::Result<Self> {
+        std::fs::create_dir_all(dir)?;
+        Ok(Self { dir: dir.to_path_buf(), format, tables: BTreeMap::new(), failed: None })
+    }
+
+    /// Appends rows to the table of `entity` (see [`Self::try_write`]); a failure is kept for
+    /// [`Self::finish`] to report and later rows of that run are not written.
+    pub fn write(&mut self, entity: &str, unit: &str, names: &[String], times: &[f64], values: &[f64]) {
+        if self.failed.is_none()
+            && let Err(e) = self.try_write(entity, unit, names, times, values)
+        {
+            self.failed = Some(e);
+        }
+    }
+
+    /// Appends rows to the table of `entity`: `times` (s) and `values` row-major, one column per
+    /// name, in `unit`.
+    pub fn try_write(&mut self, entity: &str, unit: &str, names: &[String], times: &[f64], values: &[f64]) -> Result<(), LogError> {
+        let width = names.len();
+        if !self.tables.contains_key(entity) {
+            let file = format!("{}.{}", entity.trim_start_matches('/').replace('/', "__").replace('.', "_"), self.format.extension());
+            let mut columns = vec!["t_s".to_owned()];
+            for name in names {
+                let mut c = format!("{}_{unit}", column_base(name));
+                while columns.contains(&c) {
+                    c = format!("{}_{}_{unit}", column_base(name), columns.len());
+                }
+                columns.push(c);
+            }
+            let refs: Vec<&str> = columns.iter().map(String::as_str).collect();
+            let writer = TableWriter::create(self.dir.join(file), &refs)?;
+            self.tables.insert(entity.to_owned(), writer);
+        }
+        let Some(writer) = self.tables.get_mut(entity) else { return Ok(()) };
+        let mut row = vec![0.0; width + 1];
+        for (i, t) in times.iter().enumerate() {
+            row[0] = *t;
+            row[1..].copy_from_slice(&values[i * width..(i + 1) * width]);
+            writer.write_row(&row)?;
+        }
+        Ok(())
+    }
+
+    /// Finishes every table; returns their paths (the first failed write, if any, instead: the
+    /// unfinished tables are then removed).
+    pub fn finish(&mut self) -> Result<Vec<PathBuf>, LogError> {
+        let tables = std::mem::take(&mut self.tables);
+        if let Some(e) = self.failed.take() {
+            return Err(e);
+        }
+        let mut out = Vec::new();
+        for (entity, writer) in tables {
+            let file = format!("{}.{}", entity.trim_start_matches('/').replace('/', "__").replace('.', "_"), self.format.extension());
+            writer.finish()?;
+            out.push(self.dir.join(file));
+        }
+        Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn entity_units_and_column_names() {
+        assert_eq!(unit_of("attitude_error_arcsec/pitch"), Some("arcsec"));
+        assert_eq!(unit_of("ins/gyro_raw_deg_per_s"), Some("deg_per_s"));
+        assert_eq!(unit_of("ins/position_error_m"), Some("m"));
+        assert_eq!(column_base("+3σ"), "plus_3_sigma");
+        assert_eq!(column_base("exact LSQ (final)"), "exact_lsq_final");
+        assert_eq!(column_base("closed form"), "closed_form");
+    }
+}
