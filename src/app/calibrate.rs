@@ -4,7 +4,7 @@
 
 use crate::calib::report::{build as build_report, Compensation, Report};
 use crate::calib::montecarlo::{self, RunErrors, Setup, Shard, Summary};
-use crate::calib::{attitude_errors, calibrate, AttitudeSource, CalibError, Calibration, Data, History, Measurement, Nuisance, ParamSet};
+use crate::calib::{attitude_errors, calibrate, AttitudeSource, CalibError, Calibration, Data, History, Measurement, Nuisance, ParamSet, Samples, Thinned};
 use crate::app::playback::{Playback, PlaybackError};
 use crate::ins::pipeline::InsRun;
 use crate::scenario::logset::LogSet;
@@ -15,51 +15,60 @@ use std::sync::atomic::AtomicBool;
 use crate::app::run::record_run;
 use crate::sim::{encoder_readings, DemodState};
 
-/// Runs the static test of `params` with noise seed `seed` and collects one sample per INS output.
-pub fn collect(params: &Params, seed: u64) -> Result<Data, CalibError> {
+/// Runs the static test of `params` with noise seed `seed` and collects one sample per INS output
+/// (kept in memory while it fits, else simulated again for each pass: see [`Samples`]).
+pub fn collect(params: &Params, seed: u64, stop: &AtomicBool) -> Result<Data, CalibError> {
     let Some((attitude, n_from_b)) = params.table_model().fixed_state() else {
         return Err(CalibError::VehicleMoves(params.meta.name.clone()));
     };
     let mut p = params.clone();
     p.meta.seed = seed;
-    let mut model = p.table_model();
-    // The demodulation knows every error it does not estimate: the compensation's values.
-    let set = ParamSet::new(&p.table.chain, Nuisance::None);
-    model.compensation = set.without_estimated(&p.table.compensation);
-    let chain = p.table.chain.clone();
-    let timeline = p.timeline();
-    let duration = timeline.end_s();
-    let tau = |t: f64| (2.0 * t / duration - 1.0).clamp(-1.0, 1.0);
-    let mut samples = Vec::with_capacity(timeline.intervals() as usize);
-    let mut demod = DemodState::default();
     let source = if p.ins.is_some() { AttitudeSource::Ins } else { AttitudeSource::Ideal };
-    match &p.ins {
-        Some(ins_params) => {
-            let mut ins = InsRun::new(ins_params, p.site, p.meta.seed, model.clone());
-            for _ in 0..timeline.intervals() {
-                if ins.step().updated {
-                    let (t, q) = ins.output_attitude(0);
-                    // Matched synchronisation: the encoders are read for the instant the data represent.
+    let duration_s = p.timeline().end_s();
+    let replay = move |sink: &mut dyn FnMut(&Measurement) -> bool| -> Result<(), CalibError> {
+        let mut model = p.table_model();
+        // The demodulation knows every error it does not estimate: the compensation's values.
+        let set = ParamSet::new(&p.table.chain, Nuisance::None);
+        model.compensation = set.without_estimated(&p.table.compensation);
+        let chain = &p.table.chain;
+        let timeline = p.timeline();
+        let mut demod = DemodState::default();
+        match &p.ins {
+            Some(ins_params) => {
+                let mut ins = InsRun::new(ins_params, p.site, p.meta.seed, model.clone());
+                for _ in 0..timeline.intervals() {
+                    if ins.step().updated {
+                        let (t, q) = ins.output_attitude(0);
+                        // Matched synchronisation: the encoders are read for the instant the data represent.
+                        let angles = demod.correct(&model.compensation, t, &encoder_readings(&model, t));
+                        if !sink(&Measurement { t_s: t, n_from_s: q, shafts: chain.shaft_rotations(&angles) }) {
+                            return Ok(());
+                        }
+                    }
+                }
+            }
+            None => {
+                let truth = model.truth_rotations().clone();
+                // The same instants as the INS's samples: t_1 ..= t_n.
+                for k in 1..=timeline.intervals() {
+                    let t = timeline.t_s(k);
+                    let (lambda, _) = model.scheme.state(t - model.scheme_t0_s);
+                    let n_from_s = n_from_b * chain.b_from_s(&truth, &lambda);
                     let angles = demod.correct(&model.compensation, t, &encoder_readings(&model, t));
-                    samples.push(Measurement { t_s: t, tau: tau(t), n_from_s: q, shafts: chain.shaft_rotations(&angles) });
+                    if !sink(&Measurement { t_s: t, n_from_s, shafts: chain.shaft_rotations(&angles) }) {
+                        return Ok(());
+                    }
                 }
             }
         }
-        None => {
-            let truth = model.truth_rotations().clone();
-            // The same instants as the INS's samples: t_1 ..= t_n.
-            for k in 1..=timeline.intervals() {
-                let t = timeline.t_s(k);
-                let (lambda, _) = model.scheme.state(t - model.scheme_t0_s);
-                let n_from_s = n_from_b * chain.b_from_s(&truth, &lambda);
-                let angles = demod.correct(&model.compensation, t, &encoder_readings(&model, t));
-                samples.push(Measurement { t_s: t, tau: tau(t), n_from_s, shafts: chain.shaft_rotations(&angles) });
-            }
-        }
-    }
-    Ok(Data { samples, n_from_b, attitude, source, seed })
+        Ok(())
+    };
+    let samples = Samples::collect(Box::new(replay), stop)?;
+    Ok(Data { samples, duration_s, n_from_b, attitude, source, seed })
 }
 
+/// The validation run's attitude errors kept for the recording: before, after KF, after LSQ.
+pub type ValidationTrace = Thinned<Vec<[f64; 3]>>;
 
 /// A calibration as `rinscope calibrate` runs it: the test, an independent validation run (noise
 /// seed + 1), both estimators, compensation before/after on the validation run, the report.
@@ -72,30 +81,39 @@ pub struct Outcome {
     pub cal: Calibration,
     /// The report.
     pub report: Report,
-    /// Per-sample attitude errors of the validation run: before, after KF, after LSQ.
-    pub validation_errors: [Vec<[f64; 3]>; 3],
+    /// The validation run's attitude errors (before, after KF, after LSQ), thinned for the recording.
+    pub validation_trace: ValidationTrace,
 }
 
-/// Runs the whole calibration of a scenario (`history`: keep the filter's snapshots for a recording).
-pub fn calibrate_scenario(params: &Params, history: bool) -> Result<Outcome, CalibError> {
+/// The four demodulations a calibration is judged by, on `data`: before (the estimated errors
+/// unknown), after the filter's and the least squares' estimates, and with the true values.
+fn judge(chain: &crate::model::gimbal::Chain, cal: &Calibration, known: &TableErrors, truth: &TableErrors, data: &Data, series_hz: f64, stop: &AtomicBool) -> Result<(Compensation, ValidationTrace), CalibError> {
+    let set = &cal.set;
+    let variants = [set.without_estimated(known), set.errors(&cal.kf.theta, known), set.errors(&cal.nls.theta, known), set.errors(&set.values(truth), known)];
+    let mut trace = Thinned::new(1.0 / series_hz.max(1e-6));
+    let s = attitude_errors(chain, &variants, data, stop, &mut trace)?;
+    // The recording plots the first three.
+    for row in &mut trace.rows {
+        row.truncate(3);
+    }
+    Ok((Compensation { before: s[0], after_kf: s[1], after_nls: s[2], with_truth: s[3] }, trace))
+}
+
+/// Runs the whole calibration of a scenario (`history`: keep the filter's snapshots for a recording;
+/// `stop` ends it early with [`CalibError::Interrupted`]).
+pub fn calibrate_scenario(params: &Params, history: bool, stop: &AtomicBool) -> Result<Outcome, CalibError> {
     let seed = params.meta.seed;
     let (data, validation) = std::thread::scope(|scope| {
-        let v = scope.spawn(|| collect(params, seed.wrapping_add(1)));
-        let d = collect(params, seed);
-        (d, v.join().unwrap_or(Err(CalibError::Singular)))
+        let v = scope.spawn(|| collect(params, seed.wrapping_add(1), stop));
+        let d = collect(params, seed, stop);
+        (d, v.join().unwrap_or(Err(CalibError::Data("the validation run's thread panicked".into()))))
     });
     let (data, validation) = (data?, validation?);
     let cfg = &params.calibration;
-    let cal = calibrate(&params.table.chain, &params.table.compensation, &data, cfg, if history { History::Snapshots(cfg.record_hz) } else { History::Final })?;
-    let known = &params.table.compensation;
-    let set = &cal.set;
-    let before = attitude_errors(&params.table.chain, &set.without_estimated(known), &validation);
-    let kf = attitude_errors(&params.table.chain, &set.errors(&cal.kf.theta, known), &validation);
-    let nls = attitude_errors(&params.table.chain, &set.errors(&cal.nls.theta, known), &validation);
-    let truth = attitude_errors(&params.table.chain, &set.errors(&set.values(&params.table.truth), known), &validation);
-    let compensation = Compensation { before: before.1, after_kf: kf.1, after_nls: nls.1, with_truth: truth.1 };
+    let cal = calibrate(&params.table.chain, &params.table.compensation, &data, cfg, if history { History::Snapshots(cfg.record_hz) } else { History::Final }, stop)?;
+    let (compensation, validation_trace) = judge(&params.table.chain, &cal, &params.table.compensation, &params.table.truth, &validation, params.recording.series_hz, stop)?;
     let report = build_report(&params.meta.name, &params.table.chain, &params.table.truth, &cal, &data, Some(compensation));
-    Ok(Outcome { data, validation, cal, report, validation_errors: [before.0, kf.0, nls.0] })
+    Ok(Outcome { data, validation, cal, report, validation_trace })
 }
 
 
@@ -119,7 +137,7 @@ pub fn monte_carlo_runs(params: &Params, runs: usize, shard: Shard, progress: &(
     let simulate = |truth: &TableErrors, seed: u64| {
         let mut p = params.clone();
         p.table.truth = truth.clone();
-        collect(&p, seed)
+        collect(&p, seed, stop)
     };
     montecarlo::run_indices(&monte_carlo_setup(params), &shard.indices(runs as u64), &simulate, progress, stop)
 }
@@ -135,11 +153,7 @@ pub fn monte_carlo(params: &Params, runs: usize, progress: &(dyn Fn() + Sync), s
 /// a plain run of the ideal demodulation (the INS is the calibration's business here), whose error
 /// plots the layout keeps in its tabs.
 pub fn record_outcome(rec: crate::record::Stream, params: &Params, outcome: &Outcome, stop: &AtomicBool) -> anyhow::Result<()> {
-    let traces = crate::record::calibration::ErrorTraces {
-        t_s: outcome.validation.samples.iter().map(|s| s.t_s).collect(),
-        errors: [&outcome.validation_errors[0], &outcome.validation_errors[1], &outcome.validation_errors[2]],
-    };
-    let recorder = crate::record::calibration::log(rec, params, &outcome.cal, &outcome.report, &traces)?;
+    let recorder = crate::record::calibration::log(rec, params, &outcome.cal, &outcome.report, &outcome.validation_trace)?;
     recorder.event(params.duration_s, &format!("calibration: {} samples, {} Gauss–Newton iterations", outcome.cal.samples, outcome.cal.nls_iterations), "INFO")?;
     for w in &outcome.report.warnings {
         recorder.event(params.duration_s, w, "WARN")?;
@@ -152,40 +166,47 @@ pub fn record_outcome(rec: crate::record::Stream, params: &Params, outcome: &Out
 
 /// The static test of a log set as calibration data: one measurement per primary update (the INS
 /// output and the encoder angles corrected with what the calibration knows, `known`), the known
-/// body attitude from the log's reference (it must be constant: the vehicle at rest).
+/// body attitude from the log's reference (it must be constant: the vehicle at rest). Kept in
+/// memory while it fits, else read from the files again for each pass.
 pub fn collect_from_log(log: &LogSet, known: &TableErrors, stop: &AtomicBool) -> Result<Data, LogCalibrationError> {
-    let mut pb = Playback::open(log, &log.table.compensation)?;
-    let mut demod = DemodState::default();
-    let mut times = Vec::new();
-    let mut samples = Vec::new();
-    let mut attitude = None;
-    let chain = &log.table.chain;
-    while let Some(s) = pb.step()? {
-        if pb.samples % 65_536 == 0 && stop.load(std::sync::atomic::Ordering::Relaxed) {
-            return Err(LogCalibrationError::Interrupted);
+    let (log2, known2) = (log.clone(), known.clone());
+    // The body attitude the first pass finds (every pass checks the same).
+    let found: std::sync::Arc<std::sync::Mutex<Option<crate::math::attitude::Attitude>>> = std::sync::Arc::default();
+    let found2 = std::sync::Arc::clone(&found);
+    let replay = move |sink: &mut dyn FnMut(&Measurement) -> bool| -> Result<(), CalibError> {
+        let fail = |e: LogCalibrationError| CalibError::Data(e.to_string());
+        let mut pb = Playback::open(&log2, &log2.table.compensation).map_err(|e| fail(e.into()))?;
+        let mut demod = DemodState::default();
+        let mut attitude = None;
+        let chain = &log2.table.chain;
+        while let Some(s) = pb.step().map_err(|e| fail(e.into()))? {
+            if !s.updated {
+                continue;
+            }
+            let (t, n_from_s) = pb.core.output_attitude(0);
+            let reference = pb.reference_at(t).map_err(|e| fail(e.into()))?.ok_or_else(|| fail(LogCalibrationError::NoReference))?;
+            let first = *attitude.get_or_insert(reference);
+            let moved = (reference.pitch_rad - first.pitch_rad).abs().max(crate::math::units::wrap_pi(reference.roll_rad - first.roll_rad).abs()).max(crate::math::units::wrap_pi(reference.heading_rad - first.heading_rad).abs());
+            if moved > 1e-9 {
+                return Err(fail(LogCalibrationError::Moves { t_s: t, arcsec: moved * crate::math::units::ARCSEC_PER_RAD }));
+            }
+            // Matched synchronisation: the encoders are read for the instant the data represent.
+            let angles = demod.correct(&known2, t, &pb.encoders_at(t).map_err(|e| fail(e.into()))?);
+            if !sink(&Measurement { t_s: t, n_from_s, shafts: chain.shaft_rotations(&angles) }) {
+                return Ok(());
+            }
         }
-        if !s.updated {
-            continue;
-        }
-        let (t, n_from_s) = pb.core.output_attitude(0);
-        let reference = pb.reference_at(t)?.ok_or(LogCalibrationError::NoReference)?;
-        let first = *attitude.get_or_insert(reference);
-        let moved = (reference.pitch_rad - first.pitch_rad).abs().max(crate::math::units::wrap_pi(reference.roll_rad - first.roll_rad).abs()).max(crate::math::units::wrap_pi(reference.heading_rad - first.heading_rad).abs());
-        if moved > 1e-9 {
-            return Err(LogCalibrationError::Moves { t_s: t, arcsec: moved * crate::math::units::ARCSEC_PER_RAD });
-        }
-        // Matched synchronisation: the encoders are read for the instant the data represent.
-        let angles = demod.correct(known, t, &pb.encoders_at(t)?);
-        times.push(t);
-        samples.push(Measurement { t_s: t, tau: 0.0, n_from_s, shafts: chain.shaft_rotations(&angles) });
-    }
-    let attitude = attitude.ok_or(LogCalibrationError::NoReference)?;
+        *found2.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = attitude;
+        Ok(())
+    };
+    let samples = Samples::collect(Box::new(replay), stop).map_err(|e| match e {
+        CalibError::Interrupted => LogCalibrationError::Interrupted,
+        other => LogCalibrationError::Calibration(other),
+    })?;
+    let attitude = found.lock().unwrap_or_else(std::sync::PoisonError::into_inner).ok_or(LogCalibrationError::NoReference)?;
     // τ ∈ [−1, 1] over the test, as the simulation's calibration has it.
-    let duration = times.last().copied().unwrap_or(1.0).max(1e-9);
-    for s in &mut samples {
-        s.tau = (2.0 * s.t_s / duration - 1.0).clamp(-1.0, 1.0);
-    }
-    Ok(Data { samples, n_from_b: attitude.n_from_b(), attitude, source: AttitudeSource::Log, seed: log.seed.unwrap_or(0) })
+    let duration_s = samples.last_t_s().max(1e-9);
+    Ok(Data { samples, duration_s, n_from_b: attitude.n_from_b(), attitude, source: AttitudeSource::Log, seed: log.seed.unwrap_or(0) })
 }
 
 /// Why a log cannot be calibrated.
@@ -215,22 +236,20 @@ pub enum LogCalibrationError {
 
 /// `calibrate --log`: seed 000's filter and the exact least squares on a log set, the compensation
 /// before/after on the same data (a log has no independent second run).
-pub fn calibrate_log(log: &LogSet, history: bool, stop: &AtomicBool) -> Result<(Calibration, Report, Data), LogCalibrationError> {
+pub fn calibrate_log(log: &LogSet, history: bool, stop: &AtomicBool) -> Result<(Calibration, Report, Data, ValidationTrace), LogCalibrationError> {
     let cfg = &log.table.calibration;
     let set = ParamSet::new(&log.table.chain, Nuisance::None);
     let known = set.without_estimated(&log.table.compensation);
     let data = collect_from_log(log, &known, stop)?;
     let chain = &log.table.chain;
-    let cal = calibrate(chain, &log.table.compensation, &data, cfg, if history { History::Snapshots(cfg.record_hz) } else { History::Final })?;
-    let comp = &log.table.compensation;
-    let set = &cal.set;
-    let before = attitude_errors(chain, &set.without_estimated(comp), &data);
-    let kf = attitude_errors(chain, &set.errors(&cal.kf.theta, comp), &data);
-    let nls = attitude_errors(chain, &set.errors(&cal.nls.theta, comp), &data);
-    let stated = attitude_errors(chain, &set.errors(&set.values(&log.table.stated), comp), &data);
-    let compensation = Compensation { before: before.1, after_kf: kf.1, after_nls: nls.1, with_truth: stated.1 };
+    let interrupted = |e: CalibError| match e {
+        CalibError::Interrupted => LogCalibrationError::Interrupted,
+        other => LogCalibrationError::Calibration(other),
+    };
+    let cal = calibrate(chain, &log.table.compensation, &data, cfg, if history { History::Snapshots(cfg.record_hz) } else { History::Final }, stop).map_err(interrupted)?;
+    let (compensation, trace) = judge(chain, &cal, &log.table.compensation, &log.table.stated, &data, log.table.recording.series_hz, stop).map_err(interrupted)?;
     let report = build_report(&log.name, chain, &log.table.stated, &cal, &data, Some(compensation));
-    Ok((cal, report, data))
+    Ok((cal, report, data, trace))
 }
 
 /// What `calibrate --json` writes: the report, and the estimates as `[compensation]` keys that

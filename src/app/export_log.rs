@@ -68,7 +68,7 @@ pub enum ExportError {
     #[error("{0}")]
     Write(String),
     /// Stopped by the user.
-    #[error("interrupted: nothing was kept")]
+    #[error("nothing was kept")]
     Interrupted,
 }
 
@@ -85,8 +85,17 @@ pub fn export_log(params: &Params, out: &Path, format: LogFormat, stop: &AtomicB
     if partial.exists() {
         return Err(ExportError::Exists(partial.display().to_string()));
     }
-    std::fs::create_dir_all(&partial).map_err(|e| ExportError::Write(format!("{}: {e}", partial.display())))?;
+    if let Some(parent) = partial.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent).map_err(|e| ExportError::Write(format!("{}: {e}", parent.display())))?;
+    }
+    // create_dir, not create_dir_all: a second export racing for the same folder is refused.
+    std::fs::create_dir(&partial).map_err(|e| match e.kind() {
+        std::io::ErrorKind::AlreadyExists => ExportError::Exists(partial.display().to_string()),
+        _ => ExportError::Write(format!("{}: {e}", partial.display())),
+    })?;
+    crate::io::files::unfinished_dir(&partial);
     let result = write_files(params, &partial, format, stop);
+    crate::io::files::finished_dir(&partial);
     match result {
         Ok(samples) => {
             std::fs::rename(&partial, out).map_err(|e| ExportError::Write(format!("{} → {}: {e}", partial.display(), out.display())))?;

@@ -247,7 +247,7 @@ pub fn run_all() -> anyhow::Result<Table> {
     // Seed 000 §6.2.2: compensation with calibrated parameters lowers the peak error 3.0-3.8×;
     // rinscope's must lower it at least as much on an independent run with the same kind of noise.
     let p = presets::load("jiang2017-calibration")?;
-    let outcome = crate::app::calibrate::calibrate_scenario(&p, false)?;
+    let outcome = crate::app::calibrate::calibrate_scenario(&p, false, &std::sync::atomic::AtomicBool::new(false))?;
     if let Some(c) = outcome.report.compensation {
         for (axis, name) in ["pitch", "roll", "heading"].iter().enumerate() {
             let (before, after) = crate::calib::report::PAPER_LAB[axis];

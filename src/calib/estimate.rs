@@ -3,7 +3,9 @@
 
 use nalgebra::{DMatrix, DVector, Vector3};
 
-use super::{CalibConfig, CalibError, Data, Measurement, Param, ParamSet, MAX_PARAMS, MAX_TABLE};
+use std::sync::atomic::AtomicBool;
+
+use super::{CalibConfig, CalibError, Data, Measurement, Param, ParamSet, Thinned, MAX_PARAMS, MAX_TABLE};
 use crate::math::frames::{Rot, B, N};
 use crate::math::rotvec;
 use crate::model::gimbal::{Chain, ErrorRotations, TableErrors};
@@ -13,7 +15,8 @@ use crate::model::gimbal::{Chain, ErrorRotations, TableErrors};
 pub enum History {
     /// The estimates only, with the filter's residual RMS (the `calibrate` command without a recording).
     Final,
-    /// Snapshots of the filter at this rate, Hz (for a recording).
+    /// Snapshots of the filter at this rate, Hz (for a recording; at most
+    /// [`super::MAX_TRACE_ROWS`], thinned over long tests).
     Snapshots(f64),
     /// The Monte Carlo's lean mode: no snapshots, no filter residuals.
     Lean,
@@ -168,8 +171,15 @@ fn solve(a: &DMatrix<f64>, b: &DVector<f64>) -> Result<(DVector<f64>, DMatrix<f6
 }
 
 /// Estimates the parameters from `data`: the static Kalman filter, then least squares on the exact
-/// model. `known` holds every error not estimated; `history` says what to keep along the way.
-pub fn calibrate(chain: &Chain, known: &TableErrors, data: &Data, cfg: &CalibConfig, history: History) -> Result<Calibration, CalibError> {
+/// model. `known` holds every error not estimated; `history` says what to keep along the way;
+/// `stop` ends it early ([`CalibError::Interrupted`]).
+///
+/// Memory is flat in the test's length: each pass (the filter's, then one per Gauss–Newton step)
+/// streams the data ([`super::Samples`]) and accumulates the normal equations.
+///
+/// # Errors
+/// No parameter, singular normal equations, the data source's error or the stop.
+pub fn calibrate(chain: &Chain, known: &TableErrors, data: &Data, cfg: &CalibConfig, history: History, stop: &AtomicBool) -> Result<Calibration, CalibError> {
     let set = ParamSet::new(chain, cfg.nuisance);
     let p = set.len();
     if set.n_table == 0 || p > MAX_PARAMS {
@@ -182,34 +192,28 @@ pub fn calibrate(chain: &Chain, known: &TableErrors, data: &Data, cfg: &CalibCon
     let n_from_b = data.n_from_b.matrix();
     let ref_inv = data.n_from_b.inverse();
 
-    // The measurement z: the demodulation with the estimated parameters at zero. H is kept for
-    // the least-squares passes (3·p numbers per sample).
+    // The measurement z: the demodulation with the estimated parameters at zero.
     let before = chain.error_rotations(&set.without_estimated(known));
     let n = data.samples.len();
     let nt = set.n_table;
-    // The table's rows of H are kept for the least-squares passes (3·n_table numbers per sample).
-    let mut rows = Vec::with_capacity(3 * nt * n);
     let mut h = [[0.0; MAX_TABLE]; 3];
     let mut sums = Sums::default();
-    let mut snapshots = Vec::new();
-    let mut next_snapshot = 0.0;
-    for s in &data.samples {
+    let mut snapshots = Thinned::new(match history {
+        History::Snapshots(hz) => 1.0 / hz,
+        _ => f64::INFINITY,
+    });
+    data.samples.each(stop, &mut |s| {
         set.table_rows(chain, &n_from_b, s, &mut h);
-        for r in &h {
-            rows.extend_from_slice(&r[..nt]);
-        }
         let z = exact_residual(chain, &before, s, &ref_inv);
-        sums.add(nt, &h, s.tau, &z, w);
-        if let History::Snapshots(hz) = history
-            && s.t_s >= next_snapshot
-        {
-            next_snapshot += 1.0 / hz;
+        sums.add(nt, &h, data.tau(s.t_s), &z, w);
+        if matches!(history, History::Snapshots(_)) && snapshots.wants(s.t_s) {
             let (a, b) = sums.assemble(&set);
+            // Early on the information can be singular: that snapshot is skipped.
             if let Ok((x, cov)) = solve(&(&prior_info + a), &(&prior_info * &x0 + b)) {
-                snapshots.push(Snapshot { t_s: s.t_s, theta: x.iter().copied().collect(), sigma: cov.diagonal().iter().map(|v| v.max(0.0).sqrt()).collect() });
+                snapshots.push(s.t_s, Snapshot { t_s: s.t_s, theta: x.iter().copied().collect(), sigma: cov.diagonal().iter().map(|v| v.max(0.0).sqrt()).collect() });
             }
         }
-    }
+    })?;
     let (data_information, rhs) = sums.assemble(&set);
     let information = &prior_info + &data_information;
     let (x_kf, cov) = solve(&information, &(&prior_info * &x0 + rhs))?;
@@ -217,28 +221,32 @@ pub fn calibrate(chain: &Chain, known: &TableErrors, data: &Data, cfg: &CalibCon
 
     // Residuals of a parameter vector under the exact model, and the Gauss–Newton right-hand side
     // Σ HᵀR⁻¹r.
-    let pass = |theta: &DVector<f64>| -> (DVector<f64>, [f64; 3]) {
+    let pass = |theta: &DVector<f64>| -> Result<(DVector<f64>, [f64; 3]), CalibError> {
         let t: Vec<f64> = theta.iter().copied().collect();
         let err = chain.error_rotations(&set.errors(&t, known));
         let mut g = Sums::default();
         let mut sq = [0.0; 3];
-        for (s, hr) in data.samples.iter().zip(rows.chunks_exact(3 * nt)) {
-            let r = exact_residual(chain, &err, s, &ref_inv) - set.nuisance(&t, s.tau);
+        let mut h = [[0.0; MAX_TABLE]; 3];
+        data.samples.each(stop, &mut |s| {
+            // H again rather than kept: 3·n_table numbers per sample would make memory grow with the test.
+            set.table_rows(chain, &n_from_b, s, &mut h);
+            let tau = data.tau(s.t_s);
+            let r = exact_residual(chain, &err, s, &ref_inv) - set.nuisance(&t, tau);
             for k in 0..3 {
                 sq[k] += r[k] * r[k];
                 let wr = w * r[k];
-                for (gj, hj) in g.b_t[..nt].iter_mut().zip(&hr[k * nt..(k + 1) * nt]) {
+                for (gj, hj) in g.b_t[..nt].iter_mut().zip(&h[k][..nt]) {
                     *gj += hj * wr;
                 }
                 g.b_off[k] += wr;
-                g.b_drift[k] += wr * s.tau;
+                g.b_drift[k] += wr * tau;
             }
-        }
+        })?;
         let nf = n.max(1) as f64;
-        (g.assemble(&set).1, sq.map(|v| (v / nf).sqrt()))
+        Ok((g.assemble(&set).1, sq.map(|v| (v / nf).sqrt())))
     };
     // The filter's residuals are reported, not needed by the estimate (the Monte Carlo skips them).
-    let kf_rms = if history == History::Lean { [f64::NAN; 3] } else { pass(&x_kf).1 };
+    let kf_rms = if history == History::Lean { [f64::NAN; 3] } else { pass(&x_kf)?.1 };
     let kf = Estimate { theta: x_kf.iter().copied().collect(), cov: cov.clone(), residual_rms_rad: kf_rms };
 
     // Chord Gauss–Newton from the filter's estimate. The residuals are exact; the Jacobian is the
@@ -247,7 +255,7 @@ pub fn calibrate(chain: &Chain, known: &TableErrors, data: &Data, cfg: &CalibCon
     let mut iterations = 0;
     let mut rms = kf_rms;
     for _ in 0..8 {
-        let (g, r) = pass(&theta);
+        let (g, r) = pass(&theta)?;
         rms = r;
         let step = chol.solve(&(g - &prior_info * (&theta - &x0)));
         theta += &step;
@@ -266,7 +274,7 @@ pub fn calibrate(chain: &Chain, known: &TableErrors, data: &Data, cfg: &CalibCon
         nls,
         nls_iterations: iterations,
         data_information,
-        history: snapshots,
+        history: snapshots.rows,
         samples: data.samples.len(),
         measurement_sigma_rad: cfg.measurement_sigma_rad,
     })

@@ -31,6 +31,8 @@ pub mod report;
 
 pub use estimate::{calibrate, Calibration, Estimate, History, Snapshot};
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use nalgebra::{Matrix3, Vector3};
 
 use crate::math::attitude::Attitude;
@@ -298,8 +300,6 @@ impl ParamSet {
 pub struct Measurement {
     /// Time, s.
     pub t_s: f64,
-    /// Time scaled to [−1, 1] over the test (for the drift state).
-    pub tau: f64,
     /// The IMU attitude C_s^n the INS reports.
     pub n_from_s: Rot<N, S>,
     /// Shaft rotations of the (corrected) encoder angles.
@@ -317,11 +317,136 @@ pub enum AttitudeSource {
     Log,
 }
 
+/// Measurements kept in memory up to this many (about 40 MB); a longer test is generated again
+/// from its source for each pass, so a calibration's memory stays flat in the test's length.
+pub const IN_MEMORY_SAMPLES: usize = 1 << 18;
+
+/// One pass over a test's measurements: calls the sink with each, in time order, until it returns
+/// `false` (then the pass ends early with `Ok`).
+pub type Replay = dyn Fn(&mut dyn FnMut(&Measurement) -> bool) -> Result<(), CalibError> + Send + Sync;
+
+/// A test's measurements: in memory while they fit [`IN_MEMORY_SAMPLES`], else replayed from their
+/// source (a deterministic simulation, a log file) for every pass.
+pub enum Samples {
+    /// All of them.
+    Memory(Vec<Measurement>),
+    /// The source, and what its first pass counted.
+    Replayed {
+        /// Generates the measurements again.
+        replay: Box<Replay>,
+        /// How many one pass gives.
+        count: usize,
+        /// The last one's time, s.
+        last_t_s: f64,
+    },
+}
+
+impl std::fmt::Debug for Samples {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Memory(v) => write!(f, "Samples::Memory({} measurements)", v.len()),
+            Self::Replayed { count, .. } => write!(f, "Samples::Replayed({count} measurements)"),
+        }
+    }
+}
+
+impl Samples {
+    /// Runs `replay` once: keeps its measurements if they fit in memory, else keeps `replay`.
+    /// `stop` ends the pass early ([`CalibError::Interrupted`]).
+    ///
+    /// # Errors
+    /// The source's error, or the stop.
+    pub fn collect(replay: Box<Replay>, stop: &AtomicBool) -> Result<Self, CalibError> {
+        let mut kept = Vec::new();
+        let (mut count, mut last_t_s, mut overflow) = (0usize, 0.0, false);
+        let mut stopped = false;
+        replay(&mut |m: &Measurement| {
+            count += 1;
+            last_t_s = m.t_s;
+            if !overflow {
+                if kept.len() < IN_MEMORY_SAMPLES {
+                    kept.push(*m);
+                } else {
+                    overflow = true;
+                    kept = Vec::new();
+                }
+            }
+            if count.is_multiple_of(65_536) && stop.load(Ordering::Relaxed) {
+                stopped = true;
+                return false;
+            }
+            true
+        })?;
+        if stopped {
+            return Err(CalibError::Interrupted);
+        }
+        Ok(if overflow { Self::Replayed { replay, count, last_t_s } } else { Self::Memory(kept) })
+    }
+
+    /// Calls `f` with every measurement in time order; `stop` ends the pass early.
+    ///
+    /// # Errors
+    /// The source's error, or [`CalibError::Interrupted`].
+    pub fn each(&self, stop: &AtomicBool, f: &mut dyn FnMut(&Measurement)) -> Result<(), CalibError> {
+        match self {
+            Self::Memory(v) => {
+                for (i, m) in v.iter().enumerate() {
+                    if i.is_multiple_of(65_536) && stop.load(Ordering::Relaxed) {
+                        return Err(CalibError::Interrupted);
+                    }
+                    f(m);
+                }
+                Ok(())
+            }
+            Self::Replayed { replay, .. } => {
+                let mut i = 0usize;
+                let mut stopped = false;
+                replay(&mut |m: &Measurement| {
+                    i += 1;
+                    if i.is_multiple_of(65_536) && stop.load(Ordering::Relaxed) {
+                        stopped = true;
+                        return false;
+                    }
+                    f(m);
+                    true
+                })?;
+                if stopped { Err(CalibError::Interrupted) } else { Ok(()) }
+            }
+        }
+    }
+
+    /// How many measurements a pass gives.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        match self {
+            Self::Memory(v) => v.len(),
+            Self::Replayed { count, .. } => *count,
+        }
+    }
+
+    /// True without measurements.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The last measurement's time, s (0 without any).
+    #[must_use]
+    pub fn last_t_s(&self) -> f64 {
+        match self {
+            Self::Memory(v) => v.last().map_or(0.0, |m| m.t_s),
+            Self::Replayed { last_t_s, .. } => *last_t_s,
+        }
+    }
+}
+
 /// The data of one static test.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct Data {
-    /// The samples, in time order.
-    pub samples: Vec<Measurement>,
+    /// The measurements, in time order.
+    pub samples: Samples,
+    /// The test's length, s: the drift state's time τ = 2t/duration − 1 runs over [−1, 1].
+    pub duration_s: f64,
     /// The known body attitude C_b^n.
     pub n_from_b: Rot<N, B>,
     /// The known body attitude as Euler angles.
@@ -330,6 +455,20 @@ pub struct Data {
     pub source: AttitudeSource,
     /// Seed of the noise.
     pub seed: u64,
+}
+
+impl Data {
+    /// The same test's description with no measurements (for building a `Data` around other samples).
+    #[must_use]
+    pub fn clone_header(&self) -> Self {
+        Self { samples: Samples::Memory(Vec::new()), duration_s: self.duration_s, n_from_b: self.n_from_b, attitude: self.attitude, source: self.source, seed: self.seed }
+    }
+
+    /// The drift state's time of a measurement at `t_s`, in [−1, 1].
+    #[must_use]
+    pub fn tau(&self, t_s: f64) -> f64 {
+        (2.0 * t_s / self.duration_s.max(1e-9) - 1.0).clamp(-1.0, 1.0)
+    }
 }
 
 /// Why a calibration cannot run.
@@ -344,6 +483,12 @@ pub enum CalibError {
     /// Singular normal equations.
     #[error("the normal equations are singular (non-finite data?)")]
     Singular,
+    /// The data source failed during a pass.
+    #[error("{0}")]
+    Data(String),
+    /// Stopped (a signal) before the end.
+    #[error("stopped before the end")]
+    Interrupted,
 }
 
 /// RMS and peak of the Euler-angle errors (pitch, roll, heading) of one demodulation, rad.
@@ -355,25 +500,91 @@ pub struct ErrorSummary {
     pub peak_rad: [f64; 3],
 }
 
-/// The attitude errors of `data` demodulated with table errors `errors` (exact chain, Euler angles,
-/// computed minus known), per sample; and their summary.
-#[must_use]
-pub fn attitude_errors(chain: &Chain, errors: &TableErrors, data: &Data) -> (Vec<[f64; 3]>, ErrorSummary) {
-    let err = chain.error_rotations(errors);
-    let mut out = Vec::with_capacity(data.samples.len());
-    let mut sum = ErrorSummary::default();
-    for s in &data.samples {
-        let b_from_s = chain.b_from_s_with(&err, &s.shafts);
-        let e = demodulate(s.n_from_s, b_from_s).error_from(&data.attitude).as_array();
-        for i in 0..3 {
-            sum.rms_rad[i] += e[i] * e[i];
-            sum.peak_rad[i] = sum.peak_rad[i].max(e[i].abs());
-        }
-        out.push(e);
+/// At most this many rows of a trace are kept (the interval between kept rows doubles when it
+/// would exceed it): a recording's calibration plots stay bounded in the test's length.
+pub const MAX_TRACE_ROWS: usize = 20_000;
+
+/// Rows kept every `interval` (at least), at most [`MAX_TRACE_ROWS`]: thinned by two, interval
+/// doubled, when full.
+#[derive(Debug, Clone)]
+pub struct Thinned<T> {
+    /// The kept rows' times, s.
+    pub t_s: Vec<f64>,
+    /// The kept rows.
+    pub rows: Vec<T>,
+    interval_s: f64,
+    next_s: f64,
+}
+
+impl<T> Thinned<T> {
+    /// Keeps a row at most every `interval_s` (0: every row until thinning starts).
+    #[must_use]
+    pub fn new(interval_s: f64) -> Self {
+        Self { t_s: Vec::new(), rows: Vec::new(), interval_s, next_s: f64::NEG_INFINITY }
     }
+
+    /// True if a row at `t_s` would be kept (check before computing an expensive row).
+    #[must_use]
+    pub fn wants(&self, t_s: f64) -> bool {
+        t_s >= self.next_s
+    }
+
+    /// Offers a row at `t_s`.
+    pub fn push(&mut self, t_s: f64, row: T) {
+        if !self.wants(t_s) {
+            return;
+        }
+        if self.rows.len() >= MAX_TRACE_ROWS {
+            let mut i = 0;
+            self.rows.retain(|_| {
+                i += 1;
+                i % 2 == 1
+            });
+            let mut j = 0;
+            self.t_s.retain(|_| {
+                j += 1;
+                j % 2 == 1
+            });
+            self.interval_s = if self.interval_s > 0.0 { 2.0 * self.interval_s } else { 2.0 * (t_s - self.t_s.first().copied().unwrap_or(0.0)) / MAX_TRACE_ROWS as f64 };
+        }
+        self.t_s.push(t_s);
+        self.rows.push(row);
+        self.next_s = t_s + self.interval_s;
+    }
+}
+
+/// The attitude errors of `data` demodulated with each of `variants` (table errors; exact chain,
+/// Euler angles, computed minus known), one pass: their summaries, and the per-sample errors of
+/// every variant thinned to `trace` (pitch, roll, heading, rad).
+///
+/// # Errors
+/// The data source's, or the stop.
+pub fn attitude_errors(chain: &Chain, variants: &[TableErrors], data: &Data, stop: &AtomicBool, trace: &mut Thinned<Vec<[f64; 3]>>) -> Result<Vec<ErrorSummary>, CalibError> {
+    let err: Vec<_> = variants.iter().map(|e| chain.error_rotations(e)).collect();
+    let mut sums = vec![ErrorSummary::default(); variants.len()];
+    data.samples.each(stop, &mut |s| {
+        let keep = trace.wants(s.t_s);
+        let mut row = Vec::with_capacity(if keep { variants.len() } else { 0 });
+        for (e, sum) in err.iter().zip(&mut sums) {
+            let b_from_s = chain.b_from_s_with(e, &s.shafts);
+            let v = demodulate(s.n_from_s, b_from_s).error_from(&data.attitude).as_array();
+            for i in 0..3 {
+                sum.rms_rad[i] += v[i] * v[i];
+                sum.peak_rad[i] = sum.peak_rad[i].max(v[i].abs());
+            }
+            if keep {
+                row.push(v);
+            }
+        }
+        if keep {
+            trace.push(s.t_s, row);
+        }
+    })?;
     let n = data.samples.len().max(1) as f64;
-    sum.rms_rad = sum.rms_rad.map(|v| (v / n).sqrt());
-    (out, sum)
+    for sum in &mut sums {
+        sum.rms_rad = sum.rms_rad.map(|v| (v / n).sqrt());
+    }
+    Ok(sums)
 }
 
 #[cfg(test)]

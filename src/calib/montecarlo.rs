@@ -237,7 +237,7 @@ pub fn run_indices(setup: &Setup<'_>, indices: &[u64], collect: &Collect<'_>, pr
                 }
             }
             let data = collect(&truth, base_seed.wrapping_add(1000).wrapping_add(i))?;
-            let cal = calibrate(setup.chain, setup.compensation, &data, &cfg, History::Lean)?;
+            let cal = calibrate(setup.chain, setup.compensation, &data, &cfg, History::Lean, stop)?;
             let truth_v = cal.set.values(&truth);
             let out = RunErrors { index: i, kf: errors(setup.chain, &cal.set, &cal.kf.theta, &truth_v), nls: errors(setup.chain, &cal.set, &cal.nls.theta, &truth_v) };
             progress();

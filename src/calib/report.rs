@@ -392,7 +392,7 @@ pub fn build(scenario: &str, chain: &Chain, truth: &TableErrors, cal: &Calibrati
             super::AttitudeSource::Log => "a log set's INS output (replayed)".into(),
         },
         samples: cal.samples,
-        duration_s: data.samples.last().map_or(0.0, |s| s.t_s),
+        duration_s: data.samples.last_t_s(),
         measurement_sigma_arcsec: cal.measurement_sigma_rad * ARCSEC_PER_RAD,
         nls_iterations: cal.nls_iterations,
         residual_rms_arcsec: [cal.kf.residual_rms_rad.map(|v| v * ARCSEC_PER_RAD), cal.nls.residual_rms_rad.map(|v| v * ARCSEC_PER_RAD)],

@@ -37,7 +37,7 @@ fn first_order_columns_are_the_closed_form_model() {
     let mut h = [[0.0; MAX_TABLE]; 3];
     for i in 0..50 {
         let angles = [0.37 * i as f64, -1.13 * i as f64 + 0.2, 0.0];
-        let s = Measurement { t_s: 0.0, tau: 0.0, n_from_s: Rot::identity(), shafts: p.table.chain.shaft_rotations(&angles) };
+        let s = Measurement { t_s: 0.0, n_from_s: Rot::identity(), shafts: p.table.chain.shaft_rotations(&angles) };
         set.table_rows(&p.table.chain, &nb, &s, &mut h);
         let ours = Vector3::from_fn(|r, _| (0..5).map(|j| h[r][j] * theta[j]).sum::<f64>());
         let closed = nb * p.table.chain.first_order_phi_b(&errors, &angles, &[0.0; 3]).v;
@@ -53,8 +53,8 @@ fn the_filter_is_eq_33_in_information_form() {
     let mut p = presets::load("jiang2017-calibration").expect("preset");
     p.duration_s = 10.0;
     p.calibration.nuisance = Nuisance::None;
-    let data = collect(&p, 5).expect("data");
-    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final).expect("calibration");
+    let data = collect(&p, 5, &AtomicBool::new(false)).expect("data");
+    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final, &AtomicBool::new(false)).expect("calibration");
     let set = &cal.set;
     let (x0, s0) = set.prior(&p.calibration);
     let mut x = DVector::from_vec(x0);
@@ -63,7 +63,8 @@ fn the_filter_is_eq_33_in_information_form() {
     let nb = data.n_from_b.matrix();
     let before = p.table.chain.error_rotations(&set.without_estimated(&p.table.compensation));
     let mut h = [[0.0; MAX_TABLE]; 3];
-    for s in &data.samples {
+    let Samples::Memory(samples) = &data.samples else { panic!("a 10 s test fits in memory") };
+    for s in samples {
         set.table_rows(&p.table.chain, &nb, s, &mut h);
         let hm = DMatrix::from_fn(3, 5, |r, j| h[r][j]);
         let z = exact_residual(&p.table.chain, &before, s, &data.n_from_b.inverse());
@@ -83,8 +84,8 @@ fn noise_free_data_give_the_true_parameters() {
     // α2 cos φ2 and η_eff = η − α2 sin φ2 — the exact least squares recovers to 0.01″ (phase: 0.01″
     // of phase angle); the first-order filter is off by its neglected second-order terms.
     let p = noise_free();
-    let data = collect(&p, 1).expect("data");
-    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final).expect("calibration");
+    let data = collect(&p, 1, &AtomicBool::new(false)).expect("data");
+    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final, &AtomicBool::new(false)).expect("calibration");
     let report = report::build("t", &p.table.chain, &p.table.truth, &cal, &data, None);
     let row = |key: &str| report.angles.iter().chain(&report.state).find(|r| r.key == key).unwrap_or_else(|| panic!("no row {key}"));
     for key in ["inner.swing_half_angle", "outer.swing_cos", "inner.effective_non_orthogonality"] {
@@ -101,7 +102,7 @@ fn noise_free_data_give_the_true_parameters() {
     let mut p = p;
     p.calibration.prior_eta_rad = p.table.truth.axes[1].non_orthogonality_rad;
     p.calibration.prior_eta_sigma_rad = 1e-9 * RAD_PER_ARCSEC;
-    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final).expect("calibration");
+    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final, &AtomicBool::new(false)).expect("calibration");
     let report = report::build("t", &p.table.chain, &p.table.truth, &cal, &data, None);
     assert!(report.unobservable.iter().all(|u| u.resolved_by_prior), "{:?}", report.unobservable);
     assert!(report.warnings.is_empty(), "{:?}", report.warnings);
@@ -131,8 +132,8 @@ fn outer_swing_and_eta_are_one_rotation_and_the_report_says_so() {
         assert!(arcsec(d) < 0.05, "difference {}″", arcsec(d));
     }
     // And the calibration reports exactly that direction as unobservable, with η_eff determined.
-    let data = collect(&p, 1).expect("data");
-    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final).expect("calibration");
+    let data = collect(&p, 1, &AtomicBool::new(false)).expect("data");
+    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final, &AtomicBool::new(false)).expect("calibration");
     let report = report::build("t", &p.table.chain, &p.table.truth, &cal, &data, None);
     assert_eq!(report.unobservable.len(), 1, "{:?}", report.unobservable);
     let dir = &report.unobservable[0].direction;
@@ -159,21 +160,21 @@ fn phase_and_eq_34_warnings_trigger_where_they_should() {
     p.ins = None;
     p.duration_s = 60.0;
     p.table.truth.axes[1].swing_phase_rad = 90.0 * RAD_PER_DEG;
-    let data = collect(&p, 3).expect("data");
-    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final).expect("calibration");
+    let data = collect(&p, 3, &AtomicBool::new(false)).expect("data");
+    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final, &AtomicBool::new(false)).expect("calibration");
     let report = report::build("t", &p.table.chain, &p.table.truth, &cal, &data, None);
     assert!(report.warnings.iter().any(|w| w.contains("eq. 34")), "{:?}", report.warnings);
     assert!(!report.warnings.iter().any(|w| w.contains("phase is undefined")), "{:?}", report.warnings);
 
     p.table.truth.axes[1].swing_half_angle_rad = 0.02 * RAD_PER_ARCSEC;
-    let data = collect(&p, 3).expect("data");
-    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final).expect("calibration");
+    let data = collect(&p, 3, &AtomicBool::new(false)).expect("data");
+    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final, &AtomicBool::new(false)).expect("calibration");
     let report = report::build("t", &p.table.chain, &p.table.truth, &cal, &data, None);
     assert!(report.warnings.iter().any(|w| w.starts_with("inner: ") && w.contains("phase is undefined")), "{:?}", report.warnings);
     // A clearly non-zero α1 at φ1 = 1° raises neither.
     let p = presets::load("jiang2017-calibration").expect("preset");
-    let data = collect(&p, 3).expect("data");
-    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final).expect("calibration");
+    let data = collect(&p, 3, &AtomicBool::new(false)).expect("data");
+    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final, &AtomicBool::new(false)).expect("calibration");
     let report = report::build("t", &p.table.chain, &p.table.truth, &cal, &data, None);
     assert!(!report.warnings.iter().any(|w| w.contains("eq. 34") || w.contains("phase is undefined")), "{:?}", report.warnings);
 }
@@ -184,7 +185,7 @@ fn compensation_with_the_estimates_beats_the_papers_factors() {
     // (heading). Under the paper's noise (Table 1 INS, 12″ encoders) rinscope's compensation with
     // its own estimates, on an independent run, must reduce each peak at least as much.
     let p = presets::load("jiang2017-calibration").expect("preset");
-    let out = calibrate_scenario(&p, false).expect("calibration");
+    let out = calibrate_scenario(&p, false, &AtomicBool::new(false)).expect("calibration");
     let c = out.report.compensation.expect("compensation");
     for (i, (before, after)) in report::PAPER_LAB.iter().enumerate() {
         let ours = c.before.peak_rad[i] / c.after_nls.peak_rad[i];
@@ -228,5 +229,44 @@ fn a_moving_vehicle_is_refused() {
     let mut p = presets::load("jiang2017-calibration").expect("preset");
     let wobble = crate::model::motion::Wobble { angle: crate::model::motion::AngleKind::Roll, amplitude_rad: 0.01, omega_rad_per_s: 0.5, phase_rad: 0.0 };
     p.table.vehicle = crate::model::motion::VehicleMotion::new(Attitude::default(), vec![], vec![wobble]).expect("motion");
-    assert!(matches!(collect(&p, 0), Err(CalibError::VehicleMoves(_))));
+    assert!(matches!(collect(&p, 0, &AtomicBool::new(false)), Err(CalibError::VehicleMoves(_))));
+}
+
+#[test]
+fn a_replayed_test_calibrates_exactly_as_one_in_memory() {
+    // A test longer than IN_MEMORY_SAMPLES is generated again for each pass instead of kept: the
+    // estimates must not depend on which (same samples, same order, same sums).
+    let mut p = presets::load("jiang2017-calibration").expect("preset");
+    p.duration_s = 20.0;
+    let stop = AtomicBool::new(false);
+    let memory = collect(&p, 4, &stop).expect("data");
+    let Samples::Memory(v) = &memory.samples else { panic!("20 s fits in memory") };
+    let (count, last_t_s, v) = (v.len(), v.last().map_or(0.0, |m| m.t_s), v.clone());
+    let replay = move |sink: &mut dyn FnMut(&Measurement) -> bool| -> Result<(), CalibError> {
+        for m in &v {
+            if !sink(m) {
+                break;
+            }
+        }
+        Ok(())
+    };
+    let replayed = Data { samples: Samples::Replayed { replay: Box::new(replay), count, last_t_s }, ..memory.clone_header() };
+    let a = calibrate(&p.table.chain, &p.table.compensation, &memory, &p.calibration, History::Snapshots(1.0), &stop).expect("memory");
+    let b = calibrate(&p.table.chain, &p.table.compensation, &replayed, &p.calibration, History::Snapshots(1.0), &stop).expect("replayed");
+    assert_eq!(a.nls.theta, b.nls.theta);
+    assert_eq!(a.kf.theta, b.kf.theta);
+    assert_eq!(a.history.len(), b.history.len());
+    assert!(a.history.len() >= 19, "{} snapshots", a.history.len());
+}
+
+#[test]
+fn a_trace_stays_bounded_and_spans_the_whole_test() {
+    let mut t = Thinned::new(0.0);
+    for i in 0..1_000_000 {
+        t.push(f64::from(i) * 0.01, i);
+    }
+    assert!(t.rows.len() <= MAX_TRACE_ROWS && t.rows.len() > MAX_TRACE_ROWS / 4, "{} rows", t.rows.len());
+    assert_eq!(t.rows[0], 0);
+    assert!(*t.t_s.last().expect("rows") > 9_900.0, "reaches the end: {:?}", t.t_s.last());
+    assert!(t.t_s.windows(2).all(|w| w[1] > w[0]));
 }

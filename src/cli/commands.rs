@@ -57,7 +57,7 @@ pub(super) fn run(args: &RunArgs) -> Result<(), Failure> {
         println!("open it with:  rerun {p}     (viewer: {})", sink::VIEWER_INSTALL_HINT);
     }
     if summary.interrupted {
-        return Err(Failure::interrupted("interrupted: the recording is complete up to the moment of Ctrl-C"));
+        return Err(Failure::interrupted("the recording is complete up to that moment"));
     }
     Ok(())
 }
@@ -98,6 +98,7 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
         spawn: args.sinks.spawn || (!viewer_given && !args.no_viewer),
         connect: args.sinks.connect.clone(),
         serve: args.sinks.serve,
+        bind: args.sinks.bind,
         ..Default::default()
     };
     let recording_id = format!("{}-seed{}-live", params.meta.name, params.meta.seed);
@@ -107,7 +108,7 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
         None
     };
     let file_sinks = match &args.sinks.save {
-        Some(p) => Some(sink::open(&SinkRequest { save: Some(p.clone()), ..Default::default() }, APPLICATION_ID, &recording_id)?),
+        Some(p) => Some(sink::open(&SinkRequest { save: Some(p.clone()), stop_on_failure: Some(stop_flag()), ..Default::default() }, APPLICATION_ID, &recording_id)?),
         None => None,
     };
     for d in viewer_sinks.iter().chain(file_sinks.iter()).flat_map(|s| &s.description) {
@@ -195,7 +196,7 @@ pub(super) fn open_sinks(request: SinkRequest, recording_id: &str) -> Result<sin
 /// Writes `value` as pretty JSON to the file given with `flag`, atomically.
 pub(super) fn write_json(flag: &str, path: &std::path::Path, value: &impl serde::Serialize) -> Result<(), Failure> {
     let json = serde_json::to_string_pretty(value).map_err(|e| Failure::run(e.to_string()))?;
-    write_atomically(path, json.as_bytes()).map_err(|e| Failure::input(format!("{flag} {}: {e}", path.display())))
+    write_atomically(path, json.as_bytes()).map_err(|e| Failure::input(format!("{flag} {e}")))
 }
 
 /// The line that tells where a saved recording is and how to open it.
@@ -228,14 +229,18 @@ pub(super) fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
         Some(open_sinks(request, &format!("{}-calibration-seed{}", params.meta.name, params.meta.seed))?)
     };
     let started = std::time::Instant::now();
-    let outcome = match calibrate_scenario(&params, sinks.is_some()) {
+    let stop = stop_flag();
+    let outcome = match calibrate_scenario(&params, sinks.is_some(), &stop) {
         Ok(o) => o,
         Err(e) => {
             if let Some(s) = sinks {
                 s.abandon();
             }
-            let code = if matches!(e, CalibError::VehicleMoves(_)) { 2 } else { 1 };
-            return Err(Failure { code, message: format!("calibrate: {e}") });
+            return Err(match e {
+                CalibError::Interrupted => Failure::interrupted("calibrate did not finish; nothing was estimated and no recording was made"),
+                CalibError::VehicleMoves(_) => Failure::input(format!("calibrate: {e}")),
+                e => Failure::run(format!("calibrate: {e}")),
+            });
         }
     };
     let wall = started.elapsed().as_secs_f64();
@@ -246,11 +251,14 @@ pub(super) fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
         write_json("--json", path, &CalibrationOutput { report: &outcome.report, estimated_compensation: compensation })?;
     }
     if let Some(sinks) = sinks {
-        if let Err(e) = record_outcome(sinks.stream(), &params, &outcome, &stop_flag()) {
+        if let Err(e) = record_outcome(sinks.stream(), &params, &outcome, &stop) {
             sinks.abandon();
             return Err(Failure::run(format!("rerun: {e}")));
         }
         print_saved(&sinks.finish()?);
+    }
+    if stop.load(Ordering::SeqCst) {
+        return Err(Failure::interrupted("the estimates above are complete; the recording's table motion stops where it was cut short"));
     }
     Ok(())
 }
@@ -308,7 +316,7 @@ pub(super) fn montecarlo(args: &MonteCarloArgs) -> Result<(), Failure> {
         }
     }
     if done.len() < mine {
-        return Err(Failure::interrupted(format!("interrupted after {} of {mine} runs (statistics above are over those)", done.len())));
+        return Err(Failure::interrupted(format!("after {} of {mine} runs (the statistics above are over those only)", done.len())));
     }
     Ok(())
 }
@@ -376,14 +384,14 @@ pub(super) fn tpr(args: &TprArgs) -> Result<(), Failure> {
     }
     print_saved(&saved);
     if !result.complete {
-        return Err(Failure::interrupted("interrupted: the recording holds what was simulated"));
+        return Err(Failure::interrupted("the recording holds what was simulated until then"));
     }
     if let Some(n) = args.seeds {
         eprintln!("rinscope: {n} seeds from {} in parallel...", params.meta.seed);
         let started = std::time::Instant::now();
         let rows = tpr::sweep(&params, n, &stop).map_err(|e| Failure::input(format!("tpr: {e}")))?;
         if stop.load(Ordering::SeqCst) {
-            return Err(Failure::interrupted("interrupted"));
+            return Err(Failure::interrupted("the seed sweep did not finish"));
         }
         print!("{}", sweep_text(&rows));
         println!("  {n} runs of {:.1} h in {:.1} s", params.duration_s / 3600.0, started.elapsed().as_secs_f64());
@@ -438,7 +446,7 @@ pub(super) fn reproduce(markdown: Option<&Path>) -> Result<(), Failure> {
     let table = reproduce::run_all()?;
     print!("{}", table.text());
     if let Some(path) = markdown {
-        write_atomically(path, table.markdown().as_bytes()).map_err(|e| Failure::input(format!("--markdown {}: {e}", path.display())))?;
+        write_atomically(path, table.markdown().as_bytes()).map_err(|e| Failure::input(format!("--markdown {e}")))?;
     }
     if table.all_agree() {
         Ok(())

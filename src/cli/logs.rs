@@ -138,7 +138,7 @@ pub(super) fn replay(args: &ReplayArgs) -> Result<(), Failure> {
     }
     print_saved(&saved);
     if summary.interrupted {
-        return Err(Failure::interrupted("interrupted: the recording is complete up to the moment of Ctrl-C"));
+        return Err(Failure::interrupted("the recording is complete up to that moment"));
     }
     Ok(())
 }
@@ -149,8 +149,8 @@ pub(super) fn calibrate_log(args: &CalibrateArgs, dir: &Path) -> Result<(), Fail
     check_output_dir("--json", args.json.as_deref())?;
     let stop = stop_flag();
     let started = std::time::Instant::now();
-    let (cal, report, data) = calibration::calibrate_log(&log, !args.no_recording, &stop).map_err(|e| match e {
-        LogCalibrationError::Interrupted => Failure::interrupted("calibrate --log: interrupted"),
+    let (cal, report, data, traces) = calibration::calibrate_log(&log, !args.no_recording, &stop).map_err(|e| match e {
+        LogCalibrationError::Interrupted => Failure::interrupted("calibrate --log did not finish; nothing was estimated"),
         LogCalibrationError::Calibration(c) => Failure::run(format!("calibrate --log: {c}")),
         other => Failure::input(format!("calibrate --log: {other}")),
     })?;
@@ -161,13 +161,9 @@ pub(super) fn calibrate_log(args: &CalibrateArgs, dir: &Path) -> Result<(), Fail
         write_json("--json", path, &CalibrationOutput { report: &report, estimated_compensation: compensation })?;
     }
     if !args.no_recording {
-        let params = log.recording_params(data.samples.last().map_or(1.0, |s| s.t_s))?;
+        let params = log.recording_params(data.samples.last_t_s().max(1.0))?;
         let default_save = PathBuf::from("recordings").join(format!("{}-calibration.rrd", log.name));
         let sinks = open_sinks(args.sinks.request(default_save)?, &format!("{}-calibration", log.name))?;
-        let errs = |e: &crate::model::gimbal::TableErrors| crate::calib::attitude_errors(&log.table.chain, e, &data).0;
-        let comp = &log.table.compensation;
-        let traces_owned = [errs(&cal.set.without_estimated(comp)), errs(&cal.set.errors(&cal.kf.theta, comp)), errs(&cal.set.errors(&cal.nls.theta, comp))];
-        let traces = crate::record::calibration::ErrorTraces { t_s: data.samples.iter().map(|s| s.t_s).collect(), errors: [&traces_owned[0], &traces_owned[1], &traces_owned[2]] };
         let logged = crate::record::calibration::log(sinks.stream(), &params, &cal, &report, &traces).and_then(|mut r| r.finish());
         if let Err(e) = logged {
             sinks.abandon();

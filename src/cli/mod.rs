@@ -10,7 +10,8 @@
 //! ```
 //!
 //! Exit codes: 0 success, 1 a failure while running (or a reproduction outside tolerance),
-//! 2 bad input (config, path, viewer), 130 interrupted by Ctrl-C (what was simulated is saved).
+//! 2 bad input (config, path, viewer), 128 + the signal when stopped by SIGINT (130), SIGTERM (143)
+//! or SIGHUP (129): what was simulated is saved, and the command says it was cut short.
 
 mod commands;
 mod logs;
@@ -114,6 +115,10 @@ struct SinkArgs {
     /// Serve the stream over gRPC on this port (default 9876) for native or web viewers.
     #[arg(long, num_args = 0..=1, default_missing_value = "9876")]
     serve: Option<u16>,
+    /// --serve: the address to listen on (default 127.0.0.1, this machine only; 0.0.0.0 shares the
+    /// session with the whole network, without authentication).
+    #[arg(long, value_name = "ADDR", requires = "serve")]
+    bind: Option<std::net::IpAddr>,
     /// Also write every recorded time series as tables into this folder (one file per plot, a
     /// t_s column, units in the column names; docs/export.md).
     #[arg(long, value_name = "DIR")]
@@ -136,7 +141,7 @@ impl SinkArgs {
             None => None,
             Some(dir) => Some((dir.clone(), ExportFormat::parse(&self.export_format).map_err(|e| Failure::input(format!("--export-format {e}")))?)),
         };
-        Ok(SinkRequest { save, spawn: self.spawn, connect: self.connect.clone(), serve: self.serve, export })
+        Ok(SinkRequest { save, spawn: self.spawn, connect: self.connect.clone(), serve: self.serve, bind: self.bind, export, stop_on_failure: Some(crate::app::terminate::stop_flag()) })
     }
 }
 
@@ -357,9 +362,10 @@ impl Failure {
         Self { code: 1, message: message.into() }
     }
 
-    /// Stopped by the user before the end (exit 130).
+    /// Stopped before the end by a signal (exit 128 + the signal: 130, 143, 129).
     fn interrupted(message: impl Into<String>) -> Self {
-        Self { code: 130, message: message.into() }
+        let by = crate::app::terminate::stop_reason().unwrap_or("a stop request");
+        Self { code: crate::app::terminate::interrupted_exit_code(), message: format!("interrupted by {by}: {}", message.into()) }
     }
 }
 
@@ -372,7 +378,7 @@ impl From<ConfigError> for Failure {
 impl From<SinkError> for Failure {
     fn from(e: SinkError) -> Self {
         let code = match e {
-            SinkError::Rerun(_) | SinkError::Spawn(_) => 1,
+            SinkError::Rerun(_) | SinkError::Spawn(_) | SinkError::Write(_) => 1,
             _ => 2,
         };
         Self { code, message: e.to_string() }

@@ -1,7 +1,7 @@
 //! Streaming table writers (CSV, Parquet, .npy) that only ever replace the target when finished.
 //!
-//! Rows go to `PATH.partial`, created with `create_new` (so an existing file, or a symlink, in
-//! that place is refused and never followed). [`TableWriter::finish`] flushes, fsyncs, renames the
+//! Rows go to `PATH.partial`, a [`PartialFile`] (locked, never through a symlink; see
+//! [`crate::io::files`]). [`TableWriter::finish`] flushes, fsyncs, renames the
 //! partial onto `PATH` and fsyncs the directory. On any error, or if the writer is dropped
 //! unfinished, the partial is removed and an existing `PATH` is left untouched. A `PATH` that is
 //! a symlink or a directory is refused.
@@ -17,11 +17,12 @@
 //!   no place for them), the caller knows their order.
 
 use crate::io::error::{LogError, Result};
+use crate::io::files::PartialFile;
 use crate::io::npy::NpyWriter;
 use crate::io::parquet_io::ParquetWriter;
 use crate::io::sniff::Format;
 use crate::io::units::split_unit;
-use std::fs::{File, OpenOptions};
+use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
@@ -34,7 +35,8 @@ enum Backend {
 /// Writes a table row by row; see the module docs. Drop it unfinished to abandon the file.
 pub struct TableWriter {
     path: PathBuf,
-    partial: PathBuf,
+    /// The locked `PATH.partial` (see [`crate::io::files`]); `None` once committed.
+    out: Option<PartialFile>,
     columns: Vec<String>,
     backend: Option<Backend>,
     rows: u64,
@@ -49,16 +51,6 @@ impl std::fmt::Debug for TableWriter {
             .field("rows", &self.rows)
             .finish_non_exhaustive()
     }
-}
-
-/// `PATH.partial`.
-fn partial_path(path: &Path) -> PathBuf {
-    let mut name = path
-        .file_name()
-        .map(std::ffi::OsStr::to_os_string)
-        .unwrap_or_default();
-    name.push(".partial");
-    path.with_file_name(name)
 }
 
 fn check_columns(path: &Path, columns: &[&str]) -> Result<()> {
@@ -105,8 +97,8 @@ impl TableWriter {
     /// Creates a writer for `path` in the format its extension names (`.csv`, `.parquet`, `.npy`).
     ///
     /// # Errors
-    /// Unknown extension or an MCAP one, bad column names, `PATH.partial` already present (or a
-    /// symlink), `PATH` a symlink or directory, or the partial cannot be created.
+    /// Unknown extension or an MCAP one, bad column names, `PATH.partial` locked by another writer
+    /// (or a symlink), `PATH` a symlink or directory, or the partial cannot be created.
     pub fn create(path: impl AsRef<Path>, columns: &[&str]) -> Result<Self> {
         let path = path.as_ref();
         let format = Format::from_extension(path);
@@ -123,37 +115,15 @@ impl TableWriter {
             }
         };
         check_columns(path, columns)?;
-        if let Ok(meta) = std::fs::symlink_metadata(path) {
-            if meta.file_type().is_symlink() {
-                return Err(output(
-                    "the output path is a symlink; refusing to write through it".into(),
-                ));
-            }
-            if meta.is_dir() {
-                return Err(output("the output path is a directory".into()));
-            }
+        if std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink()) {
+            return Err(output("the output path is a symlink; refusing to write through it".into()));
         }
-        let partial = partial_path(path);
-        if let Ok(meta) = std::fs::symlink_metadata(&partial) {
-            let what = if meta.file_type().is_symlink() {
-                "a symlink"
-            } else {
-                "a file"
-            };
-            return Err(output(format!(
-                "{} is {what} in the way (another export running, or one that crashed?); remove it to write",
-                partial.display()
-            )));
-        }
-        let file = OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&partial)
-            .map_err(|e| LogError::io(&partial, "cannot create", e))?;
+        let out = PartialFile::create(path).map_err(|e| output(e.to_string()))?;
+        let file = out.file().try_clone().map_err(|e| LogError::io(out.partial(), "cannot open", e))?;
         let names: Vec<String> = columns.iter().map(|c| (*c).to_owned()).collect();
         let mut this = Self {
             path: path.to_path_buf(),
-            partial,
+            out: Some(out),
             columns: names,
             backend: None,
             rows: 0,
@@ -249,31 +219,10 @@ impl TableWriter {
             Some(Backend::Parquet(w)) => w.finish(&self.path)?,
             Some(Backend::Npy(w)) => w.finish(&self.path)?,
         };
-        file.sync_all()
-            .map_err(|e| LogError::io(&self.path, "cannot sync", e))?;
         drop(file);
-        std::fs::rename(&self.partial, &self.path)
-            .map_err(|e| LogError::io(&self.path, "cannot rename the partial onto", e))?;
-        // The partial is gone; nothing to clean up any more.
-        self.partial = PathBuf::new();
-        let dir = match self.path.parent() {
-            Some(d) if !d.as_os_str().is_empty() => d,
-            _ => Path::new("."),
-        };
-        if let Ok(d) = File::open(dir) {
-            d.sync_all()
-                .map_err(|e| LogError::io(dir, "cannot sync", e))?;
-        }
+        let out = self.out.take().ok_or_else(|| LogError::Output { file: self.path.clone(), problem: "already finished".into() })?;
+        out.commit().map_err(|e| LogError::Output { file: self.path.clone(), problem: e.to_string() })?;
         Ok(self.rows)
-    }
-}
-
-impl Drop for TableWriter {
-    fn drop(&mut self) {
-        if !self.partial.as_os_str().is_empty() {
-            self.backend = None;
-            let _ = std::fs::remove_file(&self.partial);
-        }
     }
 }
 
@@ -303,13 +252,5 @@ mod tests {
         let mut s = String::new();
         push_f64(&mut s, 1e300);
         assert_eq!(s, "1e300");
-    }
-
-    #[test]
-    fn partial_name() {
-        assert_eq!(
-            partial_path(Path::new("/a/b.csv")),
-            Path::new("/a/b.csv.partial")
-        );
     }
 }

@@ -23,19 +23,14 @@ const ERROR_COLORS: [[u8; 3]; 3] = [[230, 76, 60], [250, 200, 60], [90, 160, 250
 const STATE_NAMES: [&str; 5] = ["static KF", "+3σ", "−3σ", "true", "exact LSQ (final)"];
 const ERROR_NAMES: [&str; 3] = ["before (no swing/η model)", "after: static KF", "after: exact LSQ"];
 
-/// Per-sample attitude errors (pitch, roll, heading, rad) of the validation run: before, after the
-/// filter's compensation, after the least squares'.
-pub struct ErrorTraces<'a> {
-    /// Sample times, s.
-    pub t_s: Vec<f64>,
-    /// Before, after KF, after LSQ.
-    pub errors: [&'a [[f64; 3]]; 3],
-}
+/// The validation run's attitude errors (pitch, roll, heading, rad) at the kept instants: before,
+/// after the filter's compensation, after the least squares'.
+pub type ErrorTraces = crate::calib::Thinned<Vec<[f64; 3]>>;
 
 /// Writes the calibration's recording into `rec`: layout, documents, the filter over time, the
 /// before/after errors and the ghost cones. Returns the table's recorder, into which the caller
 /// streams the table's motion (as in any run) and finishes.
-pub fn log(stream: Stream, params: &Params, cal: &Calibration, report: &Report, traces: &ErrorTraces<'_>) -> RecordingStreamResult<Recorder> {
+pub fn log(stream: Stream, params: &Params, cal: &Calibration, report: &Report, traces: &ErrorTraces) -> RecordingStreamResult<Recorder> {
     let chain = &params.table.chain;
     let set = &cal.set;
     let table: Vec<(usize, Param)> = set.params.iter().copied().enumerate().filter(|(_, p)| p.is_table()).collect();
@@ -102,16 +97,10 @@ pub fn log(stream: Stream, params: &Params, cal: &Calibration, report: &Report, 
         stream.send_series(&format!("calibration/state_arcsec/{}", p.key(chain)), &STATE_NAMES.map(String::from), &times, values, 5)?;
     }
 
-    // Before / after, decimated to the series rate.
-    let every = (traces.t_s.len() as f64 / (params.duration_s * params.recording.series_hz)).max(1.0).round() as usize;
-    let idx: Vec<usize> = (0..traces.t_s.len()).step_by(every).collect();
+    // Before / after (the trace is kept at the series rate, thinned over long tests).
     for (a, name) in ERROR_AXES.iter().enumerate() {
-        let mut values = Vec::with_capacity(3 * idx.len());
-        for &i in &idx {
-            values.extend(traces.errors.iter().map(|e| e[i][a] * ARCSEC_PER_RAD));
-        }
-        let times: Vec<f64> = idx.iter().map(|&i| traces.t_s[i]).collect();
-        stream.send_series(&format!("calibration/error_arcsec/{name}"), &ERROR_NAMES.map(String::from), &times, values, 3)?;
+        let values: Vec<f64> = traces.rows.iter().flat_map(|row| row.iter().map(move |e| e[a] * ARCSEC_PER_RAD)).collect();
+        stream.send_series(&format!("calibration/error_arcsec/{name}"), &ERROR_NAMES.map(String::from), &traces.t_s, values, 3)?;
     }
 
     // Ghost cones and estimated rotor axes, once per second of the test.

@@ -215,7 +215,7 @@ fn calibration_speed() -> anyhow::Result<()> {
     let stop = AtomicBool::new(false);
     let p = presets::load("jiang2017-calibration")?;
     let started = Instant::now();
-    let outcome = crate::app::calibrate::calibrate_scenario(&p, false)?;
+    let outcome = crate::app::calibrate::calibrate_scenario(&p, false, &stop)?;
     println!(
         "calibration       jiang2017-calibration: 200 s at 200 Hz, static KF + exact least squares + validation run in {:.2} s ({} measurements)",
         started.elapsed().as_secs_f64(),

@@ -54,7 +54,7 @@ impl fmt::Display for KeyPath {
 /// Why a value could not be written.
 #[derive(Debug, thiserror::Error)]
 pub enum EditError {
-    /// Reading or writing the file.
+    /// Reading the file.
     #[error("{path}: {source}")]
     Io {
         /// The file.
@@ -62,6 +62,9 @@ pub enum EditError {
         /// The I/O error.
         source: std::io::Error,
     },
+    /// Writing the file.
+    #[error(transparent)]
+    Write(#[from] crate::io::files::OutputError),
     /// The file is not valid TOML (the user is mid-edit); the slider waits.
     #[error("{path} is not valid TOML right now ({message}); not writing")]
     Syntax {
@@ -124,7 +127,7 @@ pub fn set_in_file(path: &Path, key: &KeyPath, value: Value) -> Result<(), EditE
             EditError::Missing { path: shown.clone(), key: key.to_string() }
         }
     })?;
-    write_atomically(path, new.as_bytes()).map_err(|source| EditError::Io { path: shown, source })
+    Ok(write_atomically(path, new.as_bytes())?)
 }
 
 /// A value a control writes.

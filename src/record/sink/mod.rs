@@ -1,12 +1,19 @@
-//! Where a recording goes, following Rerun's conventions: `--save FILE`, `--spawn`, `--connect [URL]`
-//! (several at once are allowed). Files are written to `FILE.partial` and renamed only when complete,
-//! so a failed or interrupted run never leaves a half-written recording under the final name.
+//! Where a recording goes, following Rerun's conventions: `--save FILE`, `--spawn`, `--connect [URL]`,
+//! `--serve [PORT]` (several at once are allowed).
+//!
+//! - The file (file.rs) is written to `FILE.partial` by a writer of ours, verified, and renamed
+//!   only when complete: a failed, interrupted or concurrent run never leaves a half-written
+//!   recording under the final name, and never replaces a good one. A write error stops the run.
+//! - Viewers (viewer.rs) are checked before anything is created (installed, a display, listening)
+//!   and streamed to through [`viewer::Detachable`]: a viewer that freezes or goes away is
+//!   reported and detached within seconds; it never holds up the file.
 
-use std::net::{SocketAddr, TcpStream, ToSocketAddrs};
+use std::net::{IpAddr, Ipv4Addr, SocketAddr, TcpStream, ToSocketAddrs};
 use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
-use rerun::sink::{FileSink, GrpcSink, LogSink};
+use rerun::sink::{GrpcSink, LogSink};
 use rerun::{RecordingStream, RecordingStreamBuilder};
 
 pub use crate::io::files::partial_path;
@@ -14,6 +21,9 @@ pub use crate::io::files::partial_path;
 use super::export::{ExportFormat, Exporter, SharedExporter};
 use super::Stream;
 use std::sync::{Arc, Mutex};
+
+mod file;
+pub mod viewer;
 
 /// The viewer version that matches the SDK this binary is built with.
 pub const VIEWER_INSTALL_HINT: &str = "pip install rerun-sdk==0.36.3";
@@ -42,21 +52,19 @@ pub enum SinkError {
         reason: String,
     },
     /// The output file cannot be created.
-    #[error("--save: cannot write {path}: {reason}")]
-    File {
-        /// The final path.
-        path: String,
-        /// Why.
-        reason: String,
-    },
+    #[error("--save: {0}")]
+    File(String),
     /// `--serve` on a port that is taken.
-    #[error("--serve: cannot listen on port {port}: {reason}")]
+    #[error("--serve: cannot listen on {addr}: {reason}")]
     Serve {
-        /// The port asked for.
-        port: u16,
+        /// The address asked for.
+        addr: SocketAddr,
         /// Why.
         reason: String,
     },
+    /// The saved file could not be completed.
+    #[error("--save: {0}; no recording was saved (a file already at that path was left as it was)")]
+    Write(String),
     /// Spawning the viewer failed.
     #[error("--spawn: {0}")]
     Spawn(String),
@@ -79,6 +87,10 @@ pub struct SinkRequest {
     pub connect: Option<String>,
     /// Serve the stream on this gRPC port for viewers (native or web) to connect to.
     pub serve: Option<u16>,
+    /// The address `serve` listens on (default 127.0.0.1: this machine only).
+    pub bind: Option<IpAddr>,
+    /// Set when the saved file cannot be written, so the run stops at its next check.
+    pub stop_on_failure: Option<Arc<AtomicBool>>,
     /// Also write every time series as tables into this folder.
     pub export: Option<(PathBuf, ExportFormat)>,
 }
@@ -89,8 +101,10 @@ pub struct OpenSinks {
     rec: RecordingStream,
     /// The export tables, if asked for.
     export: Option<SharedExporter>,
-    /// (partial path, final path) of the saved file, if any.
-    pub file: Option<(PathBuf, PathBuf)>,
+    /// The saved file being written, if any.
+    file: Option<file::RrdFile>,
+    /// What went wrong with viewers during the run.
+    viewer_problems: viewer::Problems,
     /// Human-readable description of where the data goes.
     pub description: Vec<String>,
 }
@@ -109,10 +123,14 @@ fn socket_of(url: &str) -> Option<SocketAddr> {
     hostport.to_socket_addrs().ok()?.next()
 }
 
-/// Opens every requested sink; checks viewers and paths first so that nothing is created on error.
+/// Opens every requested sink: viewers are checked (and spawned) first, then the file is created,
+/// so that nothing is created when a viewer is missing.
 pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str) -> Result<OpenSinks, SinkError> {
     let mut sinks: Vec<Box<dyn LogSink>> = Vec::new();
     let mut description = Vec::new();
+    let problems: viewer::Problems = Arc::default();
+    let file_kept = req.save.is_some();
+    let guarded = |inner: Box<dyn LogSink>, name: String| -> Box<dyn LogSink> { Box::new(viewer::Detachable::new(inner, name, Arc::clone(&problems), file_kept)) };
 
     if let Some(url) = &req.connect {
         let uri: rerun::external::re_uri::ProxyUri = url.parse().map_err(|e: rerun::external::re_uri::Error| SinkError::BadUrl { url: url.clone(), reason: e.to_string() })?;
@@ -120,50 +138,48 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
         if !listening {
             return Err(SinkError::NotListening { url: url.clone() });
         }
-        sinks.push(Box::new(GrpcSink::new(uri)));
+        sinks.push(guarded(Box::new(GrpcSink::new(uri)), format!("the viewer at {url}")));
         description.push(format!("streaming to the viewer at {url}"));
     }
 
-    let mut file = None;
-    if let Some(path) = &req.save {
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).map_err(|e| SinkError::File { path: path.display().to_string(), reason: e.to_string() })?;
-        }
-        let partial = partial_path(path);
-        let sink = FileSink::new(&partial).map_err(|e| SinkError::File { path: path.display().to_string(), reason: e.to_string() })?;
-        sinks.push(Box::new(sink));
-        file = Some((partial, path.clone()));
-        description.push(format!("saving to {}", path.display()));
-    }
-
     if req.spawn {
-        if find_on_path("rerun").is_none() {
-            if let Some((partial, _)) = &file {
-                drop(sinks);
-                std::fs::remove_file(partial).ok();
-            }
-            return Err(SinkError::NoViewer);
-        }
         // A new viewer on a free port: a viewer already listening on 9876 keeps its own data.
-        let opts = rerun::SpawnOptions { new: true, wait_for_bind: true, hide_welcome_screen: true, ..Default::default() };
-        let info = rerun::spawn(&opts).map_err(|e| SinkError::Spawn(e.to_string()))?;
-        let url = format!("rerun+http://127.0.0.1:{}/proxy", info.port);
+        let port = viewer::spawn()?;
+        let url = format!("rerun+http://127.0.0.1:{port}/proxy");
         let uri = url.parse().map_err(|e: rerun::external::re_uri::Error| SinkError::Rerun(e.to_string()))?;
-        sinks.push(Box::new(GrpcSink::new(uri)));
+        sinks.push(guarded(Box::new(GrpcSink::new(uri)), format!("the spawned viewer at {url}")));
         description.push(format!("streaming to a new viewer at {url}"));
     }
 
     if let Some(port) = req.serve {
+        let ip = req.bind.unwrap_or(IpAddr::V4(Ipv4Addr::LOCALHOST));
+        let addr = SocketAddr::new(ip, port);
         // Check the port first: the server binds in a background task and would fail silently.
-        std::net::TcpListener::bind(("0.0.0.0", port)).map_err(|e| SinkError::Serve { port, reason: e.to_string() })?;
+        std::net::TcpListener::bind(addr).map_err(|e| SinkError::Serve { addr, reason: e.to_string() })?;
         let options = rerun::ServerOptions { memory_limit: rerun::MemoryLimit::from_bytes(1 << 30), ..Default::default() };
-        let sink = rerun::grpc_server::GrpcServerSink::new("0.0.0.0", port, options).map_err(|e| SinkError::Serve { port, reason: e.to_string() })?;
+        let sink = rerun::grpc_server::GrpcServerSink::new(&ip.to_string(), port, options).map_err(|e| SinkError::Serve { addr, reason: e.to_string() })?;
         sinks.push(Box::new(sink));
-        let url = format!("rerun+http://127.0.0.1:{port}/proxy");
+        let host = if ip.is_unspecified() { "127.0.0.1".to_owned() } else { ip.to_string() };
+        let url = format!("rerun+http://{host}:{port}/proxy");
+        if !ip.is_loopback() {
+            eprintln!("rinscope: WARNING: --bind {ip}: anyone who can reach port {port} of this machine can watch this session (there is no authentication)");
+        }
         description.push(format!(
-            "serving on {url}: `rerun --connect {url}`, or in a browser https://app.rerun.io/version/0.36.3/index.html?url={}",
+            "serving on {addr}: `rerun --connect {url}`, or in a browser https://app.rerun.io/version/0.36.3/index.html?url={}",
             url.replace(':', "%3A").replace('/', "%2F").replace('+', "%2B")
         ));
+    }
+
+    let mut file = None;
+    if let Some(path) = &req.save {
+        // recordings/ (the default) and any folder named in --save are created.
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty() && !path.as_os_str().to_string_lossy().ends_with('/')) {
+            std::fs::create_dir_all(dir).map_err(|e| SinkError::File(format!("{}: cannot create its folder: {e}", path.display())))?;
+        }
+        let (rrd, sink) = file::RrdFile::create(path, req.stop_on_failure.clone()).map_err(SinkError::File)?;
+        sinks.push(Box::new(sink));
+        description.push(format!("saving to {}", path.display()));
+        file = Some(rrd);
     }
 
     let export = match &req.export {
@@ -178,7 +194,7 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
         .recording_id(recording_id.to_owned())
         .set_sinks(sinks)
         .map_err(|e| SinkError::Rerun(e.to_string()))?;
-    Ok(OpenSinks { rec, export, file, description })
+    Ok(OpenSinks { rec, export, file, viewer_problems: problems, description })
 }
 
 /// What a finished run left.
@@ -188,6 +204,8 @@ pub struct Saved {
     pub recording: Option<(PathBuf, u64)>,
     /// The export tables.
     pub exported: Vec<PathBuf>,
+    /// What went wrong with viewers (already reported when it happened).
+    pub viewer_problems: Vec<String>,
 }
 
 impl OpenSinks {
@@ -197,37 +215,47 @@ impl OpenSinks {
         Stream::new(self.rec.clone(), self.export.clone())
     }
 
-    /// Flushes, closes every sink, moves the saved file to its final name and finishes the export
-    /// tables.
+    /// The saved file's first write error, if any (the run was told to stop).
+    #[must_use]
+    pub fn write_error(&self) -> Option<String> {
+        self.file.as_ref().and_then(file::RrdFile::error)
+    }
+
+    /// Flushes, closes every sink, verifies the saved file and moves it to its final name, and
+    /// finishes the export tables.
+    ///
+    /// # Errors
+    /// The file could not be completed ([`SinkError::Write`]; nothing replaced) or an export
+    /// table failed.
     pub fn finish(self) -> Result<Saved, SinkError> {
-        let Self { rec, file, export, .. } = self;
-        // A viewer that went away fails the flush; the file must still be completed and kept.
-        if let Err(e) = rec.flush_with_timeout(std::time::Duration::from_secs(10)) {
-            eprintln!("rinscope: not every sink received the whole stream ({e}); the saved file is complete");
-        }
-        // Dropping the last handle joins the batcher and the file writer, which writes the footer.
-        drop(rec);
+        let Self { rec, file, export, viewer_problems, .. } = self;
+        // Viewers that stall are detached by their own timeouts; the file's writer is waited for
+        // by `RrdFile::finish`, so a flush timeout here loses nothing.
+        rec.flush_with_timeout(Duration::from_secs(10)).ok();
         let recording = match file {
             None => None,
-            Some((partial, path)) => {
-                std::fs::rename(&partial, &path).map_err(|e| SinkError::File { path: path.display().to_string(), reason: e.to_string() })?;
-                let bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
-                Some((path, bytes))
-            }
+            Some(f) => Some(f.finish().map_err(SinkError::Write)?),
         };
+        drop(rec);
         let exported = match export {
             None => Vec::new(),
             Some(e) => e.lock().unwrap_or_else(std::sync::PoisonError::into_inner).finish().map_err(|e| SinkError::Export(e.to_string()))?,
         };
-        Ok(Saved { recording, exported })
+        let viewer_problems = viewer_problems.lock().unwrap_or_else(std::sync::PoisonError::into_inner).clone();
+        Ok(Saved { recording, exported, viewer_problems })
     }
 
     /// Closes every sink and deletes the partial file (the run failed).
     pub fn abandon(self) {
         let Self { rec, file, .. } = self;
         drop(rec);
-        if let Some((partial, _)) = file {
-            std::fs::remove_file(partial).ok();
-        }
+        // Dropping the file unfinished removes its partial.
+        drop(file);
+    }
+
+    /// The path the recording will be saved to, if any.
+    #[must_use]
+    pub fn save_path(&self) -> Option<PathBuf> {
+        self.file.as_ref().map(file::RrdFile::path)
     }
 }
