@@ -14,6 +14,17 @@
 //! 6. [`app`] — the commands' orchestration: threads, channels, progress, files.
 //! 7. [`cli`] — clap, the sink flags declared once, exit codes.
 
+/// `print!` for what a command outputs: stdout may be a pipe whose reader has gone
+/// (`rinscope scenarios | head -5`); see [`app::terminate::write_stdout`].
+macro_rules! out {
+    ($($t:tt)*) => { $crate::app::terminate::write_stdout(format_args!($($t)*)) };
+}
+
+/// `println!` for what a command outputs (see [`out!`]).
+macro_rules! outln {
+    ($($t:tt)*) => { $crate::app::terminate::write_stdout(format_args!("{}\n", format_args!($($t)*))) };
+}
+
 pub mod app;
 pub mod calib;
 pub mod cli;

@@ -235,7 +235,7 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
         };
         let view = InsView { t_s: s.t_s, t_ref_s: pb.core.reference_instant(t_repr), errors, imu_true, imu_ins, nav: pb.core.nav_error() };
         if want_series {
-            next_series = i + series_every;
+            next_series = i.saturating_add(series_every);
             for (v, e) in out.errors[..2].iter().enumerate() {
                 for (a, x) in e.as_array().into_iter().enumerate() {
                     stats[v][a].add(x);
@@ -255,7 +255,7 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
             }
         }
         if want_scene {
-            next_scene = i + scene_every;
+            next_scene = i.saturating_add(scene_every);
             if let Some(r) = recorder.as_deref_mut() {
                 r.push_scene_row(&out, Some(&view)).map_err(|e| PlaybackError::Data(format!("rerun: {e}")))?;
             }

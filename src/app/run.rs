@@ -405,7 +405,7 @@ impl Producer<'_> {
             let core = step(self.model, &mut state, s.t_s);
             let view = ins.view(s.t_s);
             if want_series {
-                next_series = i + self.series_every;
+                next_series = i.saturating_add(self.series_every);
                 stats.add(&core);
                 ins_stats.add(&view);
                 if !out.series(OutputRow { core, ins: Some(view.clone()) }) {
@@ -413,7 +413,7 @@ impl Producer<'_> {
                 }
             }
             if want_scene {
-                next_scene = i + self.scene_every;
+                next_scene = i.saturating_add(self.scene_every);
                 if !out.scene(OutputRow { core, ins: Some(view) }) {
                     break;
                 }

@@ -73,3 +73,21 @@ pub fn interrupted_exit_code() -> u8 {
         s => u8::try_from(128 + s).unwrap_or(130),
     }
 }
+
+/// Writes a command's output to stdout. A reader that went away (a closed pipe: `rinscope scenarios
+/// | head -5`) ends the process quietly with 141 (128 + SIGPIPE), as a command-line tool does; any
+/// other write error is reported once on stderr.
+pub fn write_stdout(args: std::fmt::Arguments<'_>) {
+    use std::io::Write as _;
+    let mut out = std::io::stdout().lock();
+    if let Err(e) = out.write_fmt(args).and_then(|()| out.flush()) {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            crate::io::files::remove_unfinished();
+            std::process::exit(141);
+        }
+        static REPORTED: AtomicBool = AtomicBool::new(false);
+        if !REPORTED.swap(true, Ordering::Relaxed) {
+            eprintln!("rinscope: cannot write to stdout: {e}");
+        }
+    }
+}

@@ -21,8 +21,8 @@ use crate::scenario::{self, presets, Params};
 fn load(args: &RunArgs) -> Result<Params, Failure> {
     let mut params = args.source.load(presets::DEFAULT_SCENARIO)?;
     if let Some(d) = args.duration_s {
-        if !(d.is_finite() && d > 0.0 && d * params.step_hz <= 2.0e9) {
-            return Err(Failure::input(format!("--duration-s {d} s: must be > 0 and at most 2e9 steps at {} Hz", params.step_hz)));
+        if !(d.is_finite() && d > 0.0 && d <= scenario::MAX_DURATION_S) {
+            return Err(Failure::input(format!("--duration-s {d} s: must be > 0 and at most {} s (30 days), as simulation.duration_s", scenario::MAX_DURATION_S)));
         }
         params.duration_s = d;
     }
@@ -48,13 +48,14 @@ pub(super) fn run(args: &RunArgs) -> Result<(), Failure> {
         summary.recording_path = Some(path.display().to_string());
         summary.recording_bytes = Some(*bytes);
     }
-    print!("{}", summary.table());
+    out!("{}", summary.table());
     print_exported(&saved);
+    kept(&saved)?;
     if let Some(path) = &args.summary_json {
         write_json("--summary-json", path, &summary)?;
     }
     if let Some(p) = &summary.recording_path {
-        println!("open it with:  rerun {p}     (viewer: {})", sink::VIEWER_INSTALL_HINT);
+        outln!("open it with:  rerun {p}     (viewer: {})", sink::VIEWER_INSTALL_HINT);
     }
     if summary.interrupted {
         return Err(Failure::interrupted("the recording is complete up to that moment"));
@@ -85,9 +86,9 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
         return Err(Failure::input(format!("--speed {s}: must be > 0 and <= 10000 (x real time)")));
     }
     if let Some(d) = args.duration_s
-        && !(d.is_finite() && d > 0.0)
+        && !(d.is_finite() && d > 0.0 && d <= scenario::MAX_DURATION_S)
     {
-        return Err(Failure::input(format!("--duration-s {d} s: must be > 0")));
+        return Err(Failure::input(format!("--duration-s {d} s: must be > 0 and at most {} s (30 days)", scenario::MAX_DURATION_S)));
     }
     let viewer_given = args.sinks.viewer_asked();
     if args.no_viewer && args.sinks.save.is_none() {
@@ -103,7 +104,14 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
     };
     let recording_id = format!("{}-seed{}-live", params.meta.name, params.meta.seed);
     let viewer_sinks = if viewer_request.spawn || viewer_request.connect.is_some() || viewer_request.serve.is_some() {
-        Some(sink::open(&viewer_request, APPLICATION_ID, &recording_id)?)
+        let implicit = !viewer_given;
+        Some(sink::open(&viewer_request, APPLICATION_ID, &recording_id).map_err(|e| {
+            let mut f = Failure::from(e);
+            if implicit {
+                f.message.push_str("\n(live opens a viewer unless told otherwise: `rinscope live --no-viewer --save session.rrd` runs without one, `--serve` streams to a viewer elsewhere)");
+            }
+            f
+        })?)
     } else {
         None
     };
@@ -131,7 +139,7 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
         None => None,
     };
     let summary = result?;
-    println!(
+    outln!(
         "live session: {:.1} s simulated ({} steps), {} reloads applied, save -> applied p95 {:.1} ms",
         summary.sim_t_s,
         summary.steps,
@@ -139,7 +147,7 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
         live::p95(&summary.latencies_ms)
     );
     if let Some((p, bytes)) = saved {
-        println!("recording: {} ({:.2} MB) — open with `rerun {}`, list its events with `rinscope events {}`", p.display(), bytes as f64 / 1e6, p.display(), p.display());
+        outln!("recording: {} ({:.2} MB) — open with `rerun {}`, list its events with `rinscope events {}`", p.display(), bytes as f64 / 1e6, p.display(), p.display());
     }
     Ok(())
 }
@@ -161,22 +169,31 @@ pub(super) fn modulation(args: &ModulationArgs) -> Result<(), Failure> {
             return Err(e.into());
         }
     };
-    let table = modulation::table(&traces, started.elapsed().as_secs_f64());
+    let interrupted = stop.load(Ordering::SeqCst);
+    let mut table = modulation::table(&traces, started.elapsed().as_secs_f64());
+    if interrupted {
+        let reached = traces.iter().filter_map(|t| t.samples.last()).map(|s| s.t_s / 3600.0).fold(f64::INFINITY, f64::min);
+        table = format!("INTERRUPTED after {reached:.2} of {hours} h: the numbers below are over that part only, not the run's\n{table}");
+    }
     if let Err(e) = crate::record::modulation::log(&sinks.stream(), &traces, &table) {
         sinks.abandon();
         return Err(Failure::run(format!("rerun: {e}")));
     }
     let saved = sinks.finish()?;
-    print!("{table}");
-    print_saved(&saved);
+    out!("{table}");
+    print_saved(&saved)?;
+    if interrupted {
+        return Err(Failure::interrupted("the table and the recording cover the simulated part only"));
+    }
     Ok(())
 }
 
+/// Checks an output file's path before anything runs (see [`crate::io::files::check_output_path`]).
 pub(super) fn check_output_dir(flag: &str, path: Option<&std::path::Path>) -> Result<(), Failure> {
-    if let Some(dir) = path.and_then(|p| p.parent()).filter(|d| !d.as_os_str().is_empty() && !d.is_dir()) {
-        return Err(Failure::input(format!("{flag}: directory {} does not exist", dir.display())));
+    match path {
+        Some(p) => crate::io::files::check_output_path(p).map_err(|e| Failure::input(format!("{flag} {e}"))),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 /// The file a command saves to when no sink is asked for.
@@ -199,19 +216,29 @@ pub(super) fn write_json(flag: &str, path: &std::path::Path, value: &impl serde:
     write_atomically(path, json.as_bytes()).map_err(|e| Failure::input(format!("{flag} {e}")))
 }
 
-/// The line that tells where a saved recording is and how to open it.
-pub(super) fn print_saved(saved: &sink::Saved) {
+/// The line that tells where a saved recording is and how to open it; an error if the only
+/// destination was a viewer that failed (nothing kept the data).
+pub(super) fn print_saved(saved: &sink::Saved) -> Result<(), Failure> {
     if let Some((p, bytes)) = &saved.recording {
-        println!("recording: {} ({:.2} MB) — open with `rerun {}`", p.display(), *bytes as f64 / 1e6, p.display());
+        outln!("recording: {} ({:.2} MB) — open with `rerun {}`", p.display(), *bytes as f64 / 1e6, p.display());
     }
     print_exported(saved);
+    kept(saved)
+}
+
+/// An error if a viewer failed and no file kept the data.
+pub(super) fn kept(saved: &sink::Saved) -> Result<(), Failure> {
+    if saved.recording.is_none() && !saved.viewer_problems.is_empty() {
+        return Err(Failure::run(format!("nothing kept this run's data: {} (add --save FILE)", saved.viewer_problems.join("; "))));
+    }
+    Ok(())
 }
 
 /// The line that tells where the export tables are.
 pub(super) fn print_exported(saved: &sink::Saved) {
     if let Some(first) = saved.exported.first() {
         let dir = first.parent().map_or_else(|| ".".into(), |d| d.display().to_string());
-        println!("exported {} tables to {dir} (pandas: pd.read_parquet(path); MATLAB: parquetread(path); docs/export.md)", saved.exported.len());
+        outln!("exported {} tables to {dir} (pandas: pd.read_parquet(path); MATLAB: parquetread(path); docs/export.md)", saved.exported.len());
     }
 }
 
@@ -244,8 +271,8 @@ pub(super) fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
         }
     };
     let wall = started.elapsed().as_secs_f64();
-    print!("{}", outcome.report.text());
-    println!("({wall:.2} s wall: two {:.0}-s runs simulated, filter and least squares)", params.duration_s);
+    out!("{}", outcome.report.text());
+    outln!("({wall:.2} s wall: two {:.0}-s runs simulated, filter and least squares)", params.duration_s);
     if let Some(path) = &args.json {
         let compensation = estimated_compensation(&params.table.chain, &outcome.cal, &params.table.compensation);
         write_json("--json", path, &CalibrationOutput { report: &outcome.report, estimated_compensation: compensation })?;
@@ -255,7 +282,7 @@ pub(super) fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
             sinks.abandon();
             return Err(Failure::run(format!("rerun: {e}")));
         }
-        print_saved(&sinks.finish()?);
+        print_saved(&sinks.finish()?)?;
     }
     if stop.load(Ordering::SeqCst) {
         return Err(Failure::interrupted("the estimates above are complete; the recording's table motion stops where it was cut short"));
@@ -305,9 +332,9 @@ pub(super) fn montecarlo(args: &MonteCarloArgs) -> Result<(), Failure> {
     let done = result.map_err(|e| Failure::run(format!("montecarlo: {e}")))?;
     let summary = montecarlo::summarize(&monte_carlo_setup(&params), runs, &done, started.elapsed().as_secs_f64());
     if shard != Shard::WHOLE {
-        println!("shard {}/{}: {} of the {runs} runs (i mod {} == {})", shard.index, shard.count, mine, shard.count, shard.index);
+        outln!("shard {}/{}: {} of the {runs} runs (i mod {} == {})", shard.index, shard.count, mine, shard.count, shard.index);
     }
-    print!("{}", summary.text());
+    out!("{}", summary.text());
     if let Some(path) = &args.json {
         if shard == Shard::WHOLE {
             write_json("--json", path, &summary)?;
@@ -341,7 +368,7 @@ fn montecarlo_merge(files: &[PathBuf], source: &ScenarioSource, eta_measured_sig
             first.summary.setup, summary.setup
         )));
     }
-    print!("{}", summary.text());
+    out!("{}", summary.text());
     if let Some(path) = json {
         write_json("--json", path, &summary)?;
     }
@@ -354,6 +381,7 @@ pub(super) fn read_small_file(path: &Path, what: &str) -> Result<String, Failure
     if !meta.is_file() || meta.len() > 1 << 30 {
         return Err(Failure::input(format!("{what} {}: not a regular file of at most 1 GB", path.display())));
     }
+    crate::io::files::note_input(path);
     std::fs::read_to_string(path).map_err(|e| Failure::input(format!("{what} {}: {e}", path.display())))
 }
 
@@ -378,11 +406,11 @@ pub(super) fn tpr(args: &TprArgs) -> Result<(), Failure> {
         return Err(Failure::run(format!("rerun: {e}")));
     }
     let saved = sinks.finish()?;
-    print!("{text}");
+    out!("{text}");
     if let Some(path) = &args.json {
         write_json("--json", path, &result)?;
     }
-    print_saved(&saved);
+    print_saved(&saved)?;
     if !result.complete {
         return Err(Failure::interrupted("the recording holds what was simulated until then"));
     }
@@ -393,8 +421,8 @@ pub(super) fn tpr(args: &TprArgs) -> Result<(), Failure> {
         if stop.load(Ordering::SeqCst) {
             return Err(Failure::interrupted("the seed sweep did not finish"));
         }
-        print!("{}", sweep_text(&rows));
-        println!("  {n} runs of {:.1} h in {:.1} s", params.duration_s / 3600.0, started.elapsed().as_secs_f64());
+        out!("{}", sweep_text(&rows));
+        outln!("  {n} runs of {:.1} h in {:.1} s", params.duration_s / 3600.0, started.elapsed().as_secs_f64());
     }
     Ok(())
 }
@@ -404,8 +432,8 @@ pub(super) fn events(file: &Path) -> Result<(), Failure> {
     let events = crate::record::read::events(file).map_err(|e| Failure::input(format!("{e:#}")))?;
     for e in events {
         match e.t_s {
-            Some(t) => println!("{t:>10.3} s  {:<5} {}", e.level, e.text),
-            None => println!("{:>12}  {:<5} {}", "static", e.level, e.text),
+            Some(t) => outln!("{t:>10.3} s  {:<5} {}", e.level, e.text),
+            None => outln!("{:>12}  {:<5} {}", "static", e.level, e.text),
         }
     }
     Ok(())
@@ -417,9 +445,9 @@ pub(super) fn list_scenarios() {
         match presets::load(name) {
             Ok(p) => {
                 let mark = if *name == presets::DEFAULT_SCENARIO { " (default)" } else { "" };
-                println!("{name}{mark}\n    {}", p.meta.title);
+                outln!("{name}{mark}\n    {}", p.meta.title);
             }
-            Err(e) => println!("{name}\n    BROKEN: {e}"),
+            Err(e) => outln!("{name}\n    BROKEN: {e}"),
         }
     }
 }
@@ -428,7 +456,7 @@ pub(super) fn list_scenarios() {
 pub(super) fn check_config(file: &Path) -> Result<(), Failure> {
     let p = scenario::load_file(file)?;
     let axes: Vec<String> = p.table.chain.axes().iter().map(|a| a.name.clone()).collect();
-    println!(
+    outln!(
         "{}: ok — scenario \"{}\", {} s at {} Hz ({} steps), axes {:?}, seed {}",
         file.display(),
         p.meta.name,
@@ -444,7 +472,7 @@ pub(super) fn check_config(file: &Path) -> Result<(), Failure> {
 /// `rinscope reproduce`.
 pub(super) fn reproduce(markdown: Option<&Path>) -> Result<(), Failure> {
     let table = reproduce::run_all()?;
-    print!("{}", table.text());
+    out!("{}", table.text());
     if let Some(path) = markdown {
         write_atomically(path, table.markdown().as_bytes()).map_err(|e| Failure::input(format!("--markdown {e}")))?;
     }
@@ -459,7 +487,7 @@ pub(super) fn reproduce(markdown: Option<&Path>) -> Result<(), Failure> {
 pub(super) fn bench_peer(python: PathBuf, rounds: usize, samples: u64, json: Option<&std::path::Path>) -> Result<(), Failure> {
     use crate::app::bench::peer;
     let reports = peer::compare(&peer::PeerOptions { python, rounds, samples }).map_err(|e| Failure::run(format!("{e:#}")))?;
-    print!("{}", peer::text(&reports));
+    out!("{}", peer::text(&reports));
     if let Some(path) = json {
         write_json("--json", path, &reports)?;
     }

@@ -27,7 +27,7 @@ pub(super) fn export_log(args: &ExportLogArgs) -> Result<(), Failure> {
         crate::app::export_log::ExportError::Interrupted => Failure::interrupted(format!("export-log: {e}")),
         other => Failure::input(format!("export-log: {other}")),
     })?;
-    println!(
+    outln!(
         "log set {}: {} IMU samples of {} ({:.1} s at {} Hz), encoders, reference attitude, table.toml, log.toml ({:.2} MB)",
         written.dir.display(),
         written.samples,
@@ -36,7 +36,7 @@ pub(super) fn export_log(args: &ExportLogArgs) -> Result<(), Failure> {
         params.step_hz,
         written.bytes as f64 / 1e6
     );
-    println!("replay it with:  rinscope replay {}", written.dir.display());
+    outln!("replay it with:  rinscope replay {}", written.dir.display());
     Ok(())
 }
 
@@ -132,11 +132,11 @@ pub(super) fn replay(args: &ReplayArgs) -> Result<(), Failure> {
         summary.recording_path = Some(p.display().to_string());
         summary.recording_bytes = Some(*bytes);
     }
-    print!("{}", summary.text());
+    out!("{}", summary.text());
     if let Some(path) = &args.summary_json {
         write_json("--summary-json", path, &summary)?;
     }
-    print_saved(&saved);
+    print_saved(&saved)?;
     if summary.interrupted {
         return Err(Failure::interrupted("the recording is complete up to that moment"));
     }
@@ -154,8 +154,8 @@ pub(super) fn calibrate_log(args: &CalibrateArgs, dir: &Path) -> Result<(), Fail
         LogCalibrationError::Calibration(c) => Failure::run(format!("calibrate --log: {c}")),
         other => Failure::input(format!("calibrate --log: {other}")),
     })?;
-    print!("{}", report.text());
-    println!("({:.2} s wall: {} measurements of {}, filter and least squares; before/after on the same data)", started.elapsed().as_secs_f64(), data.samples.len(), dir.display());
+    out!("{}", report.text());
+    outln!("({:.2} s wall: {} measurements of {}, filter and least squares; before/after on the same data)", started.elapsed().as_secs_f64(), data.samples.len(), dir.display());
     if let Some(path) = &args.json {
         let compensation = estimated_compensation(&log.table.chain, &cal, &log.table.compensation);
         write_json("--json", path, &CalibrationOutput { report: &report, estimated_compensation: compensation })?;
@@ -169,7 +169,7 @@ pub(super) fn calibrate_log(args: &CalibrateArgs, dir: &Path) -> Result<(), Fail
             sinks.abandon();
             return Err(Failure::run(format!("rerun: {e}")));
         }
-        print_saved(&sinks.finish()?);
+        print_saved(&sinks.finish()?)?;
     }
     Ok(())
 }

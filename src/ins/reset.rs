@@ -98,7 +98,11 @@ impl TprResult {
         let last = self.samples.last().copied().unwrap_or_default();
         let peak_r = self.peak_radial_after_m();
         let peak_h = self.peak_heading_after_arcsec();
-        let mut s = format!(
+        let mut s = String::new();
+        if !self.complete {
+            s.push_str(&format!("INTERRUPTED at {:.2} h: the numbers below are over the simulated part only, not the run's\n", last.t_s / 3600.0));
+        }
+        s += &format!(
             "position-fix resets of {}: fixes at {:.1} h and {:.1} h, {:.1} h simulated in {:.1} s\n",
             self.scenario,
             self.fixes_s[0] / 3600.0,

@@ -44,6 +44,9 @@ pub enum OutputError {
         /// What it is.
         problem: &'static str,
     },
+    /// The output would replace a file this run reads.
+    #[error("{}: is an input of this run; choose another name for the output", .0.display())]
+    IsInput(PathBuf),
     /// Another process is writing the same output.
     #[error("{}: another run is writing this file right now ({} is locked); wait for it or choose another name", .path.display(), .partial.display())]
     Busy {
@@ -64,12 +67,38 @@ pub enum OutputError {
     },
 }
 
+/// The files this process reads (canonical paths), so that no output replaces one of them.
+static INPUTS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Notes that this run reads `path` (a scenario, a log file, a calibration): an output of the same
+/// run may not replace it.
+pub fn note_input(path: &Path) {
+    if let Ok(c) = std::fs::canonicalize(path) {
+        let mut v = INPUTS.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        if !v.contains(&c) {
+            v.push(c);
+        }
+    }
+}
+
+fn is_input(path: &Path, dir: &Path) -> bool {
+    let Some(name) = path.file_name() else { return false };
+    let Ok(dir) = std::fs::canonicalize(dir) else { return false };
+    let out = dir.join(name);
+    // A symlink at the output path is replaced by the rename, not followed: compare its own name.
+    INPUTS.lock().unwrap_or_else(std::sync::PoisonError::into_inner).contains(&out)
+}
+
 /// Checks that `path` can name an output file, before anything runs: not a directory (nor a name
-/// ending in `/`), in a directory that exists.
+/// ending in `/`), in a directory that exists, not a file this run reads ([`note_input`]).
 ///
 /// # Errors
 /// See [`OutputError`].
 pub fn check_output_path(path: &Path) -> Result<(), OutputError> {
+    check_path(path, false)
+}
+
+fn check_path(path: &Path, may_replace_input: bool) -> Result<(), OutputError> {
     let text = path.as_os_str().to_string_lossy();
     if text.ends_with('/') || path.file_name().is_none() || path.is_dir() {
         return Err(OutputError::IsDirectory(path.to_path_buf()));
@@ -80,6 +109,15 @@ pub fn check_output_path(path: &Path) -> Result<(), OutputError> {
     };
     if !dir.is_dir() {
         return Err(OutputError::NoDirectory { path: path.to_path_buf(), dir: dir.to_path_buf() });
+    }
+    if !may_replace_input && is_input(path, dir) {
+        return Err(OutputError::IsInput(path.to_path_buf()));
+    }
+    // Checked again when the partial is opened (O_NOFOLLOW); here so that a long run is not
+    // wasted on an output that will be refused at its end.
+    let partial = partial_path(path);
+    if std::fs::symlink_metadata(&partial).is_ok_and(|m| m.file_type().is_symlink()) {
+        return Err(OutputError::NotAFile { partial, problem: "is a symlink" });
     }
     Ok(())
 }
@@ -135,7 +173,11 @@ impl PartialFile {
     /// # Errors
     /// See [`OutputError`].
     pub fn create(path: &Path) -> Result<Self, OutputError> {
-        check_output_path(path)?;
+        Self::open(path, false)
+    }
+
+    fn open(path: &Path, may_replace_input: bool) -> Result<Self, OutputError> {
+        check_path(path, may_replace_input)?;
         let partial = partial_path(path);
         let io = |action, source| OutputError::Io { path: partial.clone(), action, source };
         let file = OpenOptions::new()
@@ -220,8 +262,20 @@ impl Drop for PartialFile {
 /// # Errors
 /// See [`OutputError`].
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
-    let out = PartialFile::create(path)?;
-    (&*out.file()).write_all(bytes).map_err(|e| OutputError::Io { path: out.partial().to_path_buf(), action: "write", source: e })?;
+    write_through(PartialFile::create(path)?, bytes)
+}
+
+/// [`write_atomically`] for a file this run reads and means to change (live mode's sliders
+/// writing the scenario file).
+///
+/// # Errors
+/// See [`OutputError`].
+pub fn rewrite_input(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
+    write_through(PartialFile::open(path, true)?, bytes)
+}
+
+fn write_through(out: PartialFile, bytes: &[u8]) -> Result<(), OutputError> {
+    out.file().write_all(bytes).map_err(|e| OutputError::Io { path: out.partial().to_path_buf(), action: "write", source: e })?;
     out.commit().map(|_| ())
 }
 
@@ -262,7 +316,7 @@ mod tests {
         let first = PartialFile::create(&path).expect("first writer");
         let e = PartialFile::create(&path).expect_err("second writer");
         assert!(matches!(e, OutputError::Busy { .. }), "{e}");
-        (&*first.file()).write_all(b"half").expect("write");
+        first.file().write_all(b"half").expect("write");
         drop(first); // abandoned
         assert!(!partial_path(&path).exists(), "partial removed");
         assert_eq!(std::fs::read_to_string(&path).expect("old"), "old good file");

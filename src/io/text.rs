@@ -144,6 +144,7 @@ pub(crate) fn parse_cell(text: &[u8]) -> Option<(f64, Option<i64>)> {
 impl TextSource {
     pub(crate) fn open(path: &Path, header: HeaderMode) -> Result<Self> {
         let file = File::open(path).map_err(|e| LogError::io(path, "cannot open", e))?;
+        crate::io::files::note_input(path);
         let mut source = Self {
             path: path.to_path_buf(),
             reader: BufReader::with_capacity(1 << 16, file),

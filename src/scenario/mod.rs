@@ -4,6 +4,9 @@
 //!
 //! Every error names the key, the value and the unit (and the allowed range where there is one).
 
+/// The longest simulation a scenario (or `--duration-s`) may ask for: 30 days, s.
+pub const MAX_DURATION_S: f64 = 30.0 * 86_400.0;
+
 pub mod instruments;
 pub mod logset;
 pub mod presets;
@@ -161,15 +164,23 @@ const MAX_CONFIG_BYTES: u64 = 16 << 20;
 /// Reads a configuration file: a regular file of at most [`MAX_CONFIG_BYTES`] (a FIFO, a device
 /// or `/dev/zero` would block or never end).
 pub fn read_text(path: &Path) -> Result<String, ConfigError> {
+    use std::io::Read as _;
+    use std::os::unix::fs::OpenOptionsExt as _;
     let err = |source: std::io::Error| ConfigError::Read { path: path.display().to_string(), source };
-    let meta = std::fs::metadata(path).map_err(err)?;
+    // Opened without blocking (a FIFO without a writer would wait for ever) and checked on the
+    // handle, so a path swapped for a FIFO between a check and the read cannot block either.
+    let file = std::fs::OpenOptions::new().read(true).custom_flags(libc::O_NONBLOCK).open(path).map_err(err)?;
+    let meta = file.metadata().map_err(err)?;
     if !meta.is_file() {
         return Err(err(std::io::Error::other("not a regular file (a directory, FIFO or device is not a configuration)")));
     }
     if meta.len() > MAX_CONFIG_BYTES {
         return Err(err(std::io::Error::other(format!("{} bytes: larger than any configuration ({} MB at most)", meta.len(), MAX_CONFIG_BYTES >> 20))));
     }
-    std::fs::read_to_string(path).map_err(err)
+    crate::io::files::note_input(path);
+    let mut text = String::new();
+    file.take(MAX_CONFIG_BYTES + 1).read_to_string(&mut text).map_err(err)?;
+    Ok(text)
 }
 
 /// Reads and validates a scenario file.

@@ -93,7 +93,7 @@ pub(super) fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigErr
 
     // [simulation]
     let step_hz = c.range("simulation.step_hz", raw.simulation.step_hz, "Hz", 1.0, 100_000.0, "")?;
-    let duration_s = c.positive("simulation.duration_s", raw.simulation.duration_s, "s", 30.0 * 86_400.0)?;
+    let duration_s = c.positive("simulation.duration_s", raw.simulation.duration_s, "s", super::MAX_DURATION_S)?;
     if duration_s * step_hz > 2.0e9 {
         return Err(c.invalid(
             "simulation.duration_s",
@@ -391,8 +391,8 @@ fn axis_errors_of(c: &Checker<'_>, key: &dyn Fn(&str) -> String, v: &AxisErrorKe
 /// `[recording]`: output rates (at most the simulation rate `step_hz`) and the drawing factor.
 pub(super) fn recording(c: &Checker<'_>, raw: &RawRecording, step_hz: f64) -> Result<RecordingParams, ConfigError> {
     Ok(RecordingParams {
-        series_hz: c.positive("recording.series_hz", raw.series_hz, "Hz", step_hz)?,
-        scene_hz: c.positive("recording.scene_hz", raw.scene_hz, "Hz", step_hz)?,
+        series_hz: c.range("recording.series_hz", raw.series_hz, "Hz", 1e-3, step_hz, "at most the step rate; at least one point every 1000 s")?,
+        scene_hz: c.range("recording.scene_hz", raw.scene_hz, "Hz", 1e-3, step_hz, "at most the step rate; at least one frame every 1000 s")?,
         exaggeration: c.range("recording.exaggeration", raw.exaggeration, "x", 1.0, 100_000.0, "")?,
     })
 }

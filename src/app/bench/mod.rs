@@ -39,7 +39,7 @@ pub fn run_benchmarks(steps: u64) -> anyhow::Result<()> {
             rates.push(steps as f64 / started.elapsed().as_secs_f64());
         }
         rates.sort_by(f64::total_cmp);
-        println!(
+        outln!(
             "simulation only   {name:<28} {steps} steps x5: best {:.2} M steps/s, median {:.2} M steps/s (all three variants; checksum {checksum:.6e})",
             rates[4] / 1e6,
             rates[2] / 1e6
@@ -62,7 +62,7 @@ pub fn run_benchmarks(steps: u64) -> anyhow::Result<()> {
         let summary = crate::app::run::run_recorded(&p, &sinks, &AtomicBool::new(false), false)?;
         let (_, bytes) = sinks.finish()?.recording.ok_or_else(|| anyhow::anyhow!("no file written"))?;
         let secs = started.elapsed().as_secs_f64();
-        println!(
+        outln!(
             "recorded run      {name:<28} 3600 s at {} Hz (series {} Hz, scene {} Hz): {} steps in {secs:.2} s, {:.2} MB per simulated hour",
             p.step_hz,
             p.recording.series_hz,
@@ -78,7 +78,7 @@ pub fn run_benchmarks(steps: u64) -> anyhow::Result<()> {
     let started = Instant::now();
     let summary = crate::app::run::run_recorded(&p, &sinks, &AtomicBool::new(false), false)?;
     let (_, bytes) = sinks.finish()?.recording.ok_or_else(|| anyhow::anyhow!("no file written"))?;
-    println!(
+    outln!(
         "INS 24 h          rotation-modulation-16-position: {} IMU samples at 200 Hz with navigation and recording in {:.2} s ({:.2} MB)",
         summary.steps,
         started.elapsed().as_secs_f64(),
@@ -88,7 +88,7 @@ pub fn run_benchmarks(steps: u64) -> anyhow::Result<()> {
     live_latency(&dir)?;
     std::fs::remove_dir_all(&dir).ok();
     calibration_speed()?;
-    println!("peak resident memory: {:.1} MB", peak_rss_bytes() as f64 / 1e6);
+    outln!("peak resident memory: {:.1} MB", peak_rss_bytes() as f64 / 1e6);
     Ok(())
 }
 
@@ -123,7 +123,7 @@ fn strapdown_speed() {
             best = best.max((reps * n) as f64 / started.elapsed().as_secs_f64());
             std::hint::black_box(integ.n_from_s);
         }
-        println!("strapdown update  {:<28} best of 5: {:.1} M samples/s (one core)", alg.name(), best / 1e6);
+        outln!("strapdown update  {:<28} best of 5: {:.1} M samples/s (one core)", alg.name(), best / 1e6);
     }
 }
 
@@ -150,7 +150,7 @@ fn pipeline_speed() -> anyhow::Result<()> {
             }
             best = best.max(n as f64 / started.elapsed().as_secs_f64());
         }
-        println!("INS pipeline      {name:<38} best of 3: {:.2} M samples/s (truth + IMU + strapdown + navigation + demodulation)", best / 1e6);
+        outln!("INS pipeline      {name:<38} best of 3: {:.2} M samples/s (truth + IMU + strapdown + navigation + demodulation)", best / 1e6);
     }
     Ok(())
 }
@@ -197,7 +197,7 @@ fn live_latency(dir: &std::path::Path) -> anyhow::Result<()> {
     sinks.finish()?;
     let mut sorted = latencies.clone();
     sorted.sort_by(f64::total_cmp);
-    println!(
+    outln!(
         "live reload       save -> applied over {} saves: median {:.1} ms, p95 {:.1} ms, max {:.1} ms (debounce {} ms included)",
         sorted.len(),
         sorted[sorted.len() / 2],
@@ -216,14 +216,14 @@ fn calibration_speed() -> anyhow::Result<()> {
     let p = presets::load("jiang2017-calibration")?;
     let started = Instant::now();
     let outcome = crate::app::calibrate::calibrate_scenario(&p, false, &stop)?;
-    println!(
+    outln!(
         "calibration       jiang2017-calibration: 200 s at 200 Hz, static KF + exact least squares + validation run in {:.2} s ({} measurements)",
         started.elapsed().as_secs_f64(),
         outcome.data.samples.len()
     );
     let started = Instant::now();
     let mc = crate::app::calibrate::monte_carlo(&p, 500, &|| {}, &stop)?;
-    println!(
+    outln!(
         "Monte Carlo       jiang2017-calibration: {} calibrations in {:.2} s on {} threads",
         mc.runs,
         started.elapsed().as_secs_f64(),
@@ -231,7 +231,7 @@ fn calibration_speed() -> anyhow::Result<()> {
     );
     let p = presets::load("zheng2016-tpr")?;
     let r = crate::app::tpr::compare_resets(&p, 600.0, &stop)?;
-    println!(
+    outln!(
         "TPR vs reset      zheng2016-tpr: {:.0} h at {:.0} Hz, three branches after the fork, in {:.2} s",
         p.duration_s / 3600.0,
         p.step_hz,

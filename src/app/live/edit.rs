@@ -6,7 +6,7 @@ use std::path::Path;
 
 use toml_edit::{DocumentMut, Item, Table, TableLike, Value};
 
-use crate::io::files::write_atomically;
+use crate::io::files::rewrite_input;
 
 /// One step of a key path.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -127,7 +127,7 @@ pub fn set_in_file(path: &Path, key: &KeyPath, value: Value) -> Result<(), EditE
             EditError::Missing { path: shown.clone(), key: key.to_string() }
         }
     })?;
-    Ok(write_atomically(path, new.as_bytes())?)
+    Ok(rewrite_input(path, new.as_bytes())?)
 }
 
 /// A value a control writes.

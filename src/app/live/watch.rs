@@ -72,6 +72,8 @@ fn debounce_loop(path: &Path, initial_text: String, pokes: &Receiver<Instant>, t
     let origin = path.display().to_string();
     let mut last_text = Some(initial_text);
     let mut deleted = false;
+    // An unreadable path (a directory, a FIFO, no permission) is reported once, not on every event.
+    let mut last_error: Option<String> = None;
     loop {
         // Wait for a save (or the watcher to go away).
         let Ok(seen_at) = pokes.recv() else { return };
@@ -83,17 +85,29 @@ fn debounce_loop(path: &Path, initial_text: String, pokes: &Receiver<Instant>, t
                 Err(RecvTimeoutError::Disconnected) => return,
             }
         }
-        let event = match std::fs::read_to_string(path) {
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+        // read_text refuses what is not a regular file of configuration size: a FIFO put in the
+        // config's place cannot block the watcher, /dev/zero cannot fill memory.
+        let event = match scenario::read_text(path) {
+            Err(scenario::ConfigError::Read { source, .. }) if source.kind() == std::io::ErrorKind::NotFound => {
                 if deleted {
                     continue;
                 }
                 deleted = true;
                 last_text = None;
+                last_error = None;
                 WatchEvent::Deleted
             }
-            Err(e) => WatchEvent::Invalid { message: format!("cannot read {origin}: {e}"), seen_at },
+            Err(e) => {
+                let message = e.to_string();
+                if last_error.as_deref() == Some(message.as_str()) {
+                    continue;
+                }
+                last_error = Some(message.clone());
+                last_text = None;
+                WatchEvent::Invalid { message, seen_at }
+            }
             Ok(text) => {
+                last_error = None;
                 if deleted {
                     deleted = false;
                     if tx.send(WatchEvent::Restored).is_err() {

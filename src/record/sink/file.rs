@@ -234,7 +234,7 @@ impl RrdFile {
 
 /// Reads the footer of a finished `.rrd` back: the stream header's FourCC and version, the stream
 /// footer at the end and the footer payload's checksum (Rerun's own reader does the work).
-fn verify(partial: &Path, written: u64) -> Result<(), String> {
+pub(super) fn verify(partial: &Path, written: u64) -> Result<(), String> {
     let file = std::fs::File::open(partial).map_err(|e| e.to_string())?;
     let len = file.metadata().map_err(|e| e.to_string())?.len();
     if len != written {

@@ -197,6 +197,16 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
     Ok(OpenSinks { rec, export, file, viewer_problems: problems, description })
 }
 
+/// Checks that the `.rrd` at `path` is complete: its header, its stream footer and the footer's
+/// checksum (what a saved file gets before it replaces anything).
+///
+/// # Errors
+/// Why it is not.
+pub fn verify_recording(path: &std::path::Path) -> Result<(), String> {
+    let len = std::fs::metadata(path).map_err(|e| format!("{}: {e}", path.display()))?.len();
+    file::verify(path, len).map_err(|e| format!("{}: {e}", path.display()))
+}
+
 /// What a finished run left.
 #[derive(Debug, Clone, Default)]
 pub struct Saved {

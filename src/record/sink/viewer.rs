@@ -35,7 +35,7 @@ pub type Problems = Arc<Mutex<Vec<String>>>;
 enum Cmd {
     Message(Box<LogMsg>),
     Blueprint(Vec<LogMsg>, BlueprintActivationCommand),
-    Flush(Duration, Sender<Result<(), String>>),
+    Flush(Duration, Sender<Result<(), SinkFlushError>>),
 }
 
 /// A viewer's sink behind a thread: see the module docs.
@@ -61,7 +61,7 @@ impl Detachable {
                     Cmd::Message(m) => inner.send(*m),
                     Cmd::Blueprint(b, a) => inner.send_blueprint(b, a),
                     Cmd::Flush(timeout, reply) => {
-                        reply.send(inner.flush_blocking(timeout).map_err(|e| e.to_string())).ok();
+                        reply.send(inner.flush_blocking(timeout)).ok();
                     }
                 }
             }
@@ -111,12 +111,12 @@ impl LogSink for Detachable {
         self.submit(Cmd::Flush(wait, tx));
         match rx.recv_timeout(wait + Duration::from_millis(200)) {
             Ok(Ok(())) => Ok(()),
-            Ok(Err(e)) => {
-                self.detach(&format!("is gone ({e})"));
+            Ok(Err(SinkFlushError::Failed { message })) => {
+                self.detach(&format!("is gone ({message})"));
                 Ok(())
             }
-            Err(_) if timeout < STALL => Err(SinkFlushError::Timeout),
-            Err(_) => {
+            Ok(Err(SinkFlushError::Timeout)) | Err(_) if timeout < STALL => Err(SinkFlushError::Timeout),
+            Ok(Err(SinkFlushError::Timeout)) | Err(_) => {
                 self.detach(&format!("took no data for {} s (frozen, or its machine is overloaded)", STALL.as_secs()));
                 Ok(())
             }
@@ -124,7 +124,7 @@ impl LogSink for Detachable {
     }
 
     fn default_batcher_config(&self) -> ChunkBatcherConfig {
-        self.batcher.clone()
+        self.batcher
     }
 }
 
