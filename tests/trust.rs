@@ -271,7 +271,7 @@ fn limits_hold_on_the_command_line_and_a_closed_pipe_ends_quietly() {
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("30 days"), "{}", stderr(&out));
     let dir = scratch("limits");
-    let cfg = tempconfig(&dir, "li2014-phase-lag", "series_hz = 100.0", "series_hz = 1e-300");
+    let cfg = tempconfig(&dir, "li2014-phase-lag", "[recording]", "[recording]\nseries_hz = 1e-300");
     let out = rinscope().arg("check-config").arg(&cfg).output().expect("runs");
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("recording.series_hz"), "{}", stderr(&out));
@@ -299,14 +299,25 @@ fn serve_listens_on_loopback_unless_told_otherwise() {
         .spawn()
         .expect("runs");
     wait_for_file(&dir.join("x.rrd.partial"));
-    // /proc/net/tcp lists listening sockets as local_address:port in hex; 0100007F is 127.0.0.1.
-    let tcp = std::fs::read_to_string("/proc/net/tcp").expect("/proc/net/tcp");
+    // /proc/net/tcp{,6} list listening sockets (state 0A) as local_address:port in hex; 0100007F is
+    // 127.0.0.1. The server binds in a background task: wait for it.
     let port_hex = format!(":{port:04X}");
-    let listening: Vec<&str> = tcp.lines().filter(|l| l.split_whitespace().nth(1).is_some_and(|a| a.ends_with(&port_hex)) && l.split_whitespace().nth(3) == Some("0A")).collect();
+    let started = Instant::now();
+    let listening: Vec<String> = loop {
+        let mut found = Vec::new();
+        for table in ["/proc/net/tcp", "/proc/net/tcp6"] {
+            let text = std::fs::read_to_string(table).unwrap_or_default();
+            found.extend(text.lines().filter(|l| l.split_whitespace().nth(1).is_some_and(|a| a.ends_with(&port_hex)) && l.split_whitespace().nth(3) == Some("0A")).map(str::to_owned));
+        }
+        if !found.is_empty() || started.elapsed() > Duration::from_secs(10) {
+            break found;
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
     signal(&child, "-INT");
     let _ = child.wait();
     assert!(!listening.is_empty(), "nothing listens on {port}");
-    for l in listening {
+    for l in &listening {
         let addr = l.split_whitespace().nth(1).unwrap_or_default();
         assert!(addr.starts_with("0100007F"), "listens on {addr}, not 127.0.0.1");
     }

@@ -37,7 +37,7 @@ pub fn simulate_variants(hours: f64, stop: &AtomicBool) -> anyhow::Result<Vec<Na
     let mut params = Vec::new();
     for (name, label) in MODULATION_PRESETS {
         let mut p = presets::load(name)?;
-        p.duration_s = hours * 3600.0;
+        p.set_duration(hours * 3600.0);
         params.push((p, label));
     }
     let sample_s = (hours * 3600.0 / 2000.0).max(1.0);

@@ -467,8 +467,14 @@ impl Playback {
     /// encoder angles with errors `rot` of `errors`, at its latest output.
     #[must_use]
     pub fn body_attitude(&self, k: usize, chain: &crate::model::gimbal::Chain, rot: &crate::model::gimbal::ErrorRotations, angles: &AxisValues) -> Attitude {
+        self.body_attitude_through(k, chain.b_from_s(rot, angles))
+    }
+
+    /// The body attitude integrator `k` gives through the table rotation C_b^s... as `b_from_s`.
+    #[must_use]
+    pub fn body_attitude_through(&self, k: usize, b_from_s: crate::math::frames::Rot<crate::math::frames::B, crate::math::frames::S>) -> Attitude {
         let (_, n_from_s) = self.core.output_attitude(k);
-        demodulate(n_from_s, chain.b_from_s(rot, angles))
+        demodulate(n_from_s, b_from_s)
     }
 
     /// One sample as increments in the RFU sensor frame, or None at the end.

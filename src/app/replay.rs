@@ -14,7 +14,9 @@ use super::playback::{Gap, Playback, PlaybackError};
 use super::run::{NavSummary, RmsPeak};
 use crate::ins::pipeline::InsView;
 use crate::math::attitude::{Attitude, AttitudeError};
-use crate::math::frames::Rot;
+use crate::math::frames::{Rot, B, S};
+use crate::model::gimbal::{Chain, ErrorRotations};
+use crate::model::scheme::AxisValues;
 use crate::math::stats::RunningStat;
 use crate::math::timeline::decimation;
 use crate::math::units::ARCSEC_PER_RAD;
@@ -79,6 +81,27 @@ pub struct FinalState {
     pub height_m: Option<f64>,
     /// Velocity (East, North, Up), m/s.
     pub velocity_enu_mps: Option<[f64; 3]>,
+}
+
+/// The table rotation C_s^b of the last encoder angles it was asked for: a table that stands (a
+/// dwell, a static test, no encoder file) costs one chain evaluation, not one per update.
+struct LastRotation {
+    angles: Option<AxisValues>,
+    b_from_s: Rot<B, S>,
+}
+
+impl LastRotation {
+    fn new() -> Self {
+        Self { angles: None, b_from_s: Rot::identity() }
+    }
+
+    fn get(&mut self, chain: &Chain, rot: &ErrorRotations, angles: &AxisValues) -> Rot<B, S> {
+        if self.angles.as_ref() != Some(angles) {
+            self.b_from_s = chain.b_from_s(rot, angles);
+            self.angles = Some(*angles);
+        }
+        self.b_from_s
+    }
 }
 
 fn table(names: &[String], stats: &[[RunningStat; 3]]) -> BTreeMap<String, BTreeMap<String, RmsPeak>> {
@@ -168,6 +191,8 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
     let window = log.table.ins.signal_window_s;
     let mut demod = vec![DemodState::default(); algorithms.len()];
     let mut demod_nominal = DemodState::default();
+    let mut comp_cache: Vec<LastRotation> = algorithms.iter().map(|_| LastRotation::new()).collect();
+    let mut nominal_cache = LastRotation::new();
     let mut stats = [[RunningStat::default(); 3]; 2];
     let mut ins_stats = vec![[RunningStat::default(); 3]; algorithms.len()];
     let mut nav: Option<NavSummary> = None;
@@ -196,10 +221,9 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
         if !s.updated {
             continue;
         }
+        // Every update is demodulated and counted in the statistics (as a run does); rows are
+        // recorded at the series and scene rates.
         let (want_series, want_scene) = (i >= next_series, i >= next_scene);
-        if !(want_series || want_scene) {
-            continue;
-        }
         // Each algorithm at the instant its own output stands for, as the simulation compares them.
         let mut errors = Vec::with_capacity(algorithms.len());
         let mut primary = None;
@@ -208,24 +232,46 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
             let t_ref = pb.core.reference_instant(t_repr);
             let encoder = pb.encoders_at(t_repr)?;
             let corrected = state.correct(compensation, t_repr, &encoder);
-            let body = pb.body_attitude(k, chain, &comp_rot, &corrected);
+            let body = pb.body_attitude_through(k, comp_cache[k].get(chain, &comp_rot, &corrected));
             let reference = pb.reference_at(t_ref)?;
             errors.push(body.error_from(&reference.unwrap_or(body)));
             if k == 0 {
                 let raw = demod_nominal.correct(&nominal, t_repr, &encoder);
-                let body_nominal = pb.body_attitude(0, chain, &nominal_rot, &raw);
+                let body_nominal = pb.body_attitude_through(0, nominal_cache.get(chain, &nominal_rot, &raw));
                 primary = Some((t_repr, encoder, corrected, body, body_nominal, reference));
             }
         }
         let Some((t_repr, encoder, corrected, body, body_nominal, reference)) = primary else { continue };
         let truth = reference.unwrap_or(body);
+        let table_errors = [body_nominal.error_from(&truth), body.error_from(&truth)];
+        for (v, e) in table_errors.iter().enumerate() {
+            for (a, x) in e.as_array().into_iter().enumerate() {
+                stats[v][a].add(x);
+            }
+        }
+        for (k, e) in errors.iter().enumerate() {
+            for (a, x) in e.as_array().into_iter().enumerate() {
+                ins_stats[k][a].add(x);
+            }
+        }
+        let nav_error = pb.core.nav_error();
+        if let Some(e) = nav_error {
+            let peak = nav.map_or(0.0, |n| n.peak_radial_m).max(e.radial_m);
+            nav = Some(NavSummary { peak_radial_m: peak, final_radial_m: e.radial_m, final_east_m: e.east_m, final_north_m: e.north_m });
+        }
+        if !(want_series || want_scene) || recorder.is_none() {
+            next_series = if want_series { i.saturating_add(series_every) } else { next_series };
+            next_scene = if want_scene { i.saturating_add(scene_every) } else { next_scene };
+            continue;
+        }
+        // A recorded row: the rest of what the scene and plots show.
         let out = StepOutput {
             t_s: s.t_s,
             attitude: truth,
             n_from_b: truth.n_from_b(),
             gimbal_rad: corrected,
             encoder_rad: encoder,
-            errors: [body_nominal.error_from(&truth), body.error_from(&truth), nan],
+            errors: [table_errors[0], table_errors[1], nan],
         };
         let (_, imu_ins) = pb.core.output_attitude(0);
         // The best estimate of the true IMU attitude: the reference through the compensated table.
@@ -233,23 +279,9 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
             Some(r) => r.n_from_b() * chain.b_from_s(&comp_rot, &corrected),
             None => imu_ins,
         };
-        let view = InsView { t_s: s.t_s, t_ref_s: pb.core.reference_instant(t_repr), errors, imu_true, imu_ins, nav: pb.core.nav_error() };
+        let view = InsView { t_s: s.t_s, t_ref_s: pb.core.reference_instant(t_repr), errors, imu_true, imu_ins, nav: nav_error };
         if want_series {
             next_series = i.saturating_add(series_every);
-            for (v, e) in out.errors[..2].iter().enumerate() {
-                for (a, x) in e.as_array().into_iter().enumerate() {
-                    stats[v][a].add(x);
-                }
-            }
-            for (k, e) in view.errors.iter().enumerate() {
-                for (a, x) in e.as_array().into_iter().enumerate() {
-                    ins_stats[k][a].add(x);
-                }
-            }
-            if let Some(e) = view.nav {
-                let peak = nav.map_or(0.0, |n| n.peak_radial_m).max(e.radial_m);
-                nav = Some(NavSummary { peak_radial_m: peak, final_radial_m: e.radial_m, final_east_m: e.east_m, final_north_m: e.north_m });
-            }
             if let Some(r) = recorder.as_deref_mut() {
                 r.push_row(&out, Some(&view)).map_err(|e| PlaybackError::Data(format!("rerun: {e}")))?;
             }

@@ -371,7 +371,7 @@ impl Producer<'_> {
     }
 
     /// An IMU in the loop: one IMU sample per step; outputs at the attitude updates closest to the
-    /// recording rates (statistics at the series outputs).
+    /// recording rates (statistics at every update).
     fn run_ins(&self, timeline: &Timeline) -> (ErrorStats, InsStats, u64, bool) {
         let Some(ins_params) = &self.params.ins else {
             return self.run_ideal(timeline);
@@ -397,17 +397,16 @@ impl Producer<'_> {
             if !s.updated {
                 continue;
             }
-            let want_series = i >= next_series;
-            let want_scene = i >= next_scene;
-            if !(want_series || want_scene) {
-                continue;
-            }
+            // Statistics at every attitude update (the INS's own rate), not at the recorded rows:
+            // a peak between two rows, or in the last rows of a growing drift, is not missed.
             let core = step(self.model, &mut state, s.t_s);
             let view = ins.view(s.t_s);
+            stats.add(&core);
+            ins_stats.add(&view);
+            let want_series = i >= next_series;
+            let want_scene = i >= next_scene;
             if want_series {
                 next_series = i.saturating_add(self.series_every);
-                stats.add(&core);
-                ins_stats.add(&view);
                 if !out.series(OutputRow { core, ins: Some(view.clone()) }) {
                     break;
                 }

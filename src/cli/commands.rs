@@ -24,7 +24,7 @@ fn load(args: &RunArgs) -> Result<Params, Failure> {
         if !(d.is_finite() && d > 0.0 && d <= scenario::MAX_DURATION_S) {
             return Err(Failure::input(format!("--duration-s {d} s: must be > 0 and at most {} s (30 days), as simulation.duration_s", scenario::MAX_DURATION_S)));
         }
-        params.duration_s = d;
+        params.set_duration(d);
     }
     Ok(params)
 }

@@ -103,6 +103,10 @@ pub struct RecordingParams {
     pub scene_hz: f64,
     /// Drawing factor for error angles.
     pub exaggeration: f64,
+    /// What the rates not given in the file were chosen from (series, scene: `true` if chosen).
+    pub chosen: (bool, bool),
+    /// The motion's bandwidth the chosen rates follow.
+    pub bandwidth: validate::Bandwidth,
 }
 
 /// A validated scenario in SI units.
@@ -138,6 +142,20 @@ pub struct Params {
 }
 
 impl Params {
+    /// Sets the run's length (`--duration-s`), with the recording rates the file did not give chosen
+    /// again for it.
+    pub fn set_duration(&mut self, duration_s: f64) {
+        self.duration_s = duration_s;
+        let r = &mut self.recording;
+        r.bandwidth.duration_s = duration_s;
+        if r.chosen.0 {
+            r.series_hz = r.bandwidth.series_hz().min(self.step_hz);
+        }
+        if r.chosen.1 {
+            r.scene_hz = r.bandwidth.scene_hz().min(self.step_hz);
+        }
+    }
+
     /// The run's instants at the simulation rate (the one sampling rule, `math::timeline`).
     #[must_use]
     pub fn timeline(&self) -> Timeline {

@@ -339,17 +339,19 @@ impl Default for RawSimulation {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RawRecording {
-    /// Time-series output rate, Hz of simulated time.
-    pub series_hz: f64,
-    /// 3D scene output rate, Hz of simulated time.
-    pub scene_hz: f64,
+    /// Time-series output rate, Hz of simulated time (absent: chosen from the motion's bandwidth).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub series_hz: Option<f64>,
+    /// 3D scene output rate, Hz of simulated time (absent: chosen from the motion and the length).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scene_hz: Option<f64>,
     /// Factor applied to every error angle when drawing the 3D scene.
     pub exaggeration: f64,
 }
 
 impl Default for RawRecording {
     fn default() -> Self {
-        Self { series_hz: 100.0, scene_hz: 25.0, exaggeration: 60.0 }
+        Self { series_hz: None, scene_hz: None, exaggeration: 60.0 }
     }
 }
 

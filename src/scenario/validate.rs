@@ -101,7 +101,6 @@ pub(super) fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigErr
         ));
     }
 
-    let recording = recording(&c, &raw.recording, step_hz)?;
     let site = site(&c, &raw.site)?;
 
     // [vehicle]
@@ -158,6 +157,10 @@ pub(super) fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigErr
     // [scheme]
     let scheme = validate_scheme(&c, &raw.scheme, &chain)?;
 
+    let motion_hz = raw.vehicle.wobble.iter().map(|w| w.frequency_hz).fold(raw.vehicle.coning_frequency_hz * f64::from(u8::from(raw.vehicle.coning_half_angle_deg > 0.0)), f64::max);
+    let bandwidth = Bandwidth { shaft_deg_per_s: scheme.max_rate().to_degrees(), motion_hz, duration_s };
+    let recording = recording(&c, &raw.recording, step_hz, bandwidth)?;
+
     // [compensation]
     let (compensation, resolved_comp) = validate_compensation(&c, &raw.compensation, &raw.turntable, &chain, &truth)?;
 
@@ -187,6 +190,8 @@ pub(super) fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigErr
     let written = raw.clone();
     let mut resolved = raw;
     resolved.compensation = resolved_comp;
+    resolved.recording.series_hz = Some(recording.series_hz);
+    resolved.recording.scene_hz = Some(recording.scene_hz);
     let resolved_toml = toml::to_string_pretty(&resolved).unwrap_or_else(|e| format!("# could not serialise: {e}"));
 
     Ok(Params {
@@ -388,12 +393,52 @@ fn axis_errors_of(c: &Checker<'_>, key: &dyn Fn(&str) -> String, v: &AxisErrorKe
     })
 }
 
-/// `[recording]`: output rates (at most the simulation rate `step_hz`) and the drawing factor.
-pub(super) fn recording(c: &Checker<'_>, raw: &RawRecording, step_hz: f64) -> Result<RecordingParams, ConfigError> {
+/// What the default recording rates follow: the fastest gimbal rate, the fastest periodic motion
+/// of the vehicle, the run's length.
+#[derive(Debug, Clone, Copy)]
+pub struct Bandwidth {
+    /// Fastest gimbal rate, deg/s.
+    pub shaft_deg_per_s: f64,
+    /// Fastest vehicle wobble or coning frequency, Hz.
+    pub motion_hz: f64,
+    /// The run's length, s.
+    pub duration_s: f64,
+}
+
+impl Bandwidth {
+    /// The default series rate, Hz: one point per degree of the fastest shaft (a 10″ swing error
+    /// at 10°/s is a sinusoid of period 36 s: 360 points per period), 40 per period of the fastest
+    /// vehicle motion, and at least 500 points over the run; at most 50 Hz.
+    #[must_use]
+    pub fn series_hz(&self) -> f64 {
+        self.shaft_deg_per_s.max(40.0 * self.motion_hz).max(500.0 / self.duration_s).clamp(1e-3, 50.0)
+    }
+
+    /// The default scene rate, Hz: what the eye needs when the run plays in a minute (1500 frames,
+    /// 25 per second), at least a frame per degree of the fastest shaft and 10 per period of the
+    /// vehicle's motion; at most 25 Hz.
+    #[must_use]
+    pub fn scene_hz(&self) -> f64 {
+        self.shaft_deg_per_s.max(10.0 * self.motion_hz).max(1500.0 / self.duration_s).clamp(1e-3, 25.0)
+    }
+}
+
+/// `[recording]`: output rates (at most the simulation rate `step_hz`; absent, from `bandwidth`)
+/// and the drawing factor.
+pub(super) fn recording(c: &Checker<'_>, raw: &RawRecording, step_hz: f64, bandwidth: Bandwidth) -> Result<RecordingParams, ConfigError> {
+    let hint = "at most the step rate; at least one point every 1000 s";
     Ok(RecordingParams {
-        series_hz: c.range("recording.series_hz", raw.series_hz, "Hz", 1e-3, step_hz, "at most the step rate; at least one point every 1000 s")?,
-        scene_hz: c.range("recording.scene_hz", raw.scene_hz, "Hz", 1e-3, step_hz, "at most the step rate; at least one frame every 1000 s")?,
+        series_hz: match raw.series_hz {
+            Some(v) => c.range("recording.series_hz", v, "Hz", 1e-3, step_hz, hint)?,
+            None => bandwidth.series_hz().min(step_hz),
+        },
+        scene_hz: match raw.scene_hz {
+            Some(v) => c.range("recording.scene_hz", v, "Hz", 1e-3, step_hz, hint)?,
+            None => bandwidth.scene_hz().min(step_hz),
+        },
         exaggeration: c.range("recording.exaggeration", raw.exaggeration, "x", 1.0, 100_000.0, "")?,
+        chosen: (raw.series_hz.is_none(), raw.scene_hz.is_none()),
+        bandwidth,
     })
 }
 

@@ -55,7 +55,7 @@ pub fn run_benchmarks(steps: u64) -> anyhow::Result<()> {
     std::fs::create_dir_all(&dir)?;
     for name in ["rotary-table-2016-wobble", "jiang2017-dual-axis"] {
         let mut p = presets::load(name)?;
-        p.duration_s = 3600.0;
+        p.set_duration(3600.0);
         let path = dir.join(format!("{name}.rrd"));
         let sinks = sink::open(&SinkRequest { save: Some(path.clone()), ..Default::default() }, "rinscope-bench", name)?;
         let started = Instant::now();
