@@ -106,13 +106,17 @@ pub fn log(stream: Stream, params: &Params, cal: &Calibration, report: &Report, 
     // Ghost cones and estimated rotor axes, once per second of the test.
     let x = params.recording.exaggeration;
     let n = chain.axes().len();
+    // Once a second, and at most GHOST_FRAMES times over the test (a mesh each: a 100-h test must
+    // not write 360 000 of them).
+    const GHOST_FRAMES: f64 = 400.0;
+    let every_s = (params.duration_s / GHOST_FRAMES).max(1.0);
     let mut next = 0.0;
     let last = cal.history.len().saturating_sub(1);
     for (j, s) in cal.history.iter().enumerate() {
         if s.t_s < next && j != last {
             continue;
         }
-        next = s.t_s.floor() + 1.0;
+        next = (s.t_s / every_s).floor() * every_s + every_s;
         rec.set_duration_secs(TIMELINE, s.t_s);
         let est = set.errors(&s.theta, &params.table.compensation);
         for k in 0..n {

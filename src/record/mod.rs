@@ -83,10 +83,10 @@ pub const APPLICATION_ID: &str = "rinscope";
 pub const TIMELINE: &str = "sim_time";
 
 /// Rows buffered per series before one `send_columns` call.
-const SERIES_CHUNK_ROWS: usize = 4096;
+const SERIES_CHUNK_ROWS: usize = 8192;
 
 /// Chunks sent before waiting for the sinks (see [`Recorder::throttle`]); ~2-4 MB of data.
-const MAX_CHUNKS_IN_FLIGHT: usize = 48;
+const MAX_CHUNKS_IN_FLIGHT: usize = 24;
 
 /// Nominal quaternion (w, i, j, k) to Rerun's (x, y, z, w): the one place this reordering happens.
 #[must_use]
