@@ -124,7 +124,8 @@ fn a_run_writes_a_complete_recording_and_a_consistent_summary() {
     // bounded by the sum of the error angles (10' + 5' + 20" = 920").
     let heading = e["uncompensated"]["heading"]["peak_arcsec"].as_f64().expect("number");
     assert!(heading > 300.0 && heading < 920.0, "heading peak {heading}");
-    // Compensating with the true parameters leaves nothing.
+    // Compensating with the true parameters leaves nothing (a wiring check: the compensated chain
+    // is the truth's exact inverse by construction, so this is not evidence of the physics).
     for axis in ["pitch", "roll", "heading"] {
         assert!(e["compensated"][axis]["peak_arcsec"].as_f64().expect("number") < 1e-3);
     }

@@ -67,6 +67,45 @@ pub fn collect(params: &Params, seed: u64, stop: &AtomicBool) -> Result<Data, Ca
     Ok(Data { samples, duration_s, n_from_b, attitude, source, seed })
 }
 
+/// The RMS attitude error (pitch, roll, heading, rad) that the encoders' white noise alone leaves on
+/// the static test of `params` demodulated with the true table errors: the noise propagated
+/// linearly through the exact chain at every sample (derivatives by central differences),
+/// σ²_axis = mean over samples of Σ_k σ_k² (∂e_axis/∂λ_k)². An independent value for the floor
+/// the calibration report measures by simulating the noise.
+pub fn encoder_noise_floor(params: &Params, stop: &AtomicBool) -> Result<[f64; 3], CalibError> {
+    let Some((attitude, n_from_b)) = params.table_model().fixed_state() else {
+        return Err(CalibError::VehicleMoves(params.meta.name.clone()));
+    };
+    let model = params.table_model();
+    let chain = &params.table.chain;
+    let truth = chain.error_rotations(&params.table.truth);
+    let timeline = params.timeline();
+    let h = 1e-6;
+    let mut var = [0.0; 3];
+    let n = timeline.intervals();
+    for k in 1..=n {
+        if k.is_multiple_of(65_536) && stop.load(std::sync::atomic::Ordering::Relaxed) {
+            return Err(CalibError::Interrupted);
+        }
+        let t = timeline.t_s(k);
+        let (lambda, _) = model.scheme.state(t - model.scheme_t0_s);
+        let n_from_s = n_from_b * chain.b_from_s(&truth, &lambda);
+        for (j, axis) in params.table.truth.axes.iter().enumerate() {
+            let e = |d: f64| {
+                let mut l = lambda;
+                l[j] += d;
+                crate::sim::demodulate(n_from_s, chain.b_from_s(&truth, &l)).error_from(&attitude).as_array()
+            };
+            let (plus, minus) = (e(h), e(-h));
+            for a in 0..3 {
+                let d = (plus[a] - minus[a]) / (2.0 * h);
+                var[a] += axis.encoder_noise_rad.powi(2) * d * d;
+            }
+        }
+    }
+    Ok(var.map(|v| (v / n.max(1) as f64).sqrt()))
+}
+
 /// The validation run's attitude errors kept for the recording: before, after KF, after LSQ.
 pub type ValidationTrace = Thinned<Vec<[f64; 3]>>;
 

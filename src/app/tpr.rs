@@ -62,6 +62,15 @@ pub fn compare_resets(params: &Params, sample_s: f64, stop: &AtomicBool) -> Resu
         let v_dot = [(v[0] - earlier[0]) / RATE_WINDOW_S, (v[1] - earlier[1]) / RATE_WINDOW_S];
         level_errors_from_velocity(v, v_dot, damping, lat, g)
     };
+    // The INS's true level errors (the test's reference), in the reset equations' sign: the
+    // rotation from the true to the computed frame, φ = log(C·C_trueᵀ) — the opposite sign of
+    // `[navigation] initial_error`'s C = (I − [φ×]) C_true (docs/tpr.md says so).
+    let true_level = |ins: &mut InsRun, t: f64| {
+        let v = ins.view(t);
+        let phi = crate::math::rotvec::log((v.imu_ins * v.imu_true.inverse()).quaternion());
+        [phi.x, phi.y]
+    };
+    let mut true_phi = [[0.0; 2]; 2];
     let mut v_before = [[0.0; 2]; 2];
     let mut v_before_taken = [false; 2];
     // One INS sample per interval of the run.
@@ -89,6 +98,7 @@ pub fn compare_resets(params: &Params, sample_s: f64, stop: &AtomicBool) -> Resu
         if !fix1_done && s.t_s >= t1 {
             dlat[0] = errors(&mut ins, s.t_s).1[1];
             phi1 = level(&ins, v_before[0]);
+            true_phi[0] = true_level(&mut ins, s.t_s);
             ins.core_mut().reset_position();
             fix1_done = true;
         }
@@ -111,6 +121,7 @@ pub fn compare_resets(params: &Params, sample_s: f64, stop: &AtomicBool) -> Resu
     let (heading2, [_, lat2]) = errors(&mut ins, t_fix2);
     dlat[1] = lat2;
     let phi2 = level(&ins, v_before[1]);
+    true_phi[1] = true_level(&mut ins, t_fix2);
     let dlat2 = lat2 / (rm + earth.site.height_m);
     let phi_u = azimuth_error_at_second_fix(0.0, dlat2, t2 - t1, lat);
     let phi_u_level = azimuth_error_level_corrected(phi1, phi2, dlat2, t2 - t1, lat);
@@ -162,10 +173,13 @@ pub fn compare_resets(params: &Params, sample_s: f64, stop: &AtomicBool) -> Resu
         tpr_heading_estimate_arcsec: -phi_u * ARCSEC_PER_RAD,
         level_heading_estimate_arcsec: -phi_u_level * ARCSEC_PER_RAD,
         level_errors_arcsec: [to_arcsec(phi1), to_arcsec(phi2)],
+        true_level_errors_arcsec: true_phi.map(to_arcsec),
         heading_at_second_fix_arcsec: heading2,
         duration_s: params.duration_s,
         wall_s: started.elapsed().as_secs_f64(),
         complete,
+        arw_rad_per_sqrt_s: params.ins.as_ref().map_or(0.0, |i| i.errors.gyro.arw_rad_per_sqrt_s),
+        latitude_rad: params.site.latitude_rad,
     })
 }
 
@@ -229,6 +243,14 @@ mod tests {
         assert!(level.abs() < 0.02 * at_fix.abs(), "TPR + level's residual {level}″");
         let [conv, tpr, level] = r.peak_radial_after_m();
         assert!(tpr < 0.3 * conv && level < 0.3 * conv, "radial: conventional {conv} m, TPR {tpr} m, TPR + level {level} m");
+        // The level errors read from the velocity against the INS's own tilts (the simulated truth,
+        // not the velocity equation inverted): docs/tpr.md reports agreement to 0.01″.
+        for (fix, (read, truth)) in r.level_errors_arcsec.iter().zip(&r.true_level_errors_arcsec).enumerate() {
+            for axis in 0..2 {
+                assert!(truth[axis].abs() > 0.1, "fix {fix}: a tilt to read ({truth:?}″)");
+                assert!((read[axis] - truth[axis]).abs() < 0.03, "fix {fix}, axis {axis}: read {read:?}″, true {truth:?}″");
+            }
+        }
     }
 
     #[test]

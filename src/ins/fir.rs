@@ -1,10 +1,12 @@
-//! The anti-dither FIR filter of seed 001 §2.2 (25 taps, notches at the three ring-laser-gyro dither
-//! frequencies for 2 kHz sampling), applied to each axis's increments, and its frequency response.
+//! The anti-dither FIR filter of seed 001 §2.2, applied to each axis's increments, and its frequency
+//! response. It is a low-pass filter (25 taps at 2 kHz, −4.4 dB at 100 Hz), not a notch filter: its
+//! zeros on the unit circle sit at 343.5, 369.0 Hz and above 450 Hz, not at the three ring-laser-gyro
+//! dither tones; at the tones (335.4, 375.5, 425.7 Hz) its stopband attenuates −91, −116, −106 dB.
 
 use nalgebra::Vector3;
 
-/// Seed 001 §2.2, verbatim: 25 symmetric taps designed for 2 kHz data, notches at 335.4, 375.5 and
-/// 425.7 Hz, 100 Hz bandwidth.
+/// Seed 001 §2.2, verbatim: 25 symmetric taps designed for 2 kHz data against the dither at 335.4,
+/// 375.5 and 425.7 Hz, 100 Hz bandwidth (the paper calls them notches; see the module docs).
 pub const SEED001_TAPS: [f64; 25] = [
     -3.6162e-4, -5.5582e-5, -4.6181e-4, 1.3181e-3, 4.3263e-3, 1.1456e-2, 2.3008e-2, 3.9629e-2, 6.0210e-2, 8.2250e-2, 1.0213e-1, 1.1603e-1, 1.2103e-1,
     1.1603e-1, 1.0213e-1, 8.2250e-2, 6.0210e-2, 3.9629e-2, 2.3008e-2, 1.1456e-2, 4.3263e-3, 1.3181e-3, -4.6181e-4, -5.5582e-5, -3.6162e-4,
@@ -79,9 +81,9 @@ mod tests {
     use super::*;
 
     #[test]
-    fn seed001_filter_notches_the_dither_tones() {
-        // Seed 001 §2.2: the three dither frequencies at 2 kHz are notched; the printed taps were
-        // rounded to 5 digits, so the notches are deep (< -45 dB), not infinite. The passband keeps
+    fn seed001_filter_suppresses_the_dither_tones() {
+        // Seed 001 §2.2: the three dither frequencies at 2 kHz fall in the stopband (the printed taps
+        // were rounded to 5 digits); the attenuation there is deep (< -45 dB), not infinite. The passband keeps
         // low frequencies (0.5 Hz wobble: gain 1 to 1e-6).
         let f = Fir::new(&SEED001_TAPS);
         for tone in [335.4, 375.5, 425.7] {

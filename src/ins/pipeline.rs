@@ -240,7 +240,8 @@ mod tests {
     #[test]
     fn phase_lag_theorem_holds_for_the_fir_and_the_zero_order_hold() {
         // Seed 001 eq. 16/19: a 7°, 0.5 Hz single-axis wobble seen through a 6.25 ms lag (FIR 12
-        // samples at 2 kHz + ZOH 0.25 ms) has an error amplitude A·ω·t_d = 0.1374°. Within 3%.
+        // samples at 2 kHz + ZOH 0.25 ms) has an error amplitude A·ω·t_d = 0.1374°. The theorem is
+        // first order: the neglected (ωτ)²/2 = 2e-4 and the 2 kHz sampling of the peak; within 1e-3.
         let p = params(
             "[vehicle]\n[[vehicle.wobble]]\nangle = \"heading\"\namplitude_deg = 7.0\nfrequency_hz = 0.5\n[imu]\nfir = \"seed001\"\nzero_order_hold = true\n",
             STATIC_TABLE,
@@ -256,8 +257,7 @@ mod tests {
             }
         });
         let expected = 7.0 * RAD_PER_DEG * std::f64::consts::TAU * 0.5 * 6.25e-3;
-        assert!((peak / expected - 1.0).abs() < 0.03, "peak {:.5}° vs {:.5}°", peak.to_degrees(), expected.to_degrees());
-        assert!((expected.to_degrees() - 0.1374).abs() < 5e-5, "seed 001 eq. 19");
+        assert!((peak / expected - 1.0).abs() < 1e-3, "peak {:.5}° vs {:.5}°", peak.to_degrees(), expected.to_degrees());
     }
 }
 
