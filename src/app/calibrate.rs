@@ -29,7 +29,7 @@ pub fn collect(params: &Params, seed: u64, stop: &AtomicBool) -> Result<Data, Ca
         let mut model = p.table_model();
         // The demodulation knows every error it does not estimate: the compensation's values.
         let set = ParamSet::new(&p.table.chain, Nuisance::None);
-        model.compensation = set.without_estimated(&p.table.compensation);
+        model.compensation = set.without_estimated(&p.calibration_known);
         let chain = &p.table.chain;
         let timeline = p.timeline();
         let mut demod = DemodState::default();
@@ -149,9 +149,10 @@ pub fn calibrate_scenario(params: &Params, history: bool, stop: &AtomicBool) -> 
     });
     let (data, validation) = (data?, validation?);
     let cfg = &params.calibration;
-    let cal = calibrate(&params.table.chain, &params.table.compensation, &data, cfg, if history { History::Snapshots(cfg.record_hz) } else { History::Final }, stop)?;
-    let (compensation, validation_trace) = judge(&params.table.chain, &cal, &params.table.compensation, &params.table.truth, &validation, params.recording.series_hz, stop)?;
-    let report = build_report(&params.meta.name, &params.table.chain, &params.table.truth, &cal, &data, Some(compensation));
+    let cal = calibrate(&params.table.chain, &params.calibration_known, &data, cfg, if history { History::Snapshots(cfg.record_hz) } else { History::Final }, stop)?;
+    let (compensation, validation_trace) = judge(&params.table.chain, &cal, &params.calibration_known, &params.table.truth, &validation, params.recording.series_hz, stop)?;
+    let mut report = build_report(&params.meta.name, &params.table.chain, &params.table.truth, &cal, &data, Some(compensation));
+    report.aliases = crate::calib::alias::aliases(&params.table.chain, &params.calibration_known, &data, &cal, cfg.measurement_sigma_rad, stop)?;
     Ok(Outcome { data, validation, cal, report, validation_trace })
 }
 
@@ -163,7 +164,7 @@ pub fn monte_carlo_setup(params: &Params) -> Setup<'_> {
         scenario: &params.meta.name,
         chain: &params.table.chain,
         truth: &params.table.truth,
-        compensation: &params.table.compensation,
+        compensation: &params.calibration_known,
         cfg: &params.calibration,
         seed: params.meta.seed,
     }
@@ -287,7 +288,8 @@ pub fn calibrate_log(log: &LogSet, history: bool, stop: &AtomicBool) -> Result<(
     };
     let cal = calibrate(chain, &log.table.compensation, &data, cfg, if history { History::Snapshots(cfg.record_hz) } else { History::Final }, stop).map_err(interrupted)?;
     let (compensation, trace) = judge(chain, &cal, &log.table.compensation, &log.table.stated, &data, log.table.recording.series_hz, stop).map_err(interrupted)?;
-    let report = build_report(&log.name, chain, &log.table.stated, &cal, &data, Some(compensation));
+    let mut report = build_report(&log.name, chain, &log.table.stated, &cal, &data, Some(compensation));
+    report.aliases = crate::calib::alias::aliases(chain, &log.table.compensation, &data, &cal, cfg.measurement_sigma_rad, stop).map_err(interrupted)?;
     Ok((cal, report, data, trace))
 }
 

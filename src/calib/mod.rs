@@ -25,6 +25,7 @@
 //! chain, exponential maps, no small angle) with the same Λ: a Gauss–Newton (chord) iteration that
 //! converges to the exact model's solution.
 
+pub mod alias;
 mod estimate;
 pub mod montecarlo;
 pub mod report;

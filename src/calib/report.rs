@@ -119,6 +119,8 @@ pub struct Report {
     pub notes: Vec<String>,
     /// Attitude error of an independent run (other noise seed), demodulated four ways.
     pub compensation: Option<Compensation>,
+    /// What 1″ of each error the calibration does not estimate would do to its estimates.
+    pub aliases: Vec<super::alias::Alias>,
 }
 
 fn value(est: &Estimate, i: usize, scale: f64) -> Value {
@@ -383,6 +385,17 @@ pub fn build(scenario: &str, chain: &Chain, truth: &TableErrors, cal: &Calibrati
             cal.measurement_sigma_rad * ARCSEC_PER_RAD
         ));
     }
+    // Residuals well above the measurement noise: something in the data the model does not have.
+    let sigma = cal.measurement_sigma_rad;
+    if let Some(worst) = cal.nls.residual_rms_rad.iter().copied().filter(|v| v.is_finite()).reduce(f64::max)
+        && worst > 2.0 * sigma
+    {
+        warnings.push(format!(
+            "the least-squares residuals ({:.2}″ RMS on the worst axis) are more than twice the measurement noise ({:.2}″): the data hold an error the calibration does not model (see which errors alias into which states)",
+            worst * ARCSEC_PER_RAD,
+            sigma * ARCSEC_PER_RAD
+        ));
+    }
     Report {
         scenario: scenario.to_owned(),
         seed: data.seed,
@@ -403,6 +416,7 @@ pub fn build(scenario: &str, chain: &Chain, truth: &TableErrors, cal: &Calibrati
         warnings,
         notes,
         compensation,
+        aliases: Vec::new(),
     }
 }
 
@@ -481,6 +495,13 @@ impl Report {
                 s.push_str(&format!(" {:>15.1}×", b / a));
             }
             s.push_str("   (1.6′→25.2″, 1.86′→30.24″, 2.5′→49.32″)\n");
+        }
+        if !self.aliases.is_empty() {
+            s.push_str("\nwhat the calibration assumes: each error it does not estimate is taken as `[compensation]` gives it (nominal, 0, where not given);\n1″ of each would go into the estimates as (″ per ″; |x| ≥ 0.05 shown):\n");
+            for a in &self.aliases {
+                let into = if a.into.is_empty() { "nothing".to_owned() } else { a.into.iter().map(|(k, x)| format!("{k} {x:+.2}")).collect::<Vec<_>>().join(", ") };
+                s.push_str(&format!("  {:<28} → {into}\n", a.error));
+            }
         }
         for n in &self.notes {
             s.push_str(&format!("\nnote: {n}\n"));

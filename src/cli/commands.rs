@@ -274,7 +274,7 @@ pub(super) fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
     out!("{}", outcome.report.text());
     outln!("({wall:.2} s wall: two {:.0}-s runs simulated, filter and least squares)", params.duration_s);
     if let Some(path) = &args.json {
-        let compensation = estimated_compensation(&params.table.chain, &outcome.cal, &params.table.compensation);
+        let compensation = estimated_compensation(&params.table.chain, &outcome.cal, &params.calibration_known);
         write_json("--json", path, &CalibrationOutput { report: &outcome.report, estimated_compensation: compensation })?;
     }
     if let Some(sinks) = sinks {

@@ -131,6 +131,9 @@ pub struct Params {
     /// The configuration as written (defaults of optional keys not filled in): live mode describes
     /// reloads as its differences.
     pub written: RawConfig,
+    /// What a calibration assumes about the errors it does not estimate (see
+    /// [`Params::calibration_knowledge`]).
+    pub calibration_known: crate::model::gimbal::TableErrors,
     /// `[live] speed`: simulated seconds per wall-clock second.
     pub live_speed: f64,
     /// The INS in the loop, if any.
@@ -142,6 +145,35 @@ pub struct Params {
 }
 
 impl Params {
+    /// What a calibration may assume about the errors it does not estimate: the `[compensation]`
+    /// values the file gives, and nominal (zero) for every error it does not — a user calibrating a
+    /// table does not know its true errors (the run's own `[compensation]` defaults to the truth,
+    /// which is right for demodulating, not for calibrating).
+    ///
+    /// # Errors
+    /// None in practice (the file was validated); a `ConfigError` if re-validation fails.
+    pub fn calibration_knowledge(&self) -> Result<crate::model::gimbal::TableErrors, ConfigError> {
+        let mut nominal = self.written.turntable.clone();
+        nominal.installation_x_arcsec = 0.0;
+        nominal.installation_y_arcsec = 0.0;
+        nominal.installation_z_arcsec = 0.0;
+        nominal.imu_mount_x_arcsec = 0.0;
+        nominal.imu_mount_y_arcsec = 0.0;
+        nominal.imu_mount_z_arcsec = 0.0;
+        for a in &mut nominal.axis {
+            a.swing_half_angle_arcsec = 0.0;
+            a.swing_phase_deg = 0.0;
+            a.non_orthogonality_arcsec = 0.0;
+            a.encoder_offset_arcsec = 0.0;
+            a.encoder_scale_ppm = 0.0;
+            a.encoder_delay_ms = 0.0;
+        }
+        let origin = format!("{} (what the calibration knows)", self.meta.name);
+        let c = validate::Checker { origin: &origin };
+        let zero = crate::model::gimbal::TableErrors::zero(self.table.chain.axes().len());
+        Ok(validate::validate_compensation(&c, &self.written.compensation, &nominal, &self.table.chain, &zero)?.0)
+    }
+
     /// Sets the run's length (`--duration-s`), with the recording rates the file did not give chosen
     /// again for it.
     pub fn set_duration(&mut self, duration_s: f64) {

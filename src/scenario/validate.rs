@@ -194,12 +194,13 @@ pub(super) fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigErr
     resolved.recording.scene_hz = Some(recording.scene_hz);
     let resolved_toml = toml::to_string_pretty(&resolved).unwrap_or_else(|e| format!("# could not serialise: {e}"));
 
-    Ok(Params {
+    let mut params = Params {
         meta,
         duration_s,
         step_hz,
         recording,
         site,
+        calibration_known: TableErrors::zero(chain.axes().len()),
         table: TableParams { chain, vehicle, scheme, truth, compensation },
         resolved_toml,
         resolved,
@@ -208,7 +209,9 @@ pub(super) fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigErr
         ins,
         calibration,
         position_fix_s,
-    })
+    };
+    params.calibration_known = params.calibration_knowledge()?;
+    Ok(params)
 }
 
 fn axis_index(c: &Checker<'_>, key: &str, chain: &Chain, name: &str) -> Result<usize, ConfigError> {

@@ -1,0 +1,107 @@
+//! Which errors the calibration does not estimate would go into which of its states: for each
+//! unestimated error, 1″ of it is simulated in the measurement (exact chain) and passed through the
+//! least squares' normal equations, Δθ = (Hᵀ R⁻¹ H + P₀⁻¹)⁻¹ Σ Hᵀ R⁻¹ Δz. A user whose table has such an
+//! error (an IMU mounted 30″ off about z) reads here how much of it each estimate takes.
+
+use std::sync::atomic::AtomicBool;
+
+use nalgebra::{DVector, UnitQuaternion, Vector3};
+use serde::Serialize;
+
+use super::estimate::exact_residual;
+use super::{CalibError, Calibration, Data, MAX_TABLE};
+use crate::math::units::RAD_PER_ARCSEC;
+use crate::model::gimbal::{Chain, ShaftRotations, TableErrors};
+
+/// How much of 1″ of an unestimated error each estimated state takes.
+#[derive(Debug, Clone, Serialize)]
+pub struct Alias {
+    /// The unestimated error ("IMU mounting about z", "outer encoder offset").
+    pub error: String,
+    /// Per estimated state key: arcsec of the estimate per arcsec of the error (only |x| ≥ 0.05).
+    pub into: Vec<(String, f64)>,
+}
+
+/// A small perturbation of what the measurement sees: table errors, or an encoder offset on axis k.
+enum Perturbation {
+    Errors(TableErrors),
+    Encoder(usize),
+}
+
+/// The aliases of every unestimated error of the kinds a table has (installation, IMU mounting,
+/// encoder offsets), for the calibration `cal` of `data` that assumed `known`.
+///
+/// # Errors
+/// The data source's, or the stop.
+pub fn aliases(chain: &Chain, known: &TableErrors, data: &Data, cal: &Calibration, measurement_sigma_rad: f64, stop: &AtomicBool) -> Result<Vec<Alias>, CalibError> {
+    let set = &cal.set;
+    let one = RAD_PER_ARCSEC;
+    let mut cases: Vec<(String, Perturbation)> = Vec::new();
+    for (i, axis) in ["x", "y", "z"].iter().enumerate() {
+        let mut e = known.clone();
+        e.installation_rad[i] += one;
+        cases.push((format!("installation about {axis}"), Perturbation::Errors(e)));
+        let mut e = known.clone();
+        e.imu_mount_rad[i] += one;
+        cases.push((format!("IMU mounting about {axis}"), Perturbation::Errors(e)));
+    }
+    for (k, g) in chain.axes().iter().enumerate() {
+        cases.push((format!("{} encoder offset", g.name), Perturbation::Encoder(k)));
+    }
+    let base = chain.error_rotations(known);
+    let w = 1.0 / measurement_sigma_rad.powi(2);
+    let n_from_b = data.n_from_b.matrix();
+    let ref_inv = data.n_from_b.inverse();
+    let cov = &cal.nls.cov;
+    let nt = set.n_table;
+    let mut out = Vec::new();
+    for (name, case) in cases {
+        let mut b = DVector::<f64>::zeros(set.len());
+        let mut h = [[0.0; MAX_TABLE]; 3];
+        let perturbed = match &case {
+            Perturbation::Errors(e) => Some(chain.error_rotations(e)),
+            Perturbation::Encoder(_) => None,
+        };
+        data.samples.each(stop, &mut |s| {
+            set.table_rows(chain, &n_from_b, s, &mut h);
+            let z0 = exact_residual(chain, &base, s, &ref_inv);
+            let z1 = match (&case, &perturbed) {
+                (_, Some(err)) => exact_residual(chain, err, s, &ref_inv),
+                (Perturbation::Encoder(k), None) => {
+                    // The encoder reads 1″ more than the shaft turned: the demodulation turns it back.
+                    let mut shafts = ShaftRotations(s.shafts.0);
+                    let axis = chain.axes()[*k].axis;
+                    shafts.0[*k] = shafts.0[*k] * UnitQuaternion::from_scaled_axis(axis * one);
+                    let m = super::Measurement { t_s: s.t_s, n_from_s: s.n_from_s, shafts };
+                    exact_residual(chain, &base, &m, &ref_inv)
+                }
+                _ => z0,
+            };
+            let dz: Vector3<f64> = z1 - z0;
+            for r in 0..3 {
+                for j in 0..nt {
+                    b[j] += w * h[r][j] * dz[r];
+                }
+            }
+            let tau = data.tau(s.t_s);
+            for (j, p) in set.params.iter().enumerate().skip(nt) {
+                match *p {
+                    super::Param::Offset(r) => b[j] += w * dz[r],
+                    super::Param::Drift(r) => b[j] += w * tau * dz[r],
+                    _ => {}
+                }
+            }
+        })?;
+        let dtheta = cov * b;
+        let into: Vec<(String, f64)> = set
+            .params
+            .iter()
+            .enumerate()
+            .take(nt)
+            .map(|(j, p)| (p.key(chain), dtheta[j] / one))
+            .filter(|(_, x)| x.abs() >= 0.05)
+            .collect();
+        out.push(Alias { error: name, into });
+    }
+    Ok(out)
+}
