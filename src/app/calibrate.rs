@@ -152,7 +152,7 @@ pub fn calibrate_scenario(params: &Params, history: bool, stop: &AtomicBool) -> 
     let cal = calibrate(&params.table.chain, &params.calibration_known, &data, cfg, if history { History::Snapshots(cfg.record_hz) } else { History::Final }, stop)?;
     let (compensation, validation_trace) = judge(&params.table.chain, &cal, &params.calibration_known, &params.table.truth, &validation, params.recording.series_hz, stop)?;
     let mut report = build_report(&params.meta.name, &params.table.chain, &params.table.truth, &cal, &data, Some(compensation));
-    report.aliases = crate::calib::alias::aliases(&params.table.chain, &params.calibration_known, &data, &cal, cfg.measurement_sigma_rad, stop)?;
+    report.aliases = crate::calib::alias::aliases(&params.table.chain, &params.calibration_known, &data, &cal, cfg, stop)?;
     Ok(Outcome { data, validation, cal, report, validation_trace })
 }
 
@@ -289,7 +289,7 @@ pub fn calibrate_log(log: &LogSet, history: bool, stop: &AtomicBool) -> Result<(
     let cal = calibrate(chain, &log.table.compensation, &data, cfg, if history { History::Snapshots(cfg.record_hz) } else { History::Final }, stop).map_err(interrupted)?;
     let (compensation, trace) = judge(chain, &cal, &log.table.compensation, &log.table.stated, &data, log.table.recording.series_hz, stop).map_err(interrupted)?;
     let mut report = build_report(&log.name, chain, &log.table.stated, &cal, &data, Some(compensation));
-    report.aliases = crate::calib::alias::aliases(chain, &log.table.compensation, &data, &cal, cfg.measurement_sigma_rad, stop).map_err(interrupted)?;
+    report.aliases = crate::calib::alias::aliases(chain, &log.table.compensation, &data, &cal, cfg, stop).map_err(interrupted)?;
     Ok((cal, report, data, trace))
 }
 

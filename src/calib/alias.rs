@@ -8,8 +8,8 @@ use std::sync::atomic::AtomicBool;
 use nalgebra::{DVector, UnitQuaternion, Vector3};
 use serde::Serialize;
 
-use super::estimate::exact_residual;
-use super::{CalibError, Calibration, Data, MAX_TABLE};
+use super::estimate::{exact_residual, SampleModel};
+use super::{CalibConfig, CalibError, Calibration, Data};
 use crate::math::units::RAD_PER_ARCSEC;
 use crate::model::gimbal::{Chain, ShaftRotations, TableErrors};
 
@@ -33,7 +33,7 @@ enum Perturbation {
 ///
 /// # Errors
 /// The data source's, or the stop.
-pub fn aliases(chain: &Chain, known: &TableErrors, data: &Data, cal: &Calibration, measurement_sigma_rad: f64, stop: &AtomicBool) -> Result<Vec<Alias>, CalibError> {
+pub fn aliases(chain: &Chain, known: &TableErrors, data: &Data, cal: &Calibration, cfg: &CalibConfig, stop: &AtomicBool) -> Result<Vec<Alias>, CalibError> {
     let set = &cal.set;
     let one = RAD_PER_ARCSEC;
     let mut cases: Vec<(String, Perturbation)> = Vec::new();
@@ -49,7 +49,6 @@ pub fn aliases(chain: &Chain, known: &TableErrors, data: &Data, cal: &Calibratio
         cases.push((format!("{} encoder offset", g.name), Perturbation::Encoder(k)));
     }
     let base = chain.error_rotations(known);
-    let w = 1.0 / measurement_sigma_rad.powi(2);
     let n_from_b = data.n_from_b.matrix();
     let ref_inv = data.n_from_b.inverse();
     let cov = &cal.nls.cov;
@@ -57,13 +56,13 @@ pub fn aliases(chain: &Chain, known: &TableErrors, data: &Data, cal: &Calibratio
     let mut out = Vec::new();
     for (name, case) in cases {
         let mut b = DVector::<f64>::zeros(set.len());
-        let mut h = [[0.0; MAX_TABLE]; 3];
+        let mut model = SampleModel::new();
         let perturbed = match &case {
             Perturbation::Errors(e) => Some(chain.error_rotations(e)),
             Perturbation::Encoder(_) => None,
         };
         data.samples.each(stop, &mut |s| {
-            set.table_rows(chain, &n_from_b, s, &mut h);
+            model.set(set, chain, &n_from_b, s, data.tau(s.t_s), cfg);
             let z0 = exact_residual(chain, &base, s, &ref_inv);
             let z1 = match (&case, &perturbed) {
                 (_, Some(err)) => exact_residual(chain, err, s, &ref_inv),
@@ -78,18 +77,10 @@ pub fn aliases(chain: &Chain, known: &TableErrors, data: &Data, cal: &Calibratio
                 _ => z0,
             };
             let dz: Vector3<f64> = z1 - z0;
-            for r in 0..3 {
-                for j in 0..nt {
-                    b[j] += w * h[r][j] * dz[r];
-                }
-            }
-            let tau = data.tau(s.t_s);
-            for (j, p) in set.params.iter().enumerate().skip(nt) {
-                match *p {
-                    super::Param::Offset(r) => b[j] += w * dz[r],
-                    super::Param::Drift(r) => b[j] += w * tau * dz[r],
-                    _ => {}
-                }
+            // Σ Hᵀ R⁻¹ Δz.
+            let wdz = model.w * dz;
+            for (j, bj) in b.iter_mut().enumerate() {
+                *bj += (0..3).map(|r| model.h[r][j] * wdz[r]).sum::<f64>();
             }
         })?;
         let dtheta = cov * b;

@@ -1,7 +1,7 @@
 //! The estimators on one static test's data: the static Kalman filter (seed 000 eq. 29-33) in
 //! information form and the chord Gauss–Newton least squares on the exact chain.
 
-use nalgebra::{DMatrix, DVector, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 use std::sync::atomic::AtomicBool;
 
@@ -22,85 +22,114 @@ pub enum History {
     Lean,
 }
 
-/// The filter's sums Σ HᵀR⁻¹H and Σ HᵀR⁻¹z, kept by blocks: table × table, table × nuisance, and the
-/// nuisance blocks, which are scalar multiples of I (offset: I, drift: τ·I).
-#[derive(Debug, Clone, Default)]
-struct Sums {
-    tt: [[f64; MAX_TABLE]; MAX_TABLE],
-    t_off: [[f64; 3]; MAX_TABLE],
-    t_drift: [[f64; 3]; MAX_TABLE],
-    b_t: [f64; MAX_TABLE],
-    b_off: [f64; 3],
-    b_drift: [f64; 3],
-    w: f64,
-    w_tau: f64,
-    w_tau2: f64,
+/// One sample's measurement model: the rows of H (3 × p, the table's columns then the nuisance's)
+/// and the weight R⁻¹ of its noise.
+///
+/// R is built from where the noise enters: each encoder's white noise σ_k turns the demodulated
+/// attitude about that shaft's axis u_k (nav frame), and the INS and everything else add σ² I:
+/// R = Σ_k σ_k² u_k u_kᵀ + σ² I. (An isotropic R overstates the uncertainty of the states the
+/// encoder noise does not reach, and understates the rest.)
+pub struct SampleModel {
+    /// H, row-major, p columns used.
+    pub h: [[f64; MAX_PARAMS]; 3],
+    /// R⁻¹.
+    pub w: Matrix3<f64>,
+    /// Orthonormal basis of the directions the encoders' noise acts in (the rest of a residual is
+    /// the isotropic part's), and how many.
+    encoder_basis: [Vector3<f64>; 3],
+    encoder_rank: usize,
 }
 
-impl Sums {
-    fn add(&mut self, nt: usize, h: &[[f64; MAX_TABLE]; 3], tau: f64, z: &Vector3<f64>, w: f64) {
-        for r in 0..3 {
-            let row = &h[r];
-            let zr = z[r];
-            for i in 0..nt {
-                let hi = w * row[i];
-                self.b_t[i] += hi * zr;
-                self.t_off[i][r] += hi;
-                self.t_drift[i][r] += hi * tau;
-                let tt = &mut self.tt[i];
-                for j in i..nt {
-                    tt[j] += hi * row[j];
-                }
-            }
-            self.b_off[r] += w * zr;
-            self.b_drift[r] += w * tau * zr;
-        }
-        self.w += w;
-        self.w_tau += w * tau;
-        self.w_tau2 += w * tau * tau;
+impl SampleModel {
+    pub(crate) fn new() -> Self {
+        Self { h: [[0.0; MAX_PARAMS]; 3], w: Matrix3::identity(), encoder_basis: [Vector3::zeros(); 3], encoder_rank: 0 }
     }
 
-    /// The full information matrix and right-hand side in the order of `set`.
-    fn assemble(&self, set: &ParamSet) -> (DMatrix<f64>, DVector<f64>) {
-        let p = set.len();
+    /// Fills H and R⁻¹ for sample `s` (time τ).
+    pub(crate) fn set(&mut self, set: &ParamSet, chain: &Chain, n_from_b: &Matrix3<f64>, s: &Measurement, tau: f64, cfg: &CalibConfig) {
+        let mut table = [[0.0; MAX_TABLE]; 3];
+        set.table_rows(chain, n_from_b, s, &mut table);
         let nt = set.n_table;
-        let mut a = DMatrix::zeros(p, p);
-        let mut b = DVector::zeros(p);
-        for i in 0..nt {
-            b[i] = self.b_t[i];
-            for j in i..nt {
-                a[(i, j)] = self.tt[i][j];
-                a[(j, i)] = self.tt[i][j];
-            }
+        for r in 0..3 {
+            self.h[r] = [0.0; MAX_PARAMS];
+            self.h[r][..nt].copy_from_slice(&table[r][..nt]);
         }
-        for (j, pj) in set.params.iter().enumerate().skip(nt) {
-            match *pj {
-                Param::Offset(r) => {
-                    b[j] = self.b_off[r];
-                    for i in 0..nt {
-                        a[(i, j)] = self.t_off[i][r];
-                        a[(j, i)] = self.t_off[i][r];
-                    }
-                }
-                Param::Drift(r) => {
-                    b[j] = self.b_drift[r];
-                    for i in 0..nt {
-                        a[(i, j)] = self.t_drift[i][r];
-                        a[(j, i)] = self.t_drift[i][r];
-                    }
-                }
+        for (j, p) in set.params.iter().enumerate().skip(nt) {
+            match *p {
+                Param::Offset(r) => self.h[r][j] = 1.0,
+                Param::Drift(r) => self.h[r][j] = tau,
                 _ => {}
             }
-            for (k, pk) in set.params.iter().enumerate().skip(nt) {
-                a[(j, k)] = match (*pj, *pk) {
-                    (Param::Offset(r), Param::Offset(q)) if r == q => self.w,
-                    (Param::Offset(r), Param::Drift(q)) | (Param::Drift(r), Param::Offset(q)) if r == q => self.w_tau,
-                    (Param::Drift(r), Param::Drift(q)) if r == q => self.w_tau2,
-                    _ => 0.0,
-                };
+        }
+        let mut r = Matrix3::identity() * cfg.measurement_sigma_rad.powi(2);
+        self.encoder_rank = 0;
+        for (u, sigma) in set.shaft_axes_n(chain, n_from_b, s).iter().zip(&cfg.encoder_noise_rad) {
+            r += u * u.transpose() * sigma.powi(2);
+            if *sigma > 0.0 && self.encoder_rank < 3 {
+                // Gram–Schmidt: the part of u not yet spanned.
+                let mut e = *u;
+                for b in &self.encoder_basis[..self.encoder_rank] {
+                    e -= b * b.dot(&e);
+                }
+                if e.norm() > 1e-6 {
+                    self.encoder_basis[self.encoder_rank] = e.normalize();
+                    self.encoder_rank += 1;
+                }
             }
         }
-        (a, b)
+        self.w = r.try_inverse().unwrap_or_else(Matrix3::zeros);
+    }
+
+    /// The squared part of residual `r` outside the encoders' directions, and its degrees of
+    /// freedom (what the isotropic noise alone explains).
+    fn isotropic_part(&self, r: &Vector3<f64>) -> (f64, usize) {
+        let mut perp = *r;
+        for b in &self.encoder_basis[..self.encoder_rank] {
+            perp -= b * b.dot(r);
+        }
+        (perp.norm_squared(), 3 - self.encoder_rank)
+    }
+
+    /// R⁻¹ H, row-major.
+    fn wh(&self, p: usize) -> [[f64; MAX_PARAMS]; 3] {
+        let mut out = [[0.0; MAX_PARAMS]; 3];
+        for (r, row) in out.iter_mut().enumerate() {
+            for (j, x) in row.iter_mut().enumerate().take(p) {
+                *x = (0..3).map(|c| self.w[(r, c)] * self.h[c][j]).sum();
+            }
+        }
+        out
+    }
+}
+
+/// The normal equations Σ HᵀR⁻¹H and Σ HᵀR⁻¹z (the information form of the static filter).
+#[derive(Debug, Clone)]
+struct Normal {
+    a: [[f64; MAX_PARAMS]; MAX_PARAMS],
+    b: [f64; MAX_PARAMS],
+}
+
+impl Normal {
+    fn new() -> Self {
+        Self { a: [[0.0; MAX_PARAMS]; MAX_PARAMS], b: [0.0; MAX_PARAMS] }
+    }
+
+    /// Adds one sample with its measurement z (or residual).
+    fn add(&mut self, p: usize, m: &SampleModel, z: &Vector3<f64>, with_information: bool) {
+        let wh = m.wh(p);
+        for i in 0..p {
+            self.b[i] += (0..3).map(|r| wh[r][i] * z[r]).sum::<f64>();
+            if with_information {
+                for j in i..p {
+                    self.a[i][j] += (0..3).map(|r| m.h[r][i] * wh[r][j]).sum::<f64>();
+                }
+            }
+        }
+    }
+
+    fn assemble(&self, p: usize) -> (DMatrix<f64>, DVector<f64>) {
+        let a = DMatrix::from_fn(p, p, |i, j| if i <= j { self.a[i][j] } else { self.a[j][i] });
+        (a, DVector::from_column_slice(&self.b[..p]))
     }
 }
 
@@ -113,6 +142,10 @@ pub struct Estimate {
     pub cov: DMatrix<f64>,
     /// RMS of the residuals per nav axis (E, N, U), rad.
     pub residual_rms_rad: [f64; 3],
+    /// RMS of the residuals outside the directions the encoders' noise acts in, rad (what the
+    /// isotropic part of R must cover: the INS and the first-order model's error; NaN if not
+    /// computed).
+    pub isotropic_residual_rad: f64,
 }
 
 impl Estimate {
@@ -188,75 +221,75 @@ pub fn calibrate(chain: &Chain, known: &TableErrors, data: &Data, cfg: &CalibCon
     let (x0, s0) = set.prior(cfg);
     let x0 = DVector::from_vec(x0);
     let prior_info = DMatrix::from_diagonal(&DVector::from_iterator(p, s0.iter().map(|s| 1.0 / (s * s))));
-    let w = 1.0 / cfg.measurement_sigma_rad.powi(2);
     let n_from_b = data.n_from_b.matrix();
     let ref_inv = data.n_from_b.inverse();
 
     // The measurement z: the demodulation with the estimated parameters at zero.
     let before = chain.error_rotations(&set.without_estimated(known));
     let n = data.samples.len();
-    let nt = set.n_table;
-    let mut h = [[0.0; MAX_TABLE]; 3];
-    let mut sums = Sums::default();
+    let mut model = SampleModel::new();
+    let mut sums = Normal::new();
     let mut snapshots = Thinned::new(match history {
         History::Snapshots(hz) => 1.0 / hz,
         _ => f64::INFINITY,
     });
     data.samples.each(stop, &mut |s| {
-        set.table_rows(chain, &n_from_b, s, &mut h);
+        model.set(&set, chain, &n_from_b, s, data.tau(s.t_s), cfg);
         let z = exact_residual(chain, &before, s, &ref_inv);
-        sums.add(nt, &h, data.tau(s.t_s), &z, w);
+        sums.add(p, &model, &z, true);
         if matches!(history, History::Snapshots(_)) && snapshots.wants(s.t_s) {
-            let (a, b) = sums.assemble(&set);
+            let (a, b) = sums.assemble(p);
             // Early on the information can be singular: that snapshot is skipped.
             if let Ok((x, cov)) = solve(&(&prior_info + a), &(&prior_info * &x0 + b)) {
                 snapshots.push(s.t_s, Snapshot { t_s: s.t_s, theta: x.iter().copied().collect(), sigma: cov.diagonal().iter().map(|v| v.max(0.0).sqrt()).collect() });
             }
         }
     })?;
-    let (data_information, rhs) = sums.assemble(&set);
+    let (data_information, rhs) = sums.assemble(p);
     let information = &prior_info + &data_information;
     let (x_kf, cov) = solve(&information, &(&prior_info * &x0 + rhs))?;
     let chol = information.clone().cholesky().ok_or(CalibError::Singular)?;
 
     // Residuals of a parameter vector under the exact model, and the Gauss–Newton right-hand side
     // Σ HᵀR⁻¹r.
-    let pass = |theta: &DVector<f64>| -> Result<(DVector<f64>, [f64; 3]), CalibError> {
+    let pass = |theta: &DVector<f64>| -> Result<(DVector<f64>, [f64; 3], f64), CalibError> {
         let t: Vec<f64> = theta.iter().copied().collect();
         let err = chain.error_rotations(&set.errors(&t, known));
-        let mut g = Sums::default();
+        let mut g = Normal::new();
         let mut sq = [0.0; 3];
-        let mut h = [[0.0; MAX_TABLE]; 3];
+        let mut model = SampleModel::new();
+        let (mut iso_sq, mut iso_dof) = (0.0, 0usize);
         data.samples.each(stop, &mut |s| {
-            // H again rather than kept: 3·n_table numbers per sample would make memory grow with the test.
-            set.table_rows(chain, &n_from_b, s, &mut h);
+            // H and R again rather than kept: 3·p numbers per sample would grow with the test.
             let tau = data.tau(s.t_s);
+            model.set(&set, chain, &n_from_b, s, tau, cfg);
             let r = exact_residual(chain, &err, s, &ref_inv) - set.nuisance(&t, tau);
-            for k in 0..3 {
-                sq[k] += r[k] * r[k];
-                let wr = w * r[k];
-                for (gj, hj) in g.b_t[..nt].iter_mut().zip(&h[k][..nt]) {
-                    *gj += hj * wr;
-                }
-                g.b_off[k] += wr;
-                g.b_drift[k] += wr * tau;
+            for (k, q) in sq.iter_mut().enumerate() {
+                *q += r[k] * r[k];
             }
+            g.add(p, &model, &r, false);
+            let (q, dof) = model.isotropic_part(&r);
+            iso_sq += q;
+            iso_dof += dof;
         })?;
         let nf = n.max(1) as f64;
-        Ok((g.assemble(&set).1, sq.map(|v| (v / nf).sqrt())))
+        let iso = if iso_dof > 0 { (iso_sq / iso_dof as f64).sqrt() } else { f64::NAN };
+        Ok((g.assemble(p).1, sq.map(|v| (v / nf).sqrt()), iso))
     };
     // The filter's residuals are reported, not needed by the estimate (the Monte Carlo skips them).
     let kf_rms = if history == History::Lean { [f64::NAN; 3] } else { pass(&x_kf)?.1 };
-    let kf = Estimate { theta: x_kf.iter().copied().collect(), cov: cov.clone(), residual_rms_rad: kf_rms };
+    let kf = Estimate { theta: x_kf.iter().copied().collect(), cov: cov.clone(), residual_rms_rad: kf_rms, isotropic_residual_rad: f64::NAN };
 
     // Chord Gauss–Newton from the filter's estimate. The residuals are exact; the Jacobian is the
     // first-order H (relative error ~ the error angles, 1e-3), so each step gains ~3 digits.
     let mut theta = x_kf;
     let mut iterations = 0;
     let mut rms = kf_rms;
+    let mut iso = f64::NAN;
     for _ in 0..8 {
-        let (g, r) = pass(&theta)?;
+        let (g, r, i) = pass(&theta)?;
         rms = r;
+        iso = i;
         let step = chol.solve(&(g - &prior_info * (&theta - &x0)));
         theta += &step;
         iterations += 1;
@@ -266,7 +299,7 @@ pub fn calibrate(chain: &Chain, known: &TableErrors, data: &Data, cfg: &CalibCon
             break;
         }
     }
-    let nls = Estimate { theta: theta.iter().copied().collect(), cov, residual_rms_rad: rms };
+    let nls = Estimate { theta: theta.iter().copied().collect(), cov, residual_rms_rad: rms, isotropic_residual_rad: iso };
     Ok(Calibration {
         set,
         prior: (x0.iter().copied().collect(), s0),

@@ -77,8 +77,13 @@ pub struct MonteCarloConfig {
 /// `[calibration]`, validated, SI.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CalibConfig {
-    /// R = σ² I for each nav-frame component of z, rad.
+    /// The isotropic part of each sample's measurement noise (the INS, the reference), rad:
+    /// R = Σ_k σ_k² u_k u_kᵀ + σ² I (see `estimate::SampleModel`).
     pub measurement_sigma_rad: f64,
+    /// Each encoder's white noise σ_k, rad, per axis (the table's stated `encoder_noise_arcsec`).
+    pub encoder_noise_rad: Vec<f64>,
+    /// True if `measurement_sigma_rad` was stated (else the calibration reads it off its residuals).
+    pub measurement_sigma_stated: bool,
     /// Prior 1σ of every swing component, rad (prior mean 0).
     pub prior_swing_sigma_rad: f64,
     /// Prior mean of every non-orthogonality, rad.
@@ -280,6 +285,18 @@ impl ParamSet {
             out[1][j] = col.y;
             out[2][j] = col.z;
         }
+    }
+
+    /// Each shaft's axis in the navigation frame at sample `s` (the direction its encoder noise
+    /// turns the demodulated attitude, to first order).
+    pub(crate) fn shaft_axes_n(&self, chain: &Chain, n_from_b: &Matrix3<f64>, s: &Measurement) -> Vec<Vector3<f64>> {
+        let mut m = *n_from_b;
+        let mut out = Vec::with_capacity(chain.axes().len());
+        for (k, g) in chain.axes().iter().enumerate() {
+            out.push(m * g.axis);
+            m *= s.shafts.0[k].to_rotation_matrix().into_inner();
+        }
+        out
     }
 
     /// The nuisance part of the model for one sample, nav frame.

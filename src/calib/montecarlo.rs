@@ -52,6 +52,9 @@ pub struct QuantityRow {
     pub paper: Option<(f64, f64)>,
     /// Determined by the data (false: the prior / an independent measurement decides).
     pub identifiable: bool,
+    /// Its accuracy is the independent η measurement's, returned (`--eta-measured-sigma-arcsec`).
+    #[serde(default)]
+    pub given_by_eta: bool,
 }
 
 /// The Monte Carlo's result.
@@ -82,7 +85,8 @@ struct Quantities {
     labels: Vec<Quantity>,
 }
 
-type Quantity = (String, Option<(f64, f64)>, bool);
+/// (label, the paper's (mean, std), identifiable, given by an independent η measurement).
+type Quantity = (String, Option<(f64, f64)>, bool, bool);
 
 fn quantities(chain: &Chain, set: &ParamSet, eta_known: bool) -> Quantities {
     let n = chain.axes().len();
@@ -95,15 +99,20 @@ fn quantities(chain: &Chain, set: &ParamSet, eta_known: bool) -> Quantities {
         let num = j + 1;
         // Without an independent η, the swing of the axis before an η (its sin component) is seen
         // only in the combination η_eff.
-        let swing_ok = eta_known || set.index(Param::NonOrth(k + 1)).is_none();
-        labels.push((format!("{name} α"), if dual { paper(&format!("α{num}")) } else { None }, swing_ok));
-        labels.push((format!("{name} φ (″ of phase)"), if dual { paper(&format!("φ{num}")) } else { None }, swing_ok));
-        labels.push((format!("{name} α·δφ (arc, ″)"), None, swing_ok));
+        let needs_eta = set.index(Param::NonOrth(k + 1)).is_some();
+        let swing_ok = eta_known || !needs_eta;
+        // With a measured η, what depends on it is the measurement's accuracy returned, not the
+        // calibration's: no paper comparison.
+        let given = eta_known && needs_eta;
+        let cmp = |q: &str| if dual && !given { paper(q) } else { None };
+        labels.push((format!("{name} α"), cmp(&format!("α{num}")), swing_ok, given));
+        labels.push((format!("{name} φ (″ of phase)"), cmp(&format!("φ{num}")), swing_ok, given));
+        labels.push((format!("{name} α·δφ (arc, ″)"), None, swing_ok, given));
     }
     for k in (1..n).rev() {
         let name = &chain.axes()[k].name;
-        labels.push((format!("{name} η"), if dual { paper("η") } else { None }, eta_known));
-        labels.push((format!("{name} η_eff"), None, true));
+        labels.push((format!("{name} η"), if dual && !eta_known { paper("η") } else { None }, eta_known, eta_known));
+        labels.push((format!("{name} η_eff"), None, true, false));
     }
     Quantities { labels }
 }
@@ -272,10 +281,10 @@ pub fn summarize(setup: &Setup<'_>, runs_requested: usize, done: &[RunErrors], w
         .labels
         .iter()
         .enumerate()
-        .map(|(j, (label, paper, identifiable))| {
+        .map(|(j, (label, paper, identifiable, given_by_eta))| {
             let kf: Vec<f64> = done.iter().map(|r| r.kf[j]).collect();
             let nls: Vec<f64> = done.iter().map(|r| r.nls[j]).collect();
-            QuantityRow { label: label.clone(), kf: ErrorSpread::of(&kf), nls: ErrorSpread::of(&nls), paper: *paper, identifiable: *identifiable }
+            QuantityRow { label: label.clone(), kf: ErrorSpread::of(&kf), nls: ErrorSpread::of(&nls), paper: *paper, identifiable: *identifiable, given_by_eta: *given_by_eta }
         })
         .collect();
     let deg = |r: [f64; 2]| [r[0].to_degrees(), r[1].to_degrees()];
@@ -375,7 +384,13 @@ impl Summary {
         for r in &self.rows {
             let f = |st: &ErrorSpread| format!("{:>+9.4} ±{:>8.4} |{:>8.4}|", st.mean, st.std, st.mean_abs);
             let paper = r.paper.map_or(String::new(), |(m, sd)| format!("{m:>9.2} ±{sd:>8.4}"));
-            let mark = if r.identifiable { "" } else { "   not identifiable: set by the η prior" };
+            let mark = if r.given_by_eta {
+                "   given by the η measurement (its accuracy, returned)"
+            } else if r.identifiable {
+                ""
+            } else {
+                "   not identifiable: set by the η prior"
+            };
             s.push_str(&format!("  {:<24} {} {} {:>22}{}\n", r.label, f(&r.kf), f(&r.nls), paper, mark));
         }
         s

@@ -59,7 +59,6 @@ fn the_filter_is_eq_33_in_information_form() {
     let (x0, s0) = set.prior(&p.calibration);
     let mut x = DVector::from_vec(x0);
     let mut pm = DMatrix::from_diagonal(&DVector::from_iterator(5, s0.iter().map(|s| s * s)));
-    let r_inv = 1.0 / p.calibration.measurement_sigma_rad.powi(2);
     let nb = data.n_from_b.matrix();
     let before = p.table.chain.error_rotations(&set.without_estimated(&p.table.compensation));
     let mut h = [[0.0; MAX_TABLE]; 3];
@@ -69,9 +68,18 @@ fn the_filter_is_eq_33_in_information_form() {
         let hm = DMatrix::from_fn(3, 5, |r, j| h[r][j]);
         let z = exact_residual(&p.table.chain, &before, s, &data.n_from_b.inverse());
         let z = DVector::from_column_slice(z.as_slice());
-        let p_inv = pm.clone().try_inverse().expect("invertible") + hm.transpose() * &hm * r_inv;
+        // R of this sample: each encoder's noise about its shaft's axis (nav frame) + σ² I.
+        let mut r = nalgebra::Matrix3::identity() * p.calibration.measurement_sigma_rad.powi(2);
+        let mut m = nb;
+        for (k, g) in p.table.chain.axes().iter().enumerate() {
+            let u = m * g.axis;
+            r += u * u.transpose() * p.table.truth.axes[k].encoder_noise_rad.powi(2);
+            m *= s.shafts.0[k].to_rotation_matrix().into_inner();
+        }
+        let r_inv = DMatrix::from_fn(3, 3, |i, j| r.try_inverse().expect("R invertible")[(i, j)]);
+        let p_inv = pm.clone().try_inverse().expect("invertible") + hm.transpose() * &r_inv * &hm;
         pm = p_inv.try_inverse().expect("invertible");
-        x = &x + &pm * hm.transpose() * (z - &hm * &x) * r_inv;
+        x = &x + &pm * hm.transpose() * &r_inv * (z - &hm * &x);
     }
     for j in 0..5 {
         assert!((x[j] - cal.kf.theta[j]).abs() < 1e-6 * RAD_PER_ARCSEC, "state {j}: {} vs {}", x[j], cal.kf.theta[j]);

@@ -217,11 +217,13 @@ fn validate_imu(c: &Checker<'_>, raw: &RawImu, nav: Option<&RawNavigation>, step
 }
 
 pub(super) fn validate_calibration(c: &Checker<'_>, cal: &RawCalibration, truth: &TableErrors) -> Result<CalibConfig, ConfigError> {
-    let noise_rms = (truth.axes.iter().map(|a| a.encoder_noise_rad.powi(2)).sum::<f64>() / truth.axes.len().max(1) as f64).sqrt();
+    // The isotropic part: the INS and the reference, 1″ unless stated; the encoders' part comes
+    // from their stated noise, per axis, in the direction each one acts.
     let measurement_sigma_rad = match cal.measurement_sigma_arcsec {
         Some(v) => c.positive("calibration.measurement_sigma_arcsec", v, "arcsec", MAX_ERROR_ANGLE_ARCSEC)? * RAD_PER_ARCSEC,
-        None => noise_rms.max(RAD_PER_ARCSEC),
+        None => RAD_PER_ARCSEC,
     };
+    let encoder_noise_rad: Vec<f64> = truth.axes.iter().map(|a| a.encoder_noise_rad).collect();
     let nuisance = match cal.nuisance.as_str() {
         "none" => Nuisance::None,
         "offset" => Nuisance::Offset,
@@ -250,6 +252,8 @@ pub(super) fn validate_calibration(c: &Checker<'_>, cal: &RawCalibration, truth:
     };
     Ok(CalibConfig {
         measurement_sigma_rad,
+        encoder_noise_rad,
+        measurement_sigma_stated: cal.measurement_sigma_arcsec.is_some(),
         prior_swing_sigma_rad: c.positive("calibration.prior_swing_sigma_arcsec", cal.prior_swing_sigma_arcsec, "arcsec", MAX_ERROR_ANGLE_ARCSEC)? * RAD_PER_ARCSEC,
         prior_eta_rad: c.range("calibration.prior_non_orthogonality_arcsec", cal.prior_non_orthogonality_arcsec, "arcsec", -MAX_ERROR_ANGLE_ARCSEC, MAX_ERROR_ANGLE_ARCSEC, ERROR_HINT)?
             * RAD_PER_ARCSEC,
