@@ -322,3 +322,40 @@ fn serve_listens_on_loopback_unless_told_otherwise() {
         assert!(addr.starts_with("0100007F"), "listens on {addr}, not 127.0.0.1");
     }
 }
+
+#[test]
+fn serve_web_serves_the_viewer_page_on_loopback_and_ends_cleanly() {
+    // The page (HTML + Wasm viewer) over HTTP on 127.0.0.1; after the run it stays until Ctrl-C,
+    // which then ends with exit 0 (the run was complete). A browser check: assets/web/screenshot.py.
+    let probe = std::net::TcpListener::bind("127.0.0.1:0").expect("port");
+    let port = probe.local_addr().expect("addr").port();
+    drop(probe);
+    let dir = scratch("web");
+    let child = rinscope()
+        .args(["run", "--duration-s", "60", "--serve-web", &port.to_string(), "--save"])
+        .arg(dir.join("x.rrd"))
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("runs");
+    let started = Instant::now();
+    let page = loop {
+        if let Ok(mut s) = std::net::TcpStream::connect(("127.0.0.1", port)) {
+            use std::io::Write as _;
+            s.write_all(b"GET / HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n").expect("request");
+            let mut body = String::new();
+            s.read_to_string(&mut body).ok();
+            break body;
+        }
+        assert!(started.elapsed() < Duration::from_secs(20), "nothing served on {port}");
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    wait_for_file(&dir.join("x.rrd"));
+    signal(&child, "-INT");
+    let (code, err, _) = finish(child);
+    assert!(page.starts_with("HTTP/1.") && page.contains(" 200 "), "{}", &page[..page.len().min(200)]);
+    assert!(page.contains("re_viewer"), "the viewer's page");
+    assert!(err.contains(&format!("http://127.0.0.1:{port}/?url=")), "{err}");
+    assert_eq!(code, Some(0), "{err}");
+    verify_recording(&dir.join("x.rrd")).expect("complete");
+}

@@ -293,6 +293,17 @@ pub fn record_run(mut recorder: Recorder, params: &Params, stop: &AtomicBool, pr
     };
     recorder.event(t_end, &end_text, if interrupted { "WARN" } else { "INFO" })?;
     recorder.event(t_end, &format!("summary:\n{}", summary.table()), "INFO")?;
+    if !recorder.is_live() {
+        // The plots framed on what the run reached (the layout is sent again).
+        let peak = |s: &[RunningStat; 3]| [s[0].peak(), s[1].peak(), s[2].peak()];
+        let ranges = crate::record::PlotRanges {
+            table_peak_rad: peak(&stats.stats[0]),
+            // Every algorithm's line must fit (a comparison's largest is the point of the plot).
+            ins_peak_rad: (!ins_stats.stats.is_empty()).then(|| ins_stats.stats.iter().map(peak).fold([0.0_f64; 3], |m, p| [m[0].max(p[0]), m[1].max(p[1]), m[2].max(p[2])])),
+            closed_form_peak_rad: peak(&stats.closed_form_deviation),
+        };
+        recorder.frame_plots(params, ranges)?;
+    }
     recorder.finish()?;
     Ok(summary)
 }

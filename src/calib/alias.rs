@@ -70,7 +70,7 @@ pub fn aliases(chain: &Chain, known: &TableErrors, data: &Data, cal: &Calibratio
                     // The encoder reads 1″ more than the shaft turned: the demodulation turns it back.
                     let mut shafts = ShaftRotations(s.shafts.0);
                     let axis = chain.axes()[*k].axis;
-                    shafts.0[*k] = shafts.0[*k] * UnitQuaternion::from_scaled_axis(axis * one);
+                    shafts.0[*k] *= UnitQuaternion::from_scaled_axis(axis * one);
                     let m = super::Measurement { t_s: s.t_s, n_from_s: s.n_from_s, shafts };
                     exact_residual(chain, &base, &m, &ref_inv)
                 }

@@ -100,10 +100,12 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
         connect: args.sinks.connect.clone(),
         serve: args.sinks.serve,
         bind: args.sinks.bind,
+        serve_web: args.sinks.serve_web,
+        stop_on_failure: Some(stop_flag()),
         ..Default::default()
     };
     let recording_id = format!("{}-seed{}-live", params.meta.name, params.meta.seed);
-    let viewer_sinks = if viewer_request.spawn || viewer_request.connect.is_some() || viewer_request.serve.is_some() {
+    let viewer_sinks = if viewer_request.spawn || viewer_request.connect.is_some() || viewer_request.serve.is_some() || viewer_request.serve_web.is_some() {
         let implicit = !viewer_given;
         Some(sink::open(&viewer_request, APPLICATION_ID, &recording_id).map_err(|e| {
             let mut f = Failure::from(e);

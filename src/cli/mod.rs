@@ -115,9 +115,13 @@ struct SinkArgs {
     /// Serve the stream over gRPC on this port (default 9876) for native or web viewers.
     #[arg(long, num_args = 0..=1, default_missing_value = "9876")]
     serve: Option<u16>,
-    /// --serve: the address to listen on (default 127.0.0.1, this machine only; 0.0.0.0 shares the
-    /// session with the whole network, without authentication).
-    #[arg(long, value_name = "ADDR", requires = "serve")]
+    /// Serve the viewer itself for a browser on this HTTP port (default 9090), with the stream: open
+    /// the printed URL, nothing to install. After a run the page stays until Ctrl-C.
+    #[arg(long, num_args = 0..=1, default_missing_value = "9090", value_name = "PORT")]
+    serve_web: Option<u16>,
+    /// --serve / --serve-web: the address to listen on (default 127.0.0.1, this machine only;
+    /// 0.0.0.0 shares the session with the whole network, without authentication).
+    #[arg(long, value_name = "ADDR")]
     bind: Option<std::net::IpAddr>,
     /// Also write every recorded time series as tables into this folder (one file per plot, a
     /// t_s column, units in the column names; docs/export.md).
@@ -131,7 +135,7 @@ struct SinkArgs {
 impl SinkArgs {
     /// True if a viewer (spawned, connected or served) was asked for.
     fn viewer_asked(&self) -> bool {
-        self.spawn || self.connect.is_some() || self.serve.is_some()
+        self.spawn || self.connect.is_some() || self.serve.is_some() || self.serve_web.is_some()
     }
 
     /// The request, with `default_save` when no viewer was asked for.
@@ -141,7 +145,19 @@ impl SinkArgs {
             None => None,
             Some(dir) => Some((dir.clone(), ExportFormat::parse(&self.export_format).map_err(|e| Failure::input(format!("--export-format {e}")))?)),
         };
-        Ok(SinkRequest { save, spawn: self.spawn, connect: self.connect.clone(), serve: self.serve, bind: self.bind, export, stop_on_failure: Some(crate::app::terminate::stop_flag()) })
+        if self.bind.is_some() && self.serve.is_none() && self.serve_web.is_none() {
+            return Err(Failure::input("--bind ADDR goes with --serve or --serve-web"));
+        }
+        Ok(SinkRequest {
+            save,
+            spawn: self.spawn,
+            connect: self.connect.clone(),
+            serve: self.serve,
+            bind: self.bind,
+            serve_web: self.serve_web,
+            export,
+            stop_on_failure: Some(crate::app::terminate::stop_flag()),
+        })
     }
 }
 

@@ -93,6 +93,11 @@ const UNITS: &[Unit] = &[
         to_si: ARCSEC,
     },
     Unit {
+        suffix: "arcmin",
+        quantity: Quantity::Angle,
+        to_si: ARCSEC * 60.0,
+    },
+    Unit {
         suffix: "rad_per_s",
         quantity: Quantity::AngularRate,
         to_si: 1.0,

@@ -77,3 +77,90 @@ mod tests {
         assert!((RAD_PER_ARCMIN * 60.0 - RAD_PER_DEG).abs() < 1e-18);
     }
 }
+
+/// The unit an angle plot reads in: chosen per scenario so its numbers read naturally.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AngleUnit {
+    /// Arcseconds.
+    #[default]
+    Arcsec,
+    /// Arcminutes.
+    Arcmin,
+    /// Degrees.
+    Deg,
+}
+
+impl AngleUnit {
+    /// Every choice, smallest first.
+    pub const ALL: [Self; 3] = [Self::Arcsec, Self::Arcmin, Self::Deg];
+
+    /// Its name as entity paths and columns spell it (`arcsec`, `arcmin`, `deg`).
+    #[must_use]
+    pub fn suffix(self) -> &'static str {
+        match self {
+            Self::Arcsec => "arcsec",
+            Self::Arcmin => "arcmin",
+            Self::Deg => "deg",
+        }
+    }
+
+    /// Units of this per radian.
+    #[must_use]
+    pub fn per_rad(self) -> f64 {
+        match self {
+            Self::Arcsec => ARCSEC_PER_RAD,
+            Self::Arcmin => ARCSEC_PER_RAD / 60.0,
+            Self::Deg => DEG_PER_RAD,
+        }
+    }
+
+    /// Parses a suffix.
+    #[must_use]
+    pub fn parse(s: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|u| u.suffix() == s)
+    }
+
+    /// The unit a signal of `peak_rad` reads naturally in: the largest in which its peak is at
+    /// least one (1.07° in degrees, 10′ in arcminutes, 45″ in arcseconds); arcsec for (almost)
+    /// nothing. The plot's range then follows [`nice_half_range`].
+    #[must_use]
+    pub fn for_peak(peak_rad: f64) -> Self {
+        if !(peak_rad.is_finite() && peak_rad > 0.0) {
+            return Self::Arcsec;
+        }
+        [Self::Deg, Self::Arcmin].into_iter().find(|u| peak_rad * u.per_rad() >= 1.0).unwrap_or(Self::Arcsec)
+    }
+}
+
+/// The half-range of a symmetric plot for a signal of `peak` (in the plot's unit): the smallest of
+/// 1, 2, 3 × 10^k at or above 1.05 × peak. The span is then 2, 4 or 6 × 10^k, which a plot's
+/// power-of-ten grid labels with 2-6 ticks at any height (a span of 1.2 × 10^k would show one).
+#[must_use]
+pub fn nice_half_range(peak: f64) -> f64 {
+    let p = (peak.abs() * 1.05).max(1e-12);
+    let k = p.log10().floor();
+    let base = 10f64.powf(k);
+    [1.0, 2.0, 3.0, 10.0].into_iter().map(|m| m * base).find(|h| *h >= p).unwrap_or(10.0 * base)
+}
+
+#[cfg(test)]
+mod angle_unit_tests {
+    use super::*;
+
+    #[test]
+    fn plot_ranges_have_labelled_ticks_and_units_read_naturally() {
+        // Spans of 2, 4 or 6 × 10^k, at or above 1.05 × the peak.
+        assert_eq!(nice_half_range(603.8), 1000.0);
+        assert_eq!(nice_half_range(300.06), 1000.0);
+        assert_eq!(nice_half_range(280.0), 300.0);
+        assert_eq!(nice_half_range(0.1075), 0.2);
+        assert_eq!(nice_half_range(1.0695), 2.0);
+        // Seed 004's "about 1 degree" reads in degrees; seed 000's 10′ errors in arcminutes, as the
+        // paper gives them; encoder-noise arcseconds stay arcseconds.
+        assert_eq!(AngleUnit::for_peak(1.0695 * RAD_PER_DEG), AngleUnit::Deg);
+        assert_eq!(AngleUnit::for_peak(603.8 * RAD_PER_ARCSEC), AngleUnit::Arcmin);
+        assert_eq!(AngleUnit::for_peak(0.1075 * RAD_PER_DEG), AngleUnit::Arcmin);
+        assert_eq!(AngleUnit::for_peak(45.0 * RAD_PER_ARCSEC), AngleUnit::Arcsec);
+        assert_eq!(AngleUnit::for_peak(0.0), AngleUnit::Arcsec);
+    }
+}

@@ -12,7 +12,21 @@ use crate::sim::ERROR_AXES;
 impl Recorder {
     pub(crate) fn send_blueprint(&self, p: &Params, custom: Option<CustomLayout>) -> RecordingStreamResult<()> {
         let plot = |name: String, origin: &str| Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::whole_run_time_axis());
-        let error_view = |axis: &str| plot(format!("{axis} error (arcsec)"), &format!("attitude_error_arcsec/{axis}"));
+        let unit = self.error_unit;
+        // Symmetric ranges once the run's peaks are known, with labelled ticks.
+        let framed = |node: Node, peak: Option<f64>| match peak {
+            Some(p) if p > 0.0 => {
+                let h = crate::math::units::nice_half_range(p);
+                node.with_property("ScalarAxis", &layout::scalar_range(-h, h))
+            }
+            _ => node,
+        };
+        let table_peak = |a: usize| self.ranges.map(|r| r.table_peak_rad[a] * unit.per_rad());
+        // The legend would sit over the data: the title says which line is which.
+        let key = if self.replay { "red: nominal table, green: compensated" } else { "red: uncompensated, blue: closed form, green: compensated" };
+        let error_view = |a: usize, axis: &str| {
+            framed(plot(format!("{axis} error ({}) — {key}", unit.suffix()), &super::error_path(unit, axis)), table_peak(a)).with_property("PlotLegend", &layout::no_legend())
+        };
         let scene = Node::view("3D", format!("3D: gimbal chain (errors ×{})", p.recording.exaggeration), "world")
             .with_property(
                 "EyeControls3D",
@@ -30,20 +44,26 @@ impl Recorder {
         ]);
         let docs = Node::container(ContainerKind::Tabs, doc_tabs, &[]);
         let left = Node::container(ContainerKind::Vertical, vec![scene, docs], &[3.0, 1.3]);
-        let mut more = vec![
+        let mut more = Vec::new();
+        if self.closed_form_series.is_some() {
+            let peak = self.ranges.map(|r| r.closed_form_peak_rad.iter().fold(0.0_f64, |m, x| m.max(*x)) * crate::math::units::ARCSEC_PER_RAD);
+            more.push(framed(plot("closed form − exact (arcsec)".into(), super::CLOSED_FORM_PATH), peak));
+        }
+        more.extend([
             plot("gimbal angles (deg)".into(), "gimbal_angle_deg"),
             plot("vehicle attitude (deg)".into(), "vehicle_attitude_deg"),
             plot("swing angles (arcsec)".into(), "swing_arcsec"),
-        ];
+        ]);
         let right = match (&self.ins, custom_right) {
             (_, Some(right)) => right,
             (None, None) => {
                 let more = Node::container(ContainerKind::Tabs, more, &[]);
-                Node::container(ContainerKind::Vertical, vec![error_view("pitch"), error_view("roll"), error_view("heading"), more], &[])
+                Node::container(ContainerKind::Vertical, vec![error_view(0, "pitch"), error_view(1, "roll"), error_view(2, "heading"), more], &[])
             }
             (Some(layout), None) => {
                 // The INS in the loop leads; the turntable-only (ideal-INS) plots go into the tabs.
-                let ins_view = |axis: &str| plot(format!("INS {axis} error (arcsec)"), &format!("ins/attitude_error_arcsec/{axis}"));
+                let ins_peak = |a: usize| self.ranges.and_then(|r| r.ins_peak_rad).map(|p| p[a] * crate::math::units::ARCSEC_PER_RAD);
+                let ins_view = |a: usize, axis: &str| framed(plot(format!("INS {axis} error (arcsec)"), &format!("ins/attitude_error_arcsec/{axis}")), ins_peak(a));
                 let mut tabs = Vec::new();
                 if layout.nav {
                     tabs.push(plot("position error (m)".into(), "ins/position_error_m"));
@@ -55,11 +75,11 @@ impl Recorder {
                 if layout.fir_taps.len() > 1 {
                     tabs.push(Node::view("2D", "FIR response (x: Hz, y: −5·dB)", "ins/fir_response"));
                 }
-                for axis in ERROR_AXES {
-                    tabs.push(plot(format!("table only: {axis} (arcsec)"), &format!("attitude_error_arcsec/{axis}")));
+                for (a, axis) in ERROR_AXES.iter().enumerate() {
+                    tabs.push(framed(plot(format!("table only: {axis} ({})", unit.suffix()), &super::error_path(unit, axis)), table_peak(a)));
                 }
                 tabs.append(&mut more);
-                Node::container(ContainerKind::Vertical, vec![ins_view("pitch"), ins_view("roll"), ins_view("heading"), Node::container(ContainerKind::Tabs, tabs, &[])], &[])
+                Node::container(ContainerKind::Vertical, vec![ins_view(0, "pitch"), ins_view(1, "roll"), ins_view(2, "heading"), Node::container(ContainerKind::Tabs, tabs, &[])], &[])
             }
         };
         let root = Node::container(ContainerKind::Horizontal, vec![left, right], &[1.1, 1.0]);

@@ -63,7 +63,8 @@ impl Recorder {
     pub(crate) fn log_ins_once(&self) -> RecordingStreamResult<()> {
         let Some(layout) = &self.ins else { return Ok(()) };
         let rec = &self.rec;
-        let algo_colors: Vec<rerun::Color> = (0..layout.algorithms.len()).map(|k| rgb(colors::ALGORITHMS[k % colors::ALGORITHMS.len()])).collect();
+        // Each algorithm keeps its colour in every recording (by identity, not by position).
+        let algo_colors: Vec<rerun::Color> = layout.algorithms.iter().map(|name| rgb(colors::algorithm(name))).collect();
         for axis in ERROR_AXES {
             let path = format!("ins/attitude_error_arcsec/{axis}");
             rec.log_static(path.as_str(), &rerun::SeriesLines::new().with_colors(algo_colors.clone()).with_names(self.series_names(&path)))?;

@@ -10,6 +10,7 @@ use rerun::external::re_sdk_types::blueprint::components as bpc;
 use rerun::external::re_sdk_types::datatypes;
 
 /// A view or a container of the layout.
+#[derive(Clone)]
 pub enum Node {
     /// A container of children.
     Container {

@@ -138,9 +138,39 @@ pub struct Recorder {
     replay: bool,
     /// With an IMU in the loop.
     ins: Option<InsLayout>,
+    /// Unit of the attitude-error plots.
+    error_unit: crate::math::units::AngleUnit,
+    /// Index of the closed form − exact series (not in a replay).
+    closed_form_series: Option<usize>,
+    /// Symmetric half-ranges of the error plots once known (table per axis, in `error_unit`; INS
+    /// per axis, arcsec).
+    ranges: Option<PlotRanges>,
+    /// The command's own panels, kept for when the layout is sent again.
+    custom: Option<CustomLayout>,
+}
+
+/// The error plots' symmetric ranges, from a run's peaks (see [`crate::math::units::nice_half_range`]).
+#[derive(Debug, Clone, Copy)]
+pub struct PlotRanges {
+    /// Largest uncompensated error per axis (pitch, roll, heading), rad.
+    pub table_peak_rad: [f64; 3],
+    /// Largest INS error per axis over every algorithm, rad.
+    pub ins_peak_rad: Option<[f64; 3]>,
+    /// Largest closed form − exact per axis, rad.
+    pub closed_form_peak_rad: [f64; 3],
+}
+
+/// The closed form − exact plot's entity.
+pub const CLOSED_FORM_PATH: &str = "closed_form_minus_exact_arcsec";
+
+/// The attitude-error entity of `axis` in `unit` (`attitude_error_deg/pitch`).
+#[must_use]
+pub fn error_path(unit: crate::math::units::AngleUnit, axis: &str) -> String {
+    format!("attitude_error_{}/{axis}", unit.suffix())
 }
 
 /// What a command adds to the standard layout.
+#[derive(Clone)]
 pub(crate) struct CustomLayout {
     /// The right column (replaces the error plots).
     pub right: Node,
@@ -175,13 +205,19 @@ impl Recorder {
         } else {
             DEMODULATIONS.iter().map(|v| v.replace('_', " ")).collect()
         };
-        let mut series: Vec<Series> = ERROR_AXES.iter().map(|axis| Series::new(format!("attitude_error_arcsec/{axis}"), demodulations.clone())).collect();
+        let unit = params.recording.error_unit;
+        let mut series: Vec<Series> = ERROR_AXES.iter().map(|axis| Series::new(error_path(unit, axis), demodulations.clone())).collect();
         series.push(Series::new("gimbal_angle_deg".into(), axis_names.clone()));
         series.push(Series::new("vehicle_attitude_deg".into(), ERROR_AXES.map(String::from).to_vec()));
         for (name, g) in axis_names.iter().zip(chain.axes()) {
             let about = |v: &nalgebra::Vector3<f64>| format!("{name} swing about {}", scene::axis_letter(v));
             series.push(Series::new(format!("swing_arcsec/{name}"), vec![about(&g.e1), about(&g.e2)]));
         }
+        // The closed form's residual against the exact chain, where the two lines lie on each other.
+        let closed_form_series = (!replay).then(|| {
+            series.push(Series::new(CLOSED_FORM_PATH.into(), ERROR_AXES.map(String::from).to_vec()));
+            series.len() - 1
+        });
         let ins = params.ins.as_ref().map(|cfg| {
             let algorithms: Vec<String> = cfg.algorithms().iter().map(|a| a.name().to_owned()).collect();
             let first_series = series.len();
@@ -226,6 +262,10 @@ impl Recorder {
             live,
             replay,
             ins,
+            error_unit: unit,
+            closed_form_series,
+            ranges: None,
+            custom: custom.clone(),
         };
         me.log_once(params)?;
         me.log_ins_once()?;
@@ -252,7 +292,26 @@ impl Recorder {
 
     /// Sends the layout again for `params` (a replay knows its length only at the end).
     pub fn resend_layout(&self, params: &Params) -> RecordingStreamResult<()> {
-        self.send_blueprint(params, None)
+        self.send_blueprint(params, self.custom.clone())
+    }
+
+    /// Frames the error plots on the run's peaks (symmetric, labelled ticks) and sends the layout
+    /// again: noise of 1e-5″ on a compensated line does not fill a plot and look like a drift.
+    pub fn frame_plots(&mut self, params: &Params, ranges: PlotRanges) -> RecordingStreamResult<()> {
+        self.ranges = Some(ranges);
+        self.send_blueprint(params, self.custom.clone())
+    }
+
+    /// The error plots' unit.
+    #[must_use]
+    pub fn error_unit(&self) -> crate::math::units::AngleUnit {
+        self.error_unit
+    }
+
+    /// True for a live session's recorder.
+    #[must_use]
+    pub fn is_live(&self) -> bool {
+        self.live
     }
 
     /// Live mode: new parameters apply from simulated time `t_s` on (buffered rows go out first).
@@ -288,10 +347,15 @@ impl Recorder {
 
     /// Buffers one row: the turntable-only variants and, with an IMU in the loop, the INS's view.
     pub fn push_row(&mut self, out: &StepOutput, ins: Option<&InsView>) -> RecordingStreamResult<()> {
+        let per_rad = self.error_unit.per_rad();
         for a in 0..3 {
             for e in &out.errors {
-                self.series[a].values.push(e.as_array()[a] * ARCSEC_PER_RAD);
+                self.series[a].values.push(e.as_array()[a] * per_rad);
             }
+        }
+        if let Some(i) = self.closed_form_series {
+            let (exact, closed) = (out.errors[0].as_array(), out.errors[2].as_array());
+            self.series[i].values.extend((0..3).map(|a| (closed[a] - exact[a]) * ARCSEC_PER_RAD));
         }
         let n = self.axis_names.len();
         self.series[3].values.extend(out.gimbal_rad[..n].iter().map(|x| x * DEG_PER_RAD));

@@ -10,7 +10,13 @@ pub(crate) mod colors {
     pub const EULER: [[u8; 3]; 3] = [[230, 90, 90], [90, 200, 90], [90, 140, 240]];
     pub const NOMINAL: [u8; 3] = [150, 150, 150];
     pub const SENSOR: [[u8; 3]; 3] = [[235, 50, 50], [50, 200, 50], [60, 110, 255]];
+    /// In the order of `Algorithm::ALL` (single-sample, two-sample, two-sample-p1, -p2, three-sample).
     pub const ALGORITHMS: [[u8; 3]; 5] = [[250, 200, 60], [230, 76, 60], [46, 170, 90], [70, 130, 240], [200, 90, 230]];
+
+    /// The colour of the coning algorithm named `name`, the same in every recording.
+    pub fn algorithm(name: &str) -> [u8; 3] {
+        crate::ins::coning::Algorithm::ALL.iter().position(|a| a.name() == name).map_or([200, 200, 200], |k| ALGORITHMS[k])
+    }
 }
 
 /// A point or vector as Rerun's f32 triple.

@@ -57,10 +57,19 @@ impl Recorder {
 
         // Series styles, once.
         for axis in ERROR_AXES {
-            let path = format!("attitude_error_arcsec/{axis}");
+            let path = super::error_path(self.error_unit, axis);
+            // Uncompensated wide and translucent under the closed form's thin bright line, so both
+            // read where they coincide; their difference has its own plot.
+            let [u, c, f] = colors::VARIANT;
             rec.log_static(
                 path.as_str(),
-                &rerun::SeriesLines::new().with_colors(colors::VARIANT.map(rgb)).with_names(self.series_names(&path)).with_widths([3.0, 1.5, 1.0]),
+                &rerun::SeriesLines::new().with_colors([rgba(u, 140), rgb(c), rgb(f)]).with_names(self.series_names(&path)).with_widths([5.0, 2.0, 1.5]),
+            )?;
+        }
+        if self.closed_form_series.is_some() {
+            rec.log_static(
+                super::CLOSED_FORM_PATH,
+                &rerun::SeriesLines::new().with_colors(colors::EULER.map(rgb)).with_names(self.series_names(super::CLOSED_FORM_PATH)),
             )?;
         }
         rec.log_static(

@@ -430,7 +430,7 @@ fn table_description(c: &Checker<'_>, raw: &RawTable, rate_hz: f64) -> Result<Ta
     let calibration = instruments::validate_calibration(c, &raw.calibration.clone().unwrap_or_default(), &stated)?;
     // A log's motion is not known before it is read: the defaults of a table turning at 10°/s
     // (10 Hz series and scene) unless [recording] says otherwise.
-    let recording = validate::recording(c, &raw.recording, rate_hz, validate::Bandwidth { shaft_deg_per_s: 10.0, motion_hz: 0.0, duration_s: 3600.0 })?;
+    let recording = validate::recording(c, &raw.recording, rate_hz, validate::Bandwidth { shaft_deg_per_s: 10.0, motion_hz: 0.0, duration_s: 3600.0 }, 0.0)?;
     let mut resolved = raw.clone();
     resolved.compensation = resolved_comp;
     let resolved_toml = toml::to_string_pretty(&resolved).unwrap_or_else(|e| format!("# could not serialise: {e}"));

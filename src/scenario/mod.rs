@@ -103,6 +103,8 @@ pub struct RecordingParams {
     pub scene_hz: f64,
     /// Drawing factor for error angles.
     pub exaggeration: f64,
+    /// Unit of the attitude-error plots.
+    pub error_unit: crate::math::units::AngleUnit,
     /// What the rates not given in the file were chosen from (series, scene: `true` if chosen).
     pub chosen: (bool, bool),
     /// The motion's bandwidth the chosen rates follow.

@@ -345,13 +345,17 @@ pub struct RawRecording {
     /// 3D scene output rate, Hz of simulated time (absent: chosen from the motion and the length).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub scene_hz: Option<f64>,
+    /// Unit of the attitude-error plots: "arcsec", "arcmin" or "deg" (absent: chosen from the
+    /// table errors' size so the plot's numbers read naturally).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error_unit: Option<String>,
     /// Factor applied to every error angle when drawing the 3D scene.
     pub exaggeration: f64,
 }
 
 impl Default for RawRecording {
     fn default() -> Self {
-        Self { series_hz: None, scene_hz: None, exaggeration: 60.0 }
+        Self { series_hz: None, scene_hz: None, error_unit: None, exaggeration: 60.0 }
     }
 }
 

@@ -159,10 +159,18 @@ pub(super) fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigErr
 
     let motion_hz = raw.vehicle.wobble.iter().map(|w| w.frequency_hz).fold(raw.vehicle.coning_frequency_hz * f64::from(u8::from(raw.vehicle.coning_half_angle_deg > 0.0)), f64::max);
     let bandwidth = Bandwidth { shaft_deg_per_s: scheme.max_rate().to_degrees(), motion_hz, duration_s };
-    let recording = recording(&c, &raw.recording, step_hz, bandwidth)?;
-
     // [compensation]
     let (compensation, resolved_comp) = validate_compensation(&c, &raw.compensation, &raw.turntable, &chain, &truth)?;
+
+    // The plots' unit follows the size of the table's errors: a preview of the uncompensated error
+    // on at most 2000 instants (a millisecond; the model is pure).
+    let preview = {
+        let table = TableParams { chain: chain.clone(), vehicle: vehicle.clone(), scheme: scheme.clone(), truth: truth.clone(), compensation: compensation.clone() };
+        let model = crate::sim::Model::new(&table, raw.scenario.seed);
+        let hz = (2000.0 / duration_s).min(step_hz);
+        crate::sim::run_stats(&model, &crate::math::timeline::Timeline::new(duration_s, hz)).peak_over_axes(0)
+    };
+    let recording = recording(&c, &raw.recording, step_hz, bandwidth, preview)?;
 
     let meta = ScenarioMeta {
         name: raw.scenario.name.clone(),
@@ -428,8 +436,12 @@ impl Bandwidth {
 
 /// `[recording]`: output rates (at most the simulation rate `step_hz`; absent, from `bandwidth`)
 /// and the drawing factor.
-pub(super) fn recording(c: &Checker<'_>, raw: &RawRecording, step_hz: f64, bandwidth: Bandwidth) -> Result<RecordingParams, ConfigError> {
+pub(super) fn recording(c: &Checker<'_>, raw: &RawRecording, step_hz: f64, bandwidth: Bandwidth, error_peak_rad: f64) -> Result<RecordingParams, ConfigError> {
     let hint = "at most the step rate; at least one point every 1000 s";
+    let error_unit = match &raw.error_unit {
+        None => crate::math::units::AngleUnit::for_peak(error_peak_rad),
+        Some(s) => crate::math::units::AngleUnit::parse(s).ok_or_else(|| c.invalid("recording.error_unit", format!("\"{s}\" is not a unit; use \"arcsec\", \"arcmin\" or \"deg\"")))?,
+    };
     Ok(RecordingParams {
         series_hz: match raw.series_hz {
             Some(v) => c.range("recording.series_hz", v, "Hz", 1e-3, step_hz, hint)?,
@@ -440,6 +452,7 @@ pub(super) fn recording(c: &Checker<'_>, raw: &RawRecording, step_hz: f64, bandw
             None => bandwidth.scene_hz().min(step_hz),
         },
         exaggeration: c.range("recording.exaggeration", raw.exaggeration, "x", 1.0, 100_000.0, "")?,
+        error_unit,
         chosen: (raw.series_hz.is_none(), raw.scene_hz.is_none()),
         bandwidth,
     })

@@ -87,8 +87,10 @@ pub struct SinkRequest {
     pub connect: Option<String>,
     /// Serve the stream on this gRPC port for viewers (native or web) to connect to.
     pub serve: Option<u16>,
-    /// The address `serve` listens on (default 127.0.0.1: this machine only).
+    /// The address `serve` and `serve_web` listen on (default 127.0.0.1: this machine only).
     pub bind: Option<IpAddr>,
+    /// Serve the viewer itself (Wasm, for a browser) on this HTTP port, with the stream.
+    pub serve_web: Option<u16>,
     /// Set when the saved file cannot be written, so the run stops at its next check.
     pub stop_on_failure: Option<Arc<AtomicBool>>,
     /// Also write every time series as tables into this folder.
@@ -107,6 +109,17 @@ pub struct OpenSinks {
     viewer_problems: viewer::Problems,
     /// Human-readable description of where the data goes.
     pub description: Vec<String>,
+    /// The web viewer's server (`--serve-web`), kept alive with the sinks.
+    web: Option<WebServer>,
+    /// The process's stop flag (ends the web viewer's wait after the run).
+    stop: Option<Arc<AtomicBool>>,
+}
+
+/// The web viewer's HTTP server and the page that shows the stream.
+struct WebServer {
+    /// Rerun's `WebViewerServer`: serves while it lives.
+    _server: Box<dyn std::any::Any + Send>,
+    page: String,
 }
 
 /// Looks for an executable named `name` on PATH.
@@ -170,6 +183,28 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
         ));
     }
 
+    let mut web = None;
+    if let Some(web_port) = req.serve_web {
+        let ip = req.bind.unwrap_or(IpAddr::V4(Ipv4Addr::LOCALHOST));
+        let web_addr = SocketAddr::new(ip, web_port);
+        std::net::TcpListener::bind(web_addr).map_err(|e| SinkError::Serve { addr: web_addr, reason: e.to_string() })?;
+        // The stream on a free port beside it; the page connects to it.
+        let grpc_port = std::net::TcpListener::bind((ip, 0)).and_then(|l| l.local_addr()).map_err(|e| SinkError::Serve { addr: web_addr, reason: e.to_string() })?.port();
+        let options = rerun::ServerOptions { memory_limit: rerun::MemoryLimit::from_bytes(1 << 30), ..Default::default() };
+        let sink = rerun::grpc_server::GrpcServerSink::new(&ip.to_string(), grpc_port, options).map_err(|e| SinkError::Serve { addr: SocketAddr::new(ip, grpc_port), reason: e.to_string() })?;
+        sinks.push(Box::new(sink));
+        let host = if ip.is_unspecified() { "127.0.0.1".to_owned() } else { ip.to_string() };
+        let grpc_url = format!("rerun+http://{host}:{grpc_port}/proxy");
+        let config = rerun::web_viewer::WebViewerConfig { bind_ip: ip.to_string(), web_port: web_port.into(), connect_to: vec![grpc_url], open_browser: false, ..Default::default() };
+        let server = config.host_web_viewer().map_err(|e| SinkError::Serve { addr: web_addr, reason: e.to_string() })?;
+        let page = format!("http://{host}:{web_port}/?url={}", format!("rerun+http://{host}:{grpc_port}/proxy").replace(':', "%3A").replace('/', "%2F").replace('+', "%2B"));
+        if !ip.is_loopback() {
+            eprintln!("rinscope: WARNING: --bind {ip}: anyone who can reach ports {web_port} and {grpc_port} of this machine can watch this session (there is no authentication)");
+        }
+        description.push(format!("viewer in the browser: open {page}"));
+        web = Some(WebServer { _server: Box::new(server), page });
+    }
+
     let mut file = None;
     if let Some(path) = &req.save {
         // recordings/ (the default) and any folder named in --save are created.
@@ -194,7 +229,7 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
         .recording_id(recording_id.to_owned())
         .set_sinks(sinks)
         .map_err(|e| SinkError::Rerun(e.to_string()))?;
-    Ok(OpenSinks { rec, export, file, viewer_problems: problems, description })
+    Ok(OpenSinks { rec, export, file, viewer_problems: problems, description, web, stop: req.stop_on_failure.clone() })
 }
 
 /// Checks that the `.rrd` at `path` is complete: its header, its stream footer and the footer's
@@ -238,7 +273,7 @@ impl OpenSinks {
     /// The file could not be completed ([`SinkError::Write`]; nothing replaced) or an export
     /// table failed.
     pub fn finish(self) -> Result<Saved, SinkError> {
-        let Self { rec, file, export, viewer_problems, .. } = self;
+        let Self { rec, file, export, viewer_problems, web, stop, .. } = self;
         // Viewers that stall are detached by their own timeouts; the file's writer is waited for
         // by `RrdFile::finish`, so a flush timeout here loses nothing.
         rec.flush_with_timeout(Duration::from_secs(10)).ok();
@@ -246,12 +281,21 @@ impl OpenSinks {
             None => None,
             Some(f) => Some(f.finish().map_err(SinkError::Write)?),
         };
-        drop(rec);
         let exported = match export {
             None => Vec::new(),
             Some(e) => e.lock().unwrap_or_else(std::sync::PoisonError::into_inner).finish().map_err(|e| SinkError::Export(e.to_string()))?,
         };
         let viewer_problems = viewer_problems.lock().unwrap_or_else(std::sync::PoisonError::into_inner).clone();
+        // A browser may still be reading: the page and the stream (held by `rec`) serve until the
+        // stop flag (Ctrl-C) is set.
+        if let (Some(w), Some(stop)) = (web, stop) {
+            eprintln!("rinscope: the run is complete; its viewer stays at {} until Ctrl-C", w.page);
+            while !stop.load(std::sync::atomic::Ordering::SeqCst) {
+                std::thread::sleep(Duration::from_millis(100));
+            }
+            drop(w);
+        }
+        drop(rec);
         Ok(Saved { recording, exported, viewer_problems })
     }
 
