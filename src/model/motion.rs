@@ -6,6 +6,7 @@ use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 use crate::math::attitude::Attitude;
 use crate::math::frames::{axis_angle, Rot, B, N};
+use crate::model::turning::Link;
 
 /// Which Euler angle a ramp or a wobble drives.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -225,6 +226,26 @@ impl VehicleMotion {
             None => w_e,
             Some(c) => c.rotation(t_s).inverse() * w_e + c.rate(t_s),
         }
+    }
+
+    /// C_b^n as links turning at constant rates from `t_s` to the next breakpoint (angles taken at
+    /// `t_s`, τ counted from it, rates at `rates_at_s`, an instant inside the piece: at a breakpoint
+    /// itself rounding may pick either side): `Rz(−ψ) · Rx(θ) · Ry(γ)` of the Euler angles, then the cone
+    /// `K = Rz(Ωt) · Rx(α) · Rz(−Ωt)` (the rotation by α about (cos Ωt, sin Ωt, 0), the quaternion
+    /// of [`Coning`]). None with a wobble (its angles are not linear in time).
+    #[must_use]
+    pub fn links_at(&self, t_s: f64, rates_at_s: f64) -> Option<Vec<Link>> {
+        if !self.wobble.is_empty() {
+            return None;
+        }
+        let a = self.euler(t_s);
+        let [dp, dr, dh] = self.euler_rates(rates_at_s);
+        let turning = |axis: Vector3<f64>, angle_rad: f64, rate_rad_per_s: f64| Link::Turning { axis, angle_rad, rate_rad_per_s };
+        let mut links = vec![turning(Vector3::z(), -a.heading_rad, -dh), turning(Vector3::x(), a.pitch_rad, dp), turning(Vector3::y(), a.roll_rad, dr)];
+        if let Some(c) = self.coning {
+            links.push(Link::Cone { half_angle_rad: c.half_angle_rad, phase_rad: c.omega_rad_per_s * t_s, rate_rad_per_s: c.omega_rad_per_s });
+        }
+        Some(links)
     }
 
     /// (pitch, roll, heading) rates, rad/s.
