@@ -225,13 +225,15 @@ impl ClosedForm {
     pub fn increments(&mut self, t0_s: f64, t1_s: f64) -> (Vector3<f64>, Vector3<f64>) {
         let h = t1_s - t0_s;
         let tau = 0.5 * (t0_s + t1_s) - self.t_anchor_s;
-        let slack = 1e-9 * self.h_s;
+        // The caller's times carry rounding of ~ulp(t) (t = i·h): intervals and midpoints that differ
+        // from the stepped ones by that much are still regular.
+        let slack = 1e-8 * self.h_s + 16.0 * f64::EPSILON * t1_s.abs();
         let regular = self.since_anchor < REANCHOR && (h - self.h_s).abs() <= slack && (tau - self.tau_next).abs() <= slack;
         let (mut dtheta, mut dv) = (self.omega0 * h, self.f0 * h);
         if regular {
-            // The interval and the midpoint may differ from the stepped ones by rounding of the
-            // caller's times: the phasor is turned on by ν·δτ (to second order; |νδτ| < 1e-8) and the
-            // weight follows h to first order (the next term is ν·δh²/4 ~ 1e-25 s).
+            // The interval and the midpoint differ from the stepped ones by that rounding: the phasor
+            // is turned on by ν·δτ (to second order: |νδτ| < 1e-8 leaves < 2e-25) and the weight
+            // follows h to first order (the next term, (ν/4)·sin(νh/2)·δh², is below 1e-16·h).
             let (dtau, dh) = (tau - self.tau_next, h - self.h_s);
             for t in &mut self.terms {
                 let (zr, zi) = (t.z.0 * t.step.0 - t.z.1 * t.step.1, t.z.0 * t.step.1 + t.z.1 * t.step.0);

@@ -196,6 +196,16 @@ impl TruthImu {
         point
     }
 
+    /// C_s^n at `t_s` (the attitude alone: cheaper than [`Self::eval`]).
+    #[must_use]
+    pub fn n_from_s(&mut self, t_s: f64) -> Rot<N, S> {
+        let m = &self.model;
+        let n_from_b = m.fixed_state().map_or_else(|| m.vehicle.n_from_b(t_s), |(_, r)| r);
+        let (angles, _) = m.scheme.state(t_s - m.scheme_t0_s);
+        let shafts = self.shafts.rotations(&m.chain, &angles);
+        n_from_b * m.chain.b_from_s_with(m.truth_rotations(), &shafts)
+    }
+
     /// Gyro and accelerometer increments (Δθ_s, Δv_s) from the last instant to `t1_s`, exact on each
     /// smooth piece (split at the motion's breakpoints): in closed form where the piece's rotations
     /// turn at constant rates, else by Simpson's rule (error O(h⁵·ω⁽⁴⁾)).
