@@ -65,8 +65,6 @@ pub struct InsCore {
     fir_g: Fir,
     fir_a: Fir,
     h: f64,
-    /// 1/h, 1/s.
-    inv_h: f64,
     acc: (Vector3<f64>, Vector3<f64>, usize),
     /// The integrators; `[0]` is the configured algorithm (the navigation's).
     integrators: Vec<AttitudeIntegrator>,
@@ -128,7 +126,6 @@ impl InsCore {
             fir_g,
             fir_a,
             h,
-            inv_h: 1.0 / h,
             acc: (Vector3::zeros(), Vector3::zeros(), 0),
             integrators,
             history,
@@ -198,11 +195,10 @@ impl InsCore {
     }
 
     /// One measured IMU sample (Δθ, Δv in s) ending at `t1`.
-    #[inline]
     pub fn push(&mut self, t1: f64, g_meas: Vector3<f64>, a_meas: Vector3<f64>) -> SampleOut {
         let g_filt = self.fir_g.push(g_meas);
         let a_filt = self.fir_a.push(a_meas);
-        let mut out = SampleOut { t_s: t1, updated: false, raw_rate_s: g_meas * self.inv_h, filtered_rate_s: g_filt * self.inv_h };
+        let mut out = SampleOut { t_s: t1, updated: false, raw_rate_s: g_meas / self.h, filtered_rate_s: g_filt / self.h };
         self.acc.0 += g_filt;
         self.acc.1 += a_filt;
         self.acc.2 += 1;
@@ -218,16 +214,10 @@ impl InsCore {
         }
         self.upd_g.push(dg);
         self.upd_a.push(da);
-        // ω_in^n only for the integrators this sample completes (the others ignore ζ).
-        let mut w_in = None;
+        let w_in = self.nav.as_ref().map_or(self.earth.omega_ie_n, Navigator::omega_in_n);
         let t_repr = t1 - self.fir_delay_s;
         for (k, integ) in self.integrators.iter_mut().enumerate() {
-            let zeta = if integ.completes_update() {
-                let w = *w_in.get_or_insert_with(|| self.nav.as_ref().map_or(self.earth.omega_ie_n, Navigator::omega_in_n));
-                w * (h_alg * integ.samples_per_update() as f64)
-            } else {
-                Vector3::zeros()
-            };
+            let zeta = w_in * (h_alg * integ.samples_per_update() as f64);
             if integ.push(dg, &zeta).is_some() {
                 self.history[k] = [self.history[k][1], (t_repr, integ.n_from_s)];
                 if k == 0 {

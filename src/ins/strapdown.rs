@@ -53,12 +53,6 @@ impl AttitudeIntegrator {
         self.n
     }
 
-    /// True when the next sample completes an update (only then is ζ used).
-    #[must_use]
-    pub fn completes_update(&self) -> bool {
-        self.filled + 1 == self.n
-    }
-
     /// Feeds one gyro increment Δθ_s (rad). When it completes an update, applies it with the
     /// navigation-frame rotation `zeta_n` over that update and returns the rotation vector ΔΦ.
     #[inline]
