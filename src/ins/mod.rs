@@ -1,6 +1,7 @@
 //! Layer 2, the INS in the loop: IMU increments from the exact truth, sensor errors, dither and its
 //! FIR, coning-compensated attitude algorithms, strapdown navigation, position resets.
 
+pub mod closed_form;
 pub mod coning;
 pub mod core;
 pub mod fir;

@@ -14,6 +14,7 @@ use crate::math::attitude::{Attitude, AttitudeError};
 use crate::math::frames::{Rot, B, N, S};
 use crate::math::rotvec;
 use crate::model::earth::{Earth, Site};
+use crate::model::scheme::AxisValues;
 use crate::sim::{demodulate, encoder_readings, DemodState, Model};
 
 /// The INS's view of the body at one output instant.
@@ -31,6 +32,15 @@ pub struct InsView {
     pub imu_ins: Rot<N, S>,
     /// Navigation errors, when navigating.
     pub nav: Option<NavError>,
+}
+
+/// What [`InsRun::view`] computes once per output instant for the algorithms that share it.
+struct Shared {
+    t_repr_s: f64,
+    encoder_rad: AxisValues,
+    truth: Attitude,
+    corrected_rad: AxisValues,
+    b_from_s_comp: Rot<B, S>,
 }
 
 /// The INS in the loop (cloned to fork one IMU stream into two navigation strategies).
@@ -155,18 +165,33 @@ impl InsRun {
     pub fn view(&mut self, t_s: f64) -> InsView {
         let model = self.truth.model();
         let mut errors = Vec::with_capacity(self.demod.len());
+        // Algorithms that stand for the same instant share its encoder readings (a pure function of
+        // the instant), its true attitude and, with the same corrected angles, the compensated chain.
+        let mut shared: Vec<Shared> = Vec::with_capacity(self.demod.len());
         for k in 0..self.demod.len() {
             let (t_repr, n_from_s) = self.core.output_attitude(k);
-            let t_ref = self.core.reference_instant(t_repr);
-            // The encoders are read for the instant the IMU data represent (matched synchronisation).
-            let encoder = encoder_readings(model, t_repr);
+            let known = shared.iter().position(|e| e.t_repr_s == t_repr);
+            let (encoder, truth_att) = match known {
+                Some(i) => (shared[i].encoder_rad, shared[i].truth),
+                None => {
+                    let t_ref = self.core.reference_instant(t_repr);
+                    // The encoders are read for the instant the IMU data represent (matched synchronisation).
+                    let truth_att = model.fixed_state().map_or_else(|| model.vehicle.state(t_ref).0, |(a, _)| a);
+                    (encoder_readings(model, t_repr), truth_att)
+                }
+            };
             let corrected = self.demod[k].correct(&model.compensation, t_repr, &encoder);
-            let b_from_s_comp = model.chain.b_from_s(model.compensation_rotations(), &corrected);
-            let (truth_att, _) = model.vehicle.state(t_ref);
+            let b_from_s_comp = match known {
+                Some(i) if shared[i].corrected_rad == corrected => shared[i].b_from_s_comp,
+                _ => model.chain.b_from_s(model.compensation_rotations(), &corrected),
+            };
+            if known.is_none() {
+                shared.push(Shared { t_repr_s: t_repr, encoder_rad: encoder, truth: truth_att, corrected_rad: corrected, b_from_s_comp });
+            }
             errors.push(demodulate(n_from_s, b_from_s_comp).error_from(&truth_att));
         }
         let (t_repr, imu_ins) = self.core.output_attitude(0);
-        let imu_true = self.truth.eval(t_repr).n_from_s;
+        let imu_true = self.truth.n_from_s(t_repr);
         let nav: Option<NavError> = self.core.nav_error();
         InsView { t_s, t_ref_s: t_s - self.core.config().output_compensation_s, errors, imu_true, imu_ins, nav }
     }

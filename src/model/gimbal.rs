@@ -22,6 +22,7 @@ use nalgebra::{UnitQuaternion, Vector3};
 use crate::math::frames::{axis_angle, Rot, B, S, V3};
 use crate::math::rotvec;
 use crate::model::scheme::{AxisValues, MAX_AXES};
+use crate::model::turning::Link;
 
 /// Nominal geometry of one gimbal axis.
 #[derive(Debug, Clone)]
@@ -288,6 +289,19 @@ impl Chain {
         }
         // FRAME: `suffix` is now the whole chain B·T_0·R_0·…·M = b_from_s; ω summed in s.
         (Rot::from_quaternion(suffix), V3::new(omega))
+    }
+
+    /// The exact chain `b_from_s` as links for shafts at `angles_rad` turning at the constant
+    /// `rates_rad_per_s` (the constants between the shafts folded, as in [`Self::b_from_s_with`]).
+    #[must_use]
+    pub fn links(&self, err: &ErrorRotations, angles_rad: &AxisValues, rates_rad_per_s: &AxisValues) -> Vec<Link> {
+        let n = self.axes.len();
+        let mut links = vec![Link::Fixed(err.between[0])];
+        for k in 0..n {
+            links.push(Link::Turning { axis: self.axes[k].axis, angle_rad: angles_rad[k], rate_rad_per_s: rates_rad_per_s[k] });
+            links.push(Link::Fixed(err.between[k + 1]));
+        }
+        links
     }
 
     /// The nominal (error-free) IMU-to-body rotation a real RINS uses to demodulate.

@@ -5,3 +5,4 @@ pub mod earth;
 pub mod gimbal;
 pub mod motion;
 pub mod scheme;
+pub mod turning;

@@ -6,6 +6,7 @@ use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 use crate::math::attitude::Attitude;
 use crate::math::frames::{axis_angle, Rot, B, N};
+use crate::model::turning::Link;
 
 /// Which Euler angle a ramp or a wobble drives.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -111,17 +112,21 @@ pub struct Coning {
 }
 
 impl Coning {
-    fn rotation(&self, t: f64) -> UnitQuaternion<f64> {
-        let (c, s) = ((0.5 * self.half_angle_rad).cos(), (0.5 * self.half_angle_rad).sin());
-        let (so, co) = (self.omega_rad_per_s * t).sin_cos();
-        UnitQuaternion::new_normalize(Quaternion::new(c, s * co, s * so, 0.0))
+    /// (cos α/2, sin α/2, sin α, 2 sin²(α/2)): the constants of [`Self::rotation`] and [`Self::rate`].
+    fn constants(&self) -> [f64; 4] {
+        let (s, c) = (0.5 * self.half_angle_rad).sin_cos();
+        [c, s, self.half_angle_rad.sin(), 2.0 * s * s]
     }
 
-    fn rate(&self, t: f64) -> Vector3<f64> {
+    fn rotation(&self, k: &[f64; 4], t: f64) -> UnitQuaternion<f64> {
         let (so, co) = (self.omega_rad_per_s * t).sin_cos();
-        let sa = self.half_angle_rad.sin();
+        UnitQuaternion::new_normalize(Quaternion::new(k[0], k[1] * co, k[1] * so, 0.0))
+    }
+
+    fn rate(&self, k: &[f64; 4], t: f64) -> Vector3<f64> {
+        let (so, co) = (self.omega_rad_per_s * t).sin_cos();
         let w = self.omega_rad_per_s;
-        Vector3::new(-w * sa * so, w * sa * co, -2.0 * w * (0.5 * self.half_angle_rad).sin().powi(2))
+        Vector3::new(-w * k[2] * so, w * k[2] * co, -w * k[3])
     }
 }
 
@@ -132,6 +137,10 @@ pub struct VehicleMotion {
     knots: [Knots; 3],
     wobble: Vec<Wobble>,
     coning: Option<Coning>,
+    /// The constants of the cone ([`Coning::constants`]), computed once.
+    cone_constants: [f64; 4],
+    /// C_b^n of the Euler part when it never changes (no ramp, no wobble), computed once.
+    euler_fixed: Option<Rot<N, B>>,
 }
 
 impl VehicleMotion {
@@ -154,20 +163,28 @@ impl VehicleMotion {
             k.t_s.push(r.start_s + duration);
             k.value_rad.push(r.target_rad);
         }
-        Ok(Self { base, knots, wobble, coning: None })
+        Ok(Self { base, knots, wobble, coning: None, cone_constants: [1.0, 0.0, 0.0, 0.0], euler_fixed: None }.with_constants())
     }
 
     /// A vehicle at rest at `base`.
     #[must_use]
     pub fn fixed(base: Attitude) -> Self {
-        Self { base, knots: Default::default(), wobble: Vec::new(), coning: None }
+        Self { base, knots: Default::default(), wobble: Vec::new(), coning: None, cone_constants: [1.0, 0.0, 0.0, 0.0], euler_fixed: None }.with_constants()
+    }
+
+    /// Computes the constant rotations and trigonometry once.
+    fn with_constants(mut self) -> Self {
+        self.cone_constants = self.coning.map_or([1.0, 0.0, 0.0, 0.0], |c| c.constants());
+        let still = self.wobble.is_empty() && self.knots.iter().all(|k| k.t_s.is_empty());
+        self.euler_fixed = still.then(|| self.base.n_from_b());
+        self
     }
 
     /// Adds pure coning on top of the Euler-angle motion.
     #[must_use]
     pub fn with_coning(mut self, coning: Coning) -> Self {
         self.coning = (coning.half_angle_rad != 0.0 && coning.omega_rad_per_s != 0.0).then_some(coning);
-        self
+        self.with_constants()
     }
 
     /// True when the vehicle never moves (no ramp, no wobble, no coning).
@@ -203,17 +220,20 @@ impl VehicleMotion {
     /// C_b^n at `t_s`.
     #[must_use]
     pub fn n_from_b(&self, t_s: f64) -> Rot<N, B> {
-        let e = self.euler(t_s).n_from_b();
+        let e = self.euler_fixed.unwrap_or_else(|| self.euler(t_s).n_from_b());
         match self.coning {
             None => e,
             // FRAME: the coned body b is the Euler frame turned by the cone rotation K (body side).
-            Some(c) => Rot::from_quaternion(*e.quaternion() * c.rotation(t_s)),
+            Some(c) => Rot::from_quaternion(*e.quaternion() * c.rotation(&self.cone_constants, t_s)),
         }
     }
 
     /// Angular rate of b relative to n, in b (rad/s).
     #[must_use]
     pub fn omega_nb_b(&self, t_s: f64) -> Vector3<f64> {
+        if self.euler_fixed.is_some() {
+            return self.coning.map_or_else(Vector3::zeros, |c| c.rate(&self.cone_constants, t_s));
+        }
         let a = self.euler(t_s);
         let [dp, dr, dh] = self.euler_rates(t_s);
         // ω_nb^n = −z ψ̇ + Rz(−ψ) x θ̇ + Rz(−ψ) Rx(θ) y γ̇ (euler.rs, docs/closed-form.md §2).
@@ -223,8 +243,28 @@ impl VehicleMotion {
         let w_e = a.n_from_b().quaternion().inverse() * w_n;
         match self.coning {
             None => w_e,
-            Some(c) => c.rotation(t_s).inverse() * w_e + c.rate(t_s),
+            Some(c) => c.rotation(&self.cone_constants, t_s).inverse() * w_e + c.rate(&self.cone_constants, t_s),
         }
+    }
+
+    /// C_b^n as links turning at constant rates from `t_s` to the next breakpoint (angles taken at
+    /// `t_s`, τ counted from it, rates at `rates_at_s`, an instant inside the piece: at a breakpoint
+    /// itself rounding may pick either side): `Rz(−ψ) · Rx(θ) · Ry(γ)` of the Euler angles, then the cone
+    /// `K = Rz(Ωt) · Rx(α) · Rz(−Ωt)` (the rotation by α about (cos Ωt, sin Ωt, 0), the quaternion
+    /// of [`Coning`]). None with a wobble (its angles are not linear in time).
+    #[must_use]
+    pub fn links_at(&self, t_s: f64, rates_at_s: f64) -> Option<Vec<Link>> {
+        if !self.wobble.is_empty() {
+            return None;
+        }
+        let a = self.euler(t_s);
+        let [dp, dr, dh] = self.euler_rates(rates_at_s);
+        let turning = |axis: Vector3<f64>, angle_rad: f64, rate_rad_per_s: f64| Link::Turning { axis, angle_rad, rate_rad_per_s };
+        let mut links = vec![turning(Vector3::z(), -a.heading_rad, -dh), turning(Vector3::x(), a.pitch_rad, dp), turning(Vector3::y(), a.roll_rad, dr)];
+        if let Some(c) = self.coning {
+            links.push(Link::Cone { half_angle_rad: c.half_angle_rad, phase_rad: c.omega_rad_per_s * t_s, rate_rad_per_s: c.omega_rad_per_s });
+        }
+        Some(links)
     }
 
     /// (pitch, roll, heading) rates, rad/s.

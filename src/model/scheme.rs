@@ -63,6 +63,18 @@ impl Move {
     }
 }
 
+impl Move {
+    /// True when the rate is constant from `tau` on to the move's next bend (or its end).
+    fn constant_rate_at(&self, tau: f64) -> bool {
+        let a = self.accel_rad_per_s2;
+        if a <= 0.0 || tau >= self.duration_s {
+            return true;
+        }
+        let t_acc = (self.rate_rad_per_s / a).min(0.5 * self.duration_s);
+        tau >= t_acc && tau < self.duration_s - t_acc
+    }
+}
+
 fn move_duration(step: &IndexedStep) -> f64 {
     let d = step.angle_rad.abs();
     let (r, a) = (step.rate_rad_per_s, step.accel_rad_per_s2);
@@ -202,6 +214,31 @@ impl Scheme {
             None if *repeat => cycle_start + period_s + breakpoints.first().copied().unwrap_or(0.0),
             None => f64::INFINITY,
         }
+    }
+
+    /// True when every gimbal turns at a constant rate (or rests) from `t_s` to the next breakpoint:
+    /// no move is in its acceleration or braking phase (then the angles are linear in time and the
+    /// IMU truth has closed-form increments).
+    #[must_use]
+    pub fn constant_rates_at(&self, t_s: f64) -> bool {
+        let Kind::Indexed { initial_dwell_s, period_s, repeat, moves, .. } = &self.kind else {
+            return true;
+        };
+        let tau = t_s - initial_dwell_s;
+        if t_s < 0.0 || tau < 0.0 {
+            return true;
+        }
+        let within = if *repeat {
+            tau - (tau / period_s).floor() * period_s
+        } else if tau >= *period_s {
+            return true;
+        } else {
+            tau
+        };
+        moves.iter().take(self.n_axes).all(|list| {
+            let j = list.partition_point(|m| m.t0_s <= within);
+            j == 0 || list[j - 1].constant_rate_at(within - list[j - 1].t0_s)
+        })
     }
 
     /// True gimbal angles and rates at `t_s`.
