@@ -2,6 +2,7 @@
 //! white noise and the IEEE 952/1293 stochastic terms), dither and its FIR, coning-compensated
 //! attitude algorithms, strapdown navigation, position resets.
 
+pub mod allan;
 pub mod coning;
 pub mod core;
 pub mod fir;
