@@ -158,11 +158,12 @@ fn about(r: &ImuAllan, description: &str) -> String {
         .iter()
         .map(|t| format!("| {} | {} / {} | {} |\n", t.letter(), crate::ins::allan::Sensor::Gyro.term_name(*t), crate::ins::allan::Sensor::Accel.term_name(*t), t.slope_text()))
         .collect();
+    let notes: String = r.notes.iter().map(|n| format!("\n*Note:* {n}\n")).collect();
     format!(
-        "# Allan deviation\n\n{}\n\n**How to read the plots.** Rerun has no logarithmic axis, so both axes carry **log10 values**: \
+        "# Allan deviation\n\n{}\n{notes}\n**How to read the plots.** Rerun has no logarithmic axis, so both axes carry **log10 values**: \
          the horizontal axis is the timeline `{LOG10_TAU_TIMELINE}`, whose \"seconds\" are **log10(τ / 1 s)** (−2 is 10 ms, 0 is \
          1 s, 3 is 1000 s); the vertical axis is log10 of the Allan deviation of the rate, in **log10(°/h)** for gyros and \
-         **log10(µg)** for accelerometers (0 is 1 °/h or 1 µg, −1 is 0.1). A power law σ ∝ τ^s is a straight line of slope s:\n\n\
+         **log10(µg)** for accelerometers (0 is 1 °/h or 1 µg, −1 is 0.1). A power law σ = c·τ^s is a straight line of slope s:\n\n\
          | term | gyro / accelerometer | slope |\n|---|---|---|\n{terms}\n\
          White: the measured overlapping ADEV; grey: its ±{}σ confidence bounds (χ² with the equivalent degrees of freedom of \
          NIST SP 1065); coloured: the slope line of each term the fit found, labelled with its coefficient and drawn where \
