@@ -100,6 +100,21 @@ fn a_log_set_is_analysed_from_its_files() {
             assert!(found && (value / truth - 1.0).abs() < 0.05, "{sensor} {key}: {value} vs {truth}");
         }
     }
+    // A gap of 0.5 s at 400 s (rows cut out of the csv), with the manifest's `gap_policy = "split"`:
+    // the longest stretch without a gap (rows 80 101..240 002 of the 240 002 written: 400.5 s to 1200 s, 159 902
+    // samples) is analysed, and the output says so.
+    let imu = log.join("imu.csv");
+    let text = std::fs::read_to_string(&imu).expect("imu.csv");
+    let lines: Vec<&str> = text.lines().collect();
+    let cut: Vec<&str> = lines[..80_001].iter().chain(&lines[80_101..]).copied().collect();
+    std::fs::write(&imu, cut.join("\n") + "\n").expect("write");
+    let manifest = std::fs::read_to_string(log.join("log.toml")).expect("manifest");
+    std::fs::write(log.join("log.toml"), manifest.replacen("gap_policy = \"refuse\"", "gap_policy = \"split\"", 1)).expect("write");
+    let o = rinscope().arg("allan").arg(&log).arg("--json").arg(&out).arg("--no-recording").output().expect("allan");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("1 gap(s): the longest stretch"), "{}", String::from_utf8_lossy(&o.stdout));
+    let j = json(&out);
+    assert_eq!(j["samples"].as_u64(), Some(159_902), "{}", j["notes"]);
     std::fs::remove_dir_all(&dir).ok();
 }
 
