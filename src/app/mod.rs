@@ -3,6 +3,7 @@
 //! the paper reproductions and the benchmarks. Threads, channels, progress bars and files live
 //! here, above the pure layers and the recorder.
 
+pub mod allan;
 pub mod bench;
 pub mod calibrate;
 pub mod export_log;

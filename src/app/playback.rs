@@ -302,10 +302,7 @@ struct Sample {
 pub struct Playback {
     /// The navigation computer.
     pub core: InsCore,
-    imu: ImuStream,
-    kind: SampleKind,
-    nominal_s: f64,
-    last_t: Option<f64>,
+    imu: ImuSamples,
     origin_s: f64,
     encoders: Option<Track>,
     initial_angles: AxisValues,
@@ -314,7 +311,6 @@ pub struct Playback {
     pub samples: u64,
     /// Gaps carried across.
     pub gaps: Vec<Gap>,
-    pending_gap: bool,
 }
 
 enum ReferenceTrack {
@@ -330,28 +326,9 @@ impl Playback {
         let cfg = &log.table.ins;
         let f = &log.imu;
         let static_start = matches!(log.initial, Initial::Alignment { .. }) || matches!(log.reference, Reference::Static(_));
-        let mut options = ImuOptions::new(f.layout.clone());
-        options.frame = f.frame.clone();
-        options.topic = f.topic.clone();
-        options.gap_policy = f.gap_policy;
-        options.gap_factor = f.gap_factor;
-        options.nominal_dt_s = Some(1.0 / f.rate_hz);
         // Rates declared as increments (or degrees as radians) show in a resting log's gravity and Earth rate.
-        options.static_check = static_start.then(StaticCheck::default);
-        let imu = ImuReader::open(&f.path, &options)?;
-        if imu.kind() != f.kind {
-            return Err(data_err(format!(
-                "{}: the file holds {} (its columns {}), the manifest says kind = \"{}\"",
-                f.path.display(),
-                kind_name(imu.kind()),
-                imu.columns().join(", "),
-                kind_name(f.kind)
-            )));
-        }
-        let kind = imu.kind();
+        let (imu, start) = ImuSamples::open_checked(log, static_start)?;
         let nominal_s = 1.0 / f.rate_hz;
-        let start = imu.start_time().ok_or_else(|| data_err(format!("{}: no IMU samples", f.path.display())))?;
-        let imu = ImuStream::spawn(imu)?;
         let axis_names: Vec<String> = log.table.chain.axes().iter().map(|a| a.name.clone()).collect();
         let mut initial_angles = [0.0; MAX_AXES];
         for (k, a) in log.table.chain.axes().iter().enumerate() {
@@ -385,16 +362,12 @@ impl Playback {
         let mut me = Self {
             core: InsCore::new(cfg, log.table.site, Rot::identity(), &[]),
             imu,
-            kind,
-            nominal_s,
-            last_t: None,
             origin_s: 0.0,
             encoders,
             initial_angles,
             reference,
             samples: 0,
             gaps: Vec::new(),
-            pending_gap: false,
         };
         loop {
             let Some(s) = me.read()? else {
@@ -477,32 +450,107 @@ impl Playback {
         demodulate(n_from_s, b_from_s)
     }
 
-    /// One sample as increments in the RFU sensor frame, or None at the end.
+    /// One sample as increments in the RFU sensor frame, or None at the end (gaps recorded).
     fn read(&mut self) -> Result<Option<Sample>, PlaybackError> {
         loop {
-            let Some(event) = self.imu.next() else { return Ok(None) };
-            match event? {
-                ImuEvent::Gap { t_before_s, t_after_s, .. } => {
-                    self.gaps.push(Gap { from_s: t_before_s - self.origin_s, to_s: t_after_s - self.origin_s });
-                    self.pending_gap = true;
-                }
-                ImuEvent::Sample(s) => {
-                    let (dtheta, dv) = match self.kind {
-                        SampleKind::Increments => (s.gyro, s.accel),
-                        SampleKind::Rates => {
-                            // A rate held over its interval; across a gap, over one nominal interval
-                            // (the gap itself is not integrated).
-                            let dt = match self.last_t {
-                                Some(t) if !self.pending_gap => s.t_s - t,
-                                _ => self.nominal_s,
-                            };
-                            (s.gyro * dt, s.accel * dt)
-                        }
-                    };
-                    self.pending_gap = false;
-                    self.last_t = Some(s.t_s);
-                    return Ok(Some(Sample { t_s: s.t_s, dtheta, dv }));
-                }
+            match self.imu.next_item()? {
+                None => return Ok(None),
+                Some(ImuItem::Gap { from_s, to_s }) => self.gaps.push(Gap { from_s: from_s - self.origin_s, to_s: to_s - self.origin_s }),
+                Some(ImuItem::Sample { t_s, dtheta, dv }) => return Ok(Some(Sample { t_s, dtheta, dv })),
+            }
+        }
+    }
+}
+
+/// What a log set's IMU file yields, in order.
+#[derive(Debug, Clone, Copy)]
+pub enum ImuItem {
+    /// One sample as increments in the RFU sensor frame: its stamp (s, the file's clock),
+    /// Δθ (rad) and Δv (m/s).
+    Sample {
+        /// Stamp, s.
+        t_s: f64,
+        /// Angle increment, rad.
+        dtheta: Vector3<f64>,
+        /// Velocity increment, m/s.
+        dv: Vector3<f64>,
+    },
+    /// A gap in the samples (the file's clock), s.
+    Gap {
+        /// Last stamp before it.
+        from_s: f64,
+        /// First stamp after it.
+        to_s: f64,
+    },
+}
+
+/// The IMU samples of a log set without the navigation computer (what `rinscope allan` reads):
+/// increments in the RFU sensor frame (rates held over their interval), gaps reported, not bridged.
+pub struct ImuSamples {
+    imu: ImuStream,
+    kind: SampleKind,
+    nominal_s: f64,
+    last_t: Option<f64>,
+    pending_gap: bool,
+}
+
+impl ImuSamples {
+    /// Opens `log`'s IMU file as its manifest describes it.
+    pub fn open(log: &LogSet) -> Result<Self, PlaybackError> {
+        Ok(Self::open_checked(log, false)?.0)
+    }
+
+    /// Opens it, with the static-segment plausibility check if `static_check`; also returns the
+    /// first stamp.
+    fn open_checked(log: &LogSet, static_check: bool) -> Result<(Self, StartTime), PlaybackError> {
+        let f = &log.imu;
+        let mut options = ImuOptions::new(f.layout.clone());
+        options.frame = f.frame.clone();
+        options.topic = f.topic.clone();
+        options.gap_policy = f.gap_policy;
+        options.gap_factor = f.gap_factor;
+        options.nominal_dt_s = Some(1.0 / f.rate_hz);
+        options.static_check = static_check.then(StaticCheck::default);
+        let imu = ImuReader::open(&f.path, &options)?;
+        if imu.kind() != f.kind {
+            return Err(data_err(format!(
+                "{}: the file holds {} (its columns {}), the manifest says kind = \"{}\"",
+                f.path.display(),
+                kind_name(imu.kind()),
+                imu.columns().join(", "),
+                kind_name(f.kind)
+            )));
+        }
+        let kind = imu.kind();
+        let start = imu.start_time().ok_or_else(|| data_err(format!("{}: no IMU samples", f.path.display())))?;
+        let imu = ImuStream::spawn(imu)?;
+        Ok((Self { imu, kind, nominal_s: 1.0 / f.rate_hz, last_t: None, pending_gap: false }, start))
+    }
+
+    /// The next sample or gap; None at the end of the file.
+    pub fn next_item(&mut self) -> Result<Option<ImuItem>, PlaybackError> {
+        let Some(event) = self.imu.next() else { return Ok(None) };
+        match event? {
+            ImuEvent::Gap { t_before_s, t_after_s, .. } => {
+                self.pending_gap = true;
+                Ok(Some(ImuItem::Gap { from_s: t_before_s, to_s: t_after_s }))
+            }
+            ImuEvent::Sample(s) => {
+                let (dtheta, dv) = match self.kind {
+                    SampleKind::Increments => (s.gyro, s.accel),
+                    SampleKind::Rates => {
+                        // A rate held over its interval; across a gap, over one nominal interval
+                        // (the gap itself is not integrated).
+                        let dt = match self.last_t {
+                            Some(t) if !self.pending_gap => s.t_s - t,
+                            _ => self.nominal_s,
+                        };
+                        (s.gyro * dt, s.accel * dt)
+                    }
+                };
+                self.pending_gap = false;
+                self.last_t = Some(s.t_s);
+                Ok(Some(ImuItem::Sample { t_s: s.t_s, dtheta, dv }))
             }
         }
     }

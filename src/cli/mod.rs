@@ -6,6 +6,7 @@
 //! rinscope                                   # embedded default scenario -> recordings/<scenario>.rrd
 //! rinscope run --scenario NAME --spawn       # stream to a new viewer (pip install rerun-sdk==0.36.3)
 //! rinscope run --config my.toml --save out.rrd --summary-json out.json
+//! rinscope allan --scenario static-imu-10h --json adev.json   # or: rinscope allan LOGSET_DIR
 //! rinscope scenarios | check-config FILE | reproduce | bench
 //! ```
 //!
@@ -13,6 +14,7 @@
 //! 2 bad input (config, path, viewer), 128 + the signal when stopped by SIGINT (130), SIGTERM (143)
 //! or SIGHUP (129): what was simulated is saved, and the command says it was cut short.
 
+mod allan;
 mod commands;
 mod logs;
 
@@ -57,6 +59,10 @@ enum Command {
     /// Replay a log set (or an IMU file with --imu) through the INS and the table models: the same
     /// scene and plots as a simulation, from the files.
     Replay(ReplayArgs),
+    /// Allan deviation of a static IMU log, every gyro and accelerometer axis, with the IEEE
+    /// 952/1293 coefficients (Q, N, B, K, R) fitted: a log set, or a scenario simulated (default
+    /// scenario: static-imu-10h; docs/allan.md).
+    Allan(AllanArgs),
     /// Print the event log (reloads, errors, summary) of a saved recording.
     Events {
         /// The .rrd file.
@@ -303,6 +309,40 @@ struct ReplayArgs {
 }
 
 #[derive(Args)]
+struct AllanArgs {
+    /// A log set's folder (with log.toml) to analyse instead of simulating a scenario.
+    #[arg(conflicts_with_all = ["scenario", "config", "duration_s"])]
+    dir: Option<PathBuf>,
+    // Default static-imu-10h.
+    #[command(flatten)]
+    source: ScenarioSource,
+    #[command(flatten)]
+    sinks: SinkArgs,
+    /// Write the curves, their confidence bounds and EDF, the fitted and configured coefficients as JSON.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Override the scenario's simulated duration, s.
+    #[arg(long)]
+    duration_s: Option<f64>,
+    /// Cluster times per decade (default: octaves, m = 1, 2, 4, ...).
+    #[arg(long, value_name = "N")]
+    per_decade: Option<u32>,
+    /// Sum this many samples into one before the analysis (a long, fast log in less memory).
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    decimate: usize,
+    /// Half-width of the confidence intervals, normal sigmas (1: 68.3 %).
+    #[arg(long, default_value_t = 1.0, value_name = "Z")]
+    ci_sigma: f64,
+    /// A simulation: analyse the sensor errors alone (output − truth), e.g. of a scenario whose
+    /// table turns (zheng2016-tpr); default: what the IMU outputs, as a static test logs it.
+    #[arg(long)]
+    errors_only: bool,
+    /// No recording (print and JSON only).
+    #[arg(long, conflicts_with_all = ["save", "spawn", "connect", "serve"])]
+    no_recording: bool,
+}
+
+#[derive(Args)]
 #[command(args_conflicts_with_subcommands = true)]
 struct MonteCarloArgs {
     #[command(subcommand)]
@@ -420,6 +460,7 @@ pub fn main() -> ExitCode {
         Command::Events { file } => commands::events(&file),
         Command::ExportLog(args) => logs::export_log(&args),
         Command::Replay(args) => logs::replay(&args),
+        Command::Allan(args) => allan::allan(&args),
         Command::Modulation(args) => commands::modulation(&args),
         Command::Scenarios => {
             commands::list_scenarios();

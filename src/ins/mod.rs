@@ -1,11 +1,14 @@
-//! Layer 2, the INS in the loop: IMU increments from the exact truth, sensor errors, dither and its
-//! FIR, coning-compensated attitude algorithms, strapdown navigation, position resets.
+//! Layer 3, the INS in the loop: IMU increments from the exact truth, sensor errors (constant ones,
+//! white noise and the IEEE 952/1293 stochastic terms), dither and its FIR, coning-compensated
+//! attitude algorithms, strapdown navigation, position resets.
 
+pub mod allan;
 pub mod closed_form;
 pub mod coning;
 pub mod core;
 pub mod fir;
 pub mod nav;
+pub mod noise;
 pub mod pipeline;
 pub mod reset;
 pub mod sensor;

@@ -147,6 +147,22 @@ impl InsRun {
         (t1, g, a)
     }
 
+    /// Samples the sensors' saturation clipped so far, per axis: (gyros, accelerometers).
+    #[must_use]
+    pub fn saturation_counts(&self) -> ([u64; 3], [u64; 3]) {
+        self.sensors.saturation_counts()
+    }
+
+    /// [`Self::next_measurement`] with the true increments it was measured from:
+    /// (end time, Δθ, Δv, true Δθ, true Δv).
+    pub fn next_measurement_and_truth(&mut self) -> (f64, Vector3<f64>, Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+        self.index += 1;
+        let t1 = self.index as f64 * self.h;
+        let (g_true, a_true) = self.truth.increments(t1);
+        let (g, a) = self.sensors.measure(&g_true, &a_true, t1);
+        (t1, g, a, g_true, a_true)
+    }
+
     /// One IMU sample.
     pub fn step(&mut self) -> SampleOut {
         let (t1, g, a) = self.next_measurement();

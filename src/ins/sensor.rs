@@ -1,11 +1,14 @@
-//! Gyro and accelerometer errors applied to the true increments, every random draw seeded:
-//! constant bias, scale factor, misalignment, white noise (angle / velocity random walk), bias
-//! instability (first-order Gauss-Markov), g-dependent gyro bias; and ring-laser-gyro dither.
+//! Gyro and accelerometer errors applied to the true increments, every random draw seeded: constant
+//! bias, scale factor, misalignment, a first-order Gauss-Markov bias, g-dependent gyro bias,
+//! ring-laser-gyro dither, and the stochastic terms of IEEE Std 952/1293 by their names (Q, N, B, K, R,
+//! saturation; `noise`, docs/allan.md).
 
 use nalgebra::{Matrix3, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
+
+use super::noise::{IeeeTerms, TriadNoise};
 
 /// A value given as a 1σ (each axis drawn from N(0, σ) with the seed) or as fixed per-axis values.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -52,10 +55,11 @@ pub struct GyroSpec {
     pub scale: Spec,
     /// Misalignment: 1σ of each of the six small off-diagonal angles, rad.
     pub misalignment_rad: f64,
-    /// Angle random walk (white rate noise density), rad/√s.
-    pub arw_rad_per_sqrt_s: f64,
-    /// Bias instability: σ of a first-order Gauss-Markov bias, rad/s.
-    pub instability_rad_per_s: f64,
+    /// IEEE 952's terms in rad, rad/s: Q (rad), N the angle random walk (rad/√s), B the bias
+    /// instability (rad/s), K the rate random walk (rad/s/√s), R the rate ramp (rad/s²), saturation.
+    pub noise: IeeeTerms,
+    /// A first-order Gauss-Markov bias (not IEEE's B): its stationary σ, rad/s.
+    pub markov_sigma_rad_per_s: f64,
     /// Its correlation time, s.
     pub correlation_s: f64,
 }
@@ -69,10 +73,11 @@ pub struct AccelSpec {
     pub scale: Spec,
     /// Misalignment: 1σ of each of the six small off-diagonal angles, rad.
     pub misalignment_rad: f64,
-    /// Velocity random walk (white acceleration noise density), m/s/√s.
-    pub vrw_mps_per_sqrt_s: f64,
-    /// Bias instability: σ of a first-order Gauss-Markov bias, m/s².
-    pub instability_mps2: f64,
+    /// IEEE 1293's terms in m/s, m/s²: Q (m/s), N the velocity random walk (m/s/√s), B the bias
+    /// instability (m/s²), K the acceleration random walk (m/s²/√s), R the ramp (m/s³), saturation.
+    pub noise: IeeeTerms,
+    /// A first-order Gauss-Markov bias (not IEEE's B): its stationary σ, m/s².
+    pub markov_sigma_mps2: f64,
     /// Its correlation time, s.
     pub correlation_s: f64,
 }
@@ -89,14 +94,22 @@ struct TriadErrors {
 
 impl From<&GyroSpec> for TriadErrors {
     fn from(g: &GyroSpec) -> Self {
-        Self { bias: g.bias_rad_per_s, scale: g.scale, misalignment_rad: g.misalignment_rad, white_per_sqrt_s: g.arw_rad_per_sqrt_s, instability: g.instability_rad_per_s, correlation_s: g.correlation_s }
+        Self { bias: g.bias_rad_per_s, scale: g.scale, misalignment_rad: g.misalignment_rad, white_per_sqrt_s: g.noise.random_walk_si, instability: g.markov_sigma_rad_per_s, correlation_s: g.correlation_s }
     }
 }
 
 impl From<&AccelSpec> for TriadErrors {
     fn from(a: &AccelSpec) -> Self {
-        Self { bias: a.bias_mps2, scale: a.scale, misalignment_rad: a.misalignment_rad, white_per_sqrt_s: a.vrw_mps_per_sqrt_s, instability: a.instability_mps2, correlation_s: a.correlation_s }
+        Self { bias: a.bias_mps2, scale: a.scale, misalignment_rad: a.misalignment_rad, white_per_sqrt_s: a.noise.random_walk_si, instability: a.markov_sigma_mps2, correlation_s: a.correlation_s }
     }
+}
+
+/// The generator of a triad's IEEE terms other than N (N is drawn with the constant errors, from
+/// the scenario's own stream, as it always was), or None when there are none: a scenario without
+/// them draws exactly the numbers it drew before they existed.
+fn ieee_generator(terms: &IeeeTerms, h: f64, seed: u64, first_stream: u64) -> Option<TriadNoise> {
+    let rest = IeeeTerms { random_walk_si: 0.0, ..*terms };
+    rest.is_active().then(|| TriadNoise::new(&rest, h, seed, first_stream))
 }
 
 /// Ring-laser-gyro dither: each gyro block oscillates at its own frequency; the motion is sensed by
@@ -181,6 +194,8 @@ impl Triad {
 pub struct Sensors {
     gyro: Triad,
     accel: Triad,
+    gyro_ieee: Option<TriadNoise>,
+    accel_ieee: Option<TriadNoise>,
     g_sensitivity: f64,
     dither: DitherSpec,
     dither_phase: [f64; 3],
@@ -203,7 +218,10 @@ impl Sensors {
             *p = rand::Rng::random::<f64>(&mut rng) * std::f64::consts::TAU;
         }
         let drawn_bias = (gyro.bias, accel.bias);
-        let mut me = Self { gyro, accel, g_sensitivity: spec.g_sensitivity, dither: spec.dither, dither_phase, dither_last: [0.0; 3], h, rng, drawn_bias };
+        // Streams 1-3 (gyros) and 4-6 (accelerometers) of the seed: stream 0 is `rng`'s.
+        let gyro_ieee = ieee_generator(&spec.gyro.noise, h, seed, 1);
+        let accel_ieee = ieee_generator(&spec.accel.noise, h, seed, 4);
+        let mut me = Self { gyro, accel, gyro_ieee, accel_ieee, g_sensitivity: spec.g_sensitivity, dither: spec.dither, dither_phase, dither_last: [0.0; 3], h, rng, drawn_bias };
         me.dither_last = me.dither_angles(t0);
         me
     }
@@ -223,7 +241,13 @@ impl Sensors {
     pub fn measure(&mut self, dtheta: &Vector3<f64>, dv: &Vector3<f64>, t1: f64) -> (Vector3<f64>, Vector3<f64>) {
         let f = dv / self.h;
         let mut g = self.gyro.apply(dtheta, f * self.g_sensitivity, self.h, &mut self.rng);
-        let a = self.accel.apply(dv, Vector3::zeros(), self.h, &mut self.rng);
+        let mut a = self.accel.apply(dv, Vector3::zeros(), self.h, &mut self.rng);
+        if let Some(n) = &mut self.gyro_ieee {
+            g += n.next_error();
+        }
+        if let Some(n) = &mut self.accel_ieee {
+            a += n.next_error();
+        }
         if self.dither.amplitudes_rad.iter().any(|x| *x != 0.0) {
             let now = self.dither_angles(t1);
             let c = self.dither.coupling;
@@ -231,7 +255,21 @@ impl Sensors {
             g += Vector3::new(d[0] + c * (d[1] + d[2]), d[1] + c * (d[0] + d[2]), d[2] + c * (d[0] + d[1]));
             self.dither_last = now;
         }
+        // What the readout does last: saturation and pulse counting, of the dithered total.
+        if let Some(n) = &mut self.gyro_ieee {
+            g = n.output(g);
+        }
+        if let Some(n) = &mut self.accel_ieee {
+            a = n.output(a);
+        }
         (g, a)
+    }
+
+    /// Samples clipped by saturation so far, per axis: (gyros, accelerometers).
+    #[must_use]
+    pub fn saturation_counts(&self) -> ([u64; 3], [u64; 3]) {
+        let count = |n: &Option<TriadNoise>| n.as_ref().map_or([0; 3], TriadNoise::saturation_counts);
+        (count(&self.gyro_ieee), count(&self.accel_ieee))
     }
 }
 
@@ -243,7 +281,7 @@ mod tests {
     fn white_noise_has_the_specified_density() {
         // ARW 1e-3 rad/√s at 100 Hz: per-sample σ = 1e-3·√0.01 = 1e-4 rad (sample std over 2e5 draws
         // within 1%: the standard error of a std estimate is σ/√(2n) = 0.16%).
-        let spec = ImuErrorSpec { gyro: GyroSpec { arw_rad_per_sqrt_s: 1e-3, ..Default::default() }, ..Default::default() };
+        let spec = ImuErrorSpec { gyro: GyroSpec { noise: IeeeTerms { random_walk_si: 1e-3, ..IeeeTerms::default() }, ..Default::default() }, ..Default::default() };
         let mut s = Sensors::new(&spec, 0.01, 7, 0.0);
         let n = 200_000;
         let mut sum_sq = 0.0;
@@ -258,7 +296,13 @@ mod tests {
     #[test]
     fn the_same_seed_gives_the_same_stream() {
         let spec = ImuErrorSpec {
-            gyro: GyroSpec { bias_rad_per_s: Spec::Sigma(1e-6), arw_rad_per_sqrt_s: 1e-5, instability_rad_per_s: 1e-7, correlation_s: 100.0, ..Default::default() },
+            gyro: GyroSpec {
+                bias_rad_per_s: Spec::Sigma(1e-6),
+                noise: IeeeTerms { random_walk_si: 1e-5, bias_instability_si: 1e-7, rate_random_walk_si: 1e-8, ..IeeeTerms::default() },
+                markov_sigma_rad_per_s: 1e-7,
+                correlation_s: 100.0,
+                ..Default::default()
+            },
             ..Default::default()
         };
         let run = |seed| {
@@ -293,5 +337,32 @@ mod tests {
         }
         // |Σ| ≤ 2·A·(1 + 2·coupling) on each axis.
         assert!(peak <= 2.0 * 5e-4 * 1.4 + 1e-12, "{peak}");
+    }
+
+    #[test]
+    fn the_ieee_terms_leave_every_other_draw_as_it_was() {
+        // The presets' streams must not change when a scenario adds Q, B, K, R (they draw from their
+        // own ChaCha8 streams 1-6): the measurement with them is the measurement without them plus
+        // exactly the generator's own error increments, bit for bit.
+        let base = GyroSpec {
+            bias_rad_per_s: Spec::Sigma(1e-6),
+            noise: IeeeTerms { random_walk_si: 1e-5, ..IeeeTerms::default() },
+            markov_sigma_rad_per_s: 1e-7,
+            correlation_s: 100.0,
+            ..Default::default()
+        };
+        let extra = IeeeTerms { random_walk_si: 1e-5, bias_instability_si: 3e-6, rate_random_walk_si: 1e-7, rate_ramp_si: 1e-9, ..IeeeTerms::default() };
+        let plain = ImuErrorSpec { gyro: base, ..Default::default() };
+        let full = ImuErrorSpec { gyro: GyroSpec { noise: extra, ..base }, ..Default::default() };
+        let (mut a, mut b) = (Sensors::new(&plain, 0.005, 9, 0.0), Sensors::new(&full, 0.005, 9, 0.0));
+        let mut alone = TriadNoise::new(&IeeeTerms { random_walk_si: 0.0, ..extra }, 0.005, 9, 1);
+        for i in 1..=1000 {
+            let t = f64::from(i) * 0.005;
+            let w = Vector3::new(1e-4, 2e-4, -3e-4);
+            let (ga, aa) = a.measure(&w, &Vector3::new(0.0, 0.0, 0.049), t);
+            let (gb, ab) = b.measure(&w, &Vector3::new(0.0, 0.0, 0.049), t);
+            assert_eq!(gb, ga + alone.next_error(), "sample {i}");
+            assert_eq!(ab, aa);
+        }
     }
 }

@@ -14,10 +14,20 @@ pub const DEG_PER_RAD: f64 = 1.0 / RAD_PER_DEG;
 pub const RAD_PER_S_PER_DEG_PER_H: f64 = RAD_PER_DEG / 3600.0;
 /// rad/√s per deg/√h (an angle random walk).
 pub const RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H: f64 = RAD_PER_DEG / 60.0;
+/// rad/s/√s per deg/h/√h (a gyro's rate random walk K; √h = 60 √s).
+pub const RAD_PER_S_PER_SQRT_S_PER_DEG_PER_H_PER_SQRT_H: f64 = RAD_PER_S_PER_DEG_PER_H / 60.0;
+/// rad/s² per deg/h² (a gyro's rate ramp R).
+pub const RAD_PER_S2_PER_DEG_PER_H2: f64 = RAD_PER_DEG / (3600.0 * 3600.0);
 /// Standard gravity g₀, m/s² (the unit of "µg" and "per g").
 pub const STANDARD_GRAVITY_MPS2: f64 = 9.806_65;
 /// m/s² per µg.
 pub const MPS2_PER_UG: f64 = 9.806_65e-6;
+/// m/s/√s per µg/√Hz (an accelerometer's velocity random walk N: m/s²/√Hz is m/s/√s).
+pub const MPS_PER_SQRT_S_PER_UG_PER_SQRT_HZ: f64 = MPS2_PER_UG;
+/// m/s²/√s per µg/√h (an accelerometer's acceleration random walk K).
+pub const MPS2_PER_SQRT_S_PER_UG_PER_SQRT_H: f64 = MPS2_PER_UG / 60.0;
+/// m/s³ per µg/h (an accelerometer's acceleration ramp R).
+pub const MPS3_PER_UG_PER_H: f64 = MPS2_PER_UG / 3600.0;
 
 /// Wraps an angle difference into (-pi, pi].
 #[must_use]

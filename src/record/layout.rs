@@ -73,6 +73,13 @@ pub fn window_time_axis(seconds: f64) -> bp::TimeAxis {
     }))
 }
 
+/// A plot of the timeline's range `[lo_s, hi_s]` (s, or whatever the timeline's seconds stand for).
+#[must_use]
+pub fn time_axis_range(lo_s: f64, hi_s: f64) -> bp::TimeAxis {
+    let at = |s: f64| datatypes::TimeRangeBoundary::Absolute(datatypes::TimeInt((s * 1e9) as i64));
+    bp::TimeAxis::new().with_view_range(bpc::TimeRange(datatypes::TimeRange { start: at(lo_s), end: at(hi_s) }))
+}
+
 /// A plot's value axis fixed to `[lo, hi]` (a filter's prior would otherwise set the scale).
 #[must_use]
 pub fn scalar_range(lo: f64, hi: f64) -> bp::ScalarAxis {
@@ -83,6 +90,14 @@ pub fn scalar_range(lo: f64, hi: f64) -> bp::ScalarAxis {
 #[must_use]
 pub fn no_legend() -> bp::PlotLegend {
     bp::PlotLegend::new().with_visible(false)
+}
+
+pub use bpc::Corner2D as LegendCorner;
+
+/// The legend in a corner of the plot.
+#[must_use]
+pub fn legend_at(corner: LegendCorner) -> bp::PlotLegend {
+    bp::PlotLegend::new().with_corner(corner)
 }
 
 /// A 3D eye looking at `target` from `position` with +z up.

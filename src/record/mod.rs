@@ -16,6 +16,7 @@ use rerun::{RecordingStream, RecordingStreamResult, TimeColumn};
 
 use layout::Node;
 
+pub mod allan;
 mod blueprint;
 pub mod calibration;
 pub mod export;

@@ -11,6 +11,7 @@ pub mod instruments;
 pub mod logset;
 pub mod presets;
 pub mod raw;
+mod stochastic;
 pub mod validate;
 
 use std::collections::BTreeMap;

@@ -21,6 +21,7 @@ pub const PRESETS: &[(&str, &str)] = &[
     ("li2014-wobble-2", include_str!("../../assets/scenarios/li2014-wobble-2.toml")),
     ("pure-coning", include_str!("../../assets/scenarios/pure-coning.toml")),
     ("zheng2016-tpr", include_str!("../../assets/scenarios/zheng2016-tpr.toml")),
+    ("static-imu-10h", include_str!("../../assets/scenarios/static-imu-10h.toml")),
     ("rotation-modulation-none", include_str!("../../assets/scenarios/rotation-modulation-none.toml")),
     ("rotation-modulation-continuous", include_str!("../../assets/scenarios/rotation-modulation-continuous.toml")),
     ("rotation-modulation-16-position", include_str!("../../assets/scenarios/rotation-modulation-16-position.toml")),

@@ -204,7 +204,9 @@ pub enum RawFir {
     Taps(Vec<f64>),
 }
 
-/// `[imu.gyro]`
+/// `[imu.gyro]`. The stochastic terms by IEEE Std 952's names and units (docs/allan.md): Q
+/// `quantization_arcsec`, N `arw_deg_per_sqrt_h`, B `bias_instability_deg_per_h`, K
+/// `rate_random_walk_deg_per_h_per_sqrt_h`, R `rate_ramp_deg_per_h2`.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawGyro {
@@ -217,13 +219,34 @@ pub struct RawGyro {
     /// arcsec (1σ of each small angle)
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub misalignment_arcsec: Option<f64>,
-    /// deg/√h
+    /// Q, arcsec (the Allan coefficient; a pulse weight w is Q = w/√12)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quantization_arcsec: Option<f64>,
+    /// The output pulse weight, arcsec (instead of `quantization_arcsec`)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pulse_weight_arcsec: Option<f64>,
+    /// N, deg/√h
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub arw_deg_per_sqrt_h: Option<f64>,
-    /// deg/h (1σ of a Gauss-Markov bias)
+    /// B, deg/h (flicker: the Allan floor is 0.664·B)
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bias_instability_deg_per_h: Option<f64>,
-    /// s
+    /// s, the τ range of B's flat floor (default [1, 1e4])
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bias_instability_range_s: Option<[f64; 2]>,
+    /// K, deg/h/√h
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rate_random_walk_deg_per_h_per_sqrt_h: Option<f64>,
+    /// R, deg/h² (signed)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rate_ramp_deg_per_h2: Option<f64>,
+    /// deg/s, the measurement range
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub saturation_deg_per_s: Option<f64>,
+    /// deg/h (1σ of a first-order Gauss-Markov bias)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub markov_sigma_deg_per_h: Option<f64>,
+    /// s (its correlation time)
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub correlation_time_s: Option<f64>,
     /// deg/h per g
@@ -231,7 +254,9 @@ pub struct RawGyro {
     pub g_sensitivity_deg_per_h_per_g: Option<f64>,
 }
 
-/// `[imu.accel]`
+/// `[imu.accel]`. The stochastic terms by IEEE Std 1293's names (docs/allan.md): Q
+/// `quantization_mps`, N `vrw_ug_per_sqrt_hz`, B `bias_instability_ug`, K
+/// `acceleration_random_walk_ug_per_sqrt_h`, R `acceleration_ramp_ug_per_h`.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawAccel {
@@ -244,13 +269,34 @@ pub struct RawAccel {
     /// arcsec
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub misalignment_arcsec: Option<f64>,
-    /// µg/√Hz
+    /// Q, m/s (the Allan coefficient; a pulse weight w is Q = w/√12)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quantization_mps: Option<f64>,
+    /// The output pulse weight, m/s (instead of `quantization_mps`)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pulse_weight_mps: Option<f64>,
+    /// N, µg/√Hz
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub vrw_ug_per_sqrt_hz: Option<f64>,
-    /// µg (1σ of a Gauss-Markov bias)
+    /// B, µg (flicker: the Allan floor is 0.664·B)
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bias_instability_ug: Option<f64>,
-    /// s
+    /// s, the τ range of B's flat floor (default [1, 1e4])
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bias_instability_range_s: Option<[f64; 2]>,
+    /// K, µg/√h
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub acceleration_random_walk_ug_per_sqrt_h: Option<f64>,
+    /// R, µg/h (signed)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub acceleration_ramp_ug_per_h: Option<f64>,
+    /// g, the measurement range
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub saturation_g: Option<f64>,
+    /// µg (1σ of a first-order Gauss-Markov bias)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub markov_sigma_ug: Option<f64>,
+    /// s (its correlation time)
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub correlation_time_s: Option<f64>,
 }

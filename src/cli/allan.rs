@@ -1,0 +1,109 @@
+//! `rinscope allan`: the Allan deviation of a static IMU log, simulated from a scenario or read
+//! from a log set, with the IEEE coefficients fitted (docs/allan.md).
+
+use std::sync::atomic::Ordering;
+
+use super::commands::{check_output_dir, default_recording, open_sinks, print_saved, write_json};
+use super::{AllanArgs, Failure};
+use crate::app::allan::{self, AllanRequest, AllanRunError};
+use crate::app::terminate::stop_flag;
+use crate::scenario::{self, logset};
+
+/// The preset `rinscope allan` simulates when given neither a log set nor a scenario.
+const DEFAULT_SCENARIO: &str = "static-imu-10h";
+
+impl From<AllanRunError> for Failure {
+    fn from(e: AllanRunError) -> Self {
+        match e {
+            AllanRunError::Config(_) | AllanRunError::Data(_) => Self::input(format!("allan: {e}")),
+            AllanRunError::Analysis(_) => Self::run(format!("allan: {e}")),
+            AllanRunError::Interrupted(_) => Self::interrupted(format!("allan: {e}")),
+        }
+    }
+}
+
+/// `rinscope allan`.
+pub(super) fn allan(args: &AllanArgs) -> Result<(), Failure> {
+    if args.sinks.export.is_some() {
+        return Err(Failure::input("allan: --export writes time series; the Allan curves, their bounds and the fit are in --json FILE"));
+    }
+    check_output_dir("--json", args.json.as_deref())?;
+    if args.errors_only && args.dir.is_some() {
+        return Err(Failure::input("allan: --errors-only needs the truth, which only a simulation has (give --scenario or --config)"));
+    }
+    let request = AllanRequest { per_decade: args.per_decade, decimate: args.decimate, ci_sigma: args.ci_sigma, errors_only: args.errors_only };
+    allan::options(&request)?;
+    enum Source {
+        Log(Box<logset::LogSet>),
+        Scenario(Box<scenario::Params>),
+    }
+    let (source, name, description) = match &args.dir {
+        Some(dir) => {
+            let log = logset::load(dir)?;
+            let (name, description) = (log.name.clone(), log.description.clone());
+            (Source::Log(Box::new(log)), name, description)
+        }
+        None => {
+            let mut params = args.source.load(DEFAULT_SCENARIO)?;
+            if let Some(d) = args.duration_s {
+                if !(d.is_finite() && d > 0.0 && d <= scenario::MAX_DURATION_S) {
+                    return Err(Failure::input(format!("--duration-s {d} s: must be > 0 and at most {} s (30 days), as simulation.duration_s", scenario::MAX_DURATION_S)));
+                }
+                params.set_duration(d);
+            }
+            allan::check_scenario(&params)?;
+            let (name, description) = (params.meta.name.clone(), format!("*{}*\n\n{}", params.meta.title, params.meta.description));
+            (Source::Scenario(Box::new(params)), name, description)
+        }
+    };
+    let sinks = if args.no_recording { None } else { Some(open_sinks(args.sinks.request(default_recording(&format!("{name}-allan")))?, &format!("{name}-allan"))?) };
+    let stop = stop_flag();
+    let bar = std::io::IsTerminal::is_terminal(&std::io::stderr()).then(|| {
+        let bar = indicatif::ProgressBar::new_spinner();
+        bar.enable_steady_tick(std::time::Duration::from_millis(200));
+        bar
+    });
+    let progress = |n: u64| {
+        if let Some(b) = &bar {
+            b.set_message(format!("{:.2} M samples gathered", n as f64 / 1e6));
+        }
+    };
+    let result = match &source {
+        Source::Log(log) => {
+            eprintln!("rinscope: reading {} ...", log.imu.path.display());
+            allan::log_set(log, &request, &stop, &progress)
+        }
+        Source::Scenario(p) => {
+            eprintln!("rinscope: simulating {:.2} h of {} at {} Hz, then the Allan analysis of 6 channels ...", p.duration_s / 3600.0, p.meta.name, p.step_hz);
+            allan::simulate(p, &request, &stop, &progress)
+        }
+    };
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let result = match result {
+        Ok(r) => r,
+        Err(e) => {
+            if let Some(s) = sinks {
+                s.abandon();
+            }
+            return Err(e.into());
+        }
+    };
+    out!("{}", result.text());
+    outln!("({:.1} s gathering the samples, {:.2} s for the analysis)", result.gather_s, result.analysis_s);
+    if let Some(path) = &args.json {
+        write_json("--json", path, &result.json())?;
+    }
+    if let Some(sinks) = sinks {
+        if let Err(e) = crate::record::allan::log(&sinks.stream(), &result, &description) {
+            sinks.abandon();
+            return Err(Failure::run(format!("rerun: {e}")));
+        }
+        print_saved(&sinks.finish()?)?;
+    }
+    if result.interrupted || stop.load(Ordering::SeqCst) {
+        return Err(Failure::interrupted("the analysis above is of the part of the log gathered before the stop"));
+    }
+    Ok(())
+}

@@ -1,0 +1,438 @@
+//! The Allan analysis of an IMU: the six channels (gyro and accelerometer x, y, z) of a static log
+//! in the field's units, the fitted IEEE coefficients beside the configured ones, as a terminal
+//! table, a markdown table and JSON (docs/allan.md). `app::allan` gathers the log (simulated or
+//! read), `record::allan` draws it.
+
+use serde_json::{json, Map, Value};
+
+use super::noise::IeeeTerms;
+use super::sensor::{AccelSpec, GyroSpec};
+use crate::math::allan::{analyze, gauss_markov_avar, AllanError, AllanOptions, AllanReport, Estimate, NoiseTerm, Phase, SlopeReading, TERMS};
+use crate::math::units::{
+    MPS2_PER_SQRT_S_PER_UG_PER_SQRT_H, MPS2_PER_UG, MPS3_PER_UG_PER_H, MPS_PER_SQRT_S_PER_UG_PER_SQRT_HZ, RAD_PER_ARCSEC, RAD_PER_S2_PER_DEG_PER_H2, RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H,
+    RAD_PER_S_PER_DEG_PER_H, RAD_PER_S_PER_SQRT_S_PER_DEG_PER_H_PER_SQRT_H,
+};
+
+/// The axis names, in channel order.
+pub const AXES: [&str; 3] = ["x", "y", "z"];
+
+/// Which triad a channel belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Sensor {
+    /// Gyros: increments in rad, rates in rad/s.
+    Gyro,
+    /// Accelerometers: increments in m/s, rates in m/s².
+    Accel,
+}
+
+/// A conventional unit: its name in JSON keys and entity paths, as printed, and its SI value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Unit {
+    /// In keys and paths (`deg_per_h`).
+    pub key: &'static str,
+    /// As printed (`°/h`).
+    pub text: &'static str,
+    /// SI per unit (rad/s per °/h).
+    pub si: f64,
+}
+
+impl Sensor {
+    /// Both, in channel order.
+    pub const ALL: [Sensor; 2] = [Sensor::Gyro, Sensor::Accel];
+
+    /// "gyro" or "accel".
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Gyro => "gyro",
+            Self::Accel => "accel",
+        }
+    }
+
+    /// The unit of the Allan deviation of its rate: °/h for gyros, µg for accelerometers.
+    #[must_use]
+    pub fn adev_unit(self) -> Unit {
+        match self {
+            Self::Gyro => Unit { key: "deg_per_h", text: "°/h", si: RAD_PER_S_PER_DEG_PER_H },
+            Self::Accel => Unit { key: "ug", text: "µg", si: MPS2_PER_UG },
+        }
+    }
+
+    /// The conventional unit of a coefficient (IEEE 952 for gyros, 1293 for accelerometers).
+    #[must_use]
+    pub fn unit(self, term: NoiseTerm) -> Unit {
+        let (key, text, si) = match (self, term) {
+            (Self::Gyro, NoiseTerm::Quantization) => ("arcsec", "″", RAD_PER_ARCSEC),
+            (Self::Gyro, NoiseTerm::RandomWalk) => ("deg_per_sqrt_h", "°/√h", RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H),
+            (Self::Gyro, NoiseTerm::BiasInstability) => ("deg_per_h", "°/h", RAD_PER_S_PER_DEG_PER_H),
+            (Self::Gyro, NoiseTerm::RateRandomWalk) => ("deg_per_h_per_sqrt_h", "°/h/√h", RAD_PER_S_PER_SQRT_S_PER_DEG_PER_H_PER_SQRT_H),
+            (Self::Gyro, NoiseTerm::RateRamp) => ("deg_per_h2", "°/h²", RAD_PER_S2_PER_DEG_PER_H2),
+            (Self::Accel, NoiseTerm::Quantization) => ("mps", "m/s", 1.0),
+            (Self::Accel, NoiseTerm::RandomWalk) => ("ug_per_sqrt_hz", "µg/√Hz", MPS_PER_SQRT_S_PER_UG_PER_SQRT_HZ),
+            (Self::Accel, NoiseTerm::BiasInstability) => ("ug", "µg", MPS2_PER_UG),
+            (Self::Accel, NoiseTerm::RateRandomWalk) => ("ug_per_sqrt_h", "µg/√h", MPS2_PER_SQRT_S_PER_UG_PER_SQRT_H),
+            (Self::Accel, NoiseTerm::RateRamp) => ("ug_per_h", "µg/h", MPS3_PER_UG_PER_H),
+        };
+        Unit { key, text, si }
+    }
+
+    /// The standard's name of a term for this sensor.
+    #[must_use]
+    pub fn term_name(self, term: NoiseTerm) -> &'static str {
+        match (self, term) {
+            (_, NoiseTerm::Quantization) => "quantization",
+            (Self::Gyro, NoiseTerm::RandomWalk) => "angle random walk",
+            (Self::Accel, NoiseTerm::RandomWalk) => "velocity random walk",
+            (_, NoiseTerm::BiasInstability) => "bias instability",
+            (Self::Gyro, NoiseTerm::RateRandomWalk) => "rate random walk",
+            (Self::Accel, NoiseTerm::RateRandomWalk) => "acceleration random walk",
+            (Self::Gyro, NoiseTerm::RateRamp) => "rate ramp",
+            (Self::Accel, NoiseTerm::RateRamp) => "acceleration ramp",
+        }
+    }
+
+    /// The JSON key of a coefficient: `n_deg_per_sqrt_h`.
+    #[must_use]
+    pub fn key(self, term: NoiseTerm) -> String {
+        format!("{}_{}", term.letter().to_lowercase(), self.unit(term).key)
+    }
+}
+
+/// The stochastic errors a channel was configured with (a simulation's `[imu]`, or a log set's
+/// `table.toml`), SI.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Truth {
+    /// Q, N, B, K, R.
+    pub terms: IeeeTerms,
+    /// A first-order Gauss-Markov bias: its σ (rad/s | m/s²).
+    pub markov_sigma_si: f64,
+    /// Its correlation time, s.
+    pub correlation_s: f64,
+}
+
+impl Truth {
+    /// The gyros' configured noise.
+    #[must_use]
+    pub fn gyro(g: &GyroSpec) -> Self {
+        Self { terms: g.noise, markov_sigma_si: g.markov_sigma_rad_per_s, correlation_s: g.correlation_s }
+    }
+
+    /// The accelerometers' configured noise.
+    #[must_use]
+    pub fn accel(a: &AccelSpec) -> Self {
+        Self { terms: a.noise, markov_sigma_si: a.markov_sigma_mps2, correlation_s: a.correlation_s }
+    }
+
+    /// True if the Gauss-Markov bias is in the signal.
+    #[must_use]
+    pub fn has_markov(&self) -> bool {
+        self.markov_sigma_si > 0.0 && self.correlation_s > 0.0
+    }
+
+    /// The Allan variance of what was configured at τ (s), SI rate units²: the terms' exact curves
+    /// ([`IeeeTerms::model_avar`]) and the Gauss-Markov bias's.
+    #[must_use]
+    pub fn avar(&self, tau_s: f64) -> f64 {
+        let markov = if self.has_markov() { gauss_markov_avar(self.markov_sigma_si, self.correlation_s, tau_s) } else { 0.0 };
+        self.terms.model_avar(tau_s) + markov
+    }
+}
+
+/// One channel's analysis.
+#[derive(Debug, Clone)]
+pub struct Channel {
+    /// Gyro or accelerometer.
+    pub sensor: Sensor,
+    /// 0, 1, 2 for x, y, z.
+    pub axis: usize,
+    /// The curve, its confidence, the fit.
+    pub report: AllanReport,
+    /// What was configured, if known.
+    pub truth: Option<Truth>,
+}
+
+impl Channel {
+    /// "gyro x".
+    #[must_use]
+    pub fn name(&self) -> String {
+        format!("{} {}", self.sensor.name(), AXES[self.axis])
+    }
+
+    /// The fitted coefficient of `term` in its conventional unit.
+    #[must_use]
+    pub fn fitted(&self, term: NoiseTerm) -> Estimate {
+        self.report.fit.get(term).scaled(1.0 / self.sensor.unit(term).si)
+    }
+
+    /// The configured coefficient of `term` in its conventional unit (None without a truth).
+    #[must_use]
+    pub fn configured(&self, term: NoiseTerm) -> Option<f64> {
+        self.truth.map(|t| t.terms.coefficient(term) / self.sensor.unit(term).si)
+    }
+}
+
+/// A channel that could not be analysed.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error("{channel}: {error}")]
+pub struct ChannelError {
+    /// "gyro x".
+    pub channel: String,
+    /// Why.
+    pub error: AllanError,
+}
+
+/// Analyses the six channels (`phases` in the order gyro x, y, z, accel x, y, z) sampled every
+/// `tau0_s`; `truth` holds the gyros' and the accelerometers' configured noise. `parallel`: one
+/// channel per core (rayon), else one after the other (the benchmark's single-core number).
+///
+/// # Errors
+/// The first channel that cannot be analysed, named.
+pub fn analyze_imu(phases: &[Phase], tau0_s: f64, opts: &AllanOptions, truth: Option<[Truth; 2]>, parallel: bool) -> Result<Vec<Channel>, ChannelError> {
+    use rayon::prelude::*;
+    let one = |i: usize| -> Result<Channel, ChannelError> {
+        let (sensor, axis) = (Sensor::ALL[i / 3], i % 3);
+        let report = analyze(&phases[i], tau0_s, opts).map_err(|error| ChannelError { channel: format!("{} {}", sensor.name(), AXES[axis]), error })?;
+        Ok(Channel { sensor, axis, report, truth: truth.map(|t| t[i / 3]) })
+    };
+    let n = phases.len().min(6);
+    if parallel { (0..n).into_par_iter().map(one).collect() } else { (0..n).map(one).collect() }
+}
+
+/// The analysis of an IMU log.
+#[derive(Debug, Clone)]
+pub struct ImuAllan {
+    /// What was analysed ("scenario static-imu-10h (simulated)", "log set logs/static").
+    pub source: String,
+    /// The simulation's seed.
+    pub seed: Option<u64>,
+    /// The log's sample rate, Hz.
+    pub rate_hz: f64,
+    /// Samples summed into one before the analysis.
+    pub decimate: usize,
+    /// Samples per channel analysed (after decimation).
+    pub samples: usize,
+    /// Half-width of the confidence intervals, normal sigmas.
+    pub ci_sigma: f64,
+    /// The six channels.
+    pub channels: Vec<Channel>,
+    /// What a reader must know (gaps, motion, saturation...).
+    pub notes: Vec<String>,
+    /// Stopped by a signal before the end of the log.
+    pub interrupted: bool,
+    /// Wall time of reading or simulating, s.
+    pub gather_s: f64,
+    /// Wall time of the analysis, s.
+    pub analysis_s: f64,
+}
+
+/// `x` with `digits` significant digits (scientific outside 1e-4..1e6).
+#[must_use]
+pub fn sig(x: f64, digits: usize) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let e = x.abs().log10().floor() as i32;
+    if !(-4..6).contains(&e) {
+        return format!("{:.*e}", digits.saturating_sub(1), x);
+    }
+    format!("{:.*}", (digits as i32 - 1 - e).max(0) as usize, x)
+}
+
+/// A fitted value as the table shows it: "0.02000 ±0.03% (+0.1%)", or "— (<0.0011)" when the fit
+/// did not find the term (with its 1σ detection limit).
+fn cell(e: Estimate, truth: Option<f64>) -> String {
+    if !e.significant || e.value <= 0.0 {
+        return format!("— (<{})", sig(e.sigma, 2));
+    }
+    let mut s = format!("{} ±{}%", sig(e.value, 4), sig(100.0 * e.sigma / e.value, 2));
+    if let Some(t) = truth.filter(|t| *t > 0.0) {
+        s += &format!(" ({:+.1}%)", 100.0 * (e.value / t - 1.0));
+    }
+    s
+}
+
+impl ImuAllan {
+    /// The shortest and the longest cluster time analysed, s.
+    #[must_use]
+    pub fn tau_range_s(&self) -> (f64, f64) {
+        let taus = self.channels.first().map(|c| c.report.taus_s.as_slice()).unwrap_or_default();
+        (taus.first().copied().unwrap_or(0.0), taus.last().copied().unwrap_or(0.0))
+    }
+
+    /// The one-line heading.
+    #[must_use]
+    pub fn heading(&self) -> String {
+        let tau0 = self.decimate as f64 / self.rate_hz;
+        let (lo, hi) = self.tau_range_s();
+        let seed = self.seed.map(|s| format!(", seed {s}")).unwrap_or_default();
+        format!(
+            "Allan deviation of {}{seed}: {} samples per channel at {} Hz{} ({:.2} h), {} cluster times {} s .. {} s, ±{}σ intervals",
+            self.source,
+            self.samples,
+            self.rate_hz,
+            if self.decimate > 1 { format!(" summed by {}", self.decimate) } else { String::new() },
+            self.samples as f64 * tau0 / 3600.0,
+            self.channels.first().map_or(0, |c| c.report.taus_s.len()),
+            sig(lo, 3),
+            sig(hi, 4),
+            self.ci_sigma
+        )
+    }
+
+    /// The terminal table: per sensor, one row per coefficient, one column per axis and the configured value.
+    #[must_use]
+    pub fn text(&self) -> String {
+        let mut s = String::new();
+        if self.interrupted {
+            s.push_str("INTERRUPTED: the analysis below is of the part of the log gathered before the stop\n");
+        }
+        s.push_str(&self.heading());
+        s.push('\n');
+        for sensor in Sensor::ALL {
+            let chans: Vec<&Channel> = self.channels.iter().filter(|c| c.sensor == sensor).collect();
+            if chans.is_empty() {
+                continue;
+            }
+            let truth = chans[0].truth;
+            let labels: Vec<String> = TERMS.iter().map(|t| format!("{} {} ({})", t.letter(), sensor.term_name(*t), sensor.unit(*t).text)).collect();
+            let w = labels.iter().map(|l| l.chars().count()).max().unwrap_or(0) + 2;
+            let cells: Vec<Vec<String>> = TERMS.iter().map(|t| chans.iter().map(|c| cell(c.fitted(*t), c.configured(*t))).collect()).collect();
+            let cw = cells.iter().flatten().map(|c| c.chars().count()).max().unwrap_or(0).max(4) + 2;
+            s += &format!("\n{:<w$}", format!("{} (fit ±1σ, error)", sensor.name()));
+            for c in &chans {
+                s += &format!("{:<cw$}", AXES[c.axis]);
+            }
+            if truth.is_some() {
+                s += "configured";
+            }
+            s.push('\n');
+            for (k, term) in TERMS.iter().enumerate() {
+                s += &format!("{:<w$}", labels[k]);
+                for c in &cells[k] {
+                    s += &format!("{c:<cw$}");
+                }
+                if let Some(v) = chans[0].configured(*term) {
+                    s += &sig(v, 4);
+                }
+                s = s.trim_end().to_owned();
+                s.push('\n');
+            }
+            if let Some(t) = truth.filter(Truth::has_markov) {
+                s += &format!(
+                    "also configured: a Gauss-Markov bias of σ {} {}, T {} s (not an IEEE term: its curve peaks at 0.62σ near τ = 1.9 T)\n",
+                    sig(t.markov_sigma_si / sensor.adev_unit().si, 3),
+                    sensor.adev_unit().text,
+                    t.correlation_s
+                );
+            }
+        }
+        s.push_str("\n± the fit's 1σ (weighted NNLS of the IEEE 952/1293 model, inflated by √(χ²/dof)); (…) its error against the configured value;\n— not found, with its 1σ detection limit. Slope-line readings, the curves, their bounds and EDF are in --json.\n");
+        for n in &self.notes {
+            s += &format!("note: {n}\n");
+        }
+        s
+    }
+
+    /// One sensor's coefficients as a markdown table, a row per axis (the recording's documents).
+    #[must_use]
+    pub fn markdown(&self, sensor: Sensor) -> String {
+        let chans: Vec<&Channel> = self.channels.iter().filter(|c| c.sensor == sensor).collect();
+        let title = match sensor {
+            Sensor::Gyro => "Gyros",
+            Sensor::Accel => "Accelerometers",
+        };
+        let mut s = format!("**{title}**: fit ±1σ (error vs configured); — not found (1σ detection limit)\n\n| |");
+        for term in TERMS {
+            s += &format!(" {} ({}) |", term.letter(), sensor.unit(term).text);
+        }
+        s += "\n|---|";
+        s += &"---|".repeat(TERMS.len());
+        s.push('\n');
+        for c in &chans {
+            s += &format!("| **{}** |", AXES[c.axis]);
+            for term in TERMS {
+                s += &format!(" {} |", cell(c.fitted(term), c.configured(term)));
+            }
+            s.push('\n');
+        }
+        if let Some(c) = chans.first().filter(|c| c.truth.is_some()) {
+            s += "| configured |";
+            for term in TERMS {
+                s += &format!(" {} |", c.configured(term).map_or_else(String::new, |v| sig(v, 4)));
+            }
+            s.push('\n');
+        }
+        if let Some(t) = chans.first().and_then(|c| c.truth).filter(Truth::has_markov) {
+            s += &format!("\nAlso configured: a Gauss-Markov bias, σ {} {}, T {} s.\n", sig(t.markov_sigma_si / sensor.adev_unit().si, 3), sensor.adev_unit().text, t.correlation_s);
+        }
+        s
+    }
+
+    /// Everything as JSON, units in the key names.
+    #[must_use]
+    pub fn json(&self) -> Value {
+        let mut out = Map::new();
+        out.insert("source".into(), json!(self.source));
+        out.insert("seed".into(), json!(self.seed));
+        out.insert("rate_hz".into(), json!(self.rate_hz));
+        out.insert("decimate".into(), json!(self.decimate));
+        out.insert("tau0_s".into(), json!(self.decimate as f64 / self.rate_hz));
+        out.insert("samples".into(), json!(self.samples));
+        out.insert("confidence_sigma".into(), json!(self.ci_sigma));
+        out.insert("interrupted".into(), json!(self.interrupted));
+        out.insert("notes".into(), json!(self.notes));
+        out.insert("estimator".into(), json!("overlapping Allan deviation of the rate; EDF by NIST SP 1065 Table 5 for the fitted noise mixture; chi-square interval (Wilson-Hilferty); coefficients by weighted NNLS of the IEEE 952/1293 model sigma^2 = 3Q^2/tau^2 + N^2/tau + (2 ln2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2"));
+        for sensor in Sensor::ALL {
+            let list: Vec<Value> = self.channels.iter().filter(|c| c.sensor == sensor).map(channel_json).collect();
+            out.insert(sensor.name().into(), Value::Array(list));
+        }
+        Value::Object(out)
+    }
+}
+
+fn reading_json(r: Option<SlopeReading>, si: f64) -> Value {
+    r.map_or(Value::Null, |r| json!({"value": r.value_si / si, "sigma": r.sigma_si / si, "tau_s": r.tau_s, "local_slope": r.local_slope, "nominal_slope": r.nominal_slope, "matched": r.matched}))
+}
+
+fn channel_json(c: &Channel) -> Value {
+    let s = c.sensor;
+    let u = s.adev_unit();
+    let r = &c.report;
+    let scale = |v: &[f64]| -> Vec<f64> { v.iter().map(|x| x / u.si).collect() };
+    let mut m = Map::new();
+    m.insert("axis".into(), json!(AXES[c.axis]));
+    m.insert("tau_s".into(), json!(r.taus_s));
+    m.insert(format!("adev_{}", u.key), json!(scale(&r.adev_si)));
+    m.insert(format!("adev_lower_{}", u.key), json!(scale(&r.adev_lower_si)));
+    m.insert(format!("adev_upper_{}", u.key), json!(scale(&r.adev_upper_si)));
+    m.insert("edf".into(), json!(r.edf));
+    m.insert("second_differences".into(), json!(r.n_terms));
+    m.insert("dominant".into(), json!(r.dominant.iter().map(|t| t.letter()).collect::<Vec<_>>()));
+    m.insert("fit_chi2_per_dof".into(), json!(r.fit_chi2_per_dof));
+    let mut fitted = Map::new();
+    let mut readings = Map::new();
+    for term in TERMS {
+        let e = c.fitted(term);
+        fitted.insert(s.key(term), json!({"value": e.value, "sigma": e.sigma, "significant": e.significant}));
+        readings.insert(s.key(term), reading_json(r.slope.get(term), s.unit(term).si));
+    }
+    m.insert("fitted".into(), Value::Object(fitted));
+    m.insert("slope_readings".into(), Value::Object(readings));
+    match c.truth {
+        None => {
+            m.insert("configured".into(), Value::Null);
+        }
+        Some(t) => {
+            let mut cfg = Map::new();
+            for term in TERMS {
+                cfg.insert(s.key(term), json!(c.configured(term)));
+            }
+            cfg.insert("bias_instability_range_s".into(), json!(t.terms.flicker_range_s));
+            cfg.insert(format!("markov_sigma_{}", u.key), json!(t.markov_sigma_si / u.si));
+            cfg.insert("correlation_time_s".into(), json!(t.correlation_s));
+            m.insert("configured".into(), Value::Object(cfg));
+            m.insert(format!("configured_adev_{}", u.key), json!(r.taus_s.iter().map(|tau| t.avar(*tau).sqrt() / u.si).collect::<Vec<_>>()));
+        }
+    }
+    Value::Object(m)
+}

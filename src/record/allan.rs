@@ -1,0 +1,212 @@
+//! The recording of `rinscope allan`: one log-log Allan plot per axis (gyros above, accelerometers
+//! below), the fitted slope lines of the IEEE terms over the data, the configured truth dotted, the
+//! coefficients as a table. Rerun plots against a timeline and has no logarithmic axis, so the
+//! curves are logged as log10 values on a timeline `log10_tau_s` whose "seconds" are log10(τ / 1 s),
+//! and the entity paths and the documents say so.
+
+use rerun::blueprint::components::ContainerKind;
+use rerun::{RecordingStreamResult, TimeColumn};
+
+use super::layout::{self, LegendCorner, Node};
+use super::palette::rgb;
+use super::{Stream, APPLICATION_ID};
+use crate::ins::allan::{Channel, ImuAllan, AXES};
+use crate::math::allan::TERMS;
+
+/// The x axis: a duration timeline whose value in seconds is log10(τ / 1 s).
+pub const LOG10_TAU_TIMELINE: &str = "log10_tau_s";
+
+const MEASURED: [u8; 3] = [235, 235, 235];
+const CONFIDENCE: [u8; 3] = [120, 120, 120];
+const TRUTH: [u8; 3] = [80, 220, 230];
+/// Q, N, B, K, R.
+const TERM_COLORS: [[u8; 3]; 5] = [[200, 110, 240], [80, 140, 250], [60, 200, 90], [240, 80, 80], [240, 220, 60]];
+
+/// Points per decade of the drawn lines (fit, slope lines, truth).
+const LINE_POINTS_PER_DECADE: f64 = 20.0;
+
+fn path(c: &Channel) -> String {
+    format!("allan/{}_{}", c.sensor.name(), AXES[c.axis])
+}
+
+/// One curve on the log10 τ timeline.
+fn send(stream: &Stream, entity: &str, log10_tau: &[f64], log10_value: &[f64], drawn: &mut Vec<(f64, f64)>) -> RecordingStreamResult<()> {
+    drawn.extend(log10_tau.iter().copied().zip(log10_value.iter().copied()));
+    let time = TimeColumn::new_duration_secs(LOG10_TAU_TIMELINE, log10_tau.iter().copied());
+    stream.rec().send_columns(entity, [time], rerun::Scalars::new(log10_value.iter().copied()).columns(std::iter::repeat_n(1, log10_tau.len()))?)?;
+    Ok(())
+}
+
+fn line_style(stream: &Stream, entity: &str, color: [u8; 3], width: f32, name: &str) -> RecordingStreamResult<()> {
+    stream.rec().log_static(entity, &rerun::SeriesLines::new().with_colors([rgb(color)]).with_widths([width]).with_names([name]))
+}
+
+/// A dense log-spaced grid over [lo, hi] (log10 values).
+fn grid(lo: f64, hi: f64) -> Vec<f64> {
+    let n = (((hi - lo) * LINE_POINTS_PER_DECADE).ceil() as usize).max(1);
+    (0..=n).map(|i| lo + (hi - lo) * i as f64 / n as f64).collect()
+}
+
+/// Logs one channel's plot; returns the ranges its view shows (with room for the legend).
+fn log_channel(stream: &Stream, c: &Channel, ci_sigma: f64) -> RecordingStreamResult<PlotRange> {
+    let base = path(c);
+    let u = c.sensor.adev_unit();
+    let r = &c.report;
+    let lg = |v: f64| (v / u.si).log10();
+    let keep: Vec<usize> = (0..r.taus_s.len()).filter(|&j| r.adev_si[j] > 0.0).collect();
+    if keep.is_empty() {
+        return Ok(PlotRange { x: (-3.0, 3.0), y: (-1.0, 1.0), legend: LegendCorner::RightBottom });
+    }
+    let x: Vec<f64> = keep.iter().map(|&j| r.taus_s[j].log10()).collect();
+    let y: Vec<f64> = keep.iter().map(|&j| lg(r.adev_si[j])).collect();
+    let dir = format!("{base}/log10_adev_{}", u.key);
+    let mut drawn = Vec::new();
+    let measured = format!("{dir}/measured");
+    stream.rec().log_static(
+        measured.as_str(),
+        &rerun::SeriesLines::new().with_colors([rgb(MEASURED)]).with_widths([2.0]).with_names(["ADEV (measured)"]),
+    )?;
+    stream.rec().log_static(measured.as_str(), &rerun::SeriesPoints::new().with_colors([rgb(MEASURED)]).with_marker_sizes([2.5]).with_names(["ADEV (measured)"]))?;
+    send(stream, &measured, &x, &y, &mut drawn)?;
+    let (mut y_min, mut y_max) = (f64::INFINITY, f64::NEG_INFINITY);
+    for (name, bound, sign) in [("ci_upper", &r.adev_upper_si, "+"), ("ci_lower", &r.adev_lower_si, "−")] {
+        let e = format!("{dir}/{name}");
+        line_style(stream, &e, CONFIDENCE, 1.0, &format!("{sign}{ci_sigma}σ bound"))?;
+        let yb: Vec<f64> = keep.iter().map(|&j| lg(bound[j].max(f64::MIN_POSITIVE))).collect();
+        for v in &yb {
+            (y_min, y_max) = (y_min.min(*v), y_max.max(*v));
+        }
+        send(stream, &e, &x, &yb, &mut drawn)?;
+    }
+    let (x_lo, x_hi) = (x[0], x[x.len() - 1]);
+    let (y_lo, y_hi) = (y_min - 0.3, y_max + 0.3);
+    let dense = grid(x_lo, x_hi);
+    let fit = &r.fit;
+    for term in TERMS {
+        let est = fit.get(term);
+        if !est.significant {
+            continue;
+        }
+        // The term's line log10 σ = log10 √(a c²) + (p/2) log10 τ, where the term makes at least
+        // a tenth of the fitted variance, inside the plot.
+        let (p, a0) = (f64::from(term.exponent()) / 2.0, lg(term.avar(est.value, 1.0).sqrt()));
+        let share = |lt: f64| term.avar(est.value, 10f64.powf(lt)) / fit.avar(10f64.powf(lt));
+        let pts: Vec<(f64, f64)> = dense.iter().filter(|lt| share(**lt) >= 0.1).map(|lt| (*lt, a0 + p * lt)).filter(|(_, v)| (y_lo..=y_hi).contains(v)).collect();
+        if pts.len() < 2 {
+            continue;
+        }
+        let e = format!("{dir}/slope_{}", term.letter());
+        let unit = c.sensor.unit(term);
+        let label = format!("{} {} {} ({})", term.letter(), crate::ins::allan::sig(est.value / unit.si, 3), unit.text, term.slope_text());
+        line_style(stream, &e, TERM_COLORS[term as usize], 1.5, &label)?;
+        let (xs, ys): (Vec<f64>, Vec<f64>) = pts.into_iter().unzip();
+        send(stream, &e, &xs, &ys, &mut drawn)?;
+    }
+    if let Some(t) = c.truth {
+        let e = format!("{dir}/configured");
+        stream.rec().log_static(
+            e.as_str(),
+            &rerun::SeriesPoints::new().with_colors([rgb(TRUTH)]).with_marker_sizes([1.2]).with_markers([rerun::components::MarkerShape::Circle]).with_names(["configured"]),
+        )?;
+        let yt: Vec<f64> = dense.iter().map(|lt| lg(t.avar(10f64.powf(*lt)).sqrt().max(f64::MIN_POSITIVE))).collect();
+        for v in &yt {
+            (y_min, y_max) = (y_min.min(*v), y_max.max(*v));
+        }
+        send(stream, &e, &dense, &yt, &mut drawn)?;
+    }
+    Ok(plot_range(&drawn, (x_lo, x_hi)))
+}
+
+/// The view's ranges and the legend's corner: the first corner (bottom right, bottom left, top
+/// right, top left) whose 30 % × 48 % box holds no drawn point; if every one does (a V-shaped curve
+/// fills them all), room on the right of the data (at most 30 % more: the axis keeps its ticks),
+/// else below it.
+fn plot_range(drawn: &[(f64, f64)], x: (f64, f64)) -> PlotRange {
+    let y = drawn.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (_, v)| (lo.min(*v), hi.max(*v)));
+    let sx = (x.1 - x.0).max(1e-3);
+    let sy = (y.1 - y.0).max(0.5);
+    let y_r = (y.0 - 0.04 * sy, y.1 + 0.04 * sy);
+    let free = |x_r: (f64, f64), y_r: (f64, f64), right: bool, bottom: bool| {
+        !drawn.iter().any(|(px, py)| {
+            let (nx, ny) = ((px - x_r.0) / (x_r.1 - x_r.0), (py - y_r.0) / (y_r.1 - y_r.0));
+            (if right { nx > 0.68 } else { nx < 0.32 }) && (if bottom { ny < 0.52 } else { ny > 0.48 })
+        })
+    };
+    let x_r = (x.0 - 0.02 * sx, x.1 + 0.02 * sx);
+    let corners = [(true, true, LegendCorner::RightBottom), (false, true, LegendCorner::LeftBottom), (true, false, LegendCorner::RightTop), (false, false, LegendCorner::LeftTop)];
+    if let Some((_, _, corner)) = corners.iter().find(|(r, b, _)| free(x_r, y_r, *r, *b)) {
+        return PlotRange { x: x_r, y: y_r, legend: *corner };
+    }
+    let wide = (x_r.0, x.1 + 0.3 * sx);
+    if free(wide, y_r, true, true) {
+        return PlotRange { x: wide, y: y_r, legend: LegendCorner::RightBottom };
+    }
+    PlotRange { x: wide, y: (y.0 - 0.8 * sy, y_r.1), legend: LegendCorner::RightBottom }
+}
+
+/// What a plot shows, log10 units, and where its legend goes.
+struct PlotRange {
+    x: (f64, f64),
+    y: (f64, f64),
+    legend: LegendCorner,
+}
+
+
+
+fn about(r: &ImuAllan, description: &str) -> String {
+    let terms: String = TERMS
+        .iter()
+        .map(|t| format!("| {} | {} / {} | {} |\n", t.letter(), crate::ins::allan::Sensor::Gyro.term_name(*t), crate::ins::allan::Sensor::Accel.term_name(*t), t.slope_text()))
+        .collect();
+    let notes: String = r.notes.iter().map(|n| format!("\n*Note:* {n}\n")).collect();
+    format!(
+        "# Allan deviation\n\n{}\n{notes}\n**How to read the plots.** Rerun has no logarithmic axis, so both axes carry **log10 values**: \
+         the horizontal axis is the timeline `{LOG10_TAU_TIMELINE}`, whose \"seconds\" are **log10(τ / 1 s)** (−2 is 10 ms, 0 is \
+         1 s, 3 is 1000 s); the vertical axis is log10 of the Allan deviation of the rate, in **log10(°/h)** for gyros and \
+         **log10(µg)** for accelerometers (0 is 1 °/h or 1 µg, −1 is 0.1). A power law σ = c·τ^s is a straight line of slope s:\n\n\
+         | term | gyro / accelerometer | slope |\n|---|---|---|\n{terms}\n\
+         White: the measured overlapping ADEV; grey: its ±{}σ confidence bounds (χ² with the equivalent degrees of freedom of \
+         NIST SP 1065); coloured: the slope line of each term the fit found, labelled with its coefficient and drawn where \
+         it makes at least a tenth of the fitted variance; cyan dots: the exact ADEV of the configured noise (when it is known). The flat floor of B is at 0.664·B.\n\n{}\n",
+        r.heading(),
+        r.ci_sigma,
+        description.trim()
+    )
+}
+
+/// Logs the analysis with its documents and a layout; `description` explains the source (markdown).
+pub fn log(stream: &Stream, r: &ImuAllan, description: &str) -> RecordingStreamResult<()> {
+    use crate::ins::allan::Sensor;
+    let rec = stream.rec();
+    rec.send_recording_name(format!("rinscope allan: {}", r.source))?;
+    rec.log_static("docs/allan", &rerun::TextDocument::from_markdown(about(r, description)))?;
+    for sensor in Sensor::ALL {
+        rec.log_static(format!("docs/coefficients_{}", sensor.name()), &rerun::TextDocument::from_markdown(r.markdown(sensor)))?;
+    }
+    let mut ranges = Vec::new();
+    for c in &r.channels {
+        ranges.push(log_channel(stream, c, r.ci_sigma)?);
+    }
+    let view = |(c, range): (&Channel, &PlotRange)| {
+        let u = c.sensor.adev_unit();
+        Node::view("TimeSeries", format!("{} {}: log10 ADEV [log10 {}] vs log10 τ [log10 s]", c.sensor.name(), AXES[c.axis], u.text), path(c))
+            .with_property("TimeAxis", &layout::time_axis_range(range.x.0, range.x.1))
+            .with_property("ScalarAxis", &layout::scalar_range(range.y.0, range.y.1))
+            .with_property("PlotLegend", &layout::legend_at(range.legend))
+    };
+    let row = |sensor: Sensor| Node::container(ContainerKind::Horizontal, r.channels.iter().zip(&ranges).filter(|(c, _)| c.sensor == sensor).map(view).collect(), &[]);
+    let docs = Node::container(
+        ContainerKind::Horizontal,
+        vec![
+            Node::view("TextDocument", "gyro coefficients", "docs/coefficients_gyro"),
+            Node::container(
+                ContainerKind::Tabs,
+                vec![Node::view("TextDocument", "accelerometer coefficients", "docs/coefficients_accel"), Node::view("TextDocument", "how to read the plots", "docs/allan")],
+                &[],
+            ),
+        ],
+        &[],
+    );
+    let root = Node::container(ContainerKind::Vertical, vec![row(Sensor::Gyro), row(Sensor::Accel), docs], &[1.0, 1.0, 0.62]);
+    layout::send(rec, APPLICATION_ID, &root, &layout::Playback { timeline: LOG10_TAU_TIMELINE, speed: 1.0, follow: true })
+}

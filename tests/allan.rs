@@ -1,0 +1,155 @@
+//! `rinscope allan` end to end: the 10 h static preset read back within the issue's bands on every
+//! axis (through the simulation's whole IMU chain, the JSON a user gets), a log set analysed, and
+//! the new scenario keys refused clearly when misused.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+fn rinscope() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_rinscope"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("rinscope-allan-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+const PRESET: &str = include_str!("../assets/scenarios/static-imu-10h.toml");
+
+fn json(path: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(path).expect("json written")).expect("valid json")
+}
+
+/// The fitted value of `key` on one channel and whether the fit found it.
+fn fitted(ch: &Value, key: &str) -> (f64, bool) {
+    let e = &ch["fitted"][key];
+    (e["value"].as_f64().expect("value"), e["significant"].as_bool().expect("flag"))
+}
+
+fn configured(ch: &Value, key: &str) -> f64 {
+    ch["configured"][key].as_f64().expect("configured value")
+}
+
+#[test]
+fn the_10h_preset_gives_back_n_b_and_k_on_every_axis() {
+    // Golden: the preset's configured N, B, K (assets/scenarios/static-imu-10h.toml), read back
+    // through the IEEE 952/1293 slope relations. Bands from the issue, N and K within 10 %, B within
+    // 25 %; docs/allan.md derives what each needs from the estimator's EDF (a 40-seed study of the
+    // generator gives 1σ scatters of 0.03 % (N), 0.5 % (B), 2.8 % (K): K's band is 3.5σ, the others
+    // far wider). Q and R are not configured and must not be found.
+    let dir = scratch("preset");
+    let (out, rec) = (dir.join("adev.json"), dir.join("allan.rrd"));
+    let o = rinscope().args(["allan", "--scenario", "static-imu-10h", "--json"]).arg(&out).arg("--save").arg(&rec).output().expect("run");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("angle random walk") && text.contains("acceleration random walk"), "{text}");
+    let j = json(&out);
+    assert_eq!(j["samples"].as_u64(), Some(7_200_000));
+    for (sensor, keys) in [("gyro", ["n_deg_per_sqrt_h", "b_deg_per_h", "k_deg_per_h_per_sqrt_h", "q_arcsec", "r_deg_per_h2"]), ("accel", ["n_ug_per_sqrt_hz", "b_ug", "k_ug_per_sqrt_h", "q_mps", "r_ug_per_h"])] {
+        let channels = j[sensor].as_array().expect("channels");
+        assert_eq!(channels.len(), 3);
+        for ch in channels {
+            let axis = ch["axis"].as_str().unwrap_or("?");
+            for (key, band) in [(keys[0], 0.10), (keys[1], 0.25), (keys[2], 0.10)] {
+                let (value, found) = fitted(ch, key);
+                let truth = configured(ch, key);
+                assert!(found && (value / truth - 1.0).abs() < band, "{sensor} {axis} {key}: {value} vs {truth} (band {band})");
+            }
+            for key in &keys[3..] {
+                assert!(!fitted(ch, key).1, "{sensor} {axis}: {key} found but not configured");
+            }
+            // The curve, its bounds and the configured truth are all there, at the same cluster times.
+            let taus = ch["tau_s"].as_array().expect("taus").len();
+            let unit = if sensor == "gyro" { "deg_per_h" } else { "ug" };
+            for k in ["adev", "adev_lower", "adev_upper", "configured_adev"] {
+                assert_eq!(ch[format!("{k}_{unit}")].as_array().map(Vec::len), Some(taus), "{k}");
+            }
+        }
+    }
+    assert!(std::fs::metadata(&rec).map(|m| m.len()).unwrap_or(0) > 10_000, "a recording");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_log_set_is_analysed_from_its_files() {
+    // 20 min of the preset written as a log set (csv) and read back: N, which 20 min measure to
+    // ~0.15 % (white-rate EDF ~3.6e5 at τ0), within 5 % on all six channels; the configured values
+    // come from the log set's table.toml, and the output says so.
+    let dir = scratch("logset");
+    let cfg = dir.join("short.toml");
+    std::fs::write(&cfg, PRESET.replacen("duration_s = 36000.0", "duration_s = 1200.0", 1)).expect("config");
+    let log = dir.join("log");
+    let o = rinscope().args(["export-log", "--config"]).arg(&cfg).arg("--out").arg(&log).output().expect("export");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = dir.join("adev.json");
+    let o = rinscope().arg("allan").arg(&log).arg("--json").arg(&out).arg("--no-recording").output().expect("allan");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("table.toml"), "says where \"configured\" comes from");
+    let j = json(&out);
+    for (sensor, key) in [("gyro", "n_deg_per_sqrt_h"), ("accel", "n_ug_per_sqrt_hz")] {
+        for ch in j[sensor].as_array().expect("channels") {
+            let (value, found) = fitted(ch, key);
+            let truth = configured(ch, key);
+            assert!(found && (value / truth - 1.0).abs() < 0.05, "{sensor} {key}: {value} vs {truth}");
+        }
+    }
+    // A gap of 0.5 s at 400 s (rows cut out of the csv), with the manifest's `gap_policy = "split"`:
+    // the longest stretch without a gap (rows 80 101..240 002 of the 240 002 written: 400.5 s to 1200 s, 159 902
+    // samples) is analysed, and the output says so.
+    let imu = log.join("imu.csv");
+    let text = std::fs::read_to_string(&imu).expect("imu.csv");
+    let lines: Vec<&str> = text.lines().collect();
+    let cut: Vec<&str> = lines[..80_001].iter().chain(&lines[80_101..]).copied().collect();
+    std::fs::write(&imu, cut.join("\n") + "\n").expect("write");
+    let manifest = std::fs::read_to_string(log.join("log.toml")).expect("manifest");
+    std::fs::write(log.join("log.toml"), manifest.replacen("gap_policy = \"refuse\"", "gap_policy = \"split\"", 1)).expect("write");
+    let o = rinscope().arg("allan").arg(&log).arg("--json").arg(&out).arg("--no-recording").output().expect("allan");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("1 gap(s): the longest stretch"), "{}", String::from_utf8_lossy(&o.stdout));
+    let j = json(&out);
+    assert_eq!(j["samples"].as_u64(), Some(159_902), "{}", j["notes"]);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+fn refused(args: &[&str], config: Option<(&str, &str)>, expected: &[&str]) {
+    let dir = scratch("refused");
+    let mut cmd = rinscope();
+    cmd.args(args);
+    if let Some((from, to)) = config {
+        assert!(PRESET.contains(from), "the preset has `{from}`");
+        let path = dir.join("edited.toml");
+        std::fs::write(&path, PRESET.replacen(from, to, 1)).expect("write config");
+        cmd.arg("--config").arg(&path);
+    }
+    let o = cmd.arg("--save").arg(dir.join("out.rrd")).output().expect("run");
+    assert_eq!(o.status.code(), Some(2), "exit code; stderr: {}", stderr(&o));
+    for e in expected {
+        assert!(stderr(&o).contains(e), "stderr should mention `{e}`: {}", stderr(&o));
+    }
+    assert!(!dir.join("out.rrd").exists(), "no recording");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn bad_requests_and_misused_keys_are_refused_by_name() {
+    // Before this issue `bias_instability_deg_per_h` with `correlation_time_s` was a Gauss-Markov
+    // bias; now it is IEEE's B, and the old spelling is pointed to the new one.
+    let gm = ("bias_instability_deg_per_h = 2.0", "bias_instability_deg_per_h = 2.0\ncorrelation_time_s = 100.0");
+    refused(&["allan"], Some(gm), &["imu.gyro.bias_instability_deg_per_h", "markov_sigma_deg_per_h"]);
+    let both = ("arw_deg_per_sqrt_h = 0.02", "arw_deg_per_sqrt_h = 0.02\nquantization_arcsec = 0.1\npulse_weight_arcsec = 0.3");
+    refused(&["allan"], Some(both), &["imu.gyro.pulse_weight_arcsec", "not both"]);
+    let range = ("bias_instability_range_s = [0.1, 10000.0]     # where", "bias_instability_range_s = [100.0, 10.0]     # where");
+    refused(&["allan"], Some(range), &["imu.gyro.bias_instability_range_s", "[100, 10] s"]);
+    let ramp = ("# rate_ramp_deg_per_h2 = 0.0", "rate_ramp_deg_per_h2 = 1e9");
+    refused(&["allan"], Some(ramp), &["imu.gyro.rate_ramp_deg_per_h2", "deg/h²"]);
+    refused(&["allan", "--scenario", "jiang2017-dual-axis"], None, &["needs an [imu] section"]);
+    refused(&["allan", "--scenario", "static-imu-10h", "--export", "x"], None, &["--json"]);
+    refused(&["allan", "--scenario", "static-imu-10h", "--decimate", "0"], None, &["--decimate 0"]);
+}
