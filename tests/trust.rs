@@ -135,12 +135,17 @@ fn sigterm_and_sighup_finish_a_complete_recording_and_a_second_signal_ends_at_on
 #[test]
 fn cut_short_commands_say_so_and_exit_non_zero() {
     // modulation printed a table of truncated runs and exited 0; calibrate left a .partial.
-    for args in [&["modulation", "--hours", "240"][..], &["tpr"][..]] {
+    // tpr at 100 Hz now takes about a second in all: at 2 kHz it runs long enough to be cut.
+    let tpr_dir = scratch("cut-tpr-config");
+    let tpr = tempconfig(&tpr_dir, "zheng2016-tpr", "step_hz = 100.0", "step_hz = 2000.0");
+    let tpr = tpr.to_str().expect("utf-8 path");
+    for args in [&["modulation", "--hours", "240"][..], &["tpr", "--config", tpr][..]] {
         let dir = scratch(&format!("cut-{}", args[0]));
         let save = dir.join("x.rrd");
         let mut cmd = rinscope();
         let child = cmd.args(args).arg("--save").arg(&save).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("runs");
-        std::thread::sleep(Duration::from_millis(1500));
+        wait_for_file(&dir.join("x.rrd.partial"));
+        std::thread::sleep(Duration::from_millis(500));
         signal(&child, "-INT");
         let out = child.wait_with_output().expect("wait");
         let text = String::from_utf8_lossy(&out.stdout);

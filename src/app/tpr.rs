@@ -178,7 +178,7 @@ pub fn compare_resets(params: &Params, sample_s: f64, stop: &AtomicBool) -> Resu
         duration_s: params.duration_s,
         wall_s: started.elapsed().as_secs_f64(),
         complete,
-        arw_rad_per_sqrt_s: params.ins.as_ref().map_or(0.0, |i| i.errors.gyro.arw_rad_per_sqrt_s),
+        arw_rad_per_sqrt_s: params.ins.as_ref().map_or(0.0, |i| i.errors.gyro.noise.random_walk_si),
         latitude_rad: params.site.latitude_rad,
     })
 }
