@@ -48,6 +48,7 @@ pub(super) fn run(args: &RunArgs) -> Result<(), Failure> {
         summary.recording_path = Some(path.display().to_string());
         summary.recording_bytes = Some(*bytes);
     }
+    summary.peak_rss_mb = crate::app::bench::peak_rss_bytes() as f64 / 1e6;
     out!("{}", summary.table());
     print_exported(&saved);
     kept(&saved)?;
@@ -485,9 +486,20 @@ pub(super) fn reproduce(markdown: Option<&Path>) -> Result<(), Failure> {
     }
 }
 
+/// `bench`.
+pub(super) fn bench(steps: u64, json: Option<&std::path::Path>) -> Result<(), Failure> {
+    check_output_dir("--json", json)?;
+    let figures = crate::app::bench::run_benchmarks(steps).map_err(Failure::from)?;
+    if let Some(path) = json {
+        write_json("--json", path, &figures)?;
+    }
+    Ok(())
+}
+
 /// `bench --peer pyins`.
 pub(super) fn bench_peer(python: PathBuf, rounds: usize, samples: u64, json: Option<&std::path::Path>) -> Result<(), Failure> {
     use crate::app::bench::peer;
+    check_output_dir("--json", json)?;
     let reports = peer::compare(&peer::PeerOptions { python, rounds, samples }).map_err(|e| Failure::run(format!("{e:#}")))?;
     out!("{}", peer::text(&reports));
     if let Some(path) = json {

@@ -99,7 +99,8 @@ enum Command {
         /// --peer: samples per stream (2 kHz).
         #[arg(long, default_value_t = 2_000_000)]
         samples: u64,
-        /// --peer: also write every round's numbers as JSON.
+        /// Also write every figure as JSON (with --peer: every round's numbers), to compare a change
+        /// against the last run.
         #[arg(long)]
         json: Option<PathBuf>,
     },
@@ -468,7 +469,7 @@ pub fn main() -> ExitCode {
         }
         Command::CheckConfig { file } => commands::check_config(&file),
         Command::Reproduce { markdown } => commands::reproduce(markdown.as_deref()),
-        Command::Bench { steps, peer: None, .. } => crate::app::bench::run_benchmarks(steps).map_err(Failure::from),
+        Command::Bench { steps, peer: None, json, .. } => commands::bench(steps, json.as_deref()),
         Command::Bench { peer: Some(_), python, rounds, samples, json, .. } => commands::bench_peer(python, rounds, samples, json.as_deref()),
     };
     match result {

@@ -180,6 +180,13 @@ impl VehicleMotion {
         self
     }
 
+    /// The cone, when the motion is pure coning (no Euler-angle motion, no wobble on top): the
+    /// classical test whose drift per algorithm has a closed form.
+    #[must_use]
+    pub fn pure_coning(&self) -> Option<Coning> {
+        self.coning.filter(|_| self.euler_fixed.is_some())
+    }
+
     /// Adds pure coning on top of the Euler-angle motion.
     #[must_use]
     pub fn with_coning(mut self, coning: Coning) -> Self {

@@ -63,8 +63,21 @@ impl Recorder {
             (Some(layout), None) => {
                 // The INS in the loop leads; the turntable-only (ideal-INS) plots go into the tabs.
                 let ins_peak = |a: usize| self.ranges.and_then(|r| r.ins_peak_rad).map(|p| p[a] * crate::math::units::ARCSEC_PER_RAD);
-                let ins_view = |a: usize, axis: &str| framed(plot(format!("INS {axis} error (arcsec)"), &format!("ins/attitude_error_arcsec/{axis}")), ins_peak(a));
+                // The legend would sit over the data: the title gives each algorithm's colour.
+                let algorithm_key = layout.algorithms.iter().map(|a| format!("{}: {a}", super::palette::colors::algorithm_colour_name(a))).collect::<Vec<_>>().join(", ");
+                let ins_view = |a: usize, axis: &str| {
+                    framed(plot(format!("INS {axis} error (arcsec) — {algorithm_key}"), &format!("ins/attitude_error_arcsec/{axis}")), ins_peak(a)).with_property("PlotLegend", &layout::no_legend())
+                };
                 let mut tabs = Vec::new();
+                if let Some((_, rates)) = &layout.coning_log {
+                    // Whole decades, from a tenth of the run (the lines' left part is their steep
+                    // start) to the end, of the slowest to the fastest analytic drift.
+                    let logs = rates.iter().filter(|r| **r > 0.0).map(|r| (r * p.duration_s).log10());
+                    let (lo, hi) = logs.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)));
+                    let view = plot(format!("coning drift, log10 of |heading error| in arcsec — thick: measured, thin: analytic rate × t; {algorithm_key}"), super::ins_view::CONING_LOG_PATH)
+                        .with_property("PlotLegend", &layout::no_legend());
+                    tabs.push(if lo.is_finite() { view.with_property("ScalarAxis", &layout::scalar_range((lo - 1.0).floor(), hi.ceil())) } else { view });
+                }
                 if layout.nav {
                     tabs.push(plot("position error (m)".into(), "ins/position_error_m"));
                     tabs.push(plot("velocity error (m/s)".into(), "ins/velocity_error_mps"));

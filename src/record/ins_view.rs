@@ -25,7 +25,13 @@ pub(crate) struct InsLayout {
     pub(crate) fir_taps: Vec<f64>,
     pub(crate) rate_hz: f64,
     pub(crate) signal_window_s: f64,
+    /// Pure coning: the series index of the log10 drift plot and each algorithm's analytic drift
+    /// rate about the cone axis, arcsec/s (`ins::coning::coning_drift_rate`).
+    pub(crate) coning_log: Option<(usize, Vec<f64>)>,
 }
+
+/// The log10 plot of the coning drift: each algorithm's |heading error| beside its analytic rate × t.
+pub(crate) const CONING_LOG_PATH: &str = "ins/coning_drift_log10_arcsec";
 
 /// The gyro signals' lines.
 const GYRO_NAMES: [&str; 3] = ["gyro x", "gyro y", "gyro z"];
@@ -68,6 +74,12 @@ impl Recorder {
         for axis in ERROR_AXES {
             let path = format!("ins/attitude_error_arcsec/{axis}");
             rec.log_static(path.as_str(), &rerun::SeriesLines::new().with_colors(algo_colors.clone()).with_names(self.series_names(&path)))?;
+        }
+        if layout.coning_log.is_some() {
+            // Measured: the algorithm's colour, wide; analytic: the same colour, thin.
+            let colors: Vec<rerun::Color> = layout.algorithms.iter().flat_map(|name| [rgb(colors::algorithm(name)); 2]).collect();
+            let widths: Vec<f32> = layout.algorithms.iter().flat_map(|_| [2.5, 1.0]).collect();
+            rec.log_static(CONING_LOG_PATH, &rerun::SeriesLines::new().with_colors(colors).with_widths(widths).with_names(self.series_names(CONING_LOG_PATH)))?;
         }
         for path in ["ins/position_error_m", "ins/velocity_error_mps"] {
             rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors::EULER.map(rgb)).with_names(self.series_names(path)))?;

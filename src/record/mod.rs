@@ -72,6 +72,20 @@ impl Stream {
         self.rec.send_columns(path, [time], rerun::Scalars::new(values).columns(std::iter::repeat_n(width, times.len()))?)?;
         Ok(())
     }
+
+    /// Marks events on the plot of `plot_path` where they happen: ▼ markers named `label` at
+    /// `times`, at height `y` (the top of the plot's data, or 0 when it is not known yet), in the
+    /// child entity `<plot>/<slug>` the plot's view includes. Not exported (not a measurement).
+    pub(crate) fn mark_events(&self, plot_path: &str, slug: &str, label: &str, times: &[f64], y: f64) -> RecordingStreamResult<()> {
+        let path = format!("{plot_path}/{slug}");
+        self.rec.log_static(
+            path.as_str(),
+            &rerun::SeriesPoints::new().with_markers([rerun::components::MarkerShape::Down]).with_marker_sizes([7.0]).with_colors([palette::rgb(palette::colors::EVENT)]).with_names([label]),
+        )?;
+        let time = TimeColumn::new_duration_secs(TIMELINE, times.iter().copied());
+        self.rec.send_columns(path, [time], rerun::Scalars::new(vec![y; times.len()]).columns_of_unit_batches()?)?;
+        Ok(())
+    }
 }
 
 /// What a failed Rerun call returns.
@@ -229,6 +243,18 @@ impl Recorder {
                 series.push(Series::new("ins/position_error_m".into(), ["east", "north", "radial"].map(String::from).to_vec()));
                 series.push(Series::new("ins/velocity_error_mps".into(), ["east", "north", "up"].map(String::from).to_vec()));
             }
+            // Pure coning on a table at rest: the drifts span decades, a log10 plot with the
+            // analytic rates shows each algorithm on its line.
+            let coning_log = params.table.vehicle.pure_coning().filter(|_| params.table.scheme.max_rate() == 0.0).map(|cone| {
+                let names = algorithms.iter().flat_map(|a| [format!("{a}: log10 |heading error|"), format!("{a}: analytic coning drift")]).collect();
+                series.push(Series::new(ins_view::CONING_LOG_PATH.into(), names));
+                let rates = cfg
+                    .algorithms()
+                    .iter()
+                    .map(|a| crate::ins::coning::coning_drift_rate(*a, cone.half_angle_rad, cone.omega_rad_per_s / std::f64::consts::TAU, 1.0 / params.step_hz).abs() * ARCSEC_PER_RAD)
+                    .collect();
+                (series.len() - 1, rates)
+            });
             InsLayout {
                 algorithms,
                 nav: cfg.navigation.is_some(),
@@ -242,6 +268,7 @@ impl Recorder {
                 fir_taps: cfg.fir_taps.clone(),
                 rate_hz: params.step_hz,
                 signal_window_s: cfg.signal_window_s.max(0.01),
+                coning_log,
             }
         });
         let n = axis_names.len();
@@ -321,6 +348,13 @@ impl Recorder {
         self.truth = params.table.truth.clone();
         self.exaggeration = params.recording.exaggeration;
         self.drawing = self.chain.error_rotations(&self.truth.exaggerated(self.exaggeration));
+        // Where the parameters changed, on every error plot (at 0: the plots' range is not known).
+        for axis in ERROR_AXES {
+            self.stream.mark_events(&error_path(self.error_unit, axis), "reloads", "config reloaded", &[t_s], 0.0)?;
+            if self.ins.is_some() {
+                self.stream.mark_events(&format!("ins/attitude_error_arcsec/{axis}"), "reloads", "config reloaded", &[t_s], 0.0)?;
+            }
+        }
         self.log_error_geometry(params, self.geometry_at(t_s))
     }
 
@@ -374,6 +408,15 @@ impl Recorder {
                 match ins {
                     Some(v) => values.extend(v.errors.iter().map(|e| e.as_array()[a] * ARCSEC_PER_RAD)),
                     None => values.extend(std::iter::repeat_n(f64::NAN, width)),
+                }
+            }
+            if let Some((k, rates)) = &layout.coning_log {
+                let log10 = |x: f64| if x > 0.0 && x.is_finite() { x.log10() } else { f64::NAN };
+                let t = out.t_s;
+                let values = &mut self.series[*k].values;
+                for (j, rate) in rates.iter().enumerate() {
+                    let measured = ins.map_or(f64::NAN, |v| log10(v.errors[j].heading_rad.abs() * ARCSEC_PER_RAD));
+                    values.extend([measured, log10(rate * t)]);
                 }
             }
             if layout.nav {

@@ -9,9 +9,17 @@ pub(crate) mod colors {
     pub const AXES: [[u8; 3]; 3] = [[240, 160, 40], [200, 90, 230], [60, 200, 200]];
     pub const EULER: [[u8; 3]; 3] = [[230, 90, 90], [90, 200, 90], [90, 140, 240]];
     pub const NOMINAL: [u8; 3] = [150, 150, 150];
+    /// Event markers on the plots (position fixes, live reloads).
+    pub const EVENT: [u8; 3] = [245, 245, 245];
     pub const SENSOR: [[u8; 3]; 3] = [[235, 50, 50], [50, 200, 50], [60, 110, 255]];
     /// In the order of `Algorithm::ALL` (single-sample, two-sample, two-sample-p1, -p2, three-sample).
     pub const ALGORITHMS: [[u8; 3]; 5] = [[250, 200, 60], [230, 76, 60], [46, 170, 90], [70, 130, 240], [200, 90, 230]];
+
+    /// The name of that colour, for plot titles that stand in for a legend.
+    pub fn algorithm_colour_name(name: &str) -> &'static str {
+        const NAMES: [&str; 5] = ["yellow", "red", "green", "blue", "purple"];
+        crate::ins::coning::Algorithm::ALL.iter().position(|a| a.name() == name).map_or("grey", |k| NAMES[k])
+    }
 
     /// The colour of the coning algorithm named `name`, the same in every recording.
     pub fn algorithm(name: &str) -> [u8; 3] {

@@ -47,8 +47,11 @@ pub fn log(stream: &Stream, params: &Params, r: &TprResult, table: &str) -> Reco
         r.samples.iter().flat_map(|s| s.east_north_m[1]).collect(),
     ];
     let names = BRANCH_NAMES.map(String::from);
+    let fix_label = format!("position fixes ({})", r.fixes_s.iter().map(|t| format!("{:.0} h", t / 3600.0)).collect::<Vec<_>>().join(", "));
     for (path, values) in paths.iter().zip(columns) {
+        let top = values.iter().copied().filter(|v| v.is_finite()).fold(0.0_f64, f64::max);
         stream.send_series(path, &names, &times, values, BRANCHES)?;
+        stream.mark_events(path, "fixes", &fix_label, &r.fixes_s, top)?;
     }
     for (k, t) in r.fixes_s.iter().enumerate() {
         rec.set_duration_secs(TIMELINE, *t);

@@ -191,6 +191,14 @@ impl Params {
         }
     }
 
+    /// Steps between two samples of a run's RMS and peak statistics: the step rate over
+    /// [`validate::Bandwidth::statistics_hz`], rounded down (so at least that rate), at least 1.
+    #[must_use]
+    pub fn statistics_every(&self) -> u64 {
+        let ratio = self.step_hz / self.recording.bandwidth.statistics_hz();
+        if ratio.is_finite() && ratio >= 1.0 { ratio.floor() as u64 } else { 1 }
+    }
+
     /// The run's instants at the simulation rate (the one sampling rule, `math::timeline`).
     #[must_use]
     pub fn timeline(&self) -> Timeline {

@@ -432,6 +432,18 @@ impl Bandwidth {
     pub fn scene_hz(&self) -> f64 {
         self.shaft_deg_per_s.max(10.0 * self.motion_hz).max(1500.0 / self.duration_s).clamp(1e-3, 25.0)
     }
+
+    /// The rate the run's RMS and peak statistics sample the errors at, Hz (at most the step rate):
+    /// 250 points per period of the fastest vehicle motion, 4 per degree of the fastest shaft, at
+    /// least 200 Hz. A sinusoid's peak sampled at N points per period reads at least cos(π/N) of
+    /// it: 1 − 7.9e-5 at N = 250, so a peak is read to 1e-4 of itself; the shaft-driven errors,
+    /// periodic in the shaft angle, get 1440 points per turn (1e-4 up to the 5th harmonic). The
+    /// white part of a noisy error has the same RMS at any rate; its largest sample grows with the
+    /// number of samples, so a noise peak is a statement about the rate (given in the summary).
+    #[must_use]
+    pub fn statistics_hz(&self) -> f64 {
+        (250.0 * self.motion_hz).max(4.0 * self.shaft_deg_per_s).max(200.0)
+    }
 }
 
 /// `[recording]`: output rates (at most the simulation rate `step_hz`; absent, from `bandwidth`)

@@ -6,9 +6,52 @@ pub mod peer;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
+use serde::Serialize;
+
 use crate::scenario::presets;
 use crate::sim::{step, DemodState};
 use crate::record::sink::{self, SinkRequest};
+
+/// One number of `rinscope bench`, as `bench --json` writes it: a change is compared against the
+/// last run figure by figure (names are stable; the printed lines say the same in prose).
+#[derive(Debug, Clone, Serialize)]
+pub struct Figure {
+    /// What was measured, e.g. `"INS pipeline/pure-coning (100 Hz, 5 algorithms)"`.
+    pub name: String,
+    /// The figure: the median of the repetitions where there are several.
+    pub value: f64,
+    /// Its unit, e.g. `"M samples/s"`, `"s"`, `"MB/h"`.
+    pub unit: &'static str,
+    /// The best repetition, where there are several (this VM's timings vary by 2x).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub best: Option<f64>,
+}
+
+/// The figures of one `rinscope bench` run, in the order printed.
+#[derive(Debug, Default, Serialize)]
+pub struct Figures {
+    /// rinscope's version.
+    pub version: &'static str,
+    /// Cores this process could use.
+    pub threads: usize,
+    /// Every figure.
+    pub figures: Vec<Figure>,
+}
+
+impl Figures {
+    fn new() -> Self {
+        Self { version: env!("CARGO_PKG_VERSION"), threads: std::thread::available_parallelism().map_or(1, std::num::NonZero::get), figures: Vec::new() }
+    }
+
+    fn add(&mut self, name: impl Into<String>, value: f64, unit: &'static str) {
+        self.figures.push(Figure { name: name.into(), value, unit, best: None });
+    }
+
+    /// A rate in millions per second from the best and median repetition (per second).
+    fn rate(&mut self, name: impl Into<String>, best: f64, median: f64, unit: &'static str) {
+        self.figures.push(Figure { name: name.into(), value: median / 1e6, unit, best: Some(best / 1e6) });
+    }
+}
 
 /// Peak resident memory of this process, bytes (Linux; 0 elsewhere).
 #[must_use]
@@ -19,8 +62,9 @@ pub fn peak_rss_bytes() -> u64 {
         .map_or(0, |kb| kb * 1024)
 }
 
-/// Runs the benchmarks and prints their numbers.
-pub fn run_benchmarks(steps: u64) -> anyhow::Result<()> {
+/// Runs the benchmarks, prints their numbers and returns them.
+pub fn run_benchmarks(steps: u64) -> anyhow::Result<Figures> {
+    let mut figs = Figures::new();
     // 1. Pure simulation: truth + encoders + three demodulations, one core, no recording. This VM's
     //    timings vary by 2x from run to run (shared cores), so report the best and the median of 5.
     for name in ["jiang2017-dual-axis", "rotary-table-2016-wobble"] {
@@ -39,6 +83,7 @@ pub fn run_benchmarks(steps: u64) -> anyhow::Result<()> {
             rates.push(steps as f64 / started.elapsed().as_secs_f64());
         }
         rates.sort_by(f64::total_cmp);
+        figs.rate(format!("simulation only/{name}"), rates[4], rates[2], "M steps/s");
         outln!(
             "simulation only   {name:<28} {steps} steps x5: best {:.2} M steps/s, median {:.2} M steps/s (all three variants; checksum {checksum:.6e})",
             rates[4] / 1e6,
@@ -47,8 +92,8 @@ pub fn run_benchmarks(steps: u64) -> anyhow::Result<()> {
     }
 
     // 2. The INS in the loop.
-    strapdown_speed();
-    pipeline_speed()?;
+    strapdown_speed(&mut figs);
+    pipeline_speed(&mut figs)?;
 
     // 3. A 3600 s scenario at 200 Hz with its default recording rates, saved to a file.
     let dir = std::env::temp_dir().join(format!("rinscope-bench-{}", std::process::id()));
@@ -62,6 +107,8 @@ pub fn run_benchmarks(steps: u64) -> anyhow::Result<()> {
         let summary = crate::app::run::run_recorded(&p, &sinks, &AtomicBool::new(false), false)?;
         let (_, bytes) = sinks.finish()?.recording.ok_or_else(|| anyhow::anyhow!("no file written"))?;
         let secs = started.elapsed().as_secs_f64();
+        figs.add(format!("recorded run 1 h/{name}/wall"), secs, "s");
+        figs.add(format!("recorded run 1 h/{name}/size"), bytes as f64 / 1e6, "MB/h");
         outln!(
             "recorded run      {name:<28} 3600 s at {} Hz (series {} Hz, scene {} Hz): {} steps in {secs:.2} s, {:.2} MB per simulated hour",
             p.step_hz,
@@ -71,6 +118,27 @@ pub fn run_benchmarks(steps: u64) -> anyhow::Result<()> {
             bytes as f64 / 1e6
         );
     }
+    // 3b. Every preset for one simulated hour at its default rates: the recording's size (issue 13's
+    //     target: at most 30 MB per simulated hour).
+    for (name, _) in presets::PRESETS {
+        let mut p = presets::load(name)?;
+        p.set_duration(3600.0);
+        let path = dir.join(format!("size-{name}.rrd"));
+        let sinks = sink::open(&SinkRequest { save: Some(path.clone()), ..Default::default() }, "rinscope-bench", name)?;
+        let started = Instant::now();
+        crate::app::run::run_recorded(&p, &sinks, &AtomicBool::new(false), false)?;
+        let (_, bytes) = sinks.finish()?.recording.ok_or_else(|| anyhow::anyhow!("no file written"))?;
+        let secs = started.elapsed().as_secs_f64();
+        std::fs::remove_file(&path).ok();
+        figs.add(format!("recording size/{name}"), bytes as f64 / 1e6, "MB/h");
+        outln!(
+            "recording size    {name:<32} {:6.2} MB per simulated hour (series {} Hz, scene {} Hz; {:.2} s; target <= 30)",
+            bytes as f64 / 1e6,
+            p.recording.series_hz,
+            p.recording.scene_hz,
+            secs
+        );
+    }
     // 4. A 24-hour INS run at 200 Hz with navigation, recorded.
     let p = presets::load("rotation-modulation-16-position")?;
     let path = dir.join("ins24h.rrd");
@@ -78,6 +146,8 @@ pub fn run_benchmarks(steps: u64) -> anyhow::Result<()> {
     let started = Instant::now();
     let summary = crate::app::run::run_recorded(&p, &sinks, &AtomicBool::new(false), false)?;
     let (_, bytes) = sinks.finish()?.recording.ok_or_else(|| anyhow::anyhow!("no file written"))?;
+    figs.add("INS 24 h/rotation-modulation-16-position/wall", started.elapsed().as_secs_f64(), "s");
+    figs.add("INS 24 h/rotation-modulation-16-position/size", bytes as f64 / 1e6, "MB");
     outln!(
         "INS 24 h          rotation-modulation-16-position: {} IMU samples at 200 Hz with navigation and recording in {:.2} s ({:.2} MB)",
         summary.steps,
@@ -85,16 +155,17 @@ pub fn run_benchmarks(steps: u64) -> anyhow::Result<()> {
         bytes as f64 / 1e6
     );
 
-    live_latency(&dir)?;
+    live_latency(&dir, &mut figs)?;
     std::fs::remove_dir_all(&dir).ok();
-    calibration_speed()?;
-    allan_speed()?;
+    calibration_speed(&mut figs)?;
+    allan_speed(&mut figs)?;
+    figs.add("peak resident memory", peak_rss_bytes() as f64 / 1e6, "MB");
     outln!("peak resident memory: {:.1} MB", peak_rss_bytes() as f64 / 1e6);
-    Ok(())
+    Ok(figs)
 }
 
 /// Strapdown attitude update alone: samples per second through each algorithm (one core).
-fn strapdown_speed() {
+fn strapdown_speed(figs: &mut Figures) {
     use crate::ins::coning::Algorithm;
     use crate::ins::strapdown::AttitudeIntegrator;
     use crate::math::frames::Rot;
@@ -124,6 +195,7 @@ fn strapdown_speed() {
             best = best.max((reps * n) as f64 / started.elapsed().as_secs_f64());
             std::hint::black_box(integ.n_from_s);
         }
+        figs.add(format!("strapdown update/{}", alg.name()), best / 1e6, "M samples/s");
         outln!("strapdown update  {:<28} best of 5: {:.1} M samples/s (one core)", alg.name(), best / 1e6);
     }
 }
@@ -155,7 +227,7 @@ fn best_and_median(mut chunk: impl FnMut()) -> (f64, f64) {
 /// The whole INS pipeline (truth, IMU errors, strapdown, navigation, demodulation at 100 Hz), the exact
 /// IMU truth alone on the same motion (so that its share of the pipeline's time can be stated), and
 /// attitude + navigation alone on precomputed increments.
-fn pipeline_speed() -> anyhow::Result<()> {
+fn pipeline_speed(figs: &mut Figures) -> anyhow::Result<()> {
     use crate::ins::truth::TruthImu;
     use crate::model::earth::Earth;
     let jiang = format!("{}\n[imu]\npreset = \"jiang2017-table1\"\n[navigation]\n", crate::scenario::presets::text("jiang2017-dual-axis").unwrap_or_default());
@@ -187,6 +259,9 @@ fn pipeline_speed() -> anyhow::Result<()> {
                 std::hint::black_box(truth.increments(j as f64 / p.step_hz));
             }
         });
+        figs.rate(format!("INS pipeline/{name}"), best, median, "M samples/s");
+        figs.rate(format!("IMU truth only/{name}"), truth_best, truth_median, "M samples/s");
+        figs.add(format!("IMU truth share/{name}"), 100.0 * median / truth_median, "%");
         outln!(
             "INS pipeline      {name:<44} best {:.2} M samples/s, median {:.2} (truth + IMU + strapdown + navigation + demodulation)",
             best / 1e6,
@@ -199,12 +274,12 @@ fn pipeline_speed() -> anyhow::Result<()> {
             100.0 * median / truth_median
         );
     }
-    navigation_speed(&cases[1].1)
+    navigation_speed(&cases[1].1, figs)
 }
 
 /// Attitude + navigation (the navigation computer: attitude algorithm, velocity and position) fed
 /// precomputed increments of the 2 kHz coning stream: what pyins' bare kernel is timed on.
-fn navigation_speed(p: &crate::scenario::Params) -> anyhow::Result<()> {
+fn navigation_speed(p: &crate::scenario::Params, figs: &mut Figures) -> anyhow::Result<()> {
     use crate::ins::core::InsCore;
     use crate::ins::truth::TruthImu;
     use crate::model::earth::Earth;
@@ -223,6 +298,7 @@ fn navigation_speed(p: &crate::scenario::Params) -> anyhow::Result<()> {
             std::hint::black_box(core.push(k as f64 * h, g, a));
         }
     });
+    figs.rate("attitude + nav/coning 1 deg/1 Hz + Earth rate, 2 kHz, 34 N", best, median, "M samples/s");
     outln!(
         "attitude + nav    {:<44} best {:.2} M samples/s, median {:.2} (precomputed increments, {})",
         "coning 1 deg/1 Hz + Earth rate, 2 kHz, 34 N",
@@ -235,7 +311,7 @@ fn navigation_speed(p: &crate::scenario::Params) -> anyhow::Result<()> {
 
 /// Live mode: from the moment a save starts to the moment the simulation thread runs on the new
 /// parameters, over 60 saves (half in place, half by rename), with a session running in real time.
-fn live_latency(dir: &std::path::Path) -> anyhow::Result<()> {
+fn live_latency(dir: &std::path::Path, figs: &mut Figures) -> anyhow::Result<()> {
     use crate::app::live::{self, edit};
     let path = dir.join("live.toml");
     let text = crate::scenario::presets::text("jiang2017-dual-axis").ok_or_else(|| anyhow::anyhow!("preset"))?;
@@ -275,6 +351,9 @@ fn live_latency(dir: &std::path::Path) -> anyhow::Result<()> {
     sinks.finish()?;
     let mut sorted = latencies.clone();
     sorted.sort_by(f64::total_cmp);
+    figs.add("live reload/median", sorted[sorted.len() / 2], "ms");
+    figs.add("live reload/p95", live::p95(&latencies), "ms");
+    figs.add("live reload/max", sorted[sorted.len() - 1], "ms");
     outln!(
         "live reload       save -> applied over {} saves: median {:.1} ms, p95 {:.1} ms, max {:.1} ms (debounce {} ms included)",
         sorted.len(),
@@ -289,11 +368,12 @@ fn live_latency(dir: &std::path::Path) -> anyhow::Result<()> {
 /// Issue targets for calibration and resets: one static calibration (200 s at 200 Hz, KF and exact
 /// least squares), 500 Monte Carlo calibrations on all cores (target < 10 s on 2 cores), the 30 h
 /// twice-position-fix comparison ("seconds, not minutes").
-fn calibration_speed() -> anyhow::Result<()> {
+fn calibration_speed(figs: &mut Figures) -> anyhow::Result<()> {
     let stop = AtomicBool::new(false);
     let p = presets::load("jiang2017-calibration")?;
     let started = Instant::now();
     let outcome = crate::app::calibrate::calibrate_scenario(&p, false, &stop)?;
+    figs.add("calibration/jiang2017-calibration", started.elapsed().as_secs_f64(), "s");
     outln!(
         "calibration       jiang2017-calibration: 200 s at 200 Hz, static KF + exact least squares + validation run in {:.2} s ({} measurements)",
         started.elapsed().as_secs_f64(),
@@ -301,6 +381,7 @@ fn calibration_speed() -> anyhow::Result<()> {
     );
     let started = Instant::now();
     let mc = crate::app::calibrate::monte_carlo(&p, 500, &|| {}, &stop)?;
+    figs.add("Monte Carlo/500 calibrations", started.elapsed().as_secs_f64(), "s");
     outln!(
         "Monte Carlo       jiang2017-calibration: {} calibrations in {:.2} s on {} threads",
         mc.runs,
@@ -309,6 +390,7 @@ fn calibration_speed() -> anyhow::Result<()> {
     );
     let p = presets::load("zheng2016-tpr")?;
     let r = crate::app::tpr::compare_resets(&p, 600.0, &stop)?;
+    figs.add("TPR vs reset/zheng2016-tpr", r.wall_s, "s");
     outln!(
         "TPR vs reset      zheng2016-tpr: {:.0} h at {:.0} Hz, three branches after the fork, in {:.2} s",
         p.duration_s / 3600.0,
@@ -322,7 +404,7 @@ fn calibration_speed() -> anyhow::Result<()> {
 /// intervals, the NNLS fit and the slope readings) of 10 h at 200 Hz, 6 channels, under 2 s on one
 /// core; and the simulation of `static-imu-10h` that feeds it (truth, sensor errors with the flicker
 /// bank and the rate random walk, the six cumulative sums), which `rinscope allan` runs first.
-fn allan_speed() -> anyhow::Result<()> {
+fn allan_speed(figs: &mut Figures) -> anyhow::Result<()> {
     use crate::app::allan::{simulate, AllanRequest};
     use crate::ins::allan::analyze_imu;
     use crate::math::allan::{AllanOptions, Phase, TauSpacing};
@@ -353,11 +435,14 @@ fn allan_speed() -> anyhow::Result<()> {
             best = best.min(started.elapsed().as_secs_f64());
             taus = channels[0].report.taus_s.len();
         }
+        figs.add(format!("Allan analysis/10 h, 6 channels, {label}"), best, "s");
         outln!("Allan analysis    10 h at 200 Hz, 6 channels x {n} samples, {label} ({taus} cluster times), one core: best of 3 {best:.2} s (target < 2 s)");
     }
     let p = presets::load("static-imu-10h")?;
     let started = Instant::now();
     let r = simulate(&p, &AllanRequest::default(), &AtomicBool::new(false), &|_| {})?;
+    figs.add("Allan static-imu-10h/simulation", r.gather_s, "s");
+    figs.add("Allan static-imu-10h/analysis", r.analysis_s, "s");
     outln!(
         "Allan static-imu-10h: 10 h at 200 Hz simulated (truth + sensor errors, 6 cumulative sums) in {:.2} s, analysed on all cores in {:.2} s ({:.2} s in all)",
         r.gather_s,
@@ -374,7 +459,8 @@ mod tests {
     #[test]
     #[ignore = "a benchmark, not a test"]
     fn ins_figures() -> anyhow::Result<()> {
-        super::strapdown_speed();
-        super::pipeline_speed()
+        let mut figs = super::Figures::new();
+        super::strapdown_speed(&mut figs);
+        super::pipeline_speed(&mut figs)
     }
 }

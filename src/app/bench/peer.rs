@@ -6,7 +6,8 @@
 //! is the input. Each round runs, one after the other: `rinscope replay` of the stream as a log set
 //! (whole process: reading, navigation, the recording written), pyins' bare navigation kernel and
 //! its full pipeline (`assets/bench/pyins/pyins_bench.py`; both time their own region, imports and
-//! JIT excluded, which favours pyins). Ratios are taken within a round (the three processes ran
+//! JIT excluded, which favours pyins), and `rinscope run` of the same motion as a scenario (whole
+//! process: its own exact IMU truth, the INS, the table's statistics, the recording). Ratios are taken within a round (the three processes ran
 //! within seconds of each other on a shared machine) and reported as median and range over rounds.
 
 use std::path::{Path, PathBuf};
@@ -116,6 +117,12 @@ pub struct StreamReport {
     pub pyins_kernel: Vec<Timing>,
     /// pyins' full pipeline processes.
     pub pyins_pipeline: Vec<Timing>,
+    /// `rinscope run` of the same motion (whole process: the exact IMU truth generated, the INS,
+    /// the table's error statistics, the recording written), one per round.
+    pub rinscope_run: Vec<Timing>,
+    /// pyins kernel region / `rinscope run` whole process, per round: the INS pipeline with its
+    /// own IMU truth against the bare kernel handed increments.
+    pub ratio_run_kernel: Spread,
     /// pyins kernel region / rinscope whole process, per round.
     pub ratio_kernel: Spread,
     /// pyins pipeline region / rinscope whole process, per round.
@@ -183,8 +190,10 @@ fn compare_stream(opts: &PeerOptions, dir: &Path, kind: &str) -> anyhow::Result<
 
     let logs = dir.join(format!("{kind}-log"));
     write_log_set(&logs, &stream, rate, lat, kind, &meta)?;
+    let scenario = dir.join(format!("{kind}-scenario.toml"));
+    std::fs::write(&scenario, simulated(kind, opts.samples as f64 / rate, rate, lat, &meta)?)?;
 
-    let mut rounds: Vec<[Timing; 3]> = Vec::new();
+    let mut rounds: Vec<[Timing; 4]> = Vec::new();
     let (mut ours, mut theirs) = (None, None);
     let args_pyins = |mode: &str| -> Vec<String> {
         let mut a = vec![dir.join("pyins_bench.py").display().to_string(), mode.to_owned(), stream.display().to_string(), "--rph".to_owned()];
@@ -198,18 +207,21 @@ fn compare_stream(opts: &PeerOptions, dir: &Path, kind: &str) -> anyhow::Result<
         let (r, state) = run_rinscope(&logs)?;
         let (k, kstate) = run_pyins(&opts.python, &args_pyins("kernel"))?;
         let (p, _) = run_pyins(&opts.python, &args_pyins("pipeline"))?;
+        let s = run_simulated(&scenario)?;
         ours = Some(state);
         theirs = Some(kstate);
-        rounds.push([r, k, p]);
+        rounds.push([r, k, p, s]);
     }
     let (ours, theirs) = (ours.ok_or_else(|| anyhow!("no round ran"))?, theirs.ok_or_else(|| anyhow!("no round ran"))?);
-    let ratio = |f: &dyn Fn(&[Timing; 3]) -> f64| Spread::of(rounds.iter().map(f).collect());
+    let ratio = |f: &dyn Fn(&[Timing; 4]) -> f64| Spread::of(rounds.iter().map(f).collect());
     Ok(StreamReport {
         stream: kind.to_owned(),
         samples: opts.samples,
         ratio_kernel: ratio(&|r| r[1].region_s / r[0].process_s),
         ratio_pipeline: ratio(&|r| r[2].region_s / r[0].process_s),
         ratio_pipeline_process: ratio(&|r| r[2].process_s / r[0].process_s),
+        ratio_run_kernel: ratio(&|r| r[1].region_s / r[3].process_s),
+        rinscope_run: rounds.iter().map(|r| r[3].clone()).collect(),
         rinscope: rounds.iter().map(|r| r[0].clone()).collect(),
         pyins_kernel: rounds.iter().map(|r| r[1].clone()).collect(),
         pyins_pipeline: rounds.iter().map(|r| r[2].clone()).collect(),
@@ -255,6 +267,37 @@ fn write_log_set(dir: &Path, stream: &Path, rate: f64, lat: f64, kind: &str, met
     };
     std::fs::write(dir.join("log.toml"), manifest(q))?;
     Ok(())
+}
+
+/// The stream's motion as a scenario, for `rinscope run` to generate its own exact IMU truth: the
+/// same rate, latitude, cone, start attitude convention and navigation settings as the log set.
+fn simulated(kind: &str, duration_s: f64, rate: f64, lat: f64, meta: &Value) -> anyhow::Result<String> {
+    let vehicle = if kind == "coning" {
+        let a = meta["alpha_deg"].as_f64().ok_or_else(|| anyhow!("sidecar lacks alpha_deg"))?;
+        let f = meta["freq_hz"].as_f64().ok_or_else(|| anyhow!("sidecar lacks freq_hz"))?;
+        format!("[vehicle]\nconing_half_angle_deg = {a}\nconing_frequency_hz = {f}\n")
+    } else {
+        String::new()
+    };
+    Ok(format!(
+        "[scenario]\nname = \"pyins-{kind}-simulated\"\ntitle = \"make_stream.py {kind}, simulated by rinscope\"\nseed = 0\n\
+         [simulation]\nduration_s = {duration_s}\nstep_hz = {rate}\n[site]\nlatitude_deg = {lat}\n{vehicle}\
+         [turntable]\n[[turntable.axis]]\nname = \"table\"\naxis = \"z\"\n[scheme]\nkind = \"static\"\n\
+         [imu]\nalgorithm = \"two-sample-p1\"\n[navigation]\nvertical = \"free\"\n"
+    ))
+}
+
+/// `rinscope run` of a scenario, whole process.
+fn run_simulated(scenario: &Path) -> anyhow::Result<Timing> {
+    let exe = std::env::current_exe()?;
+    let json = scenario.with_extension("json");
+    let started = Instant::now();
+    let out = Command::new(exe).arg("run").arg("--config").arg(scenario).arg("--save").arg(scenario.with_extension("rrd")).arg("--summary-json").arg(&json).output()?;
+    let process_s = started.elapsed().as_secs_f64();
+    ensure!(out.status.success(), "rinscope run failed: {}", String::from_utf8_lossy(&out.stderr));
+    let s: Value = serde_json::from_str(&std::fs::read_to_string(&json)?)?;
+    let num = |k: &str| s[k].as_f64().ok_or_else(|| anyhow!("run summary lacks {k}"));
+    Ok(Timing { process_s, region_s: num("wall_time_s")?, peak_rss_mb: num("peak_rss_mb")? })
 }
 
 fn run_rinscope(logs: &Path) -> anyhow::Result<(Timing, State)> {
@@ -307,13 +350,15 @@ pub fn text(reports: &[StreamReport]) -> String {
         s.push_str(&line("rinscope replay", &r.rinscope, "replay loop "));
         s.push_str(&line("pyins kernel", &r.pyins_kernel, "kernel      "));
         s.push_str(&line("pyins pipeline", &r.pyins_pipeline, "pipeline    "));
+        s.push_str(&line("rinscope run", &r.rinscope_run, "run loop    "));
         let ratio = |x: Spread| format!("{:.1}x [{:.1}, {:.1}]", x.median, x.min, x.max);
         s.push_str(&format!(
-            "  speed: pyins kernel / rinscope process {} (target >= 3x); pyins pipeline / rinscope process {} (target >= 10x); whole processes {}\n",
+            "  speed: pyins kernel / rinscope replay process {} (target >= 3x); pyins pipeline / rinscope replay process {} (target >= 10x); whole processes {}\n",
             ratio(r.ratio_kernel),
             ratio(r.ratio_pipeline),
             ratio(r.ratio_pipeline_process)
         ));
+        s.push_str(&format!("  speed: pyins kernel / rinscope run process (its own exact IMU truth, table statistics, recording) {} (target >= 3x)\n", ratio(r.ratio_run_kernel)));
         let diff = |d: &Difference| {
             format!(
                 "roll {:+.2e}″ pitch {:+.2e}″ heading {:+.2e}″, horizontal {:.2e} m, height {:+.2e} m, velocity ENU [{:+.1e}, {:+.1e}, {:+.1e}] m/s",
