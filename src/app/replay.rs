@@ -275,10 +275,10 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
         };
         let (_, imu_ins) = pb.core.output_attitude(0);
         // The best estimate of the true IMU attitude: the reference through the compensated table.
-        let imu_true = match reference {
+        let imu_true = Some(match reference {
             Some(r) => r.n_from_b() * chain.b_from_s(&comp_rot, &corrected),
             None => imu_ins,
-        };
+        });
         let view = InsView { t_s: s.t_s, t_ref_s: pb.core.reference_instant(t_repr), errors, imu_true, imu_ins, nav: nav_error };
         if want_series {
             next_series = i.saturating_add(series_every);

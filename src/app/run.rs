@@ -430,15 +430,14 @@ impl Producer<'_> {
             if !s.updated {
                 continue;
             }
-            // Statistics at the statistics rate (Bandwidth::statistics_hz, at most every attitude
-            // update), not at the recorded rows: a peak between two rows, or in the last rows of a
-            // growing drift, is not missed.
-            // The INS's errors at every update (their bandwidth is the algorithms', not the
-            // motion's); the table's at the statistics rate (Bandwidth::statistics_hz).
-            let view = ins.view(s.t_s);
+            // Statistics not at the recorded rows (a peak between two rows, or in the last rows of
+            // a growing drift, is not missed): the INS's errors at every update (their bandwidth
+            // is the algorithms', not the motion's), the table's at the statistics rate
+            // (Bandwidth::statistics_hz). The true IMU attitude only for the scene.
+            let (want_series, want_scene) = (i >= next_series, i >= next_scene);
+            let view = if want_scene { ins.view(s.t_s) } else { ins.errors_view(s.t_s) };
             ins_stats.add(&view);
             let want_stats = i >= next_stats || i.saturating_add(self.stats_every) > timeline.intervals();
-            let (want_series, want_scene) = (i >= next_series, i >= next_scene);
             if !(want_stats || want_series || want_scene) {
                 continue;
             }

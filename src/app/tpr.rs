@@ -67,7 +67,8 @@ pub fn compare_resets(params: &Params, sample_s: f64, stop: &AtomicBool) -> Resu
     // `[navigation] initial_error`'s C = (I − [φ×]) C_true (docs/tpr.md says so).
     let true_level = |ins: &mut InsRun, t: f64| {
         let v = ins.view(t);
-        let phi = crate::math::rotvec::log((v.imu_ins * v.imu_true.inverse()).quaternion());
+        let imu_true = v.imu_true.unwrap_or(v.imu_ins); // view() always has it
+        let phi = crate::math::rotvec::log((v.imu_ins * imu_true.inverse()).quaternion());
         [phi.x, phi.y]
     };
     let mut true_phi = [[0.0; 2]; 2];

@@ -54,12 +54,13 @@ pub struct Navigator {
 /// position has moved by more than [`REFRESH_LATITUDE_RAD`] or [`REFRESH_HEIGHT_M`] (they change on
 /// the scale of metres; recomputing them for every IMU sample was 43 % of the navigation's time).
 ///
-/// Bound: with |δL| ≤ 1e-8 rad (6 cm) and |δh| ≤ 0.1 m the stale terms are off by at most
-/// sin/cos: 1e-8; radii: |dR/dL|·δL + δh ≤ 4e4·1e-8 + 0.1 m of 6.4e6 m (1.6e-8 relative); gravity:
-/// |dg/dL|·δL + 3.1e-6·δh ≤ 5e-10 + 3.1e-7 m/s² (3e-8 g); Coriolis Ω·δL = 7e-13 rad/s. Against a
+/// Bound: with |δL| ≤ 1e-8 rad (6 cm) and |δh| ≤ 0.03 m the stale terms are off by at most
+/// sin/cos: 1e-8; radii: |dR/dL|·δL + δh ≤ 4e4·1e-8 + 0.03 m of 6.4e6 m (6e-9 relative); gravity:
+/// |dg/dL|·δL + 3.1e-6·δh ≤ 5e-10 + 9.3e-8 m/s² (9.5e-9 g); Coriolis Ω·δL = 7e-13 rad/s. Against a
 /// navigation-grade error budget (accelerometer bias 1e-5 g, gyro bias 1e-3 °/h = 4.8e-9 rad/s)
-/// that is at most 3e-3 (gravity's height term) and 1.5e-4 (Coriolis) of it; a static INS moves
-/// less than 1 m in an hour, so the terms are refreshed a few times per hour.
+/// that is at most 9.5e-4 (gravity's height term) and 1.5e-4 (Coriolis) of it, below the 1e-3
+/// asked; a static INS moves less than 1 m in an hour, so the terms are refreshed a few times per
+/// hour (a free vertical channel more often: every 3 cm of height).
 #[derive(Debug, Clone, Copy)]
 struct LatitudeTerms {
     latitude_rad: f64,
@@ -76,7 +77,7 @@ struct LatitudeTerms {
 /// Latitude change that refreshes the cached terms, rad.
 pub const REFRESH_LATITUDE_RAD: f64 = 1e-8;
 /// Height change that refreshes the cached terms, m.
-pub const REFRESH_HEIGHT_M: f64 = 0.1;
+pub const REFRESH_HEIGHT_M: f64 = 0.03;
 
 impl LatitudeTerms {
     fn at(latitude_rad: f64, height_m: f64) -> Self {

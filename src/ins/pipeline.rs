@@ -26,8 +26,9 @@ pub struct InsView {
     pub t_ref_s: f64,
     /// Body attitude error of each algorithm (computed minus true), in integrator order.
     pub errors: Vec<AttitudeError>,
-    /// True C_s^n at the instant the INS output represents.
-    pub imu_true: Rot<N, S>,
+    /// True C_s^n at the instant the INS output represents (None from [`InsRun::errors_view`]:
+    /// what only the scene draws is not computed at every update).
+    pub imu_true: Option<Rot<N, S>>,
     /// The primary algorithm's C_s^n.
     pub imu_ins: Rot<N, S>,
     /// Navigation errors, when navigating.
@@ -179,6 +180,16 @@ impl InsRun {
     /// compared at the instant its own latest output stands for (algorithms with more samples per
     /// update update less often), against the truth `output_compensation` earlier.
     pub fn view(&mut self, t_s: f64) -> InsView {
+        self.view_with(t_s, true)
+    }
+
+    /// [`Self::view`] without the true IMU attitude (`imu_true` is None): the errors and the
+    /// navigation, what statistics and plots take at every update.
+    pub fn errors_view(&mut self, t_s: f64) -> InsView {
+        self.view_with(t_s, false)
+    }
+
+    fn view_with(&mut self, t_s: f64, with_truth: bool) -> InsView {
         let model = self.truth.model();
         let mut errors = Vec::with_capacity(self.demod.len());
         // Algorithms that stand for the same instant share its encoder readings (a pure function of
@@ -207,7 +218,7 @@ impl InsRun {
             errors.push(demodulate(n_from_s, b_from_s_comp).error_from(&truth_att));
         }
         let (t_repr, imu_ins) = self.core.output_attitude(0);
-        let imu_true = self.truth.n_from_s(t_repr);
+        let imu_true = with_truth.then(|| self.truth.n_from_s(t_repr));
         let nav: Option<NavError> = self.core.nav_error();
         InsView { t_s, t_ref_s: t_s - self.core.config().output_compensation_s, errors, imu_true, imu_ins, nav }
     }

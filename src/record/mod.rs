@@ -449,7 +449,8 @@ impl Recorder {
             col.push(to_rerun_quaternion(&links.gimbal[k]));
         }
         if let Some(layout) = self.ins.as_mut() {
-            let (t, c) = ins.map_or((UnitQuaternion::identity(), UnitQuaternion::identity()), |v| (*v.imu_true.quaternion(), *v.imu_ins.quaternion()));
+            // Without an INS view (or without its truth) the trace stands still at the identity.
+            let (t, c) = ins.and_then(|v| Some((*v.imu_true?.quaternion(), *v.imu_ins.quaternion()))).unwrap_or((UnitQuaternion::identity(), UnitQuaternion::identity()));
             let err = rotvec::log(&(c * t.inverse())) * layout.exaggeration;
             layout.trace_true.push(to_rerun_quaternion(&t));
             layout.trace_ins.push(to_rerun_quaternion(&(rotvec::exp(&err) * t)));

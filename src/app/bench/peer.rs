@@ -120,9 +120,15 @@ pub struct StreamReport {
     /// `rinscope run` of the same motion (whole process: the exact IMU truth generated, the INS,
     /// the table's error statistics, the recording written), one per round.
     pub rinscope_run: Vec<Timing>,
-    /// pyins kernel region / `rinscope run` whole process, per round: the INS pipeline with its
-    /// own IMU truth against the bare kernel handed increments.
+    /// pyins kernel region / `rinscope run` whole process, per round.
     pub ratio_run_kernel: Spread,
+    /// rinscope's INS pipeline on the same motion, timed in this process (the exact IMU truth,
+    /// sensor model, strapdown, navigation and the error views at 100 Hz, as `rinscope bench`'s
+    /// "INS pipeline" line; no statistics at every update, no recording), one per round.
+    pub rinscope_pipeline: Vec<Timing>,
+    /// pyins kernel region / rinscope pipeline region, per round: the INS pipeline with its own
+    /// IMU truth against the bare kernel handed increments.
+    pub ratio_pipeline_kernel: Spread,
     /// pyins kernel region / rinscope whole process, per round.
     pub ratio_kernel: Spread,
     /// pyins pipeline region / rinscope whole process, per round.
@@ -193,7 +199,8 @@ fn compare_stream(opts: &PeerOptions, dir: &Path, kind: &str) -> anyhow::Result<
     let scenario = dir.join(format!("{kind}-scenario.toml"));
     std::fs::write(&scenario, simulated(kind, opts.samples as f64 / rate, rate, lat, &meta)?)?;
 
-    let mut rounds: Vec<[Timing; 4]> = Vec::new();
+    let pipeline_params = crate::scenario::parse(&std::fs::read_to_string(&scenario)?, "bench").map_err(|e| anyhow!("{e}"))?;
+    let mut rounds: Vec<[Timing; 5]> = Vec::new();
     let (mut ours, mut theirs) = (None, None);
     let args_pyins = |mode: &str| -> Vec<String> {
         let mut a = vec![dir.join("pyins_bench.py").display().to_string(), mode.to_owned(), stream.display().to_string(), "--rph".to_owned()];
@@ -208,12 +215,13 @@ fn compare_stream(opts: &PeerOptions, dir: &Path, kind: &str) -> anyhow::Result<
         let (k, kstate) = run_pyins(&opts.python, &args_pyins("kernel"))?;
         let (p, _) = run_pyins(&opts.python, &args_pyins("pipeline"))?;
         let s = run_simulated(&scenario)?;
+        let q = time_pipeline(&pipeline_params, opts.samples)?;
         ours = Some(state);
         theirs = Some(kstate);
-        rounds.push([r, k, p, s]);
+        rounds.push([r, k, p, s, q]);
     }
     let (ours, theirs) = (ours.ok_or_else(|| anyhow!("no round ran"))?, theirs.ok_or_else(|| anyhow!("no round ran"))?);
-    let ratio = |f: &dyn Fn(&[Timing; 4]) -> f64| Spread::of(rounds.iter().map(f).collect());
+    let ratio = |f: &dyn Fn(&[Timing; 5]) -> f64| Spread::of(rounds.iter().map(f).collect());
     Ok(StreamReport {
         stream: kind.to_owned(),
         samples: opts.samples,
@@ -222,6 +230,8 @@ fn compare_stream(opts: &PeerOptions, dir: &Path, kind: &str) -> anyhow::Result<
         ratio_pipeline_process: ratio(&|r| r[2].process_s / r[0].process_s),
         ratio_run_kernel: ratio(&|r| r[1].region_s / r[3].process_s),
         rinscope_run: rounds.iter().map(|r| r[3].clone()).collect(),
+        ratio_pipeline_kernel: ratio(&|r| r[1].region_s / r[4].region_s),
+        rinscope_pipeline: rounds.iter().map(|r| r[4].clone()).collect(),
         rinscope: rounds.iter().map(|r| r[0].clone()).collect(),
         pyins_kernel: rounds.iter().map(|r| r[1].clone()).collect(),
         pyins_pipeline: rounds.iter().map(|r| r[2].clone()).collect(),
@@ -285,6 +295,22 @@ fn simulated(kind: &str, duration_s: f64, rate: f64, lat: f64, meta: &Value) -> 
          [turntable]\n[[turntable.axis]]\nname = \"table\"\naxis = \"z\"\n[scheme]\nkind = \"static\"\n\
          [imu]\nalgorithm = \"two-sample-p1\"\n[navigation]\nvertical = \"free\"\n"
     ))
+}
+
+/// The INS pipeline over `samples` samples of `p`, in this process: what `rinscope bench` times
+/// as "INS pipeline" (the error views at 100 Hz).
+fn time_pipeline(p: &crate::scenario::Params, samples: u64) -> anyhow::Result<Timing> {
+    let mut ins = p.ins_run().ok_or_else(|| anyhow!("the scenario has no [imu]"))?;
+    let every = (p.step_hz / 100.0).round().max(1.0) as u64;
+    let started = Instant::now();
+    for i in 0..samples {
+        let s = ins.step();
+        if s.updated && i.is_multiple_of(every) {
+            std::hint::black_box(ins.errors_view(s.t_s));
+        }
+    }
+    let region_s = started.elapsed().as_secs_f64();
+    Ok(Timing { process_s: region_s, region_s, peak_rss_mb: crate::app::bench::peak_rss_bytes() as f64 / 1e6 })
 }
 
 /// `rinscope run` of a scenario, whole process.
@@ -351,6 +377,8 @@ pub fn text(reports: &[StreamReport]) -> String {
         s.push_str(&line("pyins kernel", &r.pyins_kernel, "kernel      "));
         s.push_str(&line("pyins pipeline", &r.pyins_pipeline, "pipeline    "));
         s.push_str(&line("rinscope run", &r.rinscope_run, "run loop    "));
+        let q = spread(r.rinscope_pipeline.iter().map(|x| x.region_s).collect());
+        s.push_str(&format!("  {:<16} in this process                 pipeline     {:.2} s [{:.2}, {:.2}]\n", "rinscope INS", q.median, q.min, q.max));
         let ratio = |x: Spread| format!("{:.1}x [{:.1}, {:.1}]", x.median, x.min, x.max);
         s.push_str(&format!(
             "  speed: pyins kernel / rinscope replay process {} (target >= 3x); pyins pipeline / rinscope replay process {} (target >= 10x); whole processes {}\n",
@@ -358,7 +386,11 @@ pub fn text(reports: &[StreamReport]) -> String {
             ratio(r.ratio_pipeline),
             ratio(r.ratio_pipeline_process)
         ));
-        s.push_str(&format!("  speed: pyins kernel / rinscope run process (its own exact IMU truth, table statistics, recording) {} (target >= 3x)\n", ratio(r.ratio_run_kernel)));
+        s.push_str(&format!(
+            "  speed: pyins kernel / rinscope INS pipeline with its own exact IMU truth {} (target >= 3x); / rinscope run process (+ error statistics at every update, the table, the recording) {}\n",
+            ratio(r.ratio_pipeline_kernel),
+            ratio(r.ratio_run_kernel)
+        ));
         let diff = |d: &Difference| {
             format!(
                 "roll {:+.2e}″ pitch {:+.2e}″ heading {:+.2e}″, horizontal {:.2e} m, height {:+.2e} m, velocity ENU [{:+.1e}, {:+.1e}, {:+.1e}] m/s",

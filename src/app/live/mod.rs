@@ -47,6 +47,8 @@ pub struct Status {
     pub latencies_ms: Vec<f64>,
     /// False once the simulation has ended.
     pub running: bool,
+    /// RMS and peak of the errors since the parameters last changed.
+    pub errors: crate::sim::ErrorStats,
 }
 
 /// Shared status.
@@ -179,7 +181,11 @@ pub fn sim_loop(mut sim: LiveSim, reloads: &Receiver<WatchEvent>, out: &Sender<R
         if !scene.is_empty() && out.send(RecorderMsg::Scene(scene)).is_err() {
             return sim;
         }
-        lock(status).sim_t_s = sim.t_s();
+        {
+            let mut s = lock(status);
+            s.sim_t_s = sim.t_s();
+            s.errors = sim.since_change;
+        }
         if duration_s.is_some_and(|d| sim.t_s() > d) {
             break;
         }
@@ -303,6 +309,7 @@ pub fn new_status(params: &Params, speed: f64) -> SharedStatus {
         message: String::new(),
         latencies_ms: Vec::new(),
         running: true,
+        errors: crate::sim::ErrorStats::default(),
     }))
 }
 

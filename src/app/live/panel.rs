@@ -75,7 +75,7 @@ pub struct Panel {
 }
 
 /// The one-line key help.
-pub const HELP: &str = "↑↓ select  ←→ adjust  Shift+←→/PgUp/PgDn ×10  Home/End min/max  0 zero  r reset  Space toggle  ? help  q quit";
+pub const HELP: &str = "↑↓ select  ←→ adjust  Shift+←→/PgUp/PgDn ×10  Home/End min/max  0 zero  r reset  Space toggle  ? help (Esc closes)  q quit";
 
 fn slider(label: String, key: &str, unit: &'static str, (min, max): (f64, f64), step: f64) -> Control {
     Control::Slider { label, keys: vec![KeyPath::parse(key)], unit, min, max, step, log: false, value: 0.0, initial: 0.0 }
@@ -99,8 +99,12 @@ impl Panel {
             controls.push(slider(format!("{n} encoder delay"), &k("encoder_delay_ms"), " ms", (0.0, 50.0), 0.5));
             controls.push(slider(format!("{n} encoder noise"), &k("encoder_noise_arcsec"), "″ 1σ", (0.0, 60.0), 1.0));
         }
-        controls.push(slider("installation about x".into(), "turntable.installation_x_arcsec", "″", (-1800.0, 1800.0), 10.0));
-        controls.push(slider("installation about y".into(), "turntable.installation_y_arcsec", "″", (-1800.0, 1800.0), 10.0));
+        for about in ["x", "y", "z"] {
+            controls.push(slider(format!("installation about {about}"), &format!("turntable.installation_{about}_arcsec"), "″", (-1800.0, 1800.0), 10.0));
+        }
+        for about in ["x", "y", "z"] {
+            controls.push(slider(format!("IMU mounting about {about}"), &format!("turntable.imu_mount_{about}_arcsec"), "″", (-1800.0, 1800.0), 10.0));
+        }
         match raw.scheme.kind.as_str() {
             "continuous" => {
                 for (j, r) in raw.scheme.rate.iter().enumerate() {
@@ -126,7 +130,7 @@ impl Panel {
             unit: "×",
             min,
             max,
-            step: 1.25,
+            step: 0.0, // the 1-2-5 ladder (`ladder`)
             log: true,
             value: 1.0,
             initial: 1.0,
@@ -184,7 +188,12 @@ impl Panel {
         let coarse = key.modifiers.contains(KeyModifiers::SHIFT);
         match key.code {
             KeyCode::Char('c') if key.modifiers.contains(KeyModifiers::CONTROL) => Action::Quit,
-            KeyCode::Char('q') | KeyCode::Esc => Action::Quit,
+            KeyCode::Char('q') => Action::Quit,
+            // Esc closes the help; it never ends a session by accident.
+            KeyCode::Esc => {
+                self.show_help = false;
+                Action::None
+            }
             KeyCode::Up | KeyCode::Char('k') => {
                 self.selected = (self.selected + n - 1) % n;
                 Action::None
@@ -218,7 +227,8 @@ impl Panel {
         };
         let (step, log) = (*step, *log);
         let times = if coarse { 10.0 } else { 1.0 };
-        self.set_selected(|v, _, _| if log { v * step.powf(direction * times / if coarse { 2.0 } else { 1.0 }) } else { v + direction * step * times })
+        // Logarithmic sliders walk 1, 2, 5, 10, 20, ... (coarse: a decade), so the file gets round values.
+        self.set_selected(|v, _, _| if log { if coarse { ladder(v * 10f64.powf(direction * 0.999), 0.0) } else { ladder(v, direction) } } else { v + direction * step * times })
     }
 
     fn set_selected(&mut self, f: impl Fn(f64, f64, f64) -> f64) -> Action {
@@ -259,7 +269,7 @@ impl Panel {
     /// Draws the panel.
     pub fn render(&self, frame: &mut Frame<'_>, status: &Status, config_path: &str) {
         let [top, list, bottom] =
-            Layout::vertical([Constraint::Length(2), Constraint::Min(3), Constraint::Length(if self.show_help { 11 } else { 7 })]).areas(frame.area());
+            Layout::vertical([Constraint::Length(2), Constraint::Min(3), Constraint::Length(if self.show_help { 13 } else { 9 })]).areas(frame.area());
         let head = vec![
             Line::from(Span::styled(self.title.clone(), Style::default().add_modifier(Modifier::BOLD))),
             Line::from(format!("sim t = {:.1} s   speed ×{}   config {config_path}", status.sim_t_s, trim(status.speed))),
@@ -290,18 +300,59 @@ impl Panel {
         frame.render_widget(Paragraph::new(lines).block(Block::default().borders(Borders::ALL).title(" parameters (write the config file) ")), list);
 
         let p95 = super::p95(&status.latencies_ms);
-        let mut foot = vec![
+        let mut foot = Vec::new();
+        if let Some(Control::Slider { min, max, step, log, unit, .. }) = self.controls.get(self.selected) {
+            let steps = if *log { "steps 1-2-5".to_owned() } else { format!("step {}{unit}", trim(*step)) };
+            foot.push(Line::from(Span::styled(format!("selected: range {} … {}{unit}, {steps}", trim(*min), trim(*max)), Style::default().fg(Color::Yellow))));
+        }
+        foot.push(error_line(status));
+        foot.extend([
             Line::from(format!("last: {}", if status.message.is_empty() { "—" } else { &status.message })),
             Line::from(format!("reloads: {}   save → applied p95 {:.0} ms", status.latencies_ms.len(), p95)),
             Line::from(Span::styled(HELP, Style::default().fg(Color::DarkGray))),
-        ];
+        ]);
         if self.show_help {
             foot.push(Line::from("Every slider writes its key into the config file (comments and layout kept);"));
             foot.push(Line::from("the file watcher reloads it exactly as when you save from an editor. Editing the"));
             foot.push(Line::from("file by hand moves the sliders. Bad values are reported and the old ones kept."));
-            foot.push(Line::from("q, Esc or Ctrl-C ends the session; a --save recording is completed."));
+            foot.push(Line::from("q or Ctrl-C ends the session (a --save recording is completed); Esc closes this help."));
         }
         frame.render_widget(Paragraph::new(foot).wrap(Wrap { trim: true }), bottom);
+    }
+}
+
+/// The attitude error since the parameters last changed: RMS / peak per axis of the uncompensated
+/// and the compensated table, arcsec.
+fn error_line(status: &Status) -> Line<'static> {
+    use crate::math::units::ARCSEC_PER_RAD;
+    let variant = |v: usize| {
+        crate::sim::ERROR_AXES
+            .iter()
+            .enumerate()
+            .map(|(a, axis)| {
+                let s = &status.errors.stats[v][a];
+                format!("{axis} {}/{}", trim(s.rms() * ARCSEC_PER_RAD), trim(s.peak() * ARCSEC_PER_RAD))
+            })
+            .collect::<Vec<_>>()
+            .join("  ")
+    };
+    Line::from(format!("error since the last change, RMS/peak ″ — uncompensated: {}   compensated: {}", variant(0), variant(1)))
+}
+
+/// The next value of the 1-2-5 ladder after `v` in `direction` (+1 up, −1 down; 0: the nearest).
+fn ladder(v: f64, direction: f64) -> f64 {
+    if !(v > 0.0 && v.is_finite()) {
+        return 1.0;
+    }
+    let decade = 10f64.powf(v.log10().floor());
+    let rungs: Vec<f64> = [-1.0, 0.0, 1.0].iter().flat_map(|d| [1.0, 2.0, 5.0].map(|m| m * decade * 10f64.powf(*d))).collect();
+    let tolerance = 1e-9 * v;
+    if direction > 0.0 {
+        rungs.into_iter().find(|r| *r > v + tolerance).unwrap_or(v)
+    } else if direction < 0.0 {
+        rungs.into_iter().rev().find(|r| *r < v - tolerance).unwrap_or(v)
+    } else {
+        rungs.into_iter().min_by(|a, b| (a.ln() - v.ln()).abs().total_cmp(&(b.ln() - v.ln()).abs())).unwrap_or(v)
     }
 }
 
@@ -376,10 +427,31 @@ mod tests {
     }
 
     #[test]
-    fn logarithmic_sliders_multiply() {
+    fn logarithmic_sliders_walk_the_1_2_5_ladder() {
+        // The speed slider used to write 1.25^5 = 3.051758 into the file: now round values only.
         let mut p = panel();
         p.selected = p.controls.iter().position(|c| matches!(c, Control::Slider { label, .. } if label.starts_with("speed"))).expect("speed");
-        assert_eq!(p.handle(key(KeyCode::Right)), Action::Set(vec![(KeyPath::parse("live.speed"), Scalar::Float(1.25))]));
+        let speed = |v: f64| Action::Set(vec![(KeyPath::parse("live.speed"), Scalar::Float(v))]);
+        for expected in [2.0, 5.0, 10.0, 20.0] {
+            assert_eq!(p.handle(key(KeyCode::Right)), speed(expected));
+        }
+        assert_eq!(p.handle(key(KeyCode::Left)), speed(10.0));
+        assert_eq!(p.handle(key(KeyCode::PageUp)), speed(100.0)); // coarse: a decade
+        assert_eq!(p.handle(key(KeyCode::PageDown)), speed(10.0));
+        // A value edited in by hand (3.05) steps to the next rung, 5, and back to 2.
+        assert_eq!(super::ladder(3.05, 1.0), 5.0);
+        assert_eq!(super::ladder(3.05, -1.0), 2.0);
+        assert_eq!(super::ladder(0.1, -1.0), 0.05);
+    }
+
+    #[test]
+    fn esc_closes_the_help_and_does_not_end_the_session() {
+        let mut p = panel();
+        p.handle(key(KeyCode::Char('?')));
+        assert!(p.show_help);
+        assert_eq!(p.handle(key(KeyCode::Esc)), Action::None);
+        assert!(!p.show_help);
+        assert_eq!(p.handle(key(KeyCode::Esc)), Action::None);
     }
 
     #[test]
@@ -402,5 +474,7 @@ mod tests {
         assert!(text.contains("outer swing half-angle"));
         assert!(text.contains("600″"));
         assert!(text.contains("q quit"));
+        assert!(text.contains("error since the last change"), "the current error is beside the sliders");
+        assert!(text.contains("range 0 … 3600″, step 10″"), "the selected slider shows its range");
     }
 }

@@ -15,6 +15,8 @@ pub struct LiveSim {
     step_index: u64,
     /// RMS and peak over the session.
     pub stats: ErrorStats,
+    /// RMS and peak since the parameters last changed (what the panel shows).
+    pub since_change: ErrorStats,
     last_gimbal_rad: AxisValues,
 }
 
@@ -24,7 +26,7 @@ impl LiveSim {
     pub fn new(params: Params) -> Self {
         let model = params.table_model();
         let last_gimbal_rad = model.scheme.state(0.0).0;
-        Self { params, model, state: DemodState::default(), step_index: 0, stats: ErrorStats::default(), last_gimbal_rad }
+        Self { params, model, state: DemodState::default(), step_index: 0, stats: ErrorStats::default(), since_change: ErrorStats::default(), last_gimbal_rad }
     }
 
     /// Simulated time of the next step, s.
@@ -44,6 +46,7 @@ impl LiveSim {
         let t = self.t_s();
         let out = step(&self.model, &mut self.state, t);
         self.stats.add(&out);
+        self.since_change.add(&out);
         self.last_gimbal_rad = out.gimbal_rad;
         self.step_index += 1;
         out
@@ -77,6 +80,7 @@ impl LiveSim {
         }
         self.model = model;
         self.params = new;
+        self.since_change = ErrorStats::default();
         Ok(changes)
     }
 }
