@@ -83,8 +83,9 @@ impl Recorder {
                     tabs.push(plot("velocity error (m/s)".into(), "ins/velocity_error_mps"));
                 }
                 let window = |name: &str, origin: &str| Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::window_time_axis(layout.signal_window_s));
-                tabs.push(window("gyro raw (deg/s)", "ins/gyro_raw_deg_per_s"));
-                tabs.push(window("gyro after FIR (deg/s)", "ins/gyro_filtered_deg_per_s"));
+                // Keyed in the title: a legend would sit over the signal.
+                tabs.push(window("gyro raw (deg/s) — red x, green y, blue z", "ins/gyro_raw_deg_per_s").with_property("PlotLegend", &layout::no_legend()));
+                tabs.push(window("gyro after FIR (deg/s) — red x, green y, blue z", "ins/gyro_filtered_deg_per_s").with_property("PlotLegend", &layout::no_legend()));
                 if layout.fir_taps.len() > 1 {
                     tabs.push(Node::view("2D", "FIR response (x: Hz, y: −5·dB)", "ins/fir_response"));
                 }

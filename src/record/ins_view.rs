@@ -28,6 +28,23 @@ pub(crate) struct InsLayout {
     /// Pure coning: the series index of the log10 drift plot and each algorithm's analytic drift
     /// rate about the cone axis, arcsec/s (`ins::coning::coning_drift_rate`).
     pub(crate) coning_log: Option<(usize, Vec<f64>)>,
+    /// With two algorithms or more: per algorithm, the drift dial needle's rotation, at most
+    /// [`DIAL_HZ`] (the errors grow slowly; at the scene's rate the dial would add 13 MB/h).
+    pub(crate) dial: Vec<Vec<rerun::Quaternion>>,
+    /// The dial's frame times, s, and the time of the next.
+    pub(crate) dial_t: Vec<f64>,
+    pub(crate) dial_next_t: f64,
+}
+
+/// Frames per second of the drift dial, at most.
+pub(crate) const DIAL_HZ: f64 = 4.0;
+
+/// Where the drift dial (one needle per algorithm, turned by the size of its attitude error ×N) stands.
+pub(crate) const DIAL_OFFSET: [f32; 3] = [2.3, 0.2, -0.5];
+
+/// The needle of algorithm `k` on the drift dial.
+pub(crate) fn dial_path(name: &str) -> String {
+    format!("world/drift_dial/{name}")
 }
 
 /// The log10 plot of the coning drift: each algorithm's |heading error| beside its analytic rate × t.
@@ -112,6 +129,29 @@ impl Recorder {
                 .collect();
             let labels: Vec<String> = [335.4f64, 375.5, 425.7].iter().filter(|f| **f < nyquist).map(|f| format!("{f} Hz dither")).collect();
             rec.log_static("ins/fir_response/dither", &rerun::Points2D::new(tones).with_labels(labels).with_radii([6.0]).with_colors([rgb([240, 90, 90])]))?;
+        }
+        // The drift dial: a student sees the heading error of each algorithm accumulate, ×N, and
+        // why a higher-order algorithm helps (the needles of the good ones barely move).
+        if !layout.dial.is_empty() {
+            let circle: Vec<[f32; 3]> = (0..=72).map(|i| {
+                let a = f64::from(i) * std::f64::consts::TAU / 72.0;
+                [(0.45 * a.cos()) as f32, (0.45 * a.sin()) as f32, 0.0]
+            }).collect();
+            rec.log_static("world/drift_dial", &rerun::Transform3D::from_translation(DIAL_OFFSET))?;
+            rec.log_static("world/drift_dial/rim", &rerun::LineStrips3D::new([circle]).with_colors([rgba([200, 200, 200], 160)]).with_radii([0.004]))?;
+            let title = format!("attitude error per algorithm, clockwise ×{} (a turn: {:.0}″)", layout.exaggeration, 360.0 * 3600.0 / layout.exaggeration);
+            let mut items: Vec<([f32; 3], String)> = vec![([0.0, -0.62, 0.0], title)];
+            for (k, name) in layout.algorithms.iter().enumerate() {
+                let path = dial_path(name);
+                rec.log_static(path.as_str(), &rerun::Transform3D::IDENTITY)?;
+                rec.log_static(format!("{path}/needle"), &rerun::Arrows3D::from_vectors([[0.0, 0.42, 0.0]]).with_colors([rgb(colors::algorithm(name))]).with_radii([0.01]))?;
+                items.push(([0.62, 0.0, 0.42 - 0.11 * k as f32], name.clone()));
+            }
+            let colors: Vec<rerun::Color> = std::iter::once(rgb([230, 230, 230])).chain(layout.algorithms.iter().map(|n| rgb(colors::algorithm(n)))).collect();
+            rec.log_static(
+                "world/drift_dial/labels",
+                &rerun::Points3D::new(items.iter().map(|(p, _)| *p)).with_labels(items.iter().map(|(_, t)| t.as_str())).with_colors(colors).with_radii([0.012]),
+            )?;
         }
         // The INS trace: true IMU axes (grey) and computed (coloured, error ×N), beside the table.
         let ins_label = format!("INS IMU axes (error ×{})", layout.exaggeration);

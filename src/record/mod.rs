@@ -235,6 +235,7 @@ impl Recorder {
         });
         let ins = params.ins.as_ref().map(|cfg| {
             let algorithms: Vec<String> = cfg.algorithms().iter().map(|a| a.name().to_owned()).collect();
+            let n_algorithms = algorithms.len();
             let first_series = series.len();
             for axis in ERROR_AXES {
                 series.push(Series::new(format!("ins/attitude_error_arcsec/{axis}"), algorithms.clone()));
@@ -263,6 +264,9 @@ impl Recorder {
                 raw: Vec::new(),
                 filtered: Vec::new(),
                 trace_true: Vec::new(),
+                dial: if n_algorithms >= 2 { vec![Vec::new(); n_algorithms] } else { Vec::new() },
+                dial_t: Vec::new(),
+                dial_next_t: f64::NEG_INFINITY,
                 trace_ins: Vec::new(),
                 exaggeration: params.recording.exaggeration,
                 fir_taps: cfg.fir_taps.clone(),
@@ -454,6 +458,17 @@ impl Recorder {
             let err = rotvec::log(&(c * t.inverse())) * layout.exaggeration;
             layout.trace_true.push(to_rerun_quaternion(&t));
             layout.trace_ins.push(to_rerun_quaternion(&(rotvec::exp(&err) * t)));
+            // The needles turn clockwise by the size of each algorithm's attitude error (whichever
+            // axis it is on: heading for a cone about z, pitch for seed 001's wobble), ×N.
+            let due = !layout.dial.is_empty() && out.t_s >= layout.dial_next_t;
+            if due {
+                layout.dial_t.push(out.t_s);
+                layout.dial_next_t = out.t_s + 1.0 / ins_view::DIAL_HZ - 1e-9;
+            }
+            for (k, needle) in layout.dial.iter_mut().enumerate().filter(|_| due) {
+                let size = ins.and_then(|v| v.errors.get(k)).map_or(0.0, |e| e.as_array().iter().map(|x| x * x).sum::<f64>().sqrt());
+                needle.push(to_rerun_quaternion(&UnitQuaternion::from_axis_angle(&Vector3::z_axis(), -size * layout.exaggeration)));
+            }
         }
         if self.scene_t.len() >= SERIES_CHUNK_ROWS {
             self.flush_scene()?;
@@ -522,6 +537,12 @@ impl Recorder {
                         .with_many_quaternion(q)
                         .columns_of_unit_batches()?,
                 )?;
+            }
+            let dial_t = std::mem::take(&mut layout.dial_t);
+            for (k, name) in layout.algorithms.iter().enumerate().take(layout.dial.len()) {
+                let q = std::mem::take(&mut layout.dial[k]);
+                let time = TimeColumn::new_duration_secs(TIMELINE, dial_t.iter().copied());
+                self.rec.send_columns(ins_view::dial_path(name).as_str(), [time], rerun::Transform3D::update_fields().with_many_quaternion(q).columns_of_unit_batches()?)?;
             }
         }
         Ok(())
