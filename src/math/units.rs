@@ -143,8 +143,9 @@ impl AngleUnit {
 }
 
 /// The half-range of a symmetric plot for a signal of `peak` (in the plot's unit): the smallest of
-/// 1, 2, 3 × 10^k at or above 1.05 × peak. The span is then 2, 4 or 6 × 10^k, which a plot's
-/// power-of-ten grid labels with 2-6 ticks at any height (a span of 1.2 × 10^k would show one).
+/// 1, 2, 3 × 10^k at or above 1.05 × peak. Drawn at ±1.25 × that (`record::layout::symmetric_range`),
+/// a plot's power-of-ten grid labels 3, 5 or 7 ticks (a span of 1.2 × 10^k would show one, 5 × 10^k
+/// none but 0 in a plot 170 px high).
 #[must_use]
 pub fn nice_half_range(peak: f64) -> f64 {
     let p = (peak.abs() * 1.05).max(1e-12);

@@ -17,11 +17,14 @@ impl Recorder {
         let framed = |node: Node, peak: Option<f64>| match peak {
             Some(p) if p > 0.0 => {
                 let h = crate::math::units::nice_half_range(p);
-                node.with_property("ScalarAxis", &layout::scalar_range(-h, h))
+                node.with_property("ScalarAxis", &layout::symmetric_range(h))
             }
             _ => node,
         };
-        let table_peak = |a: usize| self.ranges.map(|r| r.table_peak_rad[a] * unit.per_rad());
+        // An axis is not zoomed in beyond a hundredth of the largest axis of its group: 1e-5″ of
+        // rounding beside a 500″ error would fill its plot and look like a drift.
+        let floored = |peaks: [f64; 3], a: usize| peaks[a].max(peaks.iter().fold(0.0_f64, |m, x| m.max(*x)) / 100.0);
+        let table_peak = |a: usize| self.ranges.map(|r| floored(r.table_peak_rad, a) * unit.per_rad());
         // The legend would sit over the data: the title says which line is which.
         let key = if self.replay { "red: nominal table, green: compensated" } else { "red: uncompensated, blue: closed form, green: compensated" };
         let error_view = |a: usize, axis: &str| {
@@ -62,11 +65,17 @@ impl Recorder {
             }
             (Some(layout), None) => {
                 // The INS in the loop leads; the turntable-only (ideal-INS) plots go into the tabs.
-                let ins_peak = |a: usize| self.ranges.and_then(|r| r.ins_peak_rad).map(|p| p[a] * crate::math::units::ARCSEC_PER_RAD);
-                // The legend would sit over the data: the title gives each algorithm's colour.
-                let algorithm_key = layout.algorithms.iter().map(|a| format!("{}: {a}", super::palette::colors::algorithm_colour_name(a))).collect::<Vec<_>>().join(", ");
+                let ins_peak = |a: usize| self.ranges.and_then(|r| r.ins_peak_rad).map(|p| floored(p, a) * crate::math::units::ARCSEC_PER_RAD);
+                // The legend would sit over the data: the first plot's title gives each
+                // algorithm's colour (short, so that it is not cut), the others refer to it.
+                let algorithm_key = layout.algorithms.iter().map(|a| format!("{} {}", super::palette::colors::algorithm_colour_name(a), short_name(a))).collect::<Vec<_>>().join(" · ");
                 let ins_view = |a: usize, axis: &str| {
-                    framed(plot(format!("INS {axis} error (arcsec) — {algorithm_key}"), &format!("ins/attitude_error_arcsec/{axis}")), ins_peak(a)).with_property("PlotLegend", &layout::no_legend())
+                    let title = match (a, layout.algorithms.len()) {
+                        (_, 1) => format!("INS {axis} error (arcsec)"),
+                        (0, _) => format!("INS {axis} error (″) — {algorithm_key}"),
+                        _ => format!("INS {axis} error (arcsec), colours as above"),
+                    };
+                    framed(plot(title, &format!("ins/attitude_error_arcsec/{axis}")), ins_peak(a)).with_property("PlotLegend", &layout::no_legend())
                 };
                 let mut tabs = Vec::new();
                 if let Some((_, rates)) = &layout.coning_log {
@@ -74,7 +83,7 @@ impl Recorder {
                     // start) to the end, of the slowest to the fastest analytic drift.
                     let logs = rates.iter().filter(|r| **r > 0.0).map(|r| (r * p.duration_s).log10());
                     let (lo, hi) = logs.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)));
-                    let view = plot(format!("coning drift, log10 of |heading error| in arcsec — thick: measured, thin: analytic rate × t; {algorithm_key}"), super::ins_view::CONING_LOG_PATH)
+                    let view = plot("coning drift: log10 |heading error in ″|, thick measured, thin analytic rate × t".to_owned(), super::ins_view::CONING_LOG_PATH)
                         .with_property("PlotLegend", &layout::no_legend());
                     tabs.push(if lo.is_finite() { view.with_property("ScalarAxis", &layout::scalar_range((lo - 1.0).floor(), hi.ceil())) } else { view });
                 }
@@ -101,4 +110,10 @@ impl Recorder {
         let speed = if self.live { 1.0 } else { (p.duration_s / 60.0).max(1.0).round() };
         layout::send(&self.rec, APPLICATION_ID, &root, &layout::Playback { timeline: TIMELINE, speed, follow: self.live })
     }
+}
+
+/// A coning algorithm's name as a colour key spells it: "single-sample" → "single",
+/// "two-sample-p1" → "two-p1", "three-sample" → "three".
+fn short_name(name: &str) -> String {
+    name.replace("-sample", "")
 }

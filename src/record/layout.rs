@@ -86,6 +86,15 @@ pub fn scalar_range(lo: f64, hi: f64) -> bp::ScalarAxis {
     bp::ScalarAxis::new().with_range(rerun::components::Range1D(datatypes::Range1D([lo, hi])))
 }
 
+/// A symmetric plot range for data within ±`h` (a [`crate::math::units::nice_half_range`]):
+/// ±1.25 h. The plot labels its grid at powers of ten only, and drops the labels on the border,
+/// so ±h itself (h = 10^k) would show "0" alone; at ±1.25 h the ticks at ±h are inside. Measured
+/// in the viewer at 1600×1000 (plots ~170 px high): h = 1, 2, 3 × 10^k give 3, 5 and 7 labelled
+/// ticks.
+pub fn symmetric_range(h: f64) -> bp::ScalarAxis {
+    scalar_range(-1.25 * h, 1.25 * h)
+}
+
 /// No legend (the view's title names the lines).
 #[must_use]
 pub fn no_legend() -> bp::PlotLegend {

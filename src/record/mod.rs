@@ -63,7 +63,8 @@ impl Stream {
     /// Sends `width` series of `path` (values row-major, one row per time) to Rerun, and to the
     /// export tables with the series' `names` and the unit `path` states.
     pub(crate) fn send_series(&self, path: &str, names: &[String], times: &[f64], values: Vec<f64>, width: usize) -> RecordingStreamResult<()> {
-        if let Some(export) = &self.export {
+        // A log10 plot is a picture of a series exported in its own unit, not a measurement.
+        if let Some(export) = self.export.as_ref().filter(|_| !is_log_plot(path)) {
             let unit = export::unit_of(path).unwrap_or("1");
             let mut e = export.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
             e.write(path, unit, names, times, &values);
@@ -86,6 +87,11 @@ impl Stream {
         self.rec.send_columns(path, [time], rerun::Scalars::new(vec![y; times.len()]).columns_of_unit_batches()?)?;
         Ok(())
     }
+}
+
+/// Whether `path` is a log10 picture of another series (`…_log10_<unit>`): drawn, not exported.
+fn is_log_plot(path: &str) -> bool {
+    path.rsplit('/').next().is_some_and(|leaf| leaf.contains("_log10_") || leaf.starts_with("log10_"))
 }
 
 /// What a failed Rerun call returns.

@@ -9,6 +9,10 @@ use super::{Stream, APPLICATION_ID, TIMELINE};
 use crate::ins::trace::{NavSample, NavTrace};
 
 const COLORS: [[u8; 3]; 3] = [[230, 76, 60], [240, 180, 40], [46, 170, 90]];
+/// The colours' names, for the plot titles that stand in for legends.
+const COLOR_NAMES: [&str; 3] = ["red", "yellow", "green"];
+/// The radial error as log10 of metres: 27 m beside 30 km, each readable.
+const LOG_PATH: &str = "modulation/radial_position_error_log10_m";
 
 /// Logs the traces (sampled at the same instants) with their explanation and a layout.
 pub fn log(stream: &Stream, traces: &[NavTrace], table: &str) -> RecordingStreamResult<()> {
@@ -26,7 +30,7 @@ pub fn log(stream: &Stream, traces: &[NavTrace], table: &str) -> RecordingStream
     );
     rec.log_static("docs/modulation", &rerun::TextDocument::from_markdown(doc))?;
     let colors: Vec<rerun::Color> = COLORS.iter().map(|c| rgb(*c)).collect();
-    for path in ["modulation/radial_position_error_m", "modulation/east_error_m", "modulation/north_error_m", "modulation/heading_error_arcsec"] {
+    for path in ["modulation/radial_position_error_m", LOG_PATH, "modulation/east_error_m", "modulation/north_error_m", "modulation/heading_error_arcsec"] {
         rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors.clone()).with_names(names.clone()))?;
     }
     let n = traces.iter().map(|t| t.samples.len()).min().unwrap_or(0);
@@ -43,19 +47,28 @@ pub fn log(stream: &Stream, traces: &[NavTrace], table: &str) -> RecordingStream
     let width = traces.len();
     for (path, values) in [
         ("modulation/radial_position_error_m", column(&|s| s.position_m[2])),
+        (LOG_PATH, column(&|s| if s.position_m[2] > 0.0 { s.position_m[2].log10() } else { f64::NAN })),
         ("modulation/east_error_m", column(&|s| s.position_m[0])),
         ("modulation/north_error_m", column(&|s| s.position_m[1])),
         ("modulation/heading_error_arcsec", column(&|s| s.heading_arcsec)),
     ] {
         stream.send_series(path, &names, &times, values, width)?;
     }
-    let plot = |name: &str, origin: &str| Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::whole_run_time_axis());
+    // Legends would sit over the data: the first title gives the colours.
+    let key = names.iter().zip(COLOR_NAMES).map(|(n, c)| format!("{c} {n}")).collect::<Vec<_>>().join(" · ");
+    let plot = |name: &str, origin: &str| {
+        Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::whole_run_time_axis()).with_property("PlotLegend", &layout::no_legend())
+    };
     let root = Node::container(
         ContainerKind::Horizontal,
         vec![
             Node::container(
                 ContainerKind::Vertical,
-                vec![plot("radial position error (m)", "modulation/radial_position_error_m"), plot("heading error (arcsec)", "modulation/heading_error_arcsec")],
+                vec![
+                    plot(&format!("radial position error (m) — {key}"), "modulation/radial_position_error_m"),
+                    plot("radial position error, log10 of metres (1 = 10 m, 4 = 10 km)", LOG_PATH),
+                    plot("heading error (arcsec)", "modulation/heading_error_arcsec"),
+                ],
                 &[],
             ),
             Node::container(

@@ -65,11 +65,15 @@ pub fn log(stream: &Stream, params: &Params, r: &TprResult, table: &str) -> Reco
         };
         rec.log("events", &rerun::TextLog::new(what).with_level("INFO"))?;
     }
-    let plot = |name: &str, origin: &str| Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::whole_run_time_axis());
+    // Legends would sit over the data: the first title gives the colours.
+    let plot = |name: &str, origin: &str| {
+        Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::whole_run_time_axis()).with_property("PlotLegend", &layout::no_legend())
+    };
+    let key = format!("red {} · green {} · blue {} · ▼ fixes", BRANCH_NAMES[0], BRANCH_NAMES[1], BRANCH_NAMES[2]);
     let root = Node::container(
         ContainerKind::Horizontal,
         vec![
-            Node::container(ContainerKind::Vertical, vec![plot("azimuth (heading) error (arcsec)", "tpr/heading_error_arcsec"), plot("radial position error (m)", "tpr/radial_position_error_m")], &[]),
+            Node::container(ContainerKind::Vertical, vec![plot(&format!("azimuth (heading) error (″) — {key}"), "tpr/heading_error_arcsec"), plot("radial position error (m)", "tpr/radial_position_error_m")], &[]),
             Node::container(
                 ContainerKind::Vertical,
                 vec![
@@ -81,7 +85,8 @@ pub fn log(stream: &Stream, params: &Params, r: &TprResult, table: &str) -> Reco
                     plot("east error (m)", "tpr/east_error_m"),
                     plot("north error (m)", "tpr/north_error_m"),
                 ],
-                &[1.3, 1.0, 1.0],
+                // The about tab holds the verdict table: give it the room to show it.
+                &[2.2, 1.0, 1.0],
             ),
         ],
         &[1.4, 1.0],
