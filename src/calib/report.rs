@@ -432,7 +432,59 @@ fn fmt_row(r: &Row) -> String {
     )
 }
 
+/// A row as a markdown table row: quantity, true, KF ± 1σ (error), LSQ ± 1σ (error), flag.
+fn md_row(r: &Row) -> String {
+    let d = if r.unit == "deg" { 5 } else { 3 };
+    let u = if r.unit == "deg" { "°" } else { "″" };
+    let err_scale = if r.unit == "deg" { 3600.0 } else { 1.0 };
+    format!(
+        "| {} | {:.d$}{u} | {:.d$}{u} ± {:.d$} ({:+.3}″) | {:.d$}{u} ± {:.d$} ({:+.3}″) | {} |\n",
+        r.label,
+        r.truth,
+        r.kf.value,
+        r.kf.sigma,
+        r.kf_error() * err_scale,
+        r.nls.value,
+        r.nls.sigma,
+        r.nls_error() * err_scale,
+        r.flag,
+        d = d
+    )
+}
+
 impl Report {
+    /// The report's tables in markdown (the recording's document: a panel wraps a fixed-width
+    /// table mid-row, it lays out a markdown one); the rest of [`Self::text`] follows as text.
+    #[must_use]
+    pub fn markdown(&self) -> String {
+        let head = "| | true | static KF ± 1σ (error) | exact LSQ ± 1σ (error) | |\n|---|---:|---:|---:|---|\n";
+        let mut s = format!("{} samples over {:.0} s, {} (seed {})\n\n", self.samples, self.duration_s, self.source, self.seed);
+        let mut table = |title: &str, rows: &[Row]| {
+            if !rows.is_empty() {
+                s.push_str(&format!("**{title}**\n\n{head}"));
+                for r in rows {
+                    s.push_str(&md_row(r));
+                }
+                s.push('\n');
+            }
+        };
+        table("Angles (phase errors in arcsec of phase)", &self.angles);
+        table("Seed 000's state X (eq. 29)", &self.paper_state);
+        table("State vector (table and reference nuisance)", &self.state);
+        if let Some(c) = &self.compensation {
+            s.push_str("**Compensation**, on an independent run (other noise seed): attitude error RMS / peak, arcsec\n\n| | pitch | roll | heading |\n|---|---:|---:|---:|\n");
+            for (name, e) in [("before (no swing/η)", c.before), ("after, static KF", c.after_kf), ("after, exact LSQ", c.after_nls), ("with the true values", c.with_truth)] {
+                let cells: Vec<String> = (0..3).map(|i| format!("{:.2} / {:.2}", e.rms_rad[i] * ARCSEC_PER_RAD, e.peak_rad[i] * ARCSEC_PER_RAD)).collect();
+                s.push_str(&format!("| {name} | {} |\n", cells.join(" | ")));
+            }
+            let factors: Vec<String> = (0..3).map(|i| format!("{:.1}×", c.before.peak_rad[i] / c.after_nls.peak_rad[i].max(1e-300))).collect();
+            s.push_str(&format!("| peak reduction (LSQ) | {} |\n", factors.join(" | ")));
+            let paper: Vec<String> = PAPER_LAB.iter().map(|(b, a)| format!("{:.1}×", b / a)).collect();
+            s.push_str(&format!("| seed 000 laboratory | {} |\n\n", paper.join(" | ")));
+        }
+        s
+    }
+
     /// The report as a terminal table.
     #[must_use]
     pub fn text(&self) -> String {

@@ -94,6 +94,27 @@ pub struct TableErrors {
     pub axes: Vec<AxisErrors>,
 }
 
+/// One number per geometric error class (a drawing factor, or a size).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClassFactors {
+    /// Shaft swing cones.
+    pub swing: f64,
+    /// Axis non-orthogonality.
+    pub non_orthogonality: f64,
+    /// Installation of the base on the body.
+    pub installation: f64,
+    /// IMU mounting on the last gimbal.
+    pub imu_mount: f64,
+}
+
+impl ClassFactors {
+    /// The same factor for every class.
+    #[must_use]
+    pub fn uniform(x: f64) -> Self {
+        Self { swing: x, non_orthogonality: x, installation: x, imu_mount: x }
+    }
+}
+
 impl TableErrors {
     /// No error at all on `n_axes` axes.
     #[must_use]
@@ -101,22 +122,36 @@ impl TableErrors {
         Self { installation_rad: Vector3::zeros(), imu_mount_rad: Vector3::zeros(), axes: vec![AxisErrors::default(); n_axes] }
     }
 
-    /// Every geometric error angle multiplied by `factor` (encoder errors dropped): what the 3D scene draws.
+    /// Every geometric error angle multiplied by its class's factor (encoder errors dropped): what
+    /// the 3D scene draws.
     #[must_use]
-    pub fn exaggerated(&self, factor: f64) -> Self {
+    pub fn exaggerated(&self, f: &ClassFactors) -> Self {
         Self {
-            installation_rad: self.installation_rad * factor,
-            imu_mount_rad: self.imu_mount_rad * factor,
+            installation_rad: self.installation_rad * f.installation,
+            imu_mount_rad: self.imu_mount_rad * f.imu_mount,
             axes: self
                 .axes
                 .iter()
                 .map(|a| AxisErrors {
-                    swing_half_angle_rad: a.swing_half_angle_rad * factor,
+                    swing_half_angle_rad: a.swing_half_angle_rad * f.swing,
                     swing_phase_rad: a.swing_phase_rad,
-                    non_orthogonality_rad: a.non_orthogonality_rad * factor,
+                    non_orthogonality_rad: a.non_orthogonality_rad * f.non_orthogonality,
                     ..AxisErrors::default()
                 })
                 .collect(),
+        }
+    }
+
+    /// The largest angle of each geometric error class, rad: swing half-angle, non-orthogonality,
+    /// installation, IMU mounting.
+    #[must_use]
+    pub fn class_sizes(&self) -> ClassFactors {
+        let max = |f: &dyn Fn(&AxisErrors) -> f64| self.axes.iter().map(|a| f(a).abs()).fold(0.0, f64::max);
+        ClassFactors {
+            swing: max(&|a| a.swing_half_angle_rad),
+            non_orthogonality: max(&|a| a.non_orthogonality_rad),
+            installation: self.installation_rad.norm(),
+            imu_mount: self.imu_mount_rad.norm(),
         }
     }
 

@@ -30,7 +30,15 @@ impl Recorder {
         let error_view = |a: usize, axis: &str| {
             framed(plot(format!("{axis} error ({}) — {key}", unit.suffix()), &super::error_path(unit, axis)), table_peak(a)).with_property("PlotLegend", &layout::no_legend())
         };
-        let scene = Node::view("3D", format!("3D: gimbal chain (errors ×{})", p.recording.exaggeration), "world")
+        let x = p.recording.exaggeration;
+        let f = self.factors;
+        let own: Vec<String> = [("swing", f.swing), ("η", f.non_orthogonality), ("installation", f.installation), ("IMU mounting", f.imu_mount)]
+            .iter()
+            .filter(|(_, v)| *v != x)
+            .map(|(n, v)| format!("{n} ×{v}"))
+            .collect();
+        let scale = if own.is_empty() { format!("errors ×{x}") } else { format!("errors ×{x}, {}", own.join(", ")) };
+        let scene = Node::view("3D", format!("3D: gimbal chain ({scale})"), "world")
             .with_property(
                 "EyeControls3D",
                 // With an INS, the trace stands beside the table: step back to frame both.
@@ -50,7 +58,9 @@ impl Recorder {
         let mut more = Vec::new();
         if self.closed_form_series.is_some() {
             let peak = self.ranges.map(|r| r.closed_form_peak_rad.iter().fold(0.0_f64, |m, x| m.max(*x)) * crate::math::units::ARCSEC_PER_RAD);
-            more.push(framed(plot("closed form − exact (arcsec)".into(), super::CLOSED_FORM_PATH), peak));
+            more.push(
+                framed(plot("closed form − exact (arcsec) — red pitch, green roll, blue heading".into(), super::CLOSED_FORM_PATH), peak).with_property("PlotLegend", &layout::no_legend()),
+            );
         }
         more.extend([
             plot("gimbal angles (deg)".into(), "gimbal_angle_deg"),

@@ -42,13 +42,25 @@ pub fn log(stream: Stream, params: &Params, cal: &Calibration, report: &Report, 
         .iter()
         .map(|(i, p)| {
             let (x, sd, t) = (cal.kf.theta[*i] * ARCSEC_PER_RAD, cal.kf.sigma(*i) * ARCSEC_PER_RAD, truth[*i] * ARCSEC_PER_RAD);
-            let half = (12.0 * sd).max(1.0).max(1.5 * (x - t).abs());
+            // On the viewer's power-of-ten grid: a centre on a tick and ±1.25 × a 1-2-3 half range,
+            // so that the plot labels 3-7 ticks (layout::symmetric_range).
+            let h = crate::math::units::nice_half_range((12.0 * sd).max(1.0).max(1.5 * (x - t).abs()));
+            let tick = 10f64.powf(h.log10().floor());
+            let centre = (x / tick).round() * tick;
             plot(format!("{} (″)", p.label(chain)), format!("calibration/state_arcsec/{}", p.key(chain)))
-                .with_property("ScalarAxis", &layout::scalar_range(x - half, x + half))
+                .with_property("ScalarAxis", &layout::scalar_range(centre - 1.25 * h, centre + 1.25 * h))
                 .with_property("PlotLegend", &layout::no_legend())
         })
         .collect();
-    let errors: Vec<Node> = ERROR_AXES.iter().map(|a| plot(format!("{a} error before/after (arcsec)"), format!("calibration/error_arcsec/{a}"))).collect();
+    // Keyed in the title (a legend would cover the first trough); KF wide under LSQ thin, since
+    // the two compensations are nearly the same line.
+    let errors: Vec<Node> = ERROR_AXES
+        .iter()
+        .map(|a| {
+            plot(format!("{a} error (″) — red before, yellow (wide) after static KF, blue after exact LSQ"), format!("calibration/error_arcsec/{a}"))
+                .with_property("PlotLegend", &layout::no_legend())
+        })
+        .collect();
     let right = Node::container(ContainerKind::Vertical, vec![Node::container(ContainerKind::Grid, states, &[]), Node::container(ContainerKind::Tabs, errors, &[])], &[1.6, 1.0]);
     let custom = CustomLayout { right, docs: vec![Node::view("TextDocument", "calibration", "docs/calibration")] };
     // The table scene of the ideal demodulation; the INS is the calibration's business here.
@@ -63,8 +75,10 @@ pub fn log(stream: Stream, params: &Params, cal: &Calibration, report: &Report, 
         &rerun::TextDocument::from_markdown(format!(
             "# Calibration\n\nWhite: the cones and rotor axes as estimated, converging on the coloured true ones \
              (errors drawn ×{}). Plots: each state's static-Kalman-filter estimate (yellow) inside its ±3σ band (grey), \
-             the true value (green) and the exact least-squares result (blue). docs/calibration.md explains the model.\n\n```\n{}```\n",
+             the true value (green) and the exact least-squares result (blue). docs/calibration.md explains the model.\n\n{}\
+             The whole report as the terminal prints it:\n\n```\n{}```\n",
             params.recording.exaggeration,
+            report.markdown(),
             report.text()
         )),
     )?;
@@ -82,7 +96,7 @@ pub fn log(stream: Stream, params: &Params, cal: &Calibration, report: &Report, 
     for a in ERROR_AXES {
         rec.log_static(
             format!("calibration/error_arcsec/{a}"),
-            &rerun::SeriesLines::new().with_colors(ERROR_COLORS.map(rgb)).with_names(ERROR_NAMES),
+            &rerun::SeriesLines::new().with_colors(ERROR_COLORS.map(rgb)).with_names(ERROR_NAMES).with_widths([1.5, 4.0, 1.5]),
         )?;
     }
 
@@ -104,7 +118,7 @@ pub fn log(stream: Stream, params: &Params, cal: &Calibration, report: &Report, 
     }
 
     // Ghost cones and estimated rotor axes, once per second of the test.
-    let x = params.recording.exaggeration;
+    let x = recorder.factors.swing; // the swing cones' drawing factor (drawing_factors)
     let n = chain.axes().len();
     // Once a second, and at most GHOST_FRAMES times over the test (a mesh each: a 100-h test must
     // not write 360 000 of them).
@@ -138,7 +152,8 @@ pub fn log(stream: Stream, params: &Params, cal: &Calibration, report: &Report, 
                 format!("{}/estimated_axis", recorder.paths.gimbals[k]),
                 &rerun::LineStrips3D::new([[p3(-dir * half * 1.1), p3(dir * half * 1.1)]]).with_colors([rgb(GHOST)]).with_radii([0.006]),
             )?;
-            let tip = -g.axis * half * 1.02 + g.e2 * (half * (alpha * x).tan());
+            // At the other end of the cone from the true cone's label, so the two never overlap.
+            let tip = g.axis * half * 1.02 + g.e2 * (half * (alpha * x).tan());
             let label = format!("estimate: α = {}, φ = {:.2}°", fmt_angle(alpha), est.axes[k].swing_phase_rad.to_degrees());
             rec.log(format!("{mount}/estimated_cone/label"), &rerun::Points3D::new([p3(tip)]).with_labels([label]).with_radii([0.002]).with_colors([rgb(GHOST)]))?;
         }

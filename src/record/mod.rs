@@ -33,7 +33,7 @@ use crate::ins::core::NavError;
 use crate::ins::pipeline::InsView;
 use crate::math::rotvec;
 use crate::math::units::{ARCSEC_PER_RAD, DEG_PER_RAD};
-use crate::model::gimbal::{Chain, ErrorRotations, TableErrors};
+use crate::model::gimbal::{Chain, ClassFactors, ErrorRotations, TableErrors};
 use crate::scenario::Params;
 use crate::sim::{StepOutput, DEMODULATIONS, ERROR_AXES};
 use ins_view::{InsLayout, TRACE_OFFSET};
@@ -87,6 +87,28 @@ impl Stream {
         self.rec.send_columns(path, [time], rerun::Scalars::new(vec![y; times.len()]).columns_of_unit_batches()?)?;
         Ok(())
     }
+}
+
+/// The smallest angle an error class is drawn at, rad (2°): under it a cone or wedge cannot be seen
+/// at the default camera (seed 000's 20″ non-orthogonality is 0.56° at ×100).
+const MIN_DRAWN_RAD: f64 = 2.0 * crate::math::units::RAD_PER_DEG;
+
+/// The drawing factor of each error class: the scenario's exaggeration `x`, or, for a class whose
+/// largest angle `x` would draw under [`MIN_DRAWN_RAD`], the smallest of 1, 2, 5 × 10^k that draws
+/// it there (at most 10^5). The labels say each class's factor.
+#[must_use]
+pub fn drawing_factors(truth: &TableErrors, x: f64) -> ClassFactors {
+    let raise = |a: f64| {
+        if a <= 0.0 || a * x >= MIN_DRAWN_RAD {
+            return x;
+        }
+        let need = MIN_DRAWN_RAD / a;
+        let decade = 10f64.powf(need.log10().floor());
+        let f = [1.0, 2.0, 5.0, 10.0].into_iter().map(|m| m * decade).find(|f| *f >= need * (1.0 - 1e-12)).unwrap_or(10.0 * decade);
+        f.min(1e5).max(x)
+    };
+    let s = truth.class_sizes();
+    ClassFactors { swing: raise(s.swing), non_orthogonality: raise(s.non_orthogonality), installation: raise(s.installation), imu_mount: raise(s.imu_mount) }
 }
 
 /// Whether `path` is a log10 picture of another series (`…_log10_<unit>`): drawn, not exported.
@@ -143,7 +165,8 @@ pub struct Recorder {
     truth: TableErrors,
     /// The true errors exaggerated for drawing.
     drawing: ErrorRotations,
-    exaggeration: f64,
+    /// The drawing factor of each error class ([`drawing_factors`]).
+    factors: ClassFactors,
     paths: ChainPaths,
     axis_names: Vec<String>,
     series: Vec<Series>,
@@ -218,7 +241,8 @@ impl Recorder {
     fn build_with(stream: Stream, params: &Params, live: bool, replay: bool, custom: Option<CustomLayout>) -> RecordingStreamResult<Self> {
         let rec = stream.rec.clone();
         let chain = params.table.chain.clone();
-        let drawing = chain.error_rotations(&params.table.truth.exaggerated(params.recording.exaggeration));
+        let factors = drawing_factors(&params.table.truth, params.recording.exaggeration);
+        let drawing = chain.error_rotations(&params.table.truth.exaggerated(&factors));
         let axis_names: Vec<String> = params.table.chain.axes().iter().map(|a| a.name.clone()).collect();
         let paths = ChainPaths::new(&axis_names);
         let demodulations: Vec<String> = if replay {
@@ -288,7 +312,7 @@ impl Recorder {
             chain,
             truth: params.table.truth.clone(),
             drawing,
-            exaggeration: params.recording.exaggeration,
+            factors,
             paths,
             axis_names,
             series,
@@ -356,8 +380,8 @@ impl Recorder {
     pub fn reconfigure(&mut self, t_s: f64, params: &Params) -> RecordingStreamResult<()> {
         self.flush_now()?;
         self.truth = params.table.truth.clone();
-        self.exaggeration = params.recording.exaggeration;
-        self.drawing = self.chain.error_rotations(&self.truth.exaggerated(self.exaggeration));
+        self.factors = drawing_factors(&self.truth, params.recording.exaggeration);
+        self.drawing = self.chain.error_rotations(&self.truth.exaggerated(&self.factors));
         // Where the parameters changed, on every error plot (at 0: the plots' range is not known).
         for axis in ERROR_AXES {
             self.stream.mark_events(&error_path(self.error_unit, axis), "reloads", "config reloaded", &[t_s], 0.0)?;
@@ -585,5 +609,23 @@ mod tests {
         let p = ChainPaths::new(&["outer".into(), "inner".into()]);
         assert_eq!(p.gimbals[1], "world/vehicle/base/outer_mount/outer/inner_mount/inner");
         assert_eq!(p.imu, "world/vehicle/base/outer_mount/outer/inner_mount/inner/imu");
+    }
+
+    #[test]
+    fn each_error_class_is_drawn_large_enough_to_see() {
+        // Seed 000 at ×100: swings of 5′ and 10′ are drawn at 8.3° and 16.7° (×100 kept); the 20″
+        // non-orthogonality would be 0.56°, so it gets the smallest 1-2-5 factor that draws it at 2°
+        // (2°/20″ = 360 → ×500); a class that is absent keeps ×100.
+        let p = crate::scenario::presets::load("jiang2017-dual-axis").expect("preset");
+        let f = drawing_factors(&p.table.truth, 100.0);
+        assert_eq!(f.swing, 100.0);
+        assert_eq!(f.non_orthogonality, 500.0);
+        assert_eq!(f.installation, 100.0);
+        assert_eq!(f.imu_mount, 100.0);
+        // A factor is never lowered below the scenario's, and is capped.
+        let mut tiny = p.table.truth.clone();
+        tiny.axes[1].non_orthogonality_rad = 1e-9;
+        assert_eq!(drawing_factors(&tiny, 100.0).non_orthogonality, 1e5);
+        assert_eq!(drawing_factors(&p.table.truth, 1e4).non_orthogonality, 1e4);
     }
 }

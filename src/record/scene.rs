@@ -142,10 +142,16 @@ impl Recorder {
         )?;
         rec.log_static(
             format!("{}/sensor_axes", self.paths.imu),
-            &rerun::Arrows3D::from_vectors([[0.45, 0.0, 0.0], [0.0, 0.45, 0.0], [0.0, 0.0, 0.45]])
-                .with_colors(colors::SENSOR.map(rgb))
+            &rerun::Arrows3D::from_vectors([[0.45, 0.0, 0.0], [0.0, 0.45, 0.0], [0.0, 0.0, 0.45]]).with_colors(colors::SENSOR.map(rgb)).with_radii([0.015]),
+        )?;
+        // Labels beyond the arrow tips (an arrow's own label sits at its middle, inside the box,
+        // where the three pile up).
+        rec.log_static(
+            format!("{}/sensor_axes/labels", self.paths.imu),
+            &rerun::Points3D::new([[0.55, 0.0, 0.0], [0.0, 0.55, 0.0], [0.0, 0.0, 0.55]])
                 .with_labels(["x_s", "y_s", "z_s"])
-                .with_radii([0.015]),
+                .with_colors(colors::SENSOR.map(rgb))
+                .with_radii([0.002]),
         )?;
         Ok(())
     }
@@ -205,7 +211,9 @@ impl Recorder {
         self.put(at, "docs/config", &rerun::TextDocument::from_markdown(format!("```toml\n{}\n```\n", p.resolved_toml)))?;
 
         let x = p.recording.exaggeration;
-        self.label(at, "world/legend", &[([0.0, 0.0, 1.45], format!("error angles drawn ×{x}").as_str())])?;
+        let f = self.factors;
+        let own = if f == crate::model::gimbal::ClassFactors::uniform(x) { String::new() } else { " (a label with its own ×: that class)".to_owned() };
+        self.label(at, "world/legend", &[([0.0, 0.0, 1.45], format!("error angles drawn ×{x}{own}").as_str())])?;
         // The base, mount and IMU links do not depend on the gimbal angles.
         let draw = self.chain.link_rotations(&self.drawing, &[0.0; crate::model::scheme::MAX_AXES]);
         let t = |q: &UnitQuaternion<f64>| rerun::Transform3D::from_rotation(to_rerun_quaternion(q));
@@ -217,11 +225,11 @@ impl Recorder {
 
         let n = self.axis_names.len();
         let axes = self.chain.axes();
-        let drawing = p.table.truth.exaggerated(x);
+        let drawing = p.table.truth.exaggerated(&f);
         // Installation: a wedge in the body between the ideal first axis and the tilted one.
         let first_tilted = draw.base * axes[0].axis;
         let installation = p.table.truth.installation_rad.norm() * ARCSEC_PER_RAD;
-        self.log_wedge(at, &format!("{}/installation", self.paths.vehicle), axes[0].axis, first_tilted, 1.5, installation, x, "installation")?;
+        self.log_wedge(at, &format!("{}/installation", self.paths.vehicle), axes[0].axis, first_tilted, 1.5, installation, f.installation, "installation")?;
         for (k, g) in axes.iter().enumerate() {
             let half = ring_radius(k, n) * 1.25;
             let color = colors::AXES[k];
@@ -234,10 +242,11 @@ impl Recorder {
                 self.put(at, format!("{cone_path}/rims"), &rerun::LineStrips3D::new(rims).with_colors([rgba(color, 200)]).with_radii([0.004]))?;
                 let tip = -g.axis * half - g.e1 * (half * alpha.tan());
                 let text = format!(
-                    "{} swing α = {}, φ = {:.1}°",
+                    "{} swing α = {}, φ = {:.1}°{}",
                     g.name,
                     fmt_angle(p.table.truth.axes[k].swing_half_angle_rad),
-                    p.table.truth.axes[k].swing_phase_rad * DEG_PER_RAD
+                    p.table.truth.axes[k].swing_phase_rad * DEG_PER_RAD,
+                    if f.swing == x { String::new() } else { format!(" (drawn ×{})", f.swing) }
                 );
                 self.label(at, &format!("{cone_path}/label"), &[(p3(tip), text.as_str())])?;
             } else {
@@ -248,7 +257,7 @@ impl Recorder {
             if k > 0 {
                 let tilted = draw.mount[k] * g.axis;
                 let eta_arcsec = p.table.truth.axes[k].non_orthogonality_rad * ARCSEC_PER_RAD;
-                self.log_wedge(at, &format!("{}/non_orthogonality", self.paths.gimbals[k - 1]), g.axis, tilted, half, eta_arcsec, x, "η non-orthogonality")?;
+                self.log_wedge(at, &format!("{}/non_orthogonality", self.paths.gimbals[k - 1]), g.axis, tilted, half, eta_arcsec, f.non_orthogonality, "η non-orthogonality")?;
             }
         }
         Ok(())
