@@ -192,6 +192,32 @@ impl Scheme {
         &self.steps
     }
 
+    /// The times the indexed moves start, s (scheme time), up to `until_s`, at most `limit` of
+    /// them; empty for continuous schemes.
+    #[must_use]
+    pub fn move_starts_s(&self, until_s: f64, limit: usize) -> Vec<f64> {
+        let Kind::Indexed { initial_dwell_s, period_s, repeat, moves, .. } = &self.kind else {
+            return Vec::new();
+        };
+        let mut within: Vec<f64> = moves.iter().flatten().map(|m| m.t0_s).collect();
+        within.sort_by(f64::total_cmp);
+        within.dedup();
+        let mut out = Vec::new();
+        for cycle in 0.. {
+            let start = initial_dwell_s + f64::from(cycle) * period_s;
+            if start > until_s || (cycle > 0 && (!*repeat || *period_s <= 0.0)) {
+                break;
+            }
+            for t in within.iter().map(|w| start + w).take_while(|t| *t <= until_s) {
+                if out.len() == limit {
+                    return out;
+                }
+                out.push(t);
+            }
+        }
+        out
+    }
+
     /// First time after `t_s` where a gimbal rate jumps or bends (the IMU truth integrates piecewise
     /// between these so that a rate step does not spoil the quadrature).
     #[must_use]
@@ -317,6 +343,23 @@ mod tests {
         assert!(deg(1300.0).abs() < 1e-9);
         // Next period: same positions shifted by 1214 s.
         assert!((deg(400.0 + 1214.0) - 90.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn move_starts_are_where_the_table_starts_turning() {
+        // The hand-computed starts of the four-position sequence (290 s dwell, then 9, 9, 9, 27 s
+        // moves with 290 s dwells): 290, 589, 888, 1187, then + 1214 s.
+        let s = four_position();
+        let starts = s.move_starts_s(2500.0, 100);
+        let expected = [290.0, 589.0, 888.0, 1187.0, 1504.0, 1803.0, 2102.0, 2401.0];
+        assert_eq!(starts.len(), expected.len(), "{starts:?}");
+        for (t, e) in starts.iter().zip(expected) {
+            assert!((t - e).abs() < 1e-9, "{t} vs {e}");
+            // At rest just before, turning just after.
+            assert!(s.state(t - 1e-3).1[0].abs() < 1e-12 && s.state(t + 1e-3).1[0].abs() > 0.0, "{t}");
+        }
+        assert_eq!(s.move_starts_s(2500.0, 3).len(), 3, "the limit holds");
+        assert!(Scheme::continuous(vec![0.0], vec![0.1]).move_starts_s(100.0, 10).is_empty());
     }
 
     #[test]

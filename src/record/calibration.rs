@@ -47,6 +47,7 @@ pub fn log(stream: Stream, params: &Params, cal: &Calibration, report: &Report, 
             let h = crate::math::units::nice_half_range((12.0 * sd).max(1.0).max(1.5 * (x - t).abs()));
             let tick = 10f64.powf(h.log10().floor());
             let centre = (x / tick).round() * tick;
+            // The key is in the calibration document (the grid's cells are too narrow for it).
             plot(format!("{} (″)", p.label(chain)), format!("calibration/state_arcsec/{}", p.key(chain)))
                 .with_property("ScalarAxis", &layout::scalar_range(centre - 1.25 * h, centre + 1.25 * h))
                 .with_property("PlotLegend", &layout::no_legend())
@@ -134,12 +135,17 @@ pub fn log(stream: Stream, params: &Params, cal: &Calibration, report: &Report, 
         rec.set_duration_secs(TIMELINE, s.t_s);
         let est = set.errors(&s.theta, &params.table.compensation);
         for k in 0..n {
-            let (Some(_), Some(_)) = (set.index(Param::SwingCos(k)), set.index(Param::SwingSin(k))) else {
+            let (Some(ic), Some(is)) = (set.index(Param::SwingCos(k)), set.index(Param::SwingSin(k))) else {
                 continue;
             };
             let g = &chain.axes()[k];
             let half = ring_radius(k, n) * 1.25;
             let alpha = est.axes[k].swing_half_angle_rad;
+            // A ghost appears once its estimate stands out of its noise (α ≥ 3σ): in the first
+            // seconds the prior's wide estimates drew a tangle of cones.
+            if alpha < 3.0 * s.sigma[ic].hypot(s.sigma[is]) && j != last {
+                continue;
+            }
             let (mesh, rims) = cone(g.axis, g.e1, g.e2, alpha * x, half * 1.02);
             let mount = &recorder.paths.mounts[k];
             rec.log(format!("{mount}/estimated_cone"), &rerun::Mesh3D::new(mesh.0).with_triangle_indices(mesh.1).with_albedo_factor(albedo(GHOST, 35)))?;

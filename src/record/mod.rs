@@ -361,7 +361,30 @@ impl Recorder {
     /// again: noise of 1e-5″ on a compensated line does not fill a plot and look like a drift.
     pub fn frame_plots(&mut self, params: &Params, ranges: PlotRanges) -> RecordingStreamResult<()> {
         self.ranges = Some(ranges);
+        self.mark_moves(params, &ranges)?;
         self.send_blueprint(params, self.custom.clone())
+    }
+
+    /// The indexed scheme's moves marked on the error plots, near the top of each framed range
+    /// (a long run's hundreds of moves would be a comb: then none).
+    fn mark_moves(&self, params: &Params, ranges: &PlotRanges) -> RecordingStreamResult<()> {
+        const MOST: usize = 200;
+        let starts = params.table.scheme.move_starts_s(params.duration_s, MOST + 1);
+        if starts.is_empty() || starts.len() > MOST {
+            return Ok(());
+        }
+        let top = |peaks: [f64; 3], a: usize, per_rad: f64| {
+            let p = peaks[a].max(peaks.iter().fold(0.0_f64, |m, x| m.max(*x)) / 100.0) * per_rad;
+            if p > 0.0 { 1.1 * crate::math::units::nice_half_range(p) } else { 0.0 }
+        };
+        for (a, axis) in ERROR_AXES.iter().enumerate() {
+            let y = top(ranges.table_peak_rad, a, self.error_unit.per_rad());
+            self.stream.mark_events(&error_path(self.error_unit, axis), "moves", "scheme moves", &starts, y)?;
+            if let Some(ins) = ranges.ins_peak_rad.filter(|_| self.ins.is_some()) {
+                self.stream.mark_events(&format!("ins/attitude_error_arcsec/{axis}"), "moves", "scheme moves", &starts, top(ins, a, ARCSEC_PER_RAD))?;
+            }
+        }
+        Ok(())
     }
 
     /// The error plots' unit.

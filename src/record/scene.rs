@@ -207,6 +207,9 @@ impl Recorder {
             "\n---\nError angles in the 3D view are drawn **×{}**. {plots} Seed {}.\n",
             p.recording.exaggeration, p.meta.seed
         ));
+        if !self.replay {
+            doc.push_str(&errors_in_force(p, at));
+        }
         self.put(at, "docs/scenario", &rerun::TextDocument::from_markdown(doc))?;
         self.put(at, "docs/config", &rerun::TextDocument::from_markdown(format!("```toml\n{}\n```\n", p.resolved_toml)))?;
 
@@ -287,6 +290,30 @@ impl Recorder {
         let text = format!("{what} {} (drawn ×{x})", fmt_angle(true_arcsec / ARCSEC_PER_RAD));
         self.label(at, &format!("{path}/label"), &[(p3(tilted * length * 1.08), text.as_str())])
     }
+}
+
+/// The table's true errors as a markdown table, from the parameters in force: the description
+/// above was written for the preset's values, this follows every live reload.
+fn errors_in_force(p: &Params, at: Option<f64>) -> String {
+    let t = &p.table.truth;
+    let when = at.map_or(String::new(), |t_s| format!(" since t = {t_s:.1} s"));
+    let mut s = format!("\n**Errors in force{when}** (true values; `[compensation]` is what the compensated line assumes)\n\n| axis | swing α | swing φ | η | encoder offset | scale | delay | noise 1σ |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (g, e) in p.table.chain.axes().iter().zip(&t.axes) {
+        s.push_str(&format!(
+            "| {} | {} | {:.1}° | {} | {} | {:.0} ppm | {:.2} ms | {} |\n",
+            g.name,
+            fmt_angle(e.swing_half_angle_rad),
+            e.swing_phase_rad * DEG_PER_RAD,
+            fmt_angle(e.non_orthogonality_rad),
+            fmt_angle(e.encoder_offset_rad),
+            e.encoder_scale * 1e6,
+            e.encoder_delay_s * 1e3,
+            fmt_angle(e.encoder_noise_rad)
+        ));
+    }
+    let v = |x: &nalgebra::Vector3<f64>| format!("({:.1}, {:.1}, {:.1})″", x.x * ARCSEC_PER_RAD, x.y * ARCSEC_PER_RAD, x.z * ARCSEC_PER_RAD);
+    s.push_str(&format!("\nInstallation about (x, y, z): {}; IMU mounting: {}.\n", v(&t.installation_rad), v(&t.imu_mount_rad)));
+    s
 }
 
 /// "x", "y" or "z" for a coordinate unit vector.
