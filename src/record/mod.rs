@@ -18,6 +18,7 @@ use layout::Node;
 
 pub mod allan;
 mod blueprint;
+mod cone;
 pub mod calibration;
 pub mod export;
 mod ins_view;
@@ -174,6 +175,8 @@ pub struct Recorder {
     scene_t: Vec<f64>,
     scene_vehicle: Vec<rerun::Quaternion>,
     scene_gimbals: Vec<Vec<rerun::Quaternion>>,
+    /// Pure coning: the body axis on its magnified cone, beside the table.
+    cone: Option<cone::ConeGizmo>,
     /// Chunks sent since the sinks last caught up.
     chunks_in_flight: usize,
     /// Live mode: geometry on the timeline instead of static.
@@ -306,7 +309,7 @@ impl Recorder {
             }
         });
         let n = axis_names.len();
-        let me = Self {
+        let mut me = Self {
             rec,
             stream,
             chain,
@@ -320,6 +323,7 @@ impl Recorder {
             scene_t: Vec::new(),
             scene_vehicle: Vec::new(),
             scene_gimbals: vec![Vec::new(); n],
+            cone: None,
             chunks_in_flight: 0,
             live,
             replay,
@@ -331,6 +335,9 @@ impl Recorder {
         };
         me.log_once(params)?;
         me.log_ins_once()?;
+        if let Some(c) = params.table.vehicle.pure_coning().filter(|c| c.half_angle_rad > 0.0) {
+            me.cone = Some(cone::ConeGizmo::new(&me.rec, c.half_angle_rad)?);
+        }
         me.log_error_geometry(params, me.geometry_at(0.0))?;
         me.send_blueprint(params, custom)?;
         me.event(0.0, &format!("run started: {} ({} s at {} Hz, seed {})", params.meta.name, params.duration_s, params.step_hz, params.meta.seed), "INFO")?;
@@ -502,6 +509,9 @@ impl Recorder {
         let links = self.chain.link_rotations(&self.drawing, &out.gimbal_rad);
         self.scene_t.push(out.t_s);
         self.scene_vehicle.push(to_rerun_quaternion(out.n_from_b.quaternion()));
+        if let Some(c) = self.cone.as_mut() {
+            c.push(&out.n_from_b);
+        }
         for (k, col) in self.scene_gimbals.iter_mut().enumerate() {
             col.push(to_rerun_quaternion(&links.gimbal[k]));
         }
@@ -566,6 +576,9 @@ impl Recorder {
         let times = std::mem::take(&mut self.scene_t);
         let time = || TimeColumn::new_duration_secs(TIMELINE, times.iter().copied());
         let vehicle = std::mem::take(&mut self.scene_vehicle);
+        if let Some(c) = self.cone.as_mut() {
+            c.flush(&self.rec, &times)?;
+        }
         self.rec.send_columns(
             self.paths.vehicle.as_str(),
             [time()],
