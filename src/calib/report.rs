@@ -413,43 +413,32 @@ pub fn build(scenario: &str, chain: &Chain, truth: &TableErrors, cal: &Calibrati
     }
 }
 
-fn fmt_row(r: &Row) -> String {
+/// A row's numbers as text, in its unit: true, KF value, KF 1σ, KF error (″), LSQ value, LSQ 1σ,
+/// LSQ error (″).
+fn cells(r: &Row) -> [String; 7] {
     let d = if r.unit == "deg" { 5 } else { 3 };
     let u = if r.unit == "deg" { "°" } else { "″" };
     let err_scale = if r.unit == "deg" { 3600.0 } else { 1.0 };
-    format!(
-        "  {:<26} {:>12.d$}{u}  {:>12.d$}{u} ±{:>8.d$}  ({:>+8.3}″)  {:>12.d$}{u} ±{:>8.d$}  ({:>+8.3}″)  {}\n",
-        r.label,
-        r.truth,
-        r.kf.value,
-        r.kf.sigma,
-        r.kf_error() * err_scale,
-        r.nls.value,
-        r.nls.sigma,
-        r.nls_error() * err_scale,
-        r.flag,
-        d = d
-    )
+    [
+        format!("{:.d$}{u}", r.truth),
+        format!("{:.d$}{u}", r.kf.value),
+        format!("{:.d$}", r.kf.sigma),
+        format!("{:+.3}″", r.kf_error() * err_scale),
+        format!("{:.d$}{u}", r.nls.value),
+        format!("{:.d$}", r.nls.sigma),
+        format!("{:+.3}″", r.nls_error() * err_scale),
+    ]
+}
+
+fn fmt_row(r: &Row) -> String {
+    let [t, kv, ks, ke, nv, ns, ne] = cells(r);
+    format!("  {:<26} {t:>13}  {kv:>13} ±{ks:>8}  ({ke:>9})  {nv:>13} ±{ns:>8}  ({ne:>9})  {}\n", r.label, r.flag)
 }
 
 /// A row as a markdown table row: quantity, true, KF ± 1σ (error), LSQ ± 1σ (error), flag.
 fn md_row(r: &Row) -> String {
-    let d = if r.unit == "deg" { 5 } else { 3 };
-    let u = if r.unit == "deg" { "°" } else { "″" };
-    let err_scale = if r.unit == "deg" { 3600.0 } else { 1.0 };
-    format!(
-        "| {} | {:.d$}{u} | {:.d$}{u} ± {:.d$} ({:+.3}″) | {:.d$}{u} ± {:.d$} ({:+.3}″) | {} |\n",
-        r.label,
-        r.truth,
-        r.kf.value,
-        r.kf.sigma,
-        r.kf_error() * err_scale,
-        r.nls.value,
-        r.nls.sigma,
-        r.nls_error() * err_scale,
-        r.flag,
-        d = d
-    )
+    let [t, kv, ks, ke, nv, ns, ne] = cells(r);
+    format!("| {} | {t} | {kv} ± {ks} ({ke}) | {nv} ± {ns} ({ne}) | {} |\n", r.label, r.flag)
 }
 
 impl Report {
