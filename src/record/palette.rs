@@ -9,8 +9,9 @@ pub(crate) mod colors {
     pub const AXES: [[u8; 3]; 3] = [[240, 160, 40], [200, 90, 230], [60, 200, 200]];
     pub const EULER: [[u8; 3]; 3] = [[230, 90, 90], [90, 200, 90], [90, 140, 240]];
     pub const NOMINAL: [u8; 3] = [150, 150, 150];
-    /// Event markers on the plots (position fixes, live reloads).
-    pub const EVENT: [u8; 3] = [245, 245, 245];
+    /// Event markers on the plots (position fixes, moves, live reloads): a grey that reads on the
+    /// native viewer's dark theme and on the browser's light one.
+    pub const EVENT: [u8; 3] = [160, 160, 160];
     pub const SENSOR: [[u8; 3]; 3] = [[235, 50, 50], [50, 200, 50], [60, 110, 255]];
     /// In the order of `Algorithm::ALL` (single-sample, two-sample, two-sample-p1, -p2, three-sample).
     pub const ALGORITHMS: [[u8; 3]; 5] = [[250, 200, 60], [230, 76, 60], [46, 170, 90], [70, 130, 240], [200, 90, 230]];
