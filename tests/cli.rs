@@ -67,6 +67,15 @@ fn nan_and_out_of_range_angles_are_refused_with_key_value_and_unit() {
 }
 
 #[test]
+fn recording_choices_are_refused_by_name_with_the_allowed_values() {
+    let dir = scratch("recording-choice");
+    let cfg = with_edit(&dir, "# open_at = \"start\"", "open_at = \"middle\"");
+    refused(&dir, &cfg, &["recording.open_at", "middle", "\"start\" or \"end\""]);
+    let cfg = with_edit(&dir, "# error_unit = \"arcmin\"", "error_unit = \"mrad\"");
+    refused(&dir, &cfg, &["recording.error_unit", "mrad", "arcsec"]);
+}
+
+#[test]
 fn an_unknown_axis_in_the_scheme_is_refused() {
     let dir = scratch("axis");
     let cfg = with_edit(&dir, "axis = \"outer\"          # axis name (required)", "axis = \"middle\"");

@@ -118,7 +118,7 @@ impl Recorder {
         let root = Node::container(ContainerKind::Horizontal, vec![left, right], &[1.1, 1.0]);
         // Play a whole run in about a minute; a live session follows the newest data.
         let speed = if self.live { 1.0 } else { (p.duration_s / 60.0).max(1.0).round() };
-        layout::send(&self.rec, APPLICATION_ID, &root, &layout::Playback { timeline: TIMELINE, speed, follow: self.live })
+        layout::send(&self.rec, APPLICATION_ID, &root, &layout::Playback { timeline: TIMELINE, speed, follow: self.live || p.recording.open_at_end })
     }
 }
 

@@ -106,6 +106,8 @@ pub struct RecordingParams {
     pub exaggeration: f64,
     /// Unit of the attitude-error plots.
     pub error_unit: crate::math::units::AngleUnit,
+    /// The recording opens at the end of the run (the time cursor follows the newest data).
+    pub open_at_end: bool,
     /// What the rates not given in the file were chosen from (series, scene: `true` if chosen).
     pub chosen: (bool, bool),
     /// The motion's bandwidth the chosen rates follow.

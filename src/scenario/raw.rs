@@ -397,11 +397,15 @@ pub struct RawRecording {
     pub error_unit: Option<String>,
     /// Factor applied to every error angle when drawing the 3D scene.
     pub exaggeration: f64,
+    /// Where a saved recording opens: "start" (it plays the run in about a minute) or "end" (the
+    /// final state, the time cursor following the newest data). Default "start".
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub open_at: Option<String>,
 }
 
 impl Default for RawRecording {
     fn default() -> Self {
-        Self { series_hz: None, scene_hz: None, error_unit: None, exaggeration: 60.0 }
+        Self { series_hz: None, scene_hz: None, error_unit: None, exaggeration: 60.0, open_at: None }
     }
 }
 

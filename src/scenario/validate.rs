@@ -465,6 +465,11 @@ pub(super) fn recording(c: &Checker<'_>, raw: &RawRecording, step_hz: f64, bandw
         },
         exaggeration: c.range("recording.exaggeration", raw.exaggeration, "x", 1.0, 100_000.0, "")?,
         error_unit,
+        open_at_end: match raw.open_at.as_deref() {
+            None | Some("start") => false,
+            Some("end") => true,
+            Some(s) => return Err(c.invalid("recording.open_at", format!("\"{s}\" is not a place in the run; use \"start\" or \"end\""))),
+        },
         chosen: (raw.series_hz.is_none(), raw.scene_hz.is_none()),
         bandwidth,
     })
