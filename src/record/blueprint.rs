@@ -82,7 +82,7 @@ impl Recorder {
                 let ins_view = |a: usize, axis: &str| {
                     let title = match (a, layout.algorithms.len()) {
                         (_, 1) => format!("INS {axis} error (arcsec)"),
-                        (0, _) => format!("INS {axis} error (″) — {algorithm_key}"),
+                        (0, _) => format!("INS {axis} (″) — {algorithm_key}"),
                         _ => format!("INS {axis} error (arcsec), colours as above"),
                     };
                     framed(plot(title, &format!("ins/attitude_error_arcsec/{axis}")), ins_peak(a)).with_property("PlotLegend", &layout::no_legend())
@@ -122,8 +122,8 @@ impl Recorder {
     }
 }
 
-/// A coning algorithm's name as a colour key spells it: "single-sample" → "single",
-/// "two-sample-p1" → "two-p1", "three-sample" → "three".
+/// A coning algorithm's name as a colour key spells it (short enough that a plot title holds five):
+/// "single-sample" → "single", "two-sample" → "two", "two-sample-p1" → "p1", "three-sample" → "three".
 fn short_name(name: &str) -> String {
-    name.replace("-sample", "")
+    name.strip_prefix("two-sample-").map_or_else(|| name.replace("-sample", ""), str::to_owned)
 }
