@@ -98,13 +98,18 @@ impl Recorder {
                     tabs.push(if lo.is_finite() { view.with_property("ScalarAxis", &layout::scalar_range((lo - 1.0).floor(), hi.ceil())) } else { view });
                 }
                 if layout.nav {
-                    tabs.push(plot("position error (m)".into(), "ins/position_error_m"));
-                    tabs.push(plot("velocity error (m/s)".into(), "ins/velocity_error_mps"));
+                    // Keyed in the titles: a legend would cover the curves.
+                    tabs.push(plot("position error (m) — red east, green north, blue radial".into(), "ins/position_error_m").with_property("PlotLegend", &layout::no_legend()));
+                    tabs.push(plot("velocity error (m/s) — red east, green north, blue up".into(), "ins/velocity_error_mps").with_property("PlotLegend", &layout::no_legend()));
                 }
                 let window = |name: &str, origin: &str| Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::window_time_axis(layout.signal_window_s));
                 // Keyed in the title: a legend would sit over the signal.
-                tabs.push(window("gyro raw (deg/s) — red x, green y, blue z", "ins/gyro_raw_deg_per_s").with_property("PlotLegend", &layout::no_legend()));
-                tabs.push(window("gyro after FIR (deg/s) — red x, green y, blue z", "ins/gyro_filtered_deg_per_s").with_property("PlotLegend", &layout::no_legend()));
+                // Framed on the window's peak once the run is over (labelled ticks, like the errors).
+                let peaks = layout.signal_peak_deg_per_s;
+                let gyro = |name: String, origin: &str, k: usize| framed(window(&name, origin), self.ranges.map(|_| peaks[k])).with_property("PlotLegend", &layout::no_legend());
+                let first = format!("the first {} s", layout.signal_window_s);
+                tabs.push(gyro(format!("gyro raw (deg/s), {first} — red x, green y, blue z"), "ins/gyro_raw_deg_per_s", 0));
+                tabs.push(gyro(format!("gyro after FIR (deg/s), {first} — red x, green y, blue z"), "ins/gyro_filtered_deg_per_s", 1));
                 if layout.fir_taps.len() > 1 {
                     tabs.push(Node::view("2D", "FIR response (x: Hz, y: −5·dB)", "ins/fir_response"));
                 }

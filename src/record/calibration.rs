@@ -158,9 +158,17 @@ pub fn log(stream: Stream, params: &Params, cal: &Calibration, report: &Report, 
                 format!("{}/estimated_axis", recorder.paths.gimbals[k]),
                 &rerun::LineStrips3D::new([[p3(-dir * half * 1.1), p3(dir * half * 1.1)]]).with_colors([rgb(GHOST)]).with_radii([0.006]),
             )?;
-            // At the other end of the cone from the true cone's label, so the two never overlap.
-            let tip = g.axis * half * 1.02 + g.e2 * (half * (alpha * x).tan());
-            let label = format!("estimate: α = {}, φ = {:.2}°", fmt_angle(alpha), est.axes[k].swing_phase_rad.to_degrees());
+            // At the true cone's label's end (the other end carries the η label), across the rim
+            // from it.
+            let tip = -g.axis * half * 1.05 + g.e1 * (half * (alpha * x).tan() + 0.18);
+            // What the data do not determine is said where the number is shown.
+            let undetermined = |what: &str| report.angles.iter().any(|r| r.key == format!("{}.{what}", g.name) && !r.flag.is_empty());
+            let note = match (undetermined("swing_half_angle"), undetermined("swing_phase")) {
+                (true, _) => " (not determined by the data)",
+                (false, true) => " (φ not determined by the data)",
+                _ => "",
+            };
+            let label = format!("estimate: α = {}, φ = {:.2}°{note}", fmt_angle(alpha), est.axes[k].swing_phase_rad.to_degrees());
             rec.log(format!("{mount}/estimated_cone/label"), &rerun::Points3D::new([p3(tip)]).with_labels([label]).with_radii([0.002]).with_colors([rgb(GHOST)]))?;
         }
     }

@@ -25,6 +25,8 @@ pub(crate) struct InsLayout {
     pub(crate) fir_taps: Vec<f64>,
     pub(crate) rate_hz: f64,
     pub(crate) signal_window_s: f64,
+    /// Largest |rate| in the raw and the filtered gyro window, deg/s (their plots' framing).
+    pub(crate) signal_peak_deg_per_s: [f64; 2],
     /// Pure coning: the series index of the log10 drift plot and each algorithm's analytic drift
     /// rate about the cone axis, arcsec/s (`ins::coning::coning_drift_rate`).
     pub(crate) coning_log: Option<(usize, Vec<f64>)>,
@@ -63,6 +65,8 @@ impl Recorder {
         layout.signal_t.push(s.t_s);
         layout.raw.extend(s.raw_rate_s.iter().map(|x| x * DEG_PER_RAD));
         layout.filtered.extend(s.filtered_rate_s.iter().map(|x| x * DEG_PER_RAD));
+        layout.signal_peak_deg_per_s[0] = layout.signal_peak_deg_per_s[0].max(s.raw_rate_s.amax() * DEG_PER_RAD);
+        layout.signal_peak_deg_per_s[1] = layout.signal_peak_deg_per_s[1].max(s.filtered_rate_s.amax() * DEG_PER_RAD);
         if layout.signal_t.len() >= SERIES_CHUNK_ROWS {
             self.flush_signal()?;
         }

@@ -282,12 +282,25 @@ impl Recorder {
             let coning_log = params.table.vehicle.pure_coning().filter(|_| params.table.scheme.max_rate() == 0.0).map(|cone| {
                 let names = algorithms.iter().flat_map(|a| [format!("{a}: log10 |heading error|"), format!("{a}: analytic coning drift")]).collect();
                 series.push(Series::new(ins_view::CONING_LOG_PATH.into(), names));
-                let rates = cfg
+                let rates: Vec<f64> = cfg
                     .algorithms()
                     .iter()
                     .map(|a| crate::ins::coning::coning_drift_rate(*a, cone.half_angle_rad, cone.omega_rad_per_s / std::f64::consts::TAU, 1.0 / params.step_hz).abs() * ARCSEC_PER_RAD)
                     .collect();
                 (series.len() - 1, rates)
+            });
+            // The INS trace and the drift dial draw the INS's error ×N: where the largest error of
+            // the run is known in advance (pure coning: the analytic drifts), N is lowered to the
+            // largest 1-2-5 factor that keeps it under 150°, so the picture never wraps round.
+            let exaggeration = coning_log.as_ref().map_or(params.recording.exaggeration, |(_, rates)| {
+                let worst_rad = rates.iter().fold(0.0_f64, |m, r| m.max(*r)) * params.duration_s / ARCSEC_PER_RAD;
+                let limit = 150.0 * crate::math::units::RAD_PER_DEG;
+                if worst_rad * params.recording.exaggeration <= limit {
+                    return params.recording.exaggeration;
+                }
+                let v = limit / worst_rad;
+                let decade = 10f64.powf(v.log10().floor());
+                [5.0, 2.0, 1.0].into_iter().map(|m| m * decade).find(|f| *f <= v).unwrap_or(decade).max(1e-3)
             });
             InsLayout {
                 algorithms,
@@ -301,11 +314,12 @@ impl Recorder {
                 dial_t: Vec::new(),
                 dial_next_t: f64::NEG_INFINITY,
                 trace_ins: Vec::new(),
-                exaggeration: params.recording.exaggeration,
+                exaggeration,
                 fir_taps: cfg.fir_taps.clone(),
                 rate_hz: params.step_hz,
                 signal_window_s: cfg.signal_window_s.max(0.01),
                 coning_log,
+                signal_peak_deg_per_s: [0.0; 2],
             }
         });
         let n = axis_names.len();

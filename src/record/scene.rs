@@ -215,8 +215,14 @@ impl Recorder {
 
         let x = p.recording.exaggeration;
         let f = self.factors;
-        let own = if f == crate::model::gimbal::ClassFactors::uniform(x) { String::new() } else { " (a label with its own ×: that class)".to_owned() };
-        self.label(at, "world/legend", &[([0.0, 0.0, 1.45], format!("error angles drawn ×{x}{own}").as_str())])?;
+        let own: Vec<String> = [("swing", f.swing), ("η", f.non_orthogonality), ("installation", f.installation), ("IMU mounting", f.imu_mount)]
+            .iter()
+            .filter(|(_, v)| *v != x)
+            .map(|(n, v)| format!("{n} ×{v}"))
+            .collect();
+        let own = if own.is_empty() { String::new() } else { format!(" ({}: too small at ×{x})", own.join(", ")) };
+        // Low enough to stay in the default camera's view over a single-axis table too.
+        self.label(at, "world/legend", &[([0.0, 0.0, 1.2], format!("error angles drawn ×{x}{own}").as_str())])?;
         // The base, mount and IMU links do not depend on the gimbal angles.
         let draw = self.chain.link_rotations(&self.drawing, &[0.0; crate::model::scheme::MAX_AXES]);
         let t = |q: &UnitQuaternion<f64>| rerun::Transform3D::from_rotation(to_rerun_quaternion(q));
@@ -232,7 +238,8 @@ impl Recorder {
         // Installation: a wedge in the body between the ideal first axis and the tilted one.
         let first_tilted = draw.base * axes[0].axis;
         let installation = p.table.truth.installation_rad.norm() * ARCSEC_PER_RAD;
-        self.log_wedge(at, &format!("{}/installation", self.paths.vehicle), axes[0].axis, first_tilted, 1.5, installation, f.installation, "installation")?;
+        // 1.1 long: at 1.5 the wedge and its label ran off the top of the default view.
+        self.log_wedge(at, &format!("{}/installation", self.paths.vehicle), axes[0].axis, first_tilted, 1.1, installation, f.installation, "installation")?;
         for (k, g) in axes.iter().enumerate() {
             let half = ring_radius(k, n) * 1.25;
             let color = colors::AXES[k];
