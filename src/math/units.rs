@@ -154,9 +154,36 @@ pub fn nice_half_range(peak: f64) -> f64 {
     [1.0, 2.0, 3.0, 10.0].into_iter().map(|m| m * base).find(|h| *h >= p).unwrap_or(10.0 * base)
 }
 
+/// The 1, 2, 5 × 10^k "round" values of a logarithmic scale (drawing factors, slider steps):
+/// the smallest at or above `v` (> 0).
+#[must_use]
+pub fn nice_at_least(v: f64) -> f64 {
+    let decade = 10f64.powf(v.log10().floor());
+    // The decade's ×10 rung catches log10's rounding (log10(1000) = 2.9999999999999996).
+    [1.0, 2.0, 5.0, 10.0].into_iter().map(|m| m * decade).find(|r| *r >= v).unwrap_or(10.0 * decade)
+}
+
+/// The largest 1, 2, 5 × 10^k value at or below `v` (> 0).
+#[must_use]
+pub fn nice_at_most(v: f64) -> f64 {
+    let decade = 10f64.powf(v.log10().floor());
+    [10.0, 5.0, 2.0, 1.0].into_iter().map(|m| m * decade).find(|r| *r <= v).unwrap_or(decade)
+}
+
 #[cfg(test)]
 mod angle_unit_tests {
     use super::*;
+
+    #[test]
+    fn the_1_2_5_scale_rounds_up_and_down_onto_its_rungs() {
+        assert_eq!(nice_at_least(360.0), 500.0);
+        assert_eq!(nice_at_least(500.0), 500.0);
+        assert_eq!(nice_at_least(1000.0), 1000.0);
+        assert_eq!(nice_at_least(0.03), 0.05);
+        assert_eq!(nice_at_most(278.0), 200.0);
+        assert_eq!(nice_at_most(1000.0), 1000.0);
+        assert_eq!(nice_at_most(0.09), 0.05);
+    }
 
     #[test]
     fn plot_ranges_have_labelled_ticks_and_units_read_naturally() {

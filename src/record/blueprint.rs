@@ -21,22 +21,14 @@ impl Recorder {
             }
             _ => node,
         };
-        // An axis is not zoomed in beyond a hundredth of the largest axis of its group: 1e-5″ of
-        // rounding beside a 500″ error would fill its plot and look like a drift.
-        let floored = |peaks: [f64; 3], a: usize| peaks[a].max(peaks.iter().fold(0.0_f64, |m, x| m.max(*x)) / 100.0);
-        let table_peak = |a: usize| self.ranges.map(|r| floored(r.table_peak_rad, a) * unit.per_rad());
+        let table_peak = |a: usize| self.ranges.map(|r| super::floored_peak(r.table_peak_rad, a) * unit.per_rad());
         // The legend would sit over the data: the title says which line is which.
         let key = if self.replay { "red: nominal table, green: compensated" } else { "red: uncompensated, blue: closed form, green: compensated" };
         let error_view = |a: usize, axis: &str| {
             framed(plot(format!("{axis} error ({}) — {key}", unit.suffix()), &super::error_path(unit, axis)), table_peak(a)).with_property("PlotLegend", &layout::no_legend())
         };
         let x = p.recording.exaggeration;
-        let f = self.factors;
-        let own: Vec<String> = [("swing", f.swing), ("η", f.non_orthogonality), ("installation", f.installation), ("IMU mounting", f.imu_mount)]
-            .iter()
-            .filter(|(_, v)| *v != x)
-            .map(|(n, v)| format!("{n} ×{v}"))
-            .collect();
+        let own = super::own_factors(&self.factors, x);
         let scale = if own.is_empty() { format!("errors ×{x}") } else { format!("errors ×{x}, {}", own.join(", ")) };
         let scene = Node::view("3D", format!("3D: gimbal chain ({scale})"), "world")
             .with_property(
@@ -75,7 +67,7 @@ impl Recorder {
             }
             (Some(layout), None) => {
                 // The INS in the loop leads; the turntable-only (ideal-INS) plots go into the tabs.
-                let ins_peak = |a: usize| self.ranges.and_then(|r| r.ins_peak_rad).map(|p| floored(p, a) * crate::math::units::ARCSEC_PER_RAD);
+                let ins_peak = |a: usize| self.ranges.and_then(|r| r.ins_peak_rad).map(|p| super::floored_peak(p, a) * crate::math::units::ARCSEC_PER_RAD);
                 // The legend would sit over the data: the first plot's title gives each
                 // algorithm's colour (short, so that it is not cut), the others refer to it.
                 let algorithm_key = layout.algorithms.iter().map(|a| format!("{} {}", super::palette::colors::algorithm_colour_name(a), short_name(a))).collect::<Vec<_>>().join(" · ");

@@ -90,6 +90,22 @@ impl Stream {
     }
 }
 
+/// The classes drawn with a factor of their own (not the scenario's `x`), as "η ×500".
+fn own_factors(f: &ClassFactors, x: f64) -> Vec<String> {
+    [("swing", f.swing), ("η", f.non_orthogonality), ("installation", f.installation), ("IMU mounting", f.imu_mount)]
+        .iter()
+        .filter(|(_, v)| *v != x)
+        .map(|(n, v)| format!("{n} ×{v}"))
+        .collect()
+}
+
+/// The peak an error plot of axis `a` is framed on: its own, but not below a hundredth of the
+/// largest axis of its group (1e-5″ of rounding beside a 500″ error would fill its plot and look
+/// like a drift).
+fn floored_peak(peaks: [f64; 3], a: usize) -> f64 {
+    peaks[a].max(peaks.iter().fold(0.0_f64, |m, x| m.max(*x)) / 100.0)
+}
+
 /// The smallest angle an error class is drawn at, rad (2°): under it a cone or wedge cannot be seen
 /// at the default camera (seed 000's 20″ non-orthogonality is 0.56° at ×100).
 const MIN_DRAWN_RAD: f64 = 2.0 * crate::math::units::RAD_PER_DEG;
@@ -103,10 +119,7 @@ pub fn drawing_factors(truth: &TableErrors, x: f64) -> ClassFactors {
         if a <= 0.0 || a * x >= MIN_DRAWN_RAD {
             return x;
         }
-        let need = MIN_DRAWN_RAD / a;
-        let decade = 10f64.powf(need.log10().floor());
-        let f = [1.0, 2.0, 5.0, 10.0].into_iter().map(|m| m * decade).find(|f| *f >= need * (1.0 - 1e-12)).unwrap_or(10.0 * decade);
-        f.min(1e5).max(x)
+        crate::math::units::nice_at_least(MIN_DRAWN_RAD / a * (1.0 - 1e-12)).min(1e5).max(x)
     };
     let s = truth.class_sizes();
     ClassFactors { swing: raise(s.swing), non_orthogonality: raise(s.non_orthogonality), installation: raise(s.installation), imu_mount: raise(s.imu_mount) }
@@ -298,9 +311,7 @@ impl Recorder {
                 if worst_rad * params.recording.exaggeration <= limit {
                     return params.recording.exaggeration;
                 }
-                let v = limit / worst_rad;
-                let decade = 10f64.powf(v.log10().floor());
-                [5.0, 2.0, 1.0].into_iter().map(|m| m * decade).find(|f| *f <= v).unwrap_or(decade).max(1e-3)
+                crate::math::units::nice_at_most(limit / worst_rad).max(1e-3)
             });
             InsLayout {
                 algorithms,
@@ -395,7 +406,7 @@ impl Recorder {
             return Ok(());
         }
         let top = |peaks: [f64; 3], a: usize, per_rad: f64| {
-            let p = peaks[a].max(peaks.iter().fold(0.0_f64, |m, x| m.max(*x)) / 100.0) * per_rad;
+            let p = floored_peak(peaks, a) * per_rad;
             if p > 0.0 { 1.1 * crate::math::units::nice_half_range(p) } else { 0.0 }
         };
         for (a, axis) in ERROR_AXES.iter().enumerate() {

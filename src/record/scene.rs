@@ -215,11 +215,7 @@ impl Recorder {
 
         let x = p.recording.exaggeration;
         let f = self.factors;
-        let own: Vec<String> = [("swing", f.swing), ("η", f.non_orthogonality), ("installation", f.installation), ("IMU mounting", f.imu_mount)]
-            .iter()
-            .filter(|(_, v)| *v != x)
-            .map(|(n, v)| format!("{n} ×{v}"))
-            .collect();
+        let own = super::own_factors(&f, x);
         let own = if own.is_empty() { String::new() } else { format!(" ({}: too small at ×{x})", own.join(", ")) };
         // Low enough to stay in the default camera's view over a single-axis table too.
         self.label(at, "world/legend", &[([0.0, 0.0, 1.2], format!("error angles drawn ×{x}{own}").as_str())])?;

@@ -95,10 +95,11 @@ pub fn run_benchmarks(steps: u64) -> anyhow::Result<Figures> {
     strapdown_speed(&mut figs);
     pipeline_speed(&mut figs)?;
 
-    // 3. A 3600 s scenario at 200 Hz with its default recording rates, saved to a file.
+    // 3. Every preset for one simulated hour at its default rates, saved to a file: its speed with
+    //    the recording, and the recording's size (issue 13's target: at most 30 MB per hour).
     let dir = std::env::temp_dir().join(format!("rinscope-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
-    for name in ["rotary-table-2016-wobble", "jiang2017-dual-axis"] {
+    for (name, _) in presets::PRESETS {
         let mut p = presets::load(name)?;
         p.set_duration(3600.0);
         let path = dir.join(format!("{name}.rrd"));
@@ -107,36 +108,16 @@ pub fn run_benchmarks(steps: u64) -> anyhow::Result<Figures> {
         let summary = crate::app::run::run_recorded(&p, &sinks, &AtomicBool::new(false), false)?;
         let (_, bytes) = sinks.finish()?.recording.ok_or_else(|| anyhow::anyhow!("no file written"))?;
         let secs = started.elapsed().as_secs_f64();
+        std::fs::remove_file(&path).ok();
         figs.add(format!("recorded run 1 h/{name}/wall"), secs, "s");
         figs.add(format!("recorded run 1 h/{name}/size"), bytes as f64 / 1e6, "MB/h");
         outln!(
-            "recorded run      {name:<28} 3600 s at {} Hz (series {} Hz, scene {} Hz): {} steps in {secs:.2} s, {:.2} MB per simulated hour",
+            "recorded 1 h      {name:<32} {:6.2} MB per simulated hour (target <= 30); {} steps at {} Hz in {secs:.2} s (series {} Hz, scene {} Hz)",
+            bytes as f64 / 1e6,
+            summary.steps,
             p.step_hz,
             p.recording.series_hz,
-            p.recording.scene_hz,
-            summary.steps,
-            bytes as f64 / 1e6
-        );
-    }
-    // 3b. Every preset for one simulated hour at its default rates: the recording's size (issue 13's
-    //     target: at most 30 MB per simulated hour).
-    for (name, _) in presets::PRESETS {
-        let mut p = presets::load(name)?;
-        p.set_duration(3600.0);
-        let path = dir.join(format!("size-{name}.rrd"));
-        let sinks = sink::open(&SinkRequest { save: Some(path.clone()), ..Default::default() }, "rinscope-bench", name)?;
-        let started = Instant::now();
-        crate::app::run::run_recorded(&p, &sinks, &AtomicBool::new(false), false)?;
-        let (_, bytes) = sinks.finish()?.recording.ok_or_else(|| anyhow::anyhow!("no file written"))?;
-        let secs = started.elapsed().as_secs_f64();
-        std::fs::remove_file(&path).ok();
-        figs.add(format!("recording size/{name}"), bytes as f64 / 1e6, "MB/h");
-        outln!(
-            "recording size    {name:<32} {:6.2} MB per simulated hour (series {} Hz, scene {} Hz; {:.2} s; target <= 30)",
-            bytes as f64 / 1e6,
-            p.recording.series_hz,
-            p.recording.scene_hz,
-            secs
+            p.recording.scene_hz
         );
     }
     // 4. A 24-hour INS run at 200 Hz with navigation, recorded.

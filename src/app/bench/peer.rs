@@ -313,27 +313,31 @@ fn time_pipeline(p: &crate::scenario::Params, samples: u64) -> anyhow::Result<Ti
     Ok(Timing { process_s: region_s, region_s, peak_rss_mb: crate::app::bench::peak_rss_bytes() as f64 / 1e6 })
 }
 
-/// `rinscope run` of a scenario, whole process.
-fn run_simulated(scenario: &Path) -> anyhow::Result<Timing> {
-    let exe = std::env::current_exe()?;
-    let json = scenario.with_extension("json");
+/// This rinscope as a whole process: `command` on `input`, saving beside `stem`, its summary JSON
+/// read back. Returns the wall time of the process and the summary.
+fn run_self(command: &str, input: &[&std::ffi::OsStr], stem: &Path) -> anyhow::Result<(f64, Value)> {
+    let json = stem.with_extension("json");
     let started = Instant::now();
-    let out = Command::new(exe).arg("run").arg("--config").arg(scenario).arg("--save").arg(scenario.with_extension("rrd")).arg("--summary-json").arg(&json).output()?;
+    let out = Command::new(std::env::current_exe()?).arg(command).args(input).arg("--save").arg(stem.with_extension("rrd")).arg("--summary-json").arg(&json).output()?;
     let process_s = started.elapsed().as_secs_f64();
-    ensure!(out.status.success(), "rinscope run failed: {}", String::from_utf8_lossy(&out.stderr));
-    let s: Value = serde_json::from_str(&std::fs::read_to_string(&json)?)?;
-    let num = |k: &str| s[k].as_f64().ok_or_else(|| anyhow!("run summary lacks {k}"));
+    ensure!(out.status.success(), "rinscope {command} failed: {}", String::from_utf8_lossy(&out.stderr));
+    Ok((process_s, serde_json::from_str(&std::fs::read_to_string(&json)?)?))
+}
+
+/// The timing fields of a summary.
+fn timing(process_s: f64, s: &Value) -> anyhow::Result<Timing> {
+    let num = |k: &str| s[k].as_f64().ok_or_else(|| anyhow!("the summary lacks {k}"));
     Ok(Timing { process_s, region_s: num("wall_time_s")?, peak_rss_mb: num("peak_rss_mb")? })
 }
 
+/// `rinscope run` of a scenario, whole process.
+fn run_simulated(scenario: &Path) -> anyhow::Result<Timing> {
+    let (process_s, s) = run_self("run", &["--config".as_ref(), scenario.as_os_str()], scenario)?;
+    timing(process_s, &s)
+}
+
 fn run_rinscope(logs: &Path) -> anyhow::Result<(Timing, State)> {
-    let exe = std::env::current_exe()?;
-    let json = logs.join("replay.json");
-    let started = Instant::now();
-    let out = Command::new(exe).arg("replay").arg(logs).arg("--save").arg(logs.join("replay.rrd")).arg("--summary-json").arg(&json).output()?;
-    let process_s = started.elapsed().as_secs_f64();
-    ensure!(out.status.success(), "rinscope replay failed: {}", String::from_utf8_lossy(&out.stderr));
-    let s: Value = serde_json::from_str(&std::fs::read_to_string(&json)?)?;
+    let (process_s, s) = run_self("replay", &[logs.as_os_str()], &logs.join("replay"))?;
     let f = &s["final_state"];
     let num = |v: &Value| v.as_f64().ok_or_else(|| anyhow!("replay summary lacks a final state (is the navigation on?)"));
     let state = State {
@@ -341,7 +345,7 @@ fn run_rinscope(logs: &Path) -> anyhow::Result<(Timing, State)> {
         lla: [num(&f["latitude_deg"])?, num(&f["longitude_deg"])?, num(&f["height_m"])?],
         vel_enu_mps: [num(&f["velocity_enu_mps"][0])?, num(&f["velocity_enu_mps"][1])?, num(&f["velocity_enu_mps"][2])?],
     };
-    Ok((Timing { process_s, region_s: num(&s["wall_time_s"])?, peak_rss_mb: num(&s["peak_rss_mb"])? }, state))
+    Ok((timing(process_s, &s)?, state))
 }
 
 fn run_pyins(python: &Path, args: &[String]) -> anyhow::Result<(Timing, State)> {

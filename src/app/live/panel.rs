@@ -344,15 +344,15 @@ fn ladder(v: f64, direction: f64) -> f64 {
     if !(v > 0.0 && v.is_finite()) {
         return 1.0;
     }
-    let decade = 10f64.powf(v.log10().floor());
-    let rungs: Vec<f64> = [-1.0, 0.0, 1.0].iter().flat_map(|d| [1.0, 2.0, 5.0].map(|m| m * decade * 10f64.powf(*d))).collect();
-    let tolerance = 1e-9 * v;
+    use crate::math::units::{nice_at_least, nice_at_most};
+    // A rung within 1e-9 of `v` is `v` itself: the next one is strictly beyond it.
     if direction > 0.0 {
-        rungs.into_iter().find(|r| *r > v + tolerance).unwrap_or(v)
+        nice_at_least(v * (1.0 + 1e-9))
     } else if direction < 0.0 {
-        rungs.into_iter().rev().find(|r| *r < v - tolerance).unwrap_or(v)
+        nice_at_most(v * (1.0 - 1e-9))
     } else {
-        rungs.into_iter().min_by(|a, b| (a.ln() - v.ln()).abs().total_cmp(&(b.ln() - v.ln()).abs())).unwrap_or(v)
+        let (up, down) = (nice_at_least(v), nice_at_most(v));
+        if (up / v).ln() < (v / down).ln() { up } else { down }
     }
 }
 
