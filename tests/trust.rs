@@ -153,6 +153,16 @@ fn cut_short_commands_say_so_and_exit_non_zero() {
         assert!(text.contains("INTERRUPTED"), "{args:?}: the table says so: {text}");
         verify_recording(&save).unwrap_or_else(|e| panic!("{args:?}: {e}"));
     }
+    // bench ignored Ctrl-C for a minute and then wrote its figures with exit 0.
+    let dir = scratch("cut-bench");
+    let json = dir.join("figures.json");
+    let child = rinscope().args(["bench", "--json"]).arg(&json).stdout(Stdio::null()).stderr(Stdio::piped()).spawn().expect("runs");
+    std::thread::sleep(Duration::from_millis(1500));
+    signal(&child, "-INT");
+    let (code, err, took) = finish(child);
+    assert_eq!(code, Some(130), "{err}");
+    assert!(took < Duration::from_secs(10), "{took:?}");
+    assert!(err.contains("interrupted by") && !json.exists() && partials(&dir).is_empty(), "{err}");
     let dir = scratch("cut-calibrate");
     let cal = tempconfig(&dir, "jiang2017-calibration", "duration_s = 200.0", "duration_s = 20000.0");
     let child = rinscope().args(["calibrate", "--config"]).arg(&cal).arg("--save").arg(dir.join("c.rrd")).stdout(Stdio::null()).stderr(Stdio::piped()).spawn().expect("runs");

@@ -489,7 +489,12 @@ pub(super) fn reproduce(markdown: Option<&Path>) -> Result<(), Failure> {
 /// `bench`.
 pub(super) fn bench(steps: u64, json: Option<&std::path::Path>) -> Result<(), Failure> {
     check_output_dir("--json", json)?;
-    let figures = crate::app::bench::run_benchmarks(steps).map_err(Failure::from)?;
+    let stop = stop_flag();
+    let figures = match crate::app::bench::run_benchmarks(steps, &stop) {
+        Ok(f) => f,
+        Err(_) if stop.load(std::sync::atomic::Ordering::SeqCst) => return Err(Failure::interrupted("the figures printed so far are not a whole benchmark; none written")),
+        Err(e) => return Err(Failure::from(e)),
+    };
     if let Some(path) = json {
         write_json("--json", path, &figures)?;
     }
@@ -500,7 +505,12 @@ pub(super) fn bench(steps: u64, json: Option<&std::path::Path>) -> Result<(), Fa
 pub(super) fn bench_peer(python: PathBuf, rounds: usize, samples: u64, json: Option<&std::path::Path>) -> Result<(), Failure> {
     use crate::app::bench::peer;
     check_output_dir("--json", json)?;
-    let reports = peer::compare(&peer::PeerOptions { python, rounds, samples }).map_err(|e| Failure::run(format!("{e:#}")))?;
+    let stop = stop_flag();
+    let reports = match peer::compare(&peer::PeerOptions { python, rounds, samples }, &stop) {
+        Ok(r) => r,
+        Err(_) if stop.load(std::sync::atomic::Ordering::SeqCst) => return Err(Failure::interrupted("the comparison did not finish; nothing written")),
+        Err(e) => return Err(Failure::run(format!("{e:#}"))),
+    };
     out!("{}", peer::text(&reports));
     if let Some(path) = json {
         write_json("--json", path, &reports)?;

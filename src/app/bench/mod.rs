@@ -62,8 +62,15 @@ pub fn peak_rss_bytes() -> u64 {
         .map_or(0, |kb| kb * 1024)
 }
 
-/// Runs the benchmarks, prints their numbers and returns them.
-pub fn run_benchmarks(steps: u64) -> anyhow::Result<Figures> {
+/// An error once `stop` is set (a signal): the benchmarks end between two measurements (each at
+/// most a few seconds), as every command does.
+fn check(stop: &AtomicBool) -> anyhow::Result<()> {
+    anyhow::ensure!(!stop.load(std::sync::atomic::Ordering::SeqCst), "interrupted");
+    Ok(())
+}
+
+/// Runs the benchmarks, prints their numbers and returns them; an error as soon as `stop` is set.
+pub fn run_benchmarks(steps: u64, stop: &AtomicBool) -> anyhow::Result<Figures> {
     let mut figs = Figures::new();
     // 1. Pure simulation: truth + encoders + three demodulations, one core, no recording. This VM's
     //    timings vary by 2x from run to run (shared cores), so report the best and the median of 5.
@@ -73,6 +80,7 @@ pub fn run_benchmarks(steps: u64) -> anyhow::Result<Figures> {
         let mut rates = Vec::new();
         let mut checksum = 0.0;
         for _ in 0..5 {
+            check(stop)?;
             let mut state = DemodState::default();
             checksum = 0.0;
             let started = Instant::now();
@@ -92,23 +100,42 @@ pub fn run_benchmarks(steps: u64) -> anyhow::Result<Figures> {
     }
 
     // 2. The INS in the loop.
-    strapdown_speed(&mut figs);
-    pipeline_speed(&mut figs)?;
+    check(stop)?;
+    strapdown_speed(&mut figs, stop)?;
+    check(stop)?;
+    pipeline_speed(&mut figs, stop)?;
 
-    // 3. Every preset for one simulated hour at its default rates, saved to a file: its speed with
-    //    the recording, and the recording's size (issue 13's target: at most 30 MB per hour).
+    // 3-5, with files in a scratch folder that is removed however they end.
     let dir = std::env::temp_dir().join(format!("rinscope-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
+    let recorded = recorded_runs(&dir, &mut figs, stop);
+    std::fs::remove_dir_all(&dir).ok();
+    recorded?;
+    check(stop)?;
+    calibration_speed(&mut figs, stop)?;
+    check(stop)?;
+    allan_speed(&mut figs, stop)?;
+    figs.add("peak resident memory", peak_rss_bytes() as f64 / 1e6, "MB");
+    outln!("peak resident memory: {:.1} MB", peak_rss_bytes() as f64 / 1e6);
+    Ok(figs)
+}
+
+/// Recorded runs into `dir`: every preset's hour, a 24 h INS run, the live reload latency.
+fn recorded_runs(dir: &std::path::Path, figs: &mut Figures, stop: &AtomicBool) -> anyhow::Result<()> {
+    // 3. Every preset for one simulated hour at its default rates, saved to a file: its speed with
+    //    the recording, and the recording's size (issue 13's target: at most 30 MB per hour).
     for (name, _) in presets::PRESETS {
+        check(stop)?;
         let mut p = presets::load(name)?;
         p.set_duration(3600.0);
         let path = dir.join(format!("{name}.rrd"));
         let sinks = sink::open(&SinkRequest { save: Some(path.clone()), ..Default::default() }, "rinscope-bench", name)?;
         let started = Instant::now();
-        let summary = crate::app::run::run_recorded(&p, &sinks, &AtomicBool::new(false), false)?;
+        let summary = crate::app::run::run_recorded(&p, &sinks, stop, false)?;
         let (_, bytes) = sinks.finish()?.recording.ok_or_else(|| anyhow::anyhow!("no file written"))?;
         let secs = started.elapsed().as_secs_f64();
         std::fs::remove_file(&path).ok();
+        check(stop)?;
         figs.add(format!("recorded run 1 h/{name}/wall"), secs, "s");
         figs.add(format!("recorded run 1 h/{name}/size"), bytes as f64 / 1e6, "MB/h");
         outln!(
@@ -125,8 +152,9 @@ pub fn run_benchmarks(steps: u64) -> anyhow::Result<Figures> {
     let path = dir.join("ins24h.rrd");
     let sinks = sink::open(&SinkRequest { save: Some(path), ..Default::default() }, "rinscope-bench", "ins24h")?;
     let started = Instant::now();
-    let summary = crate::app::run::run_recorded(&p, &sinks, &AtomicBool::new(false), false)?;
+    let summary = crate::app::run::run_recorded(&p, &sinks, stop, false)?;
     let (_, bytes) = sinks.finish()?.recording.ok_or_else(|| anyhow::anyhow!("no file written"))?;
+    check(stop)?;
     figs.add("INS 24 h/rotation-modulation-16-position/wall", started.elapsed().as_secs_f64(), "s");
     figs.add("INS 24 h/rotation-modulation-16-position/size", bytes as f64 / 1e6, "MB");
     outln!(
@@ -136,17 +164,12 @@ pub fn run_benchmarks(steps: u64) -> anyhow::Result<Figures> {
         bytes as f64 / 1e6
     );
 
-    live_latency(&dir, &mut figs)?;
-    std::fs::remove_dir_all(&dir).ok();
-    calibration_speed(&mut figs)?;
-    allan_speed(&mut figs)?;
-    figs.add("peak resident memory", peak_rss_bytes() as f64 / 1e6, "MB");
-    outln!("peak resident memory: {:.1} MB", peak_rss_bytes() as f64 / 1e6);
-    Ok(figs)
+    // 5. Live mode's reload latency.
+    live_latency(dir, figs, stop)
 }
 
 /// Strapdown attitude update alone: samples per second through each algorithm (one core).
-fn strapdown_speed(figs: &mut Figures) {
+fn strapdown_speed(figs: &mut Figures, stop: &AtomicBool) -> anyhow::Result<()> {
     use crate::ins::coning::Algorithm;
     use crate::ins::strapdown::AttitudeIntegrator;
     use crate::math::frames::Rot;
@@ -163,6 +186,7 @@ fn strapdown_speed(figs: &mut Figures) {
         .collect();
     let zeta = Vector3::new(0.0, 3e-8, 4e-8);
     for alg in Algorithm::ALL {
+        check(stop)?;
         let mut best = 0.0f64;
         for _ in 0..5 {
             let mut integ = AttitudeIntegrator::new(alg, Rot::identity());
@@ -179,6 +203,7 @@ fn strapdown_speed(figs: &mut Figures) {
         figs.add(format!("strapdown update/{}", alg.name()), best / 1e6, "M samples/s");
         outln!("strapdown update  {:<28} best of 5: {:.1} M samples/s (one core)", alg.name(), best / 1e6);
     }
+    Ok(())
 }
 
 /// A 2 kHz, 1° / 1 Hz pure-coning IMU with Earth rate at latitude 34° (the stream of `bench --peer
@@ -208,7 +233,7 @@ fn best_and_median(mut chunk: impl FnMut()) -> (f64, f64) {
 /// The whole INS pipeline (truth, IMU errors, strapdown, navigation, demodulation at 100 Hz), the exact
 /// IMU truth alone on the same motion (so that its share of the pipeline's time can be stated), and
 /// attitude + navigation alone on precomputed increments.
-fn pipeline_speed(figs: &mut Figures) -> anyhow::Result<()> {
+fn pipeline_speed(figs: &mut Figures, stop: &AtomicBool) -> anyhow::Result<()> {
     use crate::ins::truth::TruthImu;
     use crate::model::earth::Earth;
     let jiang = format!("{}\n[imu]\npreset = \"jiang2017-table1\"\n[navigation]\n", crate::scenario::presets::text("jiang2017-dual-axis").unwrap_or_default());
@@ -220,6 +245,7 @@ fn pipeline_speed(figs: &mut Figures) -> anyhow::Result<()> {
         ("li2014-wobble-1 (2 kHz, dither, FIR)", presets::load("li2014-wobble-1")?),
     ];
     for (name, p) in &cases {
+        check(stop)?;
         let mut ins = p.ins_run().ok_or_else(|| anyhow::anyhow!("no [imu]"))?;
         let every = (p.step_hz / 100.0).round().max(1.0) as u64;
         let mut i = 0u64;
@@ -255,6 +281,7 @@ fn pipeline_speed(figs: &mut Figures) -> anyhow::Result<()> {
             100.0 * median / truth_median
         );
     }
+    check(stop)?;
     navigation_speed(&cases[1].1, figs)
 }
 
@@ -292,7 +319,7 @@ fn navigation_speed(p: &crate::scenario::Params, figs: &mut Figures) -> anyhow::
 
 /// Live mode: from the moment a save starts to the moment the simulation thread runs on the new
 /// parameters, over 60 saves (half in place, half by rename), with a session running in real time.
-fn live_latency(dir: &std::path::Path, figs: &mut Figures) -> anyhow::Result<()> {
+fn live_latency(dir: &std::path::Path, figs: &mut Figures, interrupt: &AtomicBool) -> anyhow::Result<()> {
     use crate::app::live::{self, edit};
     let path = dir.join("live.toml");
     let text = crate::scenario::presets::text("jiang2017-dual-axis").ok_or_else(|| anyhow::anyhow!("preset"))?;
@@ -311,6 +338,9 @@ fn live_latency(dir: &std::path::Path, figs: &mut Figures) -> anyhow::Result<()>
     std::thread::sleep(std::time::Duration::from_millis(300));
     let mut latencies = Vec::new();
     for i in 0..60 {
+        if interrupt.load(std::sync::atomic::Ordering::SeqCst) {
+            break;
+        }
         let generation = live::snapshot(&status).generation;
         let value = 300.0 + f64::from(i % 2 + 1) * 10.0 * f64::from(i + 1);
         let started = Instant::now();
@@ -330,6 +360,7 @@ fn live_latency(dir: &std::path::Path, figs: &mut Figures) -> anyhow::Result<()>
     stop.store(true, std::sync::atomic::Ordering::SeqCst);
     session.join().map_err(|_| anyhow::anyhow!("live session panicked"))??;
     sinks.finish()?;
+    check(interrupt)?;
     let mut sorted = latencies.clone();
     sorted.sort_by(f64::total_cmp);
     figs.add("live reload/median", sorted[sorted.len() / 2], "ms");
@@ -349,11 +380,11 @@ fn live_latency(dir: &std::path::Path, figs: &mut Figures) -> anyhow::Result<()>
 /// Issue targets for calibration and resets: one static calibration (200 s at 200 Hz, KF and exact
 /// least squares), 500 Monte Carlo calibrations on all cores (target < 10 s on 2 cores), the 30 h
 /// twice-position-fix comparison ("seconds, not minutes").
-fn calibration_speed(figs: &mut Figures) -> anyhow::Result<()> {
-    let stop = AtomicBool::new(false);
+fn calibration_speed(figs: &mut Figures, stop: &AtomicBool) -> anyhow::Result<()> {
     let p = presets::load("jiang2017-calibration")?;
     let started = Instant::now();
-    let outcome = crate::app::calibrate::calibrate_scenario(&p, false, &stop)?;
+    let outcome = crate::app::calibrate::calibrate_scenario(&p, false, stop)?;
+    check(stop)?;
     figs.add("calibration/jiang2017-calibration", started.elapsed().as_secs_f64(), "s");
     outln!(
         "calibration       jiang2017-calibration: 200 s at 200 Hz, static KF + exact least squares + validation run in {:.2} s ({} measurements)",
@@ -361,7 +392,8 @@ fn calibration_speed(figs: &mut Figures) -> anyhow::Result<()> {
         outcome.data.samples.len()
     );
     let started = Instant::now();
-    let mc = crate::app::calibrate::monte_carlo(&p, 500, &|| {}, &stop)?;
+    let mc = crate::app::calibrate::monte_carlo(&p, 500, &|| {}, stop)?;
+    check(stop)?;
     figs.add("Monte Carlo/500 calibrations", started.elapsed().as_secs_f64(), "s");
     outln!(
         "Monte Carlo       jiang2017-calibration: {} calibrations in {:.2} s on {} threads",
@@ -370,7 +402,8 @@ fn calibration_speed(figs: &mut Figures) -> anyhow::Result<()> {
         mc.threads
     );
     let p = presets::load("zheng2016-tpr")?;
-    let r = crate::app::tpr::compare_resets(&p, 600.0, &stop)?;
+    let r = crate::app::tpr::compare_resets(&p, 600.0, stop)?;
+    check(stop)?;
     figs.add("TPR vs reset/zheng2016-tpr", r.wall_s, "s");
     outln!(
         "TPR vs reset      zheng2016-tpr: {:.0} h at {:.0} Hz, three branches after the fork, in {:.2} s",
@@ -385,7 +418,7 @@ fn calibration_speed(figs: &mut Figures) -> anyhow::Result<()> {
 /// intervals, the NNLS fit and the slope readings) of 10 h at 200 Hz, 6 channels, under 2 s on one
 /// core; and the simulation of `static-imu-10h` that feeds it (truth, sensor errors with the flicker
 /// bank and the rate random walk, the six cumulative sums), which `rinscope allan` runs first.
-fn allan_speed(figs: &mut Figures) -> anyhow::Result<()> {
+fn allan_speed(figs: &mut Figures, stop: &AtomicBool) -> anyhow::Result<()> {
     use crate::app::allan::{simulate, AllanRequest};
     use crate::ins::allan::analyze_imu;
     use crate::math::allan::{AllanOptions, Phase, TauSpacing};
@@ -421,7 +454,8 @@ fn allan_speed(figs: &mut Figures) -> anyhow::Result<()> {
     }
     let p = presets::load("static-imu-10h")?;
     let started = Instant::now();
-    let r = simulate(&p, &AllanRequest::default(), &AtomicBool::new(false), &|_| {})?;
+    let r = simulate(&p, &AllanRequest::default(), stop, &|_| {})?;
+    check(stop)?;
     figs.add("Allan static-imu-10h/simulation", r.gather_s, "s");
     figs.add("Allan static-imu-10h/analysis", r.analysis_s, "s");
     outln!(
@@ -441,7 +475,8 @@ mod tests {
     #[ignore = "a benchmark, not a test"]
     fn ins_figures() -> anyhow::Result<()> {
         let mut figs = super::Figures::new();
-        super::strapdown_speed(&mut figs);
-        super::pipeline_speed(&mut figs)
+        let stop = super::AtomicBool::new(false);
+        super::strapdown_speed(&mut figs, &stop)?;
+        super::pipeline_speed(&mut figs, &stop)
     }
 }

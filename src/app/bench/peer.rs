@@ -31,6 +31,12 @@ pub struct PeerOptions {
     pub samples: u64,
 }
 
+/// An error once `stop` is set: the comparison ends between two processes.
+fn check(stop: &std::sync::atomic::AtomicBool) -> anyhow::Result<()> {
+    ensure!(!stop.load(std::sync::atomic::Ordering::SeqCst), "interrupted");
+    Ok(())
+}
+
 /// One process's numbers in one round.
 #[derive(Debug, Clone, Serialize)]
 pub struct Timing {
@@ -150,7 +156,7 @@ pub struct StreamReport {
 }
 
 /// Runs the comparison on the static and the coning stream in a scratch folder.
-pub fn compare(opts: &PeerOptions) -> anyhow::Result<Vec<StreamReport>> {
+pub fn compare(opts: &PeerOptions, stop: &std::sync::atomic::AtomicBool) -> anyhow::Result<Vec<StreamReport>> {
     ensure!(opts.rounds >= 1, "--rounds must be at least 1");
     check_python(&opts.python)?;
     let dir = std::env::temp_dir().join(format!("rinscope-peer-{}", std::process::id()));
@@ -160,7 +166,7 @@ pub fn compare(opts: &PeerOptions) -> anyhow::Result<Vec<StreamReport>> {
         std::fs::write(dir.join("pyins_bench.py"), PYINS_BENCH)?;
         let mut reports = Vec::new();
         for kind in ["static", "coning"] {
-            reports.push(compare_stream(opts, &dir, kind)?);
+            reports.push(compare_stream(opts, &dir, kind, stop)?);
         }
         Ok(reports)
     })();
@@ -183,7 +189,7 @@ fn check_python(python: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn compare_stream(opts: &PeerOptions, dir: &Path, kind: &str) -> anyhow::Result<StreamReport> {
+fn compare_stream(opts: &PeerOptions, dir: &Path, kind: &str, stop: &std::sync::atomic::AtomicBool) -> anyhow::Result<StreamReport> {
     let stream = dir.join(format!("{kind}.npy"));
     let out = Command::new(&opts.python).arg(dir.join("make_stream.py")).arg(kind).arg(&stream).arg("--n").arg(opts.samples.to_string()).output()?;
     ensure!(out.status.success(), "make_stream.py {kind} failed: {}", String::from_utf8_lossy(&out.stderr));
@@ -210,6 +216,7 @@ fn compare_stream(opts: &PeerOptions, dir: &Path, kind: &str) -> anyhow::Result<
         a
     };
     for round in 0..opts.rounds {
+        check(stop)?;
         eprintln!("peer pyins: {kind} stream, round {} of {}", round + 1, opts.rounds);
         let (r, state) = run_rinscope(&logs)?;
         let (k, kstate) = run_pyins(&opts.python, &args_pyins("kernel"))?;
