@@ -373,6 +373,8 @@ impl Producer<'_> {
         let mut stats = ErrorStats::default();
         let mut out = Outbox { tx: self.tx, series: Vec::new(), scene: Vec::new(), signal: Vec::new() };
         let (mut done, mut interrupted) = (0, false);
+        // Whether the previous instant was computed (else the delay correction is fed its reading).
+        let mut stepped = false;
         for i in 0..timeline.instants() {
             if i % 65_536 == 0 && self.check(i) {
                 interrupted = true;
@@ -382,8 +384,13 @@ impl Producer<'_> {
             // The last steps too: a drift's final value is often its peak.
             let want_stats = i % self.stats_every == 0 || i.saturating_add(self.stats_every) >= timeline.instants();
             let (want_series, want_scene) = (i % self.series_every == 0, i % self.scene_every == 0);
-            if !(want_stats || want_series || want_scene) {
+            let wanted = want_stats || want_series || want_scene;
+            let stepped_last = std::mem::replace(&mut stepped, wanted);
+            if !wanted {
                 continue;
+            }
+            if i > 0 && !stepped_last {
+                state.observe(self.model, timeline.t_s(i - 1));
             }
             let o = step(self.model, &mut state, timeline.t_s(i));
             if want_stats {
@@ -417,6 +424,8 @@ impl Producer<'_> {
         let window = ins.config().signal_window_s;
         let (mut done, mut interrupted) = (1, false);
         let (mut next_series, mut next_scene, mut next_stats) = (0u64, 0u64, 0u64);
+        // The latest attitude update: its instant and whether its step was computed.
+        let mut last_update: Option<(f64, bool)> = None;
         for i in 1..=timeline.intervals() {
             if i % 65_536 == 0 && self.check(i) {
                 interrupted = true;
@@ -438,8 +447,14 @@ impl Producer<'_> {
             let view = if want_scene { ins.view(s.t_s) } else { ins.errors_view(s.t_s) };
             ins_stats.add(&view);
             let want_stats = i >= next_stats || i.saturating_add(self.stats_every) > timeline.intervals();
-            if !(want_stats || want_series || want_scene) {
+            let wanted = want_stats || want_series || want_scene;
+            // The previous update's instant, for the delay correction when it was not computed.
+            let previous_update = last_update.replace((s.t_s, wanted));
+            if !wanted {
                 continue;
+            }
+            if let Some((t_prev, false)) = previous_update {
+                state.observe(self.model, t_prev);
             }
             let core = step(self.model, &mut state, s.t_s);
             if want_stats {

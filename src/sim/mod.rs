@@ -141,6 +141,14 @@ impl DemodState {
         self.previous = Some((t_s, raw_corrected));
         corrected
     }
+
+    /// Takes the encoder reading at `t_s` without demodulating: a loop that computes only some
+    /// steps feeds it the instant before each, so that the delay correction's rate comes from
+    /// successive readings exactly as when every step is computed (a reading is a pure function
+    /// of the instant).
+    pub fn observe(&mut self, model: &Model, t_s: f64) {
+        self.correct(&model.compensation, t_s, &encoder_readings(model, t_s));
+    }
 }
 
 /// Everything one step produces.
