@@ -487,10 +487,10 @@ pub(super) fn reproduce(markdown: Option<&Path>) -> Result<(), Failure> {
 }
 
 /// `bench`.
-pub(super) fn bench(steps: u64, json: Option<&std::path::Path>) -> Result<(), Failure> {
+pub(super) fn bench(steps: u64, json: Option<&std::path::Path>, only: &[String]) -> Result<(), Failure> {
     check_output_dir("--json", json)?;
     let stop = stop_flag();
-    let figures = match crate::app::bench::run_benchmarks(steps, &stop) {
+    let figures = match crate::app::bench::run_benchmarks(steps, only, &stop) {
         Ok(f) => f,
         Err(_) if stop.load(std::sync::atomic::Ordering::SeqCst) => return Err(Failure::interrupted("the figures printed so far are not a whole benchmark; none written")),
         Err(e) => return Err(Failure::from(e)),

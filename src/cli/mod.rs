@@ -103,6 +103,10 @@ enum Command {
         /// against the last run.
         #[arg(long)]
         json: Option<PathBuf>,
+        /// Only these sections (comma-separated): simulation, strapdown, pipeline, navigation,
+        /// recorded, calibration, allan. Default: all.
+        #[arg(long, value_delimiter = ',', value_parser = crate::app::bench::SECTIONS)]
+        only: Vec<String>,
     },
 }
 
@@ -469,7 +473,7 @@ pub fn main() -> ExitCode {
         }
         Command::CheckConfig { file } => commands::check_config(&file),
         Command::Reproduce { markdown } => commands::reproduce(markdown.as_deref()),
-        Command::Bench { steps, peer: None, json, .. } => commands::bench(steps, json.as_deref()),
+        Command::Bench { steps, peer: None, json, only, .. } => commands::bench(steps, json.as_deref(), &only),
         Command::Bench { peer: Some(_), python, rounds, samples, json, .. } => commands::bench_peer(python, rounds, samples, json.as_deref()),
     };
     match result {

@@ -75,8 +75,10 @@ pub struct InsCore {
     history: Vec<[(f64, Rot<N, S>); 2]>,
     nav: Option<Navigator>,
     nav_start: Rot<N, S>,
-    upd_g: Vec<Vector3<f64>>,
-    upd_a: Vec<Vector3<f64>>,
+    /// The primary update's samples so far (Δθ, Δv; at most N = 3, a fixed buffer: no heap on the hot path).
+    upd_g: [Vector3<f64>; 3],
+    upd_a: [Vector3<f64>; 3],
+    upd_len: usize,
     /// FIR group delay, s.
     pub fir_delay_s: f64,
     /// Zero-order-hold delay, s.
@@ -135,8 +137,9 @@ impl InsCore {
             history,
             nav,
             nav_start: start,
-            upd_g: Vec::new(),
-            upd_a: Vec::new(),
+            upd_g: [Vector3::zeros(); 3],
+            upd_a: [Vector3::zeros(); 3],
+            upd_len: 0,
             fir_delay_s,
             zoh_delay_s,
             cfg,
@@ -202,7 +205,11 @@ impl InsCore {
     pub fn push(&mut self, t1: f64, g_meas: Vector3<f64>, a_meas: Vector3<f64>) -> SampleOut {
         let g_filt = self.fir_g.push(g_meas);
         let a_filt = self.fir_a.push(a_meas);
-        let mut out = SampleOut { t_s: t1, updated: false, raw_rate_s: g_meas * self.inv_h, filtered_rate_s: g_filt * self.inv_h };
+        let out = SampleOut { t_s: t1, updated: false, raw_rate_s: g_meas * self.inv_h, filtered_rate_s: g_filt * self.inv_h };
+        if self.cfg.decimation == 1 {
+            // No sums to keep (written and read back through memory they stalled the update).
+            return self.push_decimated(t1, g_filt, a_filt, out);
+        }
         self.acc.0 += g_filt;
         self.acc.1 += a_filt;
         self.acc.2 += 1;
@@ -211,27 +218,38 @@ impl InsCore {
         }
         let (dg, da) = (self.acc.0, self.acc.1);
         self.acc = (Vector3::zeros(), Vector3::zeros(), 0);
+        self.push_decimated(t1, dg, da, out)
+    }
+
+    /// One algorithm sample (the decimated sums) ending at `t1`.
+    #[inline]
+    fn push_decimated(&mut self, t1: f64, dg: Vector3<f64>, da: Vector3<f64>, mut out: SampleOut) -> SampleOut {
         let h_alg = self.h * self.cfg.decimation as f64;
         // The attitude at the start of the primary update, for the velocity update.
-        if self.upd_g.is_empty() {
+        if self.upd_len == 0 {
             self.nav_start = self.integrators[0].n_from_s;
         }
-        self.upd_g.push(dg);
-        self.upd_a.push(da);
-        let w_in = self.nav.as_ref().map_or(self.earth.omega_ie_n, Navigator::omega_in_n);
+        self.upd_g[self.upd_len] = dg;
+        self.upd_a[self.upd_len] = da;
+        self.upd_len += 1;
         let t_repr = t1 - self.fir_delay_s;
+        // ω_in^n only for the updates that need it (it changes with the velocity: once per update).
+        let w_in = if self.integrators.iter().any(AttitudeIntegrator::completes_with_next) {
+            self.nav.as_ref().map_or(self.earth.omega_ie_n, Navigator::omega_in_n)
+        } else {
+            Vector3::zeros()
+        };
         for (k, integ) in self.integrators.iter_mut().enumerate() {
             let zeta = w_in * (h_alg * integ.samples_per_update() as f64);
-            if integ.push(dg, &zeta).is_some() {
-                self.history[k] = [self.history[k][1], (t_repr, integ.n_from_s)];
+            if let Some(n_from_s) = integ.push(dg, &zeta) {
+                self.history[k] = [self.history[k][1], (t_repr, n_from_s)];
                 if k == 0 {
                     out.updated = true;
-                    let h_upd = h_alg * self.upd_g.len() as f64;
+                    let m = self.upd_len;
                     if let Some(nav) = self.nav.as_mut() {
-                        nav.update(&self.nav_start, &self.upd_g, &self.upd_a, &zeta, h_upd);
+                        nav.update(&self.nav_start, &self.upd_g[..m], &self.upd_a[..m], &zeta, h_alg * m as f64);
                     }
-                    self.upd_g.clear();
-                    self.upd_a.clear();
+                    self.upd_len = 0;
                 }
             }
         }

@@ -65,11 +65,12 @@ pub struct Navigator {
 struct LatitudeTerms {
     latitude_rad: f64,
     height_m: f64,
-    sin_lat: f64,
-    cos_lat: f64,
-    /// Meridian and transverse radii plus height, m.
-    rm: f64,
-    rn: f64,
+    /// Meridian and transverse radii plus height, m, as reciprocals (1/m), and tan L/(R_N + h).
+    inv_rm: f64,
+    inv_rn: f64,
+    tan_over_rn: f64,
+    /// 1/((R_N + h) cos L), 1/m.
+    inv_rn_cos: f64,
     omega_ie_n: Vector3<f64>,
     gravity_mps2: f64,
 }
@@ -83,7 +84,29 @@ impl LatitudeTerms {
     fn at(latitude_rad: f64, height_m: f64) -> Self {
         let (sin_lat, cos_lat) = latitude_rad.sin_cos();
         let (rm, rn) = Earth::radii(latitude_rad);
-        Self { latitude_rad, height_m, sin_lat, cos_lat, rm: rm + height_m, rn: rn + height_m, omega_ie_n: omega_ie_n(latitude_rad), gravity_mps2: normal_gravity(latitude_rad, height_m) }
+        let (rm, rn) = (rm + height_m, rn + height_m);
+        Self {
+            latitude_rad,
+            height_m,
+            inv_rm: 1.0 / rm,
+            inv_rn: 1.0 / rn,
+            tan_over_rn: sin_lat / (cos_lat * rn),
+            inv_rn_cos: 1.0 / (rn * cos_lat),
+            omega_ie_n: omega_ie_n(latitude_rad),
+            gravity_mps2: normal_gravity(latitude_rad, height_m),
+        }
+    }
+
+    /// ω_en^n + ω_ie^n at velocity `v` (ENU, m/s).
+    #[inline]
+    fn omega_in_n(&self, v: &Vector3<f64>) -> Vector3<f64> {
+        self.omega_ie_n + self.omega_en_n(v)
+    }
+
+    /// The transport rate ω_en^n at velocity `v`.
+    #[inline]
+    fn omega_en_n(&self, v: &Vector3<f64>) -> Vector3<f64> {
+        Vector3::new(-v.y * self.inv_rm, v.x * self.inv_rn, v.x * self.tan_over_rn)
     }
 
     fn refresh(&mut self, latitude_rad: f64, height_m: f64) {
@@ -109,9 +132,7 @@ impl Navigator {
     /// ω_in^n = ω_ie^n + ω_en^n at the current state.
     #[must_use]
     pub fn omega_in_n(&self) -> Vector3<f64> {
-        let (v, t) = (&self.state.v_n, &self.terms);
-        let w_en = Vector3::new(-v.y / t.rm, v.x / t.rn, v.x * t.sin_lat / (t.cos_lat * t.rn));
-        t.omega_ie_n + w_en
+        self.terms.omega_in_n(&self.state.v_n)
     }
 
     /// One velocity/position update over `h` seconds from the sensor increments of the update (one
@@ -130,13 +151,13 @@ impl Navigator {
             }
             _ => {}
         }
-        let c = n_from_s_start.quaternion();
-        let dv_sf_n = c * dv_s - 0.5 * zeta_n.cross(&(c * dv_s));
+        let dv_n = n_from_s_start.quaternion() * dv_s;
+        let dv_sf_n = dv_n - 0.5 * zeta_n.cross(&dv_n);
 
         let st = &mut self.state;
         let t = self.terms;
-        let (cl, rm, rn, w_ie) = (t.cos_lat, t.rm, t.rn, t.omega_ie_n);
-        let w_en = Vector3::new(-st.v_n.y / rm, st.v_n.x / rn, st.v_n.x * t.sin_lat / (cl * rn));
+        let w_ie = t.omega_ie_n;
+        let w_en = t.omega_en_n(&st.v_n);
         let g = Vector3::new(0.0, 0.0, -t.gravity_mps2);
         let v_old = st.v_n;
         let mut v_new = v_old + dv_sf_n + (g - (2.0 * w_ie + w_en).cross(&v_old)) * h;
@@ -149,8 +170,8 @@ impl Navigator {
             v_new.z = 0.0;
         }
         let v_mid = 0.5 * (v_old + v_new);
-        st.latitude_rad += v_mid.y / rm * h;
-        st.longitude_rad += v_mid.x / (rn * cl) * h;
+        st.latitude_rad += v_mid.y * t.inv_rm * h;
+        st.longitude_rad += v_mid.x * t.inv_rn_cos * h;
         st.height_m = if self.options.vertical == Vertical::Held { self.height0 } else { st.height_m + v_mid.z * h };
         st.v_n = v_new;
         self.terms.refresh(st.latitude_rad, st.height_m);

@@ -57,6 +57,9 @@ pub struct InsRun {
     pre_roll: Vec<(f64, Vector3<f64>, Vector3<f64>)>,
     /// The computer's initial C_s^n (at −d, with the alignment error).
     start: Rot<N, S>,
+    /// Each algorithm's latest error and the (instant, attitude) it was computed for: an algorithm
+    /// that has not updated since (more samples per update than the primary) is not recomputed.
+    last_error: Vec<Option<(f64, Rot<N, S>, AttitudeError)>>,
 }
 
 impl InsRun {
@@ -87,7 +90,8 @@ impl InsRun {
         let samples: Vec<(Vector3<f64>, Vector3<f64>)> = pre_roll.iter().map(|(_, g, a)| (*g, *a)).collect();
         let core = InsCore::new(cfg, site, start, &samples);
         let demod = vec![DemodState::default(); core.algorithms().len()];
-        Self { truth, sensors, core, h, index: 0, demod, pre_roll, start }
+        let last_error = vec![None; demod.len()];
+        Self { truth, sensors, core, h, index: 0, demod, pre_roll, start, last_error }
     }
 
     /// The measured (end time, Δθ, Δv) samples before t = 0 that pre-rolled the computer (what a log
@@ -197,6 +201,14 @@ impl InsRun {
         let mut shared: Vec<Shared> = Vec::with_capacity(self.demod.len());
         for k in 0..self.demod.len() {
             let (t_repr, n_from_s) = self.core.output_attitude(k);
+            if let Some((t, q, e)) = self.last_error[k] {
+                // The same output as last time: the same error (the demodulation's state is that of
+                // having read this instant already).
+                if t == t_repr && q.quaternion() == n_from_s.quaternion() {
+                    errors.push(e);
+                    continue;
+                }
+            }
             let known = shared.iter().position(|e| e.t_repr_s == t_repr);
             let (encoder, truth_att) = match known {
                 Some(i) => (shared[i].encoder_rad, shared[i].truth),
@@ -215,7 +227,9 @@ impl InsRun {
             if known.is_none() {
                 shared.push(Shared { t_repr_s: t_repr, encoder_rad: encoder, truth: truth_att, corrected_rad: corrected, b_from_s_comp });
             }
-            errors.push(demodulate(n_from_s, b_from_s_comp).error_from(&truth_att));
+            let error = demodulate(n_from_s, b_from_s_comp).error_from(&truth_att);
+            self.last_error[k] = Some((t_repr, n_from_s, error));
+            errors.push(error);
         }
         let (t_repr, imu_ins) = self.core.output_attitude(0);
         let imu_true = with_truth.then(|| self.truth.n_from_s(t_repr));

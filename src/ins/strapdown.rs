@@ -11,14 +11,26 @@ use crate::math::rotvec;
 use super::coning::{coefficients, Algorithm};
 
 /// One attitude integrator (one algorithm) fed gyro increments of the sensor frame s.
+///
+/// The coning term Σ K_m (Δθ_m × Δθ_N) is accumulated as (Σ K_m Δθ_m) × Δθ_N: each sample is
+/// weighted as it arrives and one cross product closes the update (the samples need not be kept).
 #[derive(Debug, Clone)]
 pub struct AttitudeIntegrator {
     /// Which algorithm.
     pub algorithm: Algorithm,
     n: usize,
     p: usize,
-    k: Vec<f64>,
-    cur: [Vector3<f64>; 3],
+    /// K_m of this update's samples m = 1 ..= N−1 (index m − 1).
+    k_cur: [f64; 2],
+    /// K_m of the previous update's samples m = 0, −1 (index −m).
+    k_prev: [f64; 2],
+    /// Σ Δθ of this update so far.
+    sum: Vector3<f64>,
+    /// Σ K_m Δθ_m of this update so far (the previous update's samples included).
+    weighted: Vector3<f64>,
+    /// The sample pushed last.
+    last_in: Vector3<f64>,
+    /// prev[0] = the previous update's last sample θ_0, prev[1] = θ_−1.
     prev: [Vector3<f64>; 2],
     filled: usize,
     /// The current attitude C_s^n.
@@ -32,7 +44,18 @@ impl AttitudeIntegrator {
     #[must_use]
     pub fn new(algorithm: Algorithm, n_from_s: Rot<N, S>) -> Self {
         let (n, p) = algorithm.n_p();
-        Self { algorithm, n, p, k: coefficients(n, p), cur: [Vector3::zeros(); 3], prev: [Vector3::zeros(); 2], filled: 0, n_from_s, updates: 0 }
+        let (mut k_cur, mut k_prev) = ([0.0; 2], [0.0; 2]);
+        for (j, kj) in coefficients(n, p).into_iter().enumerate() {
+            // Index j is m = j + 1 − P.
+            let m = j as i64 + 1 - p as i64;
+            if m >= 1 {
+                k_cur[(m - 1) as usize] = kj;
+            } else {
+                k_prev[(-m) as usize] = kj;
+            }
+        }
+        let zero = Vector3::zeros();
+        Self { algorithm, n, p, k_cur, k_prev, sum: zero, weighted: zero, last_in: zero, prev: [zero; 2], filled: 0, n_from_s, updates: 0 }
     }
 
     /// Sets the previous samples (oldest first) as if the integrator had been running: the
@@ -41,10 +64,12 @@ impl AttitudeIntegrator {
         let n = previous.len();
         if n >= 1 {
             self.prev[0] = previous[n - 1];
+            self.last_in = previous[n - 1];
         }
         if n >= 2 {
             self.prev[1] = previous[n - 2];
         }
+        self.start_update();
     }
 
     /// Gyro samples per attitude update (N).
@@ -53,32 +78,40 @@ impl AttitudeIntegrator {
         self.n
     }
 
-    /// Feeds one gyro increment Δθ_s (rad). When it completes an update, applies it with the
-    /// navigation-frame rotation `zeta_n` over that update and returns the rotation vector ΔΦ.
+    /// True if the next sample completes an update (the navigation-frame rotation is needed then only).
+    #[must_use]
     #[inline]
-    pub fn push(&mut self, dtheta_s: Vector3<f64>, zeta_n: &Vector3<f64>) -> Option<Vector3<f64>> {
-        self.cur[self.filled] = dtheta_s;
+    pub fn completes_with_next(&self) -> bool {
+        self.filled + 1 == self.n
+    }
+
+    /// Clears the update's sums; the previous update's samples enter the coning term's weighted sum.
+    #[inline]
+    fn start_update(&mut self) {
+        self.filled = 0;
+        self.sum = Vector3::zeros();
+        self.weighted = self.prev[0] * self.k_prev[0] + self.prev[1] * self.k_prev[1];
+    }
+
+    /// Feeds one gyro increment Δθ_s (rad). When it completes an update, applies it with the
+    /// navigation-frame rotation `zeta_n` over that update and returns the new attitude C_s^n
+    /// (by value: read back from `n_from_s` at once, it stalled on the store it had just made).
+    #[inline(always)]
+    pub fn push(&mut self, dtheta_s: Vector3<f64>, zeta_n: &Vector3<f64>) -> Option<Rot<N, S>> {
+        self.sum += dtheta_s;
         self.filled += 1;
+        let before = self.last_in;
+        self.last_in = dtheta_s;
         if self.filled < self.n {
+            self.weighted += dtheta_s * self.k_cur[self.filled - 1];
             return None;
         }
-        self.filled = 0;
-        let last = self.cur[self.n - 1];
-        let mut phi = Vector3::zeros();
-        for s in &self.cur[..self.n] {
-            phi += s;
-        }
-        // K_m for m = 1-P ..= N-1; m <= 0 are the previous update's last samples.
-        for (j, kj) in self.k.iter().enumerate() {
-            let m = j as i64 + 1 - self.p as i64;
-            let sample = if m >= 1 { self.cur[(m - 1) as usize] } else { self.prev[(-m) as usize] };
-            phi += sample.cross(&last) * *kj;
-        }
-        // prev[0] = θ_0 (the newest of this update), prev[1] = θ_-1.
+        let phi = self.sum + self.weighted.cross(&dtheta_s);
         if self.p > 0 {
-            self.prev[0] = self.cur[self.n - 1];
-            self.prev[1] = if self.n >= 2 { self.cur[self.n - 2] } else { self.prev[0] };
+            self.prev[1] = if self.n >= 2 { before } else { self.prev[0] };
+            self.prev[0] = dtheta_s;
         }
+        self.start_update();
         let n_from_s = *self.n_from_s.quaternion();
         let q = if *zeta_n == Vector3::zeros() { n_from_s * rotvec::exp(&phi) } else { rotvec::exp(&-*zeta_n) * n_from_s * rotvec::exp(&phi) };
         // Renormalise: |q|² = 1 + ε after the products (ε ~ 1e-16); q·(3 − |q|²)/2 has norm
@@ -86,9 +119,10 @@ impl AttitudeIntegrator {
         let q = q.into_inner();
         let q = q * (0.5 * (3.0 - q.norm_squared()));
         // FRAME: exp(−ζ) carries n over the update, exp(ΔΦ) the sensor frame: still C_s^n, one update on.
-        self.n_from_s = Rot::from_quaternion(UnitQuaternion::new_unchecked(q));
+        let n_from_s = Rot::from_quaternion(UnitQuaternion::new_unchecked(q));
+        self.n_from_s = n_from_s;
         self.updates += 1;
-        Some(phi)
+        Some(n_from_s)
     }
 }
 

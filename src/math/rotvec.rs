@@ -12,7 +12,11 @@ pub fn exp(phi: &Vector3<f64>) -> UnitQuaternion<f64> {
     let x2 = phi.norm_squared();
     let (c, s_over) = if x2 < 1e-4 {
         // cos(x/2) and sin(x/2)/x to x^6: error < 1e-20 at x = 0.01.
-        (1.0 - x2 / 8.0 + x2 * x2 / 384.0 - x2 * x2 * x2 / 46_080.0, 0.5 - x2 / 48.0 + x2 * x2 / 3840.0 - x2 * x2 * x2 / 645_120.0)
+        // Horner form with the reciprocals as constants (a division by 48 is not a multiplication
+        // to the compiler, and these divisions were a tenth of the attitude update's time).
+        const C: [f64; 3] = [1.0 / 8.0, 1.0 / 384.0, 1.0 / 46_080.0];
+        const S: [f64; 3] = [1.0 / 48.0, 1.0 / 3840.0, 1.0 / 645_120.0];
+        (1.0 - x2 * (C[0] - x2 * (C[1] - x2 * C[2])), 0.5 - x2 * (S[0] - x2 * (S[1] - x2 * S[2])))
     } else {
         let x = x2.sqrt();
         ((0.5 * x).cos(), (0.5 * x).sin() / x)

@@ -69,12 +69,17 @@ fn check(stop: &AtomicBool) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Runs the benchmarks, prints their numbers and returns them; an error as soon as `stop` is set.
-pub fn run_benchmarks(steps: u64, stop: &AtomicBool) -> anyhow::Result<Figures> {
+/// The benchmark sections, in the order they run (`bench --only`).
+pub const SECTIONS: [&str; 7] = ["simulation", "strapdown", "pipeline", "navigation", "recorded", "calibration", "allan"];
+
+/// Runs the benchmarks (the sections in `only`; all when it is empty), prints their numbers and
+/// returns them; an error as soon as `stop` is set.
+pub fn run_benchmarks(steps: u64, only: &[String], stop: &AtomicBool) -> anyhow::Result<Figures> {
     let mut figs = Figures::new();
+    let on = |section: &str| only.is_empty() || only.iter().any(|o| o == section);
     // 1. Pure simulation: truth + encoders + three demodulations, one core, no recording. This VM's
     //    timings vary by 2x from run to run (shared cores), so report the best and the median of 5.
-    for name in ["jiang2017-dual-axis", "rotary-table-2016-wobble"] {
+    for name in ["jiang2017-dual-axis", "rotary-table-2016-wobble"].into_iter().filter(|_| on("simulation")) {
         let p = presets::load(name)?;
         let model = p.table_model();
         let mut rates = Vec::new();
@@ -101,20 +106,34 @@ pub fn run_benchmarks(steps: u64, stop: &AtomicBool) -> anyhow::Result<Figures> 
 
     // 2. The INS in the loop.
     check(stop)?;
-    strapdown_speed(&mut figs, stop)?;
+    if on("strapdown") {
+        strapdown_speed(&mut figs, stop)?;
+    }
     check(stop)?;
-    pipeline_speed(&mut figs, stop)?;
+    if on("pipeline") {
+        pipeline_speed(&mut figs, stop)?;
+    }
+    check(stop)?;
+    if on("navigation") {
+        navigation_speed(&crate::scenario::parse(CONING_2KHZ, "bench")?, &mut figs);
+    }
 
     // 3-5, with files in a scratch folder that is removed however they end.
-    let dir = std::env::temp_dir().join(format!("rinscope-bench-{}", std::process::id()));
-    std::fs::create_dir_all(&dir)?;
-    let recorded = recorded_runs(&dir, &mut figs, stop);
-    std::fs::remove_dir_all(&dir).ok();
-    recorded?;
+    if on("recorded") {
+        let dir = std::env::temp_dir().join(format!("rinscope-bench-{}", std::process::id()));
+        std::fs::create_dir_all(&dir)?;
+        let recorded = recorded_runs(&dir, &mut figs, stop);
+        std::fs::remove_dir_all(&dir).ok();
+        recorded?;
+    }
     check(stop)?;
-    calibration_speed(&mut figs, stop)?;
+    if on("calibration") {
+        calibration_speed(&mut figs, stop)?;
+    }
     check(stop)?;
-    allan_speed(&mut figs, stop)?;
+    if on("allan") {
+        allan_speed(&mut figs, stop)?;
+    }
     figs.add("peak resident memory", peak_rss_bytes() as f64 / 1e6, "MB");
     outln!("peak resident memory: {:.1} MB", peak_rss_bytes() as f64 / 1e6);
     Ok(figs)
@@ -281,17 +300,16 @@ fn pipeline_speed(figs: &mut Figures, stop: &AtomicBool) -> anyhow::Result<()> {
             100.0 * median / truth_median
         );
     }
-    check(stop)?;
-    navigation_speed(&cases[1].1, figs)
+    Ok(())
 }
 
 /// Attitude + navigation (the navigation computer: attitude algorithm, velocity and position) fed
 /// precomputed increments of the 2 kHz coning stream: what pyins' bare kernel is timed on.
-fn navigation_speed(p: &crate::scenario::Params, figs: &mut Figures) -> anyhow::Result<()> {
+fn navigation_speed(p: &crate::scenario::Params, figs: &mut Figures) {
     use crate::ins::core::InsCore;
     use crate::ins::truth::TruthImu;
     use crate::model::earth::Earth;
-    let cfg = p.ins.as_ref().ok_or_else(|| anyhow::anyhow!("no [imu]"))?;
+    let Some(cfg) = p.ins.as_ref() else { return };
     let mut truth = TruthImu::new(p.table_model(), Earth::at(p.site), 0.0);
     // 32 cone periods, replayed cyclically: the stream stays that of a vehicle at rest.
     let samples: Vec<_> = (1..=64_000u32).map(|i| truth.increments(f64::from(i) / p.step_hz)).collect();
@@ -314,7 +332,6 @@ fn navigation_speed(p: &crate::scenario::Params, figs: &mut Figures) -> anyhow::
         median / 1e6,
         cfg.algorithm.name()
     );
-    Ok(())
 }
 
 /// Live mode: from the moment a save starts to the moment the simulation thread runs on the new
