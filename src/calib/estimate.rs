@@ -5,7 +5,7 @@ use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 use std::sync::atomic::AtomicBool;
 
-use super::{CalibConfig, CalibError, Data, Measurement, Param, ParamSet, Thinned, MAX_PARAMS, MAX_TABLE};
+use super::{CalibConfig, CalibError, Data, InsErrorModel, Measurement, Param, ParamSet, Thinned, MAX_PARAMS, MAX_TABLE};
 use crate::math::frames::{Rot, B, N};
 use crate::math::rotvec;
 use crate::model::gimbal::{Chain, ErrorRotations, TableErrors};
@@ -114,9 +114,8 @@ impl Normal {
         Self { a: [[0.0; MAX_PARAMS]; MAX_PARAMS], b: [0.0; MAX_PARAMS] }
     }
 
-    /// Adds one sample with its measurement z (or residual).
-    fn add(&mut self, p: usize, m: &SampleModel, z: &Vector3<f64>, with_information: bool) {
-        let wh = m.wh(p);
+    /// Adds one sample with its measurement z (or residual); `wh` = R⁻¹H of its model `m`.
+    fn add(&mut self, p: usize, m: &SampleModel, wh: &[[f64; MAX_PARAMS]; 3], z: &Vector3<f64>, with_information: bool) {
         for i in 0..p {
             self.b[i] += (0..3).map(|r| wh[r][i] * z[r]).sum::<f64>();
             if with_information {
@@ -130,6 +129,103 @@ impl Normal {
     fn assemble(&self, p: usize) -> (DMatrix<f64>, DVector<f64>) {
         let a = DMatrix::from_fn(p, p, |i, j| if i <= j { self.a[i][j] } else { self.a[j][i] });
         (a, DVector::from_column_slice(&self.b[..p]))
+    }
+}
+
+/// The INS term of the estimate's covariance. The estimate is θ̂ = A⁻¹(P₀x₀ + Σ Gᵢᵀzᵢ) with
+/// Gᵢ = R⁻¹Hᵢ and A = P₀ + Σ HᵢᵀR⁻¹Hᵢ; an INS error φᵢ common to the samples adds Σ Gᵢᵀφᵢ, whose
+/// covariance M makes the estimate's A⁻¹ + A⁻¹MA⁻¹ (R covers only what is white from sample to
+/// sample). With φᵢ = −Σ_{k≤i} C_k (ε Δt_k + w_k), w_k the random walk's increments
+/// (E w wᵀ = N²Δt I) and ε the unknown bias (E ε εᵀ = σ_b² I):
+///
+/// - random walk: Σ_i Gᵢᵀφᵢ = −Σ_k S_kᵀ C_k w_k with the suffix sums S_k = Σ_{i≥k} Gᵢ = T − P_{k−1}
+///   (T the total, P the prefix), so M_N = Σ_k N²Δt_k (T − P_{k−1})ᵀ(T − P_{k−1}), accumulated in
+///   one pass from Σq, Σ q P and Σ q PᵀP;
+/// - bias: Σ_i Gᵢᵀφᵢ = −(Σ_i Gᵢᵀ Dᵢ) ε with Dᵢ = Σ_{k≤i} C_k Δt_k, so M_b = σ_b² B Bᵀ.
+///
+/// (Earth rate's coupling −ω_ie×φ is left out: 1.5 % over 200 s.)
+#[derive(Debug, Clone)]
+struct InsTerm {
+    model: InsErrorModel,
+    last_t: Option<f64>,
+    /// T = Σ Gᵢ (3 × p).
+    total: [[f64; MAX_PARAMS]; 3],
+    q_sum: f64,
+    /// Σ q_k P_{k−1} (3 × p).
+    u: [[f64; MAX_PARAMS]; 3],
+    /// Σ q_k P_{k−1}ᵀ P_{k−1} (p × p, upper triangle).
+    v: [[f64; MAX_PARAMS]; MAX_PARAMS],
+    /// Dᵢ = Σ C_k Δt_k.
+    d: Matrix3<f64>,
+    /// B = Σ Gᵢᵀ Dᵢ (p × 3).
+    b: [[f64; 3]; MAX_PARAMS],
+}
+
+impl InsTerm {
+    fn new(model: InsErrorModel) -> Self {
+        Self { model, last_t: None, total: [[0.0; MAX_PARAMS]; 3], q_sum: 0.0, u: [[0.0; MAX_PARAMS]; 3], v: [[0.0; MAX_PARAMS]; MAX_PARAMS], d: Matrix3::zeros(), b: [[0.0; 3]; MAX_PARAMS] }
+    }
+
+    /// Adds sample i at `t_s` with the INS attitude `n_from_s` and Gᵢ = `wh`.
+    fn add(&mut self, p: usize, t_s: f64, n_from_s: &Matrix3<f64>, wh: &[[f64; MAX_PARAMS]; 3]) {
+        if !self.model.is_some() {
+            return;
+        }
+        // The first sample's interval is not known: the error before it is the offset's.
+        let dt = self.last_t.map_or(0.0, |t| (t_s - t).max(0.0));
+        self.last_t = Some(t_s);
+        let q = self.model.random_walk_rad_per_sqrt_s.powi(2) * dt;
+        if q > 0.0 {
+            // P_{i−1} is the total before this sample.
+            let t = &self.total;
+            for r in 0..3 {
+                for j in 0..p {
+                    self.u[r][j] += q * t[r][j];
+                }
+            }
+            for j in 0..p {
+                for l in j..p {
+                    self.v[j][l] += q * (t[0][j] * t[0][l] + t[1][j] * t[1][l] + t[2][j] * t[2][l]);
+                }
+            }
+            self.q_sum += q;
+        }
+        self.d += n_from_s * dt;
+        for r in 0..3 {
+            for j in 0..p {
+                self.total[r][j] += wh[r][j];
+            }
+        }
+        if self.model.bias_sigma_rad_per_s > 0.0 {
+            for j in 0..p {
+                for c in 0..3 {
+                    self.b[j][c] += (0..3).map(|r| wh[r][j] * self.d[(r, c)]).sum::<f64>();
+                }
+            }
+        }
+    }
+
+    /// M (p × p) for the samples so far.
+    fn covariance(&self, p: usize) -> DMatrix<f64> {
+        let t = &self.total;
+        let sb2 = self.model.bias_sigma_rad_per_s.powi(2);
+        DMatrix::from_fn(p, p, |j, l| {
+            let (a, c) = (j.min(l), j.max(l));
+            let mut m = self.v[a][c];
+            for r in 0..3 {
+                m += self.q_sum * t[r][j] * t[r][l] - t[r][j] * self.u[r][l] - self.u[r][j] * t[r][l];
+            }
+            m + sb2 * (0..3).map(|k| self.b[j][k] * self.b[l][k]).sum::<f64>()
+        })
+    }
+
+    /// A⁻¹ + A⁻¹MA⁻¹ from A⁻¹.
+    fn widen(&self, a_inv: DMatrix<f64>) -> DMatrix<f64> {
+        if !self.model.is_some() {
+            return a_inv;
+        }
+        let m = self.covariance(a_inv.nrows());
+        &a_inv + &a_inv * m * &a_inv
     }
 }
 
@@ -188,6 +284,8 @@ pub struct Calibration {
     pub samples: usize,
     /// Measurement 1σ used, rad.
     pub measurement_sigma_rad: f64,
+    /// The INS error the covariance allows for through the test.
+    pub ins_error: InsErrorModel,
 }
 
 /// Exact residual of one sample for the table errors `err` (nav frame): the rotation from the known
@@ -233,14 +331,18 @@ pub fn calibrate(chain: &Chain, known: &TableErrors, data: &Data, cfg: &CalibCon
         History::Snapshots(hz) => 1.0 / hz,
         _ => f64::INFINITY,
     });
+    let mut ins = InsTerm::new(cfg.ins_error);
     data.samples.each(stop, &mut |s| {
         model.set(&set, chain, &n_from_b, s, data.tau(s.t_s), cfg);
         let z = exact_residual(chain, &before, s, &ref_inv);
-        sums.add(p, &model, &z, true);
+        let wh = model.wh(p);
+        sums.add(p, &model, &wh, &z, true);
+        ins.add(p, s.t_s, &s.n_from_s.matrix(), &wh);
         if matches!(history, History::Snapshots(_)) && snapshots.wants(s.t_s) {
             let (a, b) = sums.assemble(p);
             // Early on the information can be singular: that snapshot is skipped.
             if let Ok((x, cov)) = solve(&(&prior_info + a), &(&prior_info * &x0 + b)) {
+                let cov = ins.widen(cov);
                 snapshots.push(s.t_s, Snapshot { t_s: s.t_s, theta: x.iter().copied().collect(), sigma: cov.diagonal().iter().map(|v| v.max(0.0).sqrt()).collect() });
             }
         }
@@ -248,6 +350,7 @@ pub fn calibrate(chain: &Chain, known: &TableErrors, data: &Data, cfg: &CalibCon
     let (data_information, rhs) = sums.assemble(p);
     let information = &prior_info + &data_information;
     let (x_kf, cov) = solve(&information, &(&prior_info * &x0 + rhs))?;
+    let cov = ins.widen(cov);
     let chol = information.clone().cholesky().ok_or(CalibError::Singular)?;
 
     // Residuals of a parameter vector under the exact model, and the Gauss–Newton right-hand side
@@ -267,7 +370,7 @@ pub fn calibrate(chain: &Chain, known: &TableErrors, data: &Data, cfg: &CalibCon
             for (k, q) in sq.iter_mut().enumerate() {
                 *q += r[k] * r[k];
             }
-            g.add(p, &model, &r, false);
+            g.add(p, &model, &model.wh(p), &r, false);
             let (q, dof) = model.isotropic_part(&r);
             iso_sq += q;
             iso_dof += dof;
@@ -310,6 +413,7 @@ pub fn calibrate(chain: &Chain, known: &TableErrors, data: &Data, cfg: &CalibCon
         history: snapshots.rows,
         samples: data.samples.len(),
         measurement_sigma_rad: cfg.measurement_sigma_rad,
+        ins_error: cfg.ins_error,
     })
 }
 

@@ -90,12 +90,36 @@ pub struct CalibConfig {
     pub prior_eta_rad: f64,
     /// Its 1σ, rad.
     pub prior_eta_sigma_rad: f64,
+    /// The INS's attitude error common to the samples (a random walk and an unknown gyro bias): it
+    /// is correlated over the whole test, so it enters the estimate's covariance through the test
+    /// (`estimate::InsTerm`), not a per-sample R. Zeros: not modelled.
+    pub ins_error: InsErrorModel,
     /// Reference errors estimated alongside.
     pub nuisance: Nuisance,
     /// Snapshots of the filter for the recording, Hz.
     pub record_hz: f64,
     /// The Monte Carlo's distributions.
     pub montecarlo: MonteCarloConfig,
+}
+
+/// The INS attitude error a calibration allows for: the gyros' angle random walk and a constant
+/// bias it does not know (the turn-on bias; a Gauss–Markov bias whose correlation time is long
+/// against the test counts here too). With the INS running on Earth rate only (no navigation),
+/// over a test of minutes: φ(t) = −∫ C_s^n (ε + w) dt.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct InsErrorModel {
+    /// Angle random walk N, rad/√s (isotropic: white rate noise stays white through C_s^n).
+    pub random_walk_rad_per_sqrt_s: f64,
+    /// 1σ of each axis's unknown constant gyro bias, rad/s (turned with the IMU by C_s^n).
+    pub bias_sigma_rad_per_s: f64,
+}
+
+impl InsErrorModel {
+    /// True if it models anything.
+    #[must_use]
+    pub fn is_some(&self) -> bool {
+        self.random_walk_rad_per_sqrt_s > 0.0 || self.bias_sigma_rad_per_s > 0.0
+    }
 }
 
 /// Prior 1σ of the nuisance states, rad: effectively uninformative (1°).

@@ -101,6 +101,10 @@ pub struct Report {
     pub duration_s: f64,
     /// R: 1σ per component, arcsec.
     pub measurement_sigma_arcsec: f64,
+    /// The INS's angle random walk the 1σ allow for, °/√h (0: not modelled).
+    pub ins_random_walk_deg_per_sqrt_h: f64,
+    /// The INS's unknown gyro bias (1σ per axis) the 1σ allow for, °/h (0: not modelled).
+    pub ins_bias_deg_per_h: f64,
     /// Gauss–Newton iterations.
     pub nls_iterations: usize,
     /// Residual RMS (E, N, U) of the filter's and the least squares' solutions, arcsec.
@@ -400,6 +404,8 @@ pub fn build(scenario: &str, chain: &Chain, truth: &TableErrors, cal: &Calibrati
         samples: cal.samples,
         duration_s: data.samples.last_t_s(),
         measurement_sigma_arcsec: cal.measurement_sigma_rad * ARCSEC_PER_RAD,
+        ins_random_walk_deg_per_sqrt_h: cal.ins_error.random_walk_rad_per_sqrt_s / crate::math::units::RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H,
+        ins_bias_deg_per_h: cal.ins_error.bias_sigma_rad_per_s / crate::math::units::RAD_PER_S_PER_DEG_PER_H,
         nls_iterations: cal.nls_iterations,
         residual_rms_arcsec: [cal.kf.residual_rms_rad.map(|v| v * ARCSEC_PER_RAD), cal.nls.residual_rms_rad.map(|v| v * ARCSEC_PER_RAD)],
         state,
@@ -481,6 +487,14 @@ impl Report {
             "calibration of {}: {} samples over {:.0} s, {} (seed {}); R per sample: each encoder's noise about its axis + {:.2}″ isotropic\n",
             self.scenario, self.samples, self.duration_s, self.source, self.seed, self.measurement_sigma_arcsec
         );
+        if self.ins_random_walk_deg_per_sqrt_h > 0.0 || self.ins_bias_deg_per_h > 0.0 {
+            s.push_str(&format!(
+                "the 1σ also carry the INS's error through the whole test (correlated from sample to sample): angle random walk {}°/√h, unknown gyro bias {}°/h (1σ per axis)\n",
+                self.ins_random_walk_deg_per_sqrt_h, self.ins_bias_deg_per_h
+            ));
+        } else if !self.source.starts_with("exact") {
+            s.push_str("the INS's own error (random walk, bias) is not in the 1σ: state calibration.ins_random_walk_deg_per_sqrt_h and ins_bias_deg_per_h, or the 1σ of the states it reaches (the offsets, drifts, η_eff) are optimistic\n");
+        }
         let header = format!("  {:<26} {:>13}  {:>13} {:>9}  {:>11}  {:>13} {:>9}  {:>11}\n", "", "true", "static KF", "1σ", "(error)", "exact LSQ", "1σ", "(error)");
         s.push_str("\nangles (phase errors in arcsec of phase):\n");
         s.push_str(&header);

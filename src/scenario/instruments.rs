@@ -6,7 +6,7 @@ use nalgebra::Vector3;
 use super::raw::{RawCalibration, RawFir, RawImu, RawNavigation, RawSpec};
 use super::validate::{Checker, ERROR_HINT, MAX_ERROR_ANGLE_ARCSEC};
 use super::ConfigError;
-use crate::calib::{CalibConfig, MonteCarloConfig, Nuisance};
+use crate::calib::{CalibConfig, InsErrorModel, MonteCarloConfig, Nuisance};
 use crate::ins::coning::Algorithm;
 use crate::ins::nav::{NavOptions, Vertical};
 use crate::ins::noise::IeeeTerms;
@@ -216,7 +216,29 @@ fn validate_imu(c: &Checker<'_>, raw: &RawImu, nav: Option<&RawNavigation>, step
     Ok(cfg)
 }
 
-pub(super) fn validate_calibration(c: &Checker<'_>, cal: &RawCalibration, truth: &TableErrors) -> Result<CalibConfig, ConfigError> {
+/// The INS error a calibration allows for: the stated keys, else what `ins` simulates (its angle
+/// random walk; its bias's 1σ — the RMS per axis of a fixed bias, which the calibration does not
+/// know either — with a Gauss–Markov bias, nearly constant over a test, added in quadrature).
+fn calibration_ins_error(c: &Checker<'_>, cal: &RawCalibration, ins: Option<&InsParams>) -> Result<InsErrorModel, ConfigError> {
+    let gyro = ins.map(|i| i.errors.gyro);
+    let walk = match cal.ins_random_walk_deg_per_sqrt_h {
+        Some(v) => c.range("calibration.ins_random_walk_deg_per_sqrt_h", v, "deg/sqrt(h)", 0.0, 100.0, "")? * RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H,
+        None => gyro.map_or(0.0, |g| g.noise.random_walk_si),
+    };
+    let bias = match cal.ins_bias_deg_per_h {
+        Some(v) => c.range("calibration.ins_bias_deg_per_h", v, "deg/h", 0.0, 3600.0, "")? * RAD_PER_S_PER_DEG_PER_H,
+        None => gyro.map_or(0.0, |g| {
+            let constant = match g.bias_rad_per_s {
+                Spec::Sigma(s) => s,
+                Spec::Fixed(v) => (v.iter().map(|x| x * x).sum::<f64>() / 3.0).sqrt(),
+            };
+            constant.hypot(g.markov_sigma_rad_per_s)
+        }),
+    };
+    Ok(InsErrorModel { random_walk_rad_per_sqrt_s: walk, bias_sigma_rad_per_s: bias })
+}
+
+pub(super) fn validate_calibration(c: &Checker<'_>, cal: &RawCalibration, truth: &TableErrors, ins: Option<&InsParams>) -> Result<CalibConfig, ConfigError> {
     // The isotropic part: the INS and the reference, 1″ unless stated; the encoders' part comes
     // from their stated noise, per axis, in the direction each one acts.
     let measurement_sigma_rad = match cal.measurement_sigma_arcsec {
@@ -254,6 +276,7 @@ pub(super) fn validate_calibration(c: &Checker<'_>, cal: &RawCalibration, truth:
         measurement_sigma_rad,
         encoder_noise_rad,
         measurement_sigma_stated: cal.measurement_sigma_arcsec.is_some(),
+        ins_error: calibration_ins_error(c, cal, ins)?,
         prior_swing_sigma_rad: c.positive("calibration.prior_swing_sigma_arcsec", cal.prior_swing_sigma_arcsec, "arcsec", MAX_ERROR_ANGLE_ARCSEC)? * RAD_PER_ARCSEC,
         prior_eta_rad: c.range("calibration.prior_non_orthogonality_arcsec", cal.prior_non_orthogonality_arcsec, "arcsec", -MAX_ERROR_ANGLE_ARCSEC, MAX_ERROR_ANGLE_ARCSEC, ERROR_HINT)?
             * RAD_PER_ARCSEC,

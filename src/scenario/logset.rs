@@ -427,7 +427,8 @@ fn table_description(c: &Checker<'_>, raw: &RawTable, rate_hz: f64) -> Result<Ta
     let (chain, stated) = validate::turntable(c, &raw.turntable)?;
     let (compensation, resolved_comp) = validate::validate_compensation(c, &raw.compensation, &raw.turntable, &chain, &stated)?;
     let ins = instruments::validate_ins(c, Some(&raw.imu.clone().unwrap_or_default()), raw.navigation.as_ref(), rate_hz)?.unwrap_or_else(|| InsParams::ideal(rate_hz, crate::ins::coning::Algorithm::TwoSampleP1));
-    let calibration = instruments::validate_calibration(c, &raw.calibration.clone().unwrap_or_default(), &stated)?;
+    // The calibration allows for the INS error the [imu] section states (a datasheet's), if any.
+    let calibration = instruments::validate_calibration(c, &raw.calibration.clone().unwrap_or_default(), &stated, raw.imu.is_some().then_some(&ins))?;
     // A log's motion is not known before it is read: the defaults of a table turning at 10°/s
     // (10 Hz series and scene) unless [recording] says otherwise.
     let recording = validate::recording(c, &raw.recording, rate_hz, validate::Bandwidth { shaft_deg_per_s: 10.0, motion_hz: 0.0, duration_s: 3600.0 }, 0.0)?;

@@ -65,6 +65,14 @@ pub struct RawCalibration {
     /// Its 1σ, arcsec.
     #[serde(default = "default_prior_eta")]
     pub prior_non_orthogonality_sigma_arcsec: f64,
+    /// The INS gyros' angle random walk the 1σ allow for, °/√h (default: the `[imu]`'s; a log's
+    /// table.toml states it or it is not modelled).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ins_random_walk_deg_per_sqrt_h: Option<f64>,
+    /// 1σ of the INS gyros' unknown constant bias the 1σ allow for, °/h (default: the `[imu]`'s
+    /// turn-on and Gauss–Markov bias; a log's table.toml states it or it is not modelled).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ins_bias_deg_per_h: Option<f64>,
     /// Slow errors of the attitude reference estimated alongside: "none", "offset" or "offset+drift".
     #[serde(default = "default_nuisance")]
     pub nuisance: String,
@@ -80,6 +88,8 @@ impl Default for RawCalibration {
     fn default() -> Self {
         Self {
             measurement_sigma_arcsec: None,
+            ins_random_walk_deg_per_sqrt_h: None,
+            ins_bias_deg_per_h: None,
             prior_swing_sigma_arcsec: default_prior_swing(),
             prior_non_orthogonality_arcsec: 0.0,
             prior_non_orthogonality_sigma_arcsec: default_prior_eta(),

@@ -180,7 +180,7 @@ pub(super) fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigErr
     };
     let live_speed = c.range("live.speed", raw.live.speed, "x real time", 0.01, 10_000.0, "")?;
     let ins = instruments::validate_ins(&c, raw.imu.as_ref(), raw.navigation.as_ref(), step_hz)?;
-    let calibration = instruments::validate_calibration(&c, &raw.calibration.clone().unwrap_or_default(), &truth)?;
+    let calibration = instruments::validate_calibration(&c, &raw.calibration.clone().unwrap_or_default(), &truth, ins.as_ref())?;
     let mut position_fix_s = Vec::new();
     if let Some(fix) = &raw.position_fix {
         if raw.navigation.is_none() {
