@@ -393,8 +393,9 @@ fn calibration_rows(rows: &mut Vec<Row>) -> anyhow::Result<()> {
     // The least-squares compensation against compensating with the true values, on the independent
     // run: RMS² adds, so the ratio is √(1 + (3σ/floor)²) at most, σ the largest estimate 1σ; fitting
     // the noise could lower it by no more than p/n.
-    // The states the data determine (a prior-dominated direction does not change the demodulation).
-    let sig = outcome.report.state.iter().filter(|r| r.flag.is_empty() && r.unit == "arcsec").map(|r| r.nls.sigma).fold(0.0, f64::max) * crate::math::units::RAD_PER_ARCSEC;
+    // The table states the data determine (a prior-dominated direction does not change the
+    // demodulation; the reference's nuisance states are not part of the compensation).
+    let sig = outcome.report.state.iter().take(outcome.cal.set.n_table).filter(|r| r.flag.is_empty() && r.unit == "arcsec").map(|r| r.nls.sigma).fold(0.0, f64::max) * crate::math::units::RAD_PER_ARCSEC;
     let n = outcome.cal.samples.max(1) as f64;
     let p_over_n = outcome.cal.set.len() as f64 / n;
     if let Some(c) = outcome.report.compensation {
@@ -411,7 +412,7 @@ fn calibration_rows(rows: &mut Vec<Row>) -> anyhow::Result<()> {
                     format!("{:.2}× ({before}″ → {after}″)", before / after),
                     ratio,
                     (1.0 - p_over_n, hi),
-                    format!("√(1 + (3σ/floor)²) with σ = {:.3}″ the largest determined state's 1σ, floor {:.2}″; − p/n below", sig * ARCSEC_PER_RAD, floor * ARCSEC_PER_RAD),
+                    format!("√(1 + (3σ/floor)²) with σ = {:.3}″ the largest determined table state's 1σ, floor {:.2}″; − p/n below", sig * ARCSEC_PER_RAD, floor * ARCSEC_PER_RAD),
                 )
                 .note(format!(
                     "the paper's factor {:.2}× before/after is set by its lab's residual ({after}″: turntable and INS errors beyond the model); rinscope's before/after peak factor is {:.1}×, set by the 12″ encoder noise",

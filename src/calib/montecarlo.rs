@@ -48,6 +48,9 @@ pub struct QuantityRow {
     pub kf: ErrorSpread,
     /// Exact least squares.
     pub nls: ErrorSpread,
+    /// The mean of the least squares' reported 1σ over the runs, ″ (to set beside `nls.std`).
+    #[serde(default)]
+    pub nls_reported_sigma: Option<f64>,
     /// Seed 000 Table 3's (mean, std), when it has the quantity.
     pub paper: Option<(f64, f64)>,
     /// Determined by the data (false: the prior / an independent measurement decides).
@@ -138,6 +141,29 @@ fn errors(chain: &Chain, set: &ParamSet, theta: &[f64], truth: &[f64]) -> Vec<f6
     out
 }
 
+/// The reported 1σ (″) of one estimate, in the order of [`quantities`] (first-order propagation of
+/// its covariance, as the report does).
+fn sigmas(chain: &Chain, set: &ParamSet, est: &super::Estimate) -> Vec<f64> {
+    use super::report::propagate;
+    let n = chain.axes().len();
+    let mut out = Vec::new();
+    for k in (0..n).rev() {
+        let (ic, is) = (set.index(Param::SwingCos(k)).unwrap_or(0), set.index(Param::SwingSin(k)).unwrap_or(0));
+        let alpha = propagate(est, &move |x: &[f64]| x[ic].hypot(x[is]), ARCSEC_PER_RAD);
+        let phi = propagate(est, &move |x: &[f64]| x[is].atan2(x[ic]), ARCSEC_PER_RAD);
+        out.push(alpha.sigma);
+        out.push(phi.sigma);
+        out.push(alpha.value / ARCSEC_PER_RAD * phi.sigma);
+    }
+    for k in (1..n).rev() {
+        let ie = set.index(Param::NonOrth(k)).unwrap_or(0);
+        out.push(est.sigma(ie) * ARCSEC_PER_RAD);
+        let f = super::report::effective_eta(chain, set, k);
+        out.push(f.map_or(f64::NAN, |f| propagate(est, &f, ARCSEC_PER_RAD).sigma));
+    }
+    out
+}
+
 /// Draws run `i`'s true errors.
 fn draw(base: &TableErrors, mc: &super::MonteCarloConfig, seed: u64, i: u64) -> (TableErrors, ChaCha8Rng) {
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x4D43_5F43_414C_4942);
@@ -216,6 +242,9 @@ pub struct RunErrors {
     pub kf: Vec<f64>,
     /// Exact least squares.
     pub nls: Vec<f64>,
+    /// The least squares' reported 1σ (″), same order (absent in shard files of before).
+    #[serde(default)]
+    pub nls_sigma: Vec<f64>,
 }
 
 /// Runs calibrations `indices` in parallel, each on the data `collect` simulates for a drawn table
@@ -248,7 +277,12 @@ pub fn run_indices(setup: &Setup<'_>, indices: &[u64], collect: &Collect<'_>, pr
             let data = collect(&truth, base_seed.wrapping_add(1000).wrapping_add(i))?;
             let cal = calibrate(setup.chain, setup.compensation, &data, &cfg, History::Lean, stop)?;
             let truth_v = cal.set.values(&truth);
-            let out = RunErrors { index: i, kf: errors(setup.chain, &cal.set, &cal.kf.theta, &truth_v), nls: errors(setup.chain, &cal.set, &cal.nls.theta, &truth_v) };
+            let out = RunErrors {
+                index: i,
+                kf: errors(setup.chain, &cal.set, &cal.kf.theta, &truth_v),
+                nls: errors(setup.chain, &cal.set, &cal.nls.theta, &truth_v),
+                nls_sigma: sigmas(setup.chain, &cal.set, &cal.nls),
+            };
             progress();
             Ok(Some(out))
         })
@@ -284,7 +318,9 @@ pub fn summarize(setup: &Setup<'_>, runs_requested: usize, done: &[RunErrors], w
         .map(|(j, (label, paper, identifiable, given_by_eta))| {
             let kf: Vec<f64> = done.iter().map(|r| r.kf[j]).collect();
             let nls: Vec<f64> = done.iter().map(|r| r.nls[j]).collect();
-            QuantityRow { label: label.clone(), kf: ErrorSpread::of(&kf), nls: ErrorSpread::of(&nls), paper: *paper, identifiable: *identifiable, given_by_eta: *given_by_eta }
+            let sig: Vec<f64> = done.iter().filter_map(|r| r.nls_sigma.get(j).copied()).filter(|v| v.is_finite()).collect();
+            let nls_reported_sigma = (!sig.is_empty() && sig.len() == done.len()).then(|| sig.iter().sum::<f64>() / sig.len() as f64);
+            QuantityRow { label: label.clone(), kf: ErrorSpread::of(&kf), nls: ErrorSpread::of(&nls), nls_reported_sigma, paper: *paper, identifiable: *identifiable, given_by_eta: *given_by_eta }
         })
         .collect();
     let deg = |r: [f64; 2]| [r[0].to_degrees(), r[1].to_degrees()];
@@ -377,10 +413,10 @@ impl Summary {
     #[must_use]
     pub fn text(&self) -> String {
         let mut s = format!(
-            "Monte Carlo: {} of {} runs of {} in {:.1} s on {} threads\n{}\nerrors in arcsec (mean ± std of the signed error, mean |error|)\n",
+            "Monte Carlo: {} of {} runs of {} in {:.1} s on {} threads\n{}\nerrors in arcsec (mean ± std of the signed error, mean |error|; the least squares' reported 1σ, mean over the runs, beside its std)\n",
             self.runs, self.runs_requested, self.scenario, self.wall_s, self.threads, self.setup
         );
-        s.push_str(&format!("  {:<24} {:>28} {:>28} {:>22}\n", "", "static KF", "exact least squares", "seed 000 Table 3"));
+        s.push_str(&format!("  {:<24} {:>30} {:>30} {:>12} {:>22}\n", "", "static KF", "exact least squares", "reported 1σ", "seed 000 Table 3"));
         for r in &self.rows {
             let f = |st: &ErrorSpread| format!("{:>+9.4} ±{:>8.4} |{:>8.4}|", st.mean, st.std, st.mean_abs);
             let paper = r.paper.map_or(String::new(), |(m, sd)| format!("{m:>9.2} ±{sd:>8.4}"));
@@ -391,7 +427,8 @@ impl Summary {
             } else {
                 "   not identifiable: set by the η prior"
             };
-            s.push_str(&format!("  {:<24} {} {} {:>22}{}\n", r.label, f(&r.kf), f(&r.nls), paper, mark));
+            let reported = r.nls_reported_sigma.map_or(String::new(), |v| format!("{v:.4}"));
+            s.push_str(&format!("  {:<24} {} {} {:>12} {:>22}{}\n", r.label, f(&r.kf), f(&r.nls), reported, paper, mark));
         }
         s
     }

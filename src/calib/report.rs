@@ -132,7 +132,7 @@ fn value(est: &Estimate, i: usize, scale: f64) -> Value {
 }
 
 /// A function of the parameters propagated to first order: value and 1σ from the gradient.
-fn propagate(est: &Estimate, f: &dyn Fn(&[f64]) -> f64, scale: f64) -> Value {
+pub(crate) fn propagate(est: &Estimate, f: &dyn Fn(&[f64]) -> f64, scale: f64) -> Value {
     let x = &est.theta;
     let v = f(x);
     let mut grad = DVector::zeros(x.len());
