@@ -36,6 +36,7 @@ pub struct InsView {
 }
 
 /// What [`InsRun::view`] computes once per output instant for the algorithms that share it.
+#[derive(Clone)]
 struct Shared {
     t_repr_s: f64,
     encoder_rad: AxisValues,
@@ -60,6 +61,11 @@ pub struct InsRun {
     /// Each algorithm's latest error and the (instant, attitude) it was computed for: an algorithm
     /// that has not updated since (more samples per update than the primary) is not recomputed.
     last_error: Vec<Option<(f64, Rot<N, S>, AttitudeError)>>,
+    /// The view's per-instant scratch, kept between views (no allocation per view).
+    shared: Vec<Shared>,
+    /// The last compensated chain and the corrected angles it was computed for (a table at rest,
+    /// or in a dwell, keeps its angles from view to view).
+    last_chain: Option<(AxisValues, Rot<B, S>)>,
 }
 
 impl InsRun {
@@ -91,7 +97,7 @@ impl InsRun {
         let core = InsCore::new(cfg, site, start, &samples);
         let demod = vec![DemodState::default(); core.algorithms().len()];
         let last_error = vec![None; demod.len()];
-        Self { truth, sensors, core, h, index: 0, demod, pre_roll, start, last_error }
+        Self { truth, sensors, core, h, index: 0, demod, pre_roll, start, last_error, shared: Vec::new(), last_chain: None }
     }
 
     /// The measured (end time, Δθ, Δv) samples before t = 0 that pre-rolled the computer (what a log
@@ -198,7 +204,8 @@ impl InsRun {
         let mut errors = Vec::with_capacity(self.demod.len());
         // Algorithms that stand for the same instant share its encoder readings (a pure function of
         // the instant), its true attitude and, with the same corrected angles, the compensated chain.
-        let mut shared: Vec<Shared> = Vec::with_capacity(self.demod.len());
+        let mut shared = std::mem::take(&mut self.shared);
+        shared.clear();
         for k in 0..self.demod.len() {
             let (t_repr, n_from_s) = self.core.output_attitude(k);
             if let Some((t, q, e)) = self.last_error[k] {
@@ -220,9 +227,14 @@ impl InsRun {
                 }
             };
             let corrected = self.demod[k].correct(&model.compensation, t_repr, &encoder);
-            let b_from_s_comp = match known {
-                Some(i) if shared[i].corrected_rad == corrected => shared[i].b_from_s_comp,
-                _ => model.chain.b_from_s(model.compensation_rotations(), &corrected),
+            let b_from_s_comp = match (known, self.last_chain) {
+                (Some(i), _) if shared[i].corrected_rad == corrected => shared[i].b_from_s_comp,
+                (_, Some((angles, b_from_s))) if angles == corrected => b_from_s,
+                _ => {
+                    let b_from_s = model.chain.b_from_s(model.compensation_rotations(), &corrected);
+                    self.last_chain = Some((corrected, b_from_s));
+                    b_from_s
+                }
             };
             if known.is_none() {
                 shared.push(Shared { t_repr_s: t_repr, encoder_rad: encoder, truth: truth_att, corrected_rad: corrected, b_from_s_comp });
@@ -234,6 +246,7 @@ impl InsRun {
         let (t_repr, imu_ins) = self.core.output_attitude(0);
         let imu_true = with_truth.then(|| self.truth.n_from_s(t_repr));
         let nav: Option<NavError> = self.core.nav_error();
+        self.shared = shared;
         InsView { t_s, t_ref_s: t_s - self.core.config().output_compensation_s, errors, imu_true, imu_ins, nav }
     }
 
