@@ -149,6 +149,15 @@ impl DemodState {
     pub fn observe(&mut self, model: &Model, t_s: f64) {
         self.correct(&model.compensation, t_s, &encoder_readings(model, t_s));
     }
+
+    /// [`Self::observe`] at `t_s` if nothing has been read yet: the navigation computer reads the
+    /// encoders with every IMU sample, so its first output already has the reading before it (without
+    /// it the first demodulation would lack the delay correction: rate × delay).
+    pub fn observe_if_first(&mut self, model: &Model, t_s: f64) {
+        if self.previous.is_none() {
+            self.observe(model, t_s);
+        }
+    }
 }
 
 /// Everything one step produces.
