@@ -201,6 +201,9 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
     let mut t_end = 0.0;
     let mut i = 0u64;
     let nan = AttitudeError { pitch_rad: f64::NAN, roll_rad: f64::NAN, heading_rad: f64::NAN };
+    // Each update's errors, one per algorithm (the buffer kept: an allocation per update was a
+    // tenth of a replay's time); a recorded row takes a copy.
+    let mut errors: Vec<AttitudeError> = Vec::with_capacity(algorithms.len());
     while let Some(s) = pb.step()? {
         i += 1;
         t_end = s.t_s;
@@ -225,7 +228,7 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
         // recorded at the series and scene rates.
         let (want_series, want_scene) = (i >= next_series, i >= next_scene);
         // Each algorithm at the instant its own output stands for, as the simulation compares them.
-        let mut errors = Vec::with_capacity(algorithms.len());
+        errors.clear();
         let mut primary = None;
         for (k, state) in demod.iter_mut().enumerate() {
             let (t_repr, _) = pb.core.output_attitude(k);
@@ -237,7 +240,9 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
             errors.push(body.error_from(&reference.unwrap_or(body)));
             if k == 0 {
                 let raw = demod_nominal.correct(&nominal, t_repr, &encoder);
-                let body_nominal = pb.body_attitude_through(0, nominal_cache.get(chain, &nominal_rot, &raw));
+                let nominal_b_from_s = nominal_cache.get(chain, &nominal_rot, &raw);
+                // Nothing compensated (no table errors known): the same chain, the same attitude.
+                let body_nominal = if nominal_b_from_s.quaternion() == comp_cache[k].b_from_s.quaternion() { body } else { pb.body_attitude_through(0, nominal_b_from_s) };
                 primary = Some((t_repr, encoder, corrected, body, body_nominal, reference));
             }
         }
@@ -279,7 +284,7 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
             Some(r) => r.n_from_b() * chain.b_from_s(&comp_rot, &corrected),
             None => imu_ins,
         });
-        let view = InsView { t_s: s.t_s, t_ref_s: pb.core.reference_instant(t_repr), errors, imu_true, imu_ins, nav: nav_error };
+        let view = InsView { t_s: s.t_s, t_ref_s: pb.core.reference_instant(t_repr), errors: errors.clone(), imu_true, imu_ins, nav: nav_error };
         if want_series {
             next_series = i.saturating_add(series_every);
             if let Some(r) = recorder.as_deref_mut() {

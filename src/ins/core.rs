@@ -79,6 +79,9 @@ pub struct InsCore {
     upd_g: [Vector3<f64>; 3],
     upd_a: [Vector3<f64>; 3],
     upd_len: usize,
+    /// Metres per radian of latitude and of longitude at the start site (R_M + h, (R_N + h) cos L):
+    /// the navigation error is asked for at every update.
+    site_m_per_rad: (f64, f64),
     /// FIR group delay, s.
     pub fir_delay_s: f64,
     /// Zero-order-hold delay, s.
@@ -126,7 +129,10 @@ impl InsCore {
             .collect();
         let history = vec![[(-fir_delay_s, start), (-fir_delay_s, start)]; integrators.len()];
         let nav = cfg.navigation.map(|o| Navigator::new(&earth, o));
+        let (rm, rn) = Earth::radii(site.latitude_rad);
+        let site_m_per_rad = (rm + site.height_m, (rn + site.height_m) * site.latitude_rad.cos());
         Self {
+            site_m_per_rad,
             earth,
             fir_g,
             fir_a,
@@ -283,10 +289,11 @@ impl InsCore {
         self.nav.as_ref().map(|n| {
             let s = &n.state;
             let site = self.earth.site;
-            let (rm, rn) = Earth::radii(site.latitude_rad);
-            let north = (s.latitude_rad - site.latitude_rad) * (rm + site.height_m);
-            let east = (s.longitude_rad - site.longitude_rad) * (rn + site.height_m) * site.latitude_rad.cos();
-            NavError { east_m: east, north_m: north, radial_m: north.hypot(east), velocity_enu_mps: s.v_n }
+            let (m_per_rad_north, m_per_rad_east) = self.site_m_per_rad;
+            let north = (s.latitude_rad - site.latitude_rad) * m_per_rad_north;
+            let east = (s.longitude_rad - site.longitude_rad) * m_per_rad_east;
+            // metres: no overflow for hypot to guard against (and it cost 2.5 % of a replay).
+            NavError { east_m: east, north_m: north, radial_m: (north * north + east * east).sqrt(), velocity_enu_mps: s.v_n }
         })
     }
 
