@@ -14,9 +14,8 @@ use super::playback::{Gap, Playback, PlaybackError};
 use super::run::{NavSummary, RmsPeak};
 use crate::ins::pipeline::InsView;
 use crate::math::attitude::{Attitude, AttitudeError};
-use crate::math::frames::{Rot, B, S};
-use crate::model::gimbal::{Chain, ErrorRotations};
-use crate::model::scheme::AxisValues;
+use crate::math::frames::Rot;
+use crate::model::gimbal::ChainMemo;
 use crate::math::stats::RunningStat;
 use crate::math::timeline::decimation;
 use crate::math::units::ARCSEC_PER_RAD;
@@ -81,27 +80,6 @@ pub struct FinalState {
     pub height_m: Option<f64>,
     /// Velocity (East, North, Up), m/s.
     pub velocity_enu_mps: Option<[f64; 3]>,
-}
-
-/// The table rotation C_s^b of the last encoder angles it was asked for: a table that stands (a
-/// dwell, a static test, no encoder file) costs one chain evaluation, not one per update.
-struct LastRotation {
-    angles: Option<AxisValues>,
-    b_from_s: Rot<B, S>,
-}
-
-impl LastRotation {
-    fn new() -> Self {
-        Self { angles: None, b_from_s: Rot::identity() }
-    }
-
-    fn get(&mut self, chain: &Chain, rot: &ErrorRotations, angles: &AxisValues) -> Rot<B, S> {
-        if self.angles.as_ref() != Some(angles) {
-            self.b_from_s = chain.b_from_s(rot, angles);
-            self.angles = Some(*angles);
-        }
-        self.b_from_s
-    }
 }
 
 fn table(names: &[String], stats: &[[RunningStat; 3]]) -> BTreeMap<String, BTreeMap<String, RmsPeak>> {
@@ -191,8 +169,9 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
     let window = log.table.ins.signal_window_s;
     let mut demod = vec![DemodState::default(); algorithms.len()];
     let mut demod_nominal = DemodState::default();
-    let mut comp_cache: Vec<LastRotation> = algorithms.iter().map(|_| LastRotation::new()).collect();
-    let mut nominal_cache = LastRotation::new();
+    // A table that stands (a dwell, a static test, no encoder file) costs one chain evaluation.
+    let mut comp_cache = ChainMemo::new(algorithms.len());
+    let mut nominal_cache = ChainMemo::new(1);
     let mut stats = [[RunningStat::default(); 3]; 2];
     let mut ins_stats = vec![[RunningStat::default(); 3]; algorithms.len()];
     let mut nav: Option<NavSummary> = None;
@@ -235,14 +214,15 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
             let t_ref = pb.core.reference_instant(t_repr);
             let encoder = pb.encoders_at(t_repr)?;
             let corrected = state.correct(compensation, t_repr, &encoder);
-            let body = pb.body_attitude_through(k, comp_cache[k].get(chain, &comp_rot, &corrected));
+            let comp_b_from_s = comp_cache.get(chain, &comp_rot, &corrected);
+            let body = pb.body_attitude_through(k, comp_b_from_s);
             let reference = pb.reference_at(t_ref)?;
             errors.push(body.error_from(&reference.unwrap_or(body)));
             if k == 0 {
                 let raw = demod_nominal.correct(&nominal, t_repr, &encoder);
                 let nominal_b_from_s = nominal_cache.get(chain, &nominal_rot, &raw);
                 // Nothing compensated (no table errors known): the same chain, the same attitude.
-                let body_nominal = if nominal_b_from_s.quaternion() == comp_cache[k].b_from_s.quaternion() { body } else { pb.body_attitude_through(0, nominal_b_from_s) };
+                let body_nominal = if nominal_b_from_s.quaternion() == comp_b_from_s.quaternion() { body } else { pb.body_attitude_through(0, nominal_b_from_s) };
                 primary = Some((t_repr, encoder, corrected, body, body_nominal, reference));
             }
         }

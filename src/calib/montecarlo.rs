@@ -120,48 +120,32 @@ fn quantities(chain: &Chain, set: &ParamSet, eta_known: bool) -> Quantities {
     Quantities { labels }
 }
 
-/// Errors (″) of one estimate, in the order of [`quantities`].
-fn errors(chain: &Chain, set: &ParamSet, theta: &[f64], truth: &[f64]) -> Vec<f64> {
+/// Errors (″) of one estimate against `truth` and its reported 1σ (″, first-order propagation of
+/// its covariance, as the report does), both in the order of [`quantities`].
+fn errors_and_sigmas(chain: &Chain, set: &ParamSet, est: &super::Estimate, truth: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    use super::report::{effective_eta, propagate};
+    let theta = &est.theta;
     let n = chain.axes().len();
-    let mut out = Vec::new();
+    let (mut err, mut sig) = (Vec::new(), Vec::new());
     for k in (0..n).rev() {
         let (ic, is) = (set.index(Param::SwingCos(k)).unwrap_or(0), set.index(Param::SwingSin(k)).unwrap_or(0));
-        let (a, at) = (theta[ic].hypot(theta[is]), truth[ic].hypot(truth[is]));
-        let dphi = wrap_pi(theta[is].atan2(theta[ic]) - truth[is].atan2(truth[ic]));
-        out.push((a - at) * ARCSEC_PER_RAD);
-        out.push(dphi * ARCSEC_PER_RAD);
-        out.push(at * dphi * ARCSEC_PER_RAD);
+        let alpha = move |x: &[f64]| x[ic].hypot(x[is]);
+        let phi = move |x: &[f64]| x[is].atan2(x[ic]);
+        let (a, at) = (alpha(theta), alpha(truth));
+        let dphi = wrap_pi(phi(theta) - phi(truth));
+        let sigma_phi = propagate(est, &phi, ARCSEC_PER_RAD).sigma;
+        err.extend([(a - at) * ARCSEC_PER_RAD, dphi * ARCSEC_PER_RAD, at * dphi * ARCSEC_PER_RAD]);
+        sig.extend([propagate(est, &alpha, ARCSEC_PER_RAD).sigma, sigma_phi, a * sigma_phi]);
     }
     for k in (1..n).rev() {
         let ie = set.index(Param::NonOrth(k)).unwrap_or(0);
-        out.push((theta[ie] - truth[ie]) * ARCSEC_PER_RAD);
-        let f = super::report::effective_eta(chain, set, k);
-        out.push(f.map_or(f64::NAN, |f| (f(theta) - f(truth)) * ARCSEC_PER_RAD));
+        err.push((theta[ie] - truth[ie]) * ARCSEC_PER_RAD);
+        sig.push(est.sigma(ie) * ARCSEC_PER_RAD);
+        let f = effective_eta(chain, set, k);
+        err.push(f.as_ref().map_or(f64::NAN, |f| (f(theta) - f(truth)) * ARCSEC_PER_RAD));
+        sig.push(f.map_or(f64::NAN, |f| propagate(est, &f, ARCSEC_PER_RAD).sigma));
     }
-    out
-}
-
-/// The reported 1σ (″) of one estimate, in the order of [`quantities`] (first-order propagation of
-/// its covariance, as the report does).
-fn sigmas(chain: &Chain, set: &ParamSet, est: &super::Estimate) -> Vec<f64> {
-    use super::report::propagate;
-    let n = chain.axes().len();
-    let mut out = Vec::new();
-    for k in (0..n).rev() {
-        let (ic, is) = (set.index(Param::SwingCos(k)).unwrap_or(0), set.index(Param::SwingSin(k)).unwrap_or(0));
-        let alpha = propagate(est, &move |x: &[f64]| x[ic].hypot(x[is]), ARCSEC_PER_RAD);
-        let phi = propagate(est, &move |x: &[f64]| x[is].atan2(x[ic]), ARCSEC_PER_RAD);
-        out.push(alpha.sigma);
-        out.push(phi.sigma);
-        out.push(alpha.value / ARCSEC_PER_RAD * phi.sigma);
-    }
-    for k in (1..n).rev() {
-        let ie = set.index(Param::NonOrth(k)).unwrap_or(0);
-        out.push(est.sigma(ie) * ARCSEC_PER_RAD);
-        let f = super::report::effective_eta(chain, set, k);
-        out.push(f.map_or(f64::NAN, |f| propagate(est, &f, ARCSEC_PER_RAD).sigma));
-    }
-    out
+    (err, sig)
 }
 
 /// Draws run `i`'s true errors.
@@ -277,12 +261,9 @@ pub fn run_indices(setup: &Setup<'_>, indices: &[u64], collect: &Collect<'_>, pr
             let data = collect(&truth, base_seed.wrapping_add(1000).wrapping_add(i))?;
             let cal = calibrate(setup.chain, setup.compensation, &data, &cfg, History::Lean, stop)?;
             let truth_v = cal.set.values(&truth);
-            let out = RunErrors {
-                index: i,
-                kf: errors(setup.chain, &cal.set, &cal.kf.theta, &truth_v),
-                nls: errors(setup.chain, &cal.set, &cal.nls.theta, &truth_v),
-                nls_sigma: sigmas(setup.chain, &cal.set, &cal.nls),
-            };
+            let (kf, _) = errors_and_sigmas(setup.chain, &cal.set, &cal.kf, &truth_v);
+            let (nls, nls_sigma) = errors_and_sigmas(setup.chain, &cal.set, &cal.nls, &truth_v);
+            let out = RunErrors { index: i, kf, nls, nls_sigma };
             progress();
             Ok(Some(out))
         })

@@ -14,6 +14,7 @@ use crate::math::attitude::{Attitude, AttitudeError};
 use crate::math::frames::{Rot, B, N, S};
 use crate::math::rotvec;
 use crate::model::earth::{Earth, Site};
+use crate::model::gimbal::ChainMemo;
 use crate::model::scheme::AxisValues;
 use crate::sim::{demodulate, encoder_readings, DemodState, Model};
 
@@ -41,8 +42,6 @@ struct Shared {
     t_repr_s: f64,
     encoder_rad: AxisValues,
     truth: Attitude,
-    corrected_rad: AxisValues,
-    b_from_s_comp: Rot<B, S>,
 }
 
 /// The INS in the loop (cloned to fork one IMU stream into two navigation strategies).
@@ -63,9 +62,8 @@ pub struct InsRun {
     last_error: Vec<Option<(f64, Rot<N, S>, AttitudeError)>>,
     /// The view's per-instant scratch, kept between views (no allocation per view).
     shared: Vec<Shared>,
-    /// The last compensated chain and the corrected angles it was computed for (a table at rest,
-    /// or in a dwell, keeps its angles from view to view).
-    last_chain: Option<(AxisValues, Rot<B, S>)>,
+    /// The compensated chain at the latest corrected angles, one per algorithm at most.
+    chains: ChainMemo,
 }
 
 impl InsRun {
@@ -96,8 +94,9 @@ impl InsRun {
         let samples: Vec<(Vector3<f64>, Vector3<f64>)> = pre_roll.iter().map(|(_, g, a)| (*g, *a)).collect();
         let core = InsCore::new(cfg, site, start, &samples);
         let demod = vec![DemodState::default(); core.algorithms().len()];
-        let last_error = vec![None; demod.len()];
-        Self { truth, sensors, core, h, index: 0, demod, pre_roll, start, last_error, shared: Vec::new(), last_chain: None }
+        let demod_len = demod.len();
+        let last_error = vec![None; demod_len];
+        Self { truth, sensors, core, h, index: 0, demod, pre_roll, start, last_error, shared: Vec::new(), chains: ChainMemo::new(demod_len) }
     }
 
     /// The measured (end time, Δθ, Δv) samples before t = 0 that pre-rolled the computer (what a log
@@ -203,7 +202,7 @@ impl InsRun {
         let model = self.truth.model();
         let mut errors = Vec::with_capacity(self.demod.len());
         // Algorithms that stand for the same instant share its encoder readings (a pure function of
-        // the instant), its true attitude and, with the same corrected angles, the compensated chain.
+        // the instant) and its true attitude; the same corrected angles, the compensated chain.
         let mut shared = std::mem::take(&mut self.shared);
         shared.clear();
         for k in 0..self.demod.len() {
@@ -228,17 +227,9 @@ impl InsRun {
             };
             self.demod[k].observe_if_first(model, t_repr - self.h);
             let corrected = self.demod[k].correct(&model.compensation, t_repr, &encoder);
-            let b_from_s_comp = match (known, self.last_chain) {
-                (Some(i), _) if shared[i].corrected_rad == corrected => shared[i].b_from_s_comp,
-                (_, Some((angles, b_from_s))) if angles == corrected => b_from_s,
-                _ => {
-                    let b_from_s = model.chain.b_from_s(model.compensation_rotations(), &corrected);
-                    self.last_chain = Some((corrected, b_from_s));
-                    b_from_s
-                }
-            };
+            let b_from_s_comp = self.chains.get(&model.chain, model.compensation_rotations(), &corrected);
             if known.is_none() {
-                shared.push(Shared { t_repr_s: t_repr, encoder_rad: encoder, truth: truth_att, corrected_rad: corrected, b_from_s_comp });
+                shared.push(Shared { t_repr_s: t_repr, encoder_rad: encoder, truth: truth_att });
             }
             let error = demodulate(n_from_s, b_from_s_comp).error_from(&truth_att);
             self.last_error[k] = Some((t_repr, n_from_s, error));

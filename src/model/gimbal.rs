@@ -418,6 +418,39 @@ impl Chain {
 #[derive(Debug, Clone, Copy)]
 pub struct ShaftRotations(pub [UnitQuaternion<f64>; MAX_AXES]);
 
+/// The latest rotations C_b^s of one chain with one set of error rotations, and the angles each
+/// was computed for (at most `capacity`, the oldest dropped): outputs demodulated at the same
+/// angles (several algorithms at one instant, a table at rest or in a dwell) cost one chain
+/// evaluation, not one each.
+#[derive(Debug, Clone)]
+pub struct ChainMemo {
+    capacity: usize,
+    entries: Vec<(AxisValues, Rot<B, S>)>,
+}
+
+impl ChainMemo {
+    /// An empty memo keeping `capacity` (at least 1) rotations.
+    #[must_use]
+    pub fn new(capacity: usize) -> Self {
+        Self { capacity: capacity.max(1), entries: Vec::new() }
+    }
+
+    /// `chain.b_from_s(err, angles)`, from the memo when these angles were asked for lately (the
+    /// caller passes the same `chain` and `err` every time). The newest entry is looked at first.
+    #[inline]
+    pub fn get(&mut self, chain: &Chain, err: &ErrorRotations, angles: &AxisValues) -> Rot<B, S> {
+        if let Some((_, b_from_s)) = self.entries.iter().rev().find(|(a, _)| a == angles) {
+            return *b_from_s;
+        }
+        let b_from_s = chain.b_from_s(err, angles);
+        if self.entries.len() == self.capacity {
+            self.entries.remove(0);
+        }
+        self.entries.push((*angles, b_from_s));
+        b_from_s
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
