@@ -76,63 +76,25 @@ pub const SECTIONS: [&str; 7] = ["simulation", "strapdown", "pipeline", "navigat
 /// returns them; an error as soon as `stop` is set.
 pub fn run_benchmarks(steps: u64, only: &[String], stop: &AtomicBool) -> anyhow::Result<Figures> {
     let mut figs = Figures::new();
-    let on = |section: &str| only.is_empty() || only.iter().any(|o| o == section);
-    // 1. Pure simulation: truth + encoders + three demodulations, one core, no recording. This VM's
-    //    timings vary by 2x from run to run (shared cores), so report the best and the median of 5.
-    for name in ["jiang2017-dual-axis", "rotary-table-2016-wobble"].into_iter().filter(|_| on("simulation")) {
-        let p = presets::load(name)?;
-        let model = p.table_model();
-        let mut rates = Vec::new();
-        let mut checksum = 0.0;
-        for _ in 0..5 {
-            check(stop)?;
-            let mut state = DemodState::default();
-            checksum = 0.0;
-            let started = Instant::now();
-            for i in 0..steps {
-                let out = step(&model, &mut state, i as f64 / p.step_hz);
-                checksum += out.errors[0].heading_rad + out.errors[1].pitch_rad + out.errors[2].roll_rad;
-            }
-            rates.push(steps as f64 / started.elapsed().as_secs_f64());
+    type Section<'a> = Box<dyn FnOnce(&mut Figures) -> anyhow::Result<()> + 'a>;
+    // One per SECTIONS entry, in its order (the names `--only` accepts).
+    let sections: [Section<'_>; SECTIONS.len()] = [
+        Box::new(|f| simulation_speed(steps, f, stop)),
+        Box::new(|f| strapdown_speed(f, stop)),
+        Box::new(|f| pipeline_speed(f, stop)),
+        Box::new(|f| {
+            navigation_speed(&crate::scenario::parse(CONING_2KHZ, "bench")?, f);
+            Ok(())
+        }),
+        Box::new(|f| recorded_in_scratch(f, stop)),
+        Box::new(|f| calibration_speed(f, stop)),
+        Box::new(|f| allan_speed(f, stop)),
+    ];
+    for (name, run) in SECTIONS.into_iter().zip(sections) {
+        check(stop)?;
+        if only.is_empty() || only.iter().any(|o| o == name) {
+            run(&mut figs)?;
         }
-        rates.sort_by(f64::total_cmp);
-        figs.rate(format!("simulation only/{name}"), rates[4], rates[2], "M steps/s");
-        outln!(
-            "simulation only   {name:<28} {steps} steps x5: best {:.2} M steps/s, median {:.2} M steps/s (all three variants; checksum {checksum:.6e})",
-            rates[4] / 1e6,
-            rates[2] / 1e6
-        );
-    }
-
-    // 2. The INS in the loop.
-    check(stop)?;
-    if on("strapdown") {
-        strapdown_speed(&mut figs, stop)?;
-    }
-    check(stop)?;
-    if on("pipeline") {
-        pipeline_speed(&mut figs, stop)?;
-    }
-    check(stop)?;
-    if on("navigation") {
-        navigation_speed(&crate::scenario::parse(CONING_2KHZ, "bench")?, &mut figs);
-    }
-
-    // 3-5, with files in a scratch folder that is removed however they end.
-    if on("recorded") {
-        let dir = std::env::temp_dir().join(format!("rinscope-bench-{}", std::process::id()));
-        std::fs::create_dir_all(&dir)?;
-        let recorded = recorded_runs(&dir, &mut figs, stop);
-        std::fs::remove_dir_all(&dir).ok();
-        recorded?;
-    }
-    check(stop)?;
-    if on("calibration") {
-        calibration_speed(&mut figs, stop)?;
-    }
-    check(stop)?;
-    if on("allan") {
-        allan_speed(&mut figs, stop)?;
     }
     figs.add("peak resident memory", peak_rss_bytes() as f64 / 1e6, "MB");
     outln!("peak resident memory: {:.1} MB", peak_rss_bytes() as f64 / 1e6);
@@ -185,6 +147,55 @@ fn recorded_runs(dir: &std::path::Path, figs: &mut Figures, stop: &AtomicBool) -
 
     // 5. Live mode's reload latency.
     live_latency(dir, figs, stop)
+}
+
+/// Pure simulation: truth + encoders + three demodulations, one core, no recording. This VM's
+/// timings vary by 2x from run to run (shared cores), so the best and the median of 5.
+fn simulation_speed(steps: u64, figs: &mut Figures, stop: &AtomicBool) -> anyhow::Result<()> {
+    for name in ["jiang2017-dual-axis", "rotary-table-2016-wobble"] {
+        let p = presets::load(name)?;
+        let model = p.table_model();
+        let mut rates = Vec::new();
+        let mut checksum = 0.0;
+        for _ in 0..5 {
+            check(stop)?;
+            let mut state = DemodState::default();
+            checksum = 0.0;
+            let started = Instant::now();
+            for i in 0..steps {
+                let out = step(&model, &mut state, i as f64 / p.step_hz);
+                checksum += out.errors[0].heading_rad + out.errors[1].pitch_rad + out.errors[2].roll_rad;
+            }
+            rates.push(steps as f64 / started.elapsed().as_secs_f64());
+        }
+        rates.sort_by(f64::total_cmp);
+        figs.rate(format!("simulation only/{name}"), rates[4], rates[2], "M steps/s");
+        outln!(
+            "simulation only   {name:<28} {steps} steps x5: best {:.2} M steps/s, median {:.2} M steps/s (all three variants; checksum {checksum:.6e})",
+            rates[4] / 1e6,
+            rates[2] / 1e6
+        );
+    }
+
+    Ok(())
+}
+
+/// Runs `f` in a scratch folder `rinscope-NAME-PID` under the temporary directory, removed however
+/// it ends: returned, failed, or the process ended early (a second signal, a closed stdout: it is
+/// registered with [`crate::io::files::remove_unfinished`]).
+pub(crate) fn in_scratch<T>(name: &str, f: impl FnOnce(&std::path::Path) -> anyhow::Result<T>) -> anyhow::Result<T> {
+    let dir = std::env::temp_dir().join(format!("rinscope-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)?;
+    crate::io::files::unfinished_dir(&dir);
+    let result = f(&dir);
+    std::fs::remove_dir_all(&dir).ok();
+    crate::io::files::finished_dir(&dir);
+    result
+}
+
+/// The recorded runs, with their files in a scratch folder.
+fn recorded_in_scratch(figs: &mut Figures, stop: &AtomicBool) -> anyhow::Result<()> {
+    in_scratch("bench", |dir| recorded_runs(dir, figs, stop))
 }
 
 /// Strapdown attitude update alone: samples per second through each algorithm (one core).

@@ -159,19 +159,15 @@ pub struct StreamReport {
 pub fn compare(opts: &PeerOptions, stop: &std::sync::atomic::AtomicBool) -> anyhow::Result<Vec<StreamReport>> {
     ensure!(opts.rounds >= 1, "--rounds must be at least 1");
     check_python(&opts.python)?;
-    let dir = std::env::temp_dir().join(format!("rinscope-peer-{}", std::process::id()));
-    std::fs::create_dir_all(&dir)?;
-    let result = (|| {
+    super::in_scratch("peer", |dir| {
         std::fs::write(dir.join("make_stream.py"), MAKE_STREAM)?;
         std::fs::write(dir.join("pyins_bench.py"), PYINS_BENCH)?;
         let mut reports = Vec::new();
         for kind in ["static", "coning"] {
-            reports.push(compare_stream(opts, &dir, kind, stop)?);
+            reports.push(compare_stream(opts, dir, kind, stop)?);
         }
         Ok(reports)
-    })();
-    std::fs::remove_dir_all(&dir).ok();
-    result
+    })
 }
 
 fn check_python(python: &Path) -> anyhow::Result<()> {
