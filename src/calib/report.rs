@@ -105,6 +105,9 @@ pub struct Report {
     pub ins_random_walk_deg_per_sqrt_h: f64,
     /// The INS's unknown gyro bias (1σ per axis) the 1σ allow for, °/h (0: not modelled).
     pub ins_bias_deg_per_h: f64,
+    /// What the 1σ include, in words (the per-sample R, and the INS's error through the test or
+    /// that it is not modelled).
+    pub sigma_basis: String,
     /// Gauss–Newton iterations.
     pub nls_iterations: usize,
     /// Residual RMS (E, N, U) of the filter's and the least squares' solutions, arcsec.
@@ -393,6 +396,13 @@ pub fn build(scenario: &str, chain: &Chain, truth: &TableErrors, cal: &Calibrati
             cal.measurement_sigma_rad * ARCSEC_PER_RAD
         ));
     }
+    let (walk, bias) = (cal.ins_error.random_walk_rad_per_sqrt_s / crate::math::units::RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H, cal.ins_error.bias_sigma_rad_per_s / crate::math::units::RAD_PER_S_PER_DEG_PER_H);
+    let mut sigma_basis = format!("R per sample: each encoder's noise about its axis + {:.2}″ isotropic", cal.measurement_sigma_rad * ARCSEC_PER_RAD);
+    if cal.ins_error.is_some() {
+        sigma_basis.push_str(&format!("; the 1σ also carry the INS's error through the whole test (correlated from sample to sample): angle random walk {walk}°/√h, unknown gyro bias {bias}°/h (1σ per axis)"));
+    } else if data.source != super::AttitudeSource::Ideal {
+        sigma_basis.push_str("; the INS's own error (random walk, bias) is not in the 1σ: state calibration.ins_random_walk_deg_per_sqrt_h and ins_bias_deg_per_h, or the 1σ of the states it reaches (the offsets, drifts, η_eff) are optimistic");
+    }
     Report {
         scenario: scenario.to_owned(),
         seed: data.seed,
@@ -404,8 +414,9 @@ pub fn build(scenario: &str, chain: &Chain, truth: &TableErrors, cal: &Calibrati
         samples: cal.samples,
         duration_s: data.samples.last_t_s(),
         measurement_sigma_arcsec: cal.measurement_sigma_rad * ARCSEC_PER_RAD,
-        ins_random_walk_deg_per_sqrt_h: cal.ins_error.random_walk_rad_per_sqrt_s / crate::math::units::RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H,
-        ins_bias_deg_per_h: cal.ins_error.bias_sigma_rad_per_s / crate::math::units::RAD_PER_S_PER_DEG_PER_H,
+        ins_random_walk_deg_per_sqrt_h: walk,
+        ins_bias_deg_per_h: bias,
+        sigma_basis,
         nls_iterations: cal.nls_iterations,
         residual_rms_arcsec: [cal.kf.residual_rms_rad.map(|v| v * ARCSEC_PER_RAD), cal.nls.residual_rms_rad.map(|v| v * ARCSEC_PER_RAD)],
         state,
@@ -453,7 +464,7 @@ impl Report {
     #[must_use]
     pub fn markdown(&self) -> String {
         let head = "| | true | static KF ± 1σ (error) | exact LSQ ± 1σ (error) | |\n|---|---:|---:|---:|---|\n";
-        let mut s = format!("{} samples over {:.0} s, {} (seed {})\n\n", self.samples, self.duration_s, self.source, self.seed);
+        let mut s = format!("{} samples over {:.0} s, {} (seed {}). {}\n\n", self.samples, self.duration_s, self.source, self.seed, self.sigma_basis);
         let mut table = |title: &str, rows: &[Row]| {
             if !rows.is_empty() {
                 s.push_str(&format!("**{title}**\n\n{head}"));
@@ -483,18 +494,7 @@ impl Report {
     /// The report as a terminal table.
     #[must_use]
     pub fn text(&self) -> String {
-        let mut s = format!(
-            "calibration of {}: {} samples over {:.0} s, {} (seed {}); R per sample: each encoder's noise about its axis + {:.2}″ isotropic\n",
-            self.scenario, self.samples, self.duration_s, self.source, self.seed, self.measurement_sigma_arcsec
-        );
-        if self.ins_random_walk_deg_per_sqrt_h > 0.0 || self.ins_bias_deg_per_h > 0.0 {
-            s.push_str(&format!(
-                "the 1σ also carry the INS's error through the whole test (correlated from sample to sample): angle random walk {}°/√h, unknown gyro bias {}°/h (1σ per axis)\n",
-                self.ins_random_walk_deg_per_sqrt_h, self.ins_bias_deg_per_h
-            ));
-        } else if !self.source.starts_with("exact") {
-            s.push_str("the INS's own error (random walk, bias) is not in the 1σ: state calibration.ins_random_walk_deg_per_sqrt_h and ins_bias_deg_per_h, or the 1σ of the states it reaches (the offsets, drifts, η_eff) are optimistic\n");
-        }
+        let mut s = format!("calibration of {}: {} samples over {:.0} s, {} (seed {})\n{}\n", self.scenario, self.samples, self.duration_s, self.source, self.seed, self.sigma_basis);
         let header = format!("  {:<26} {:>13}  {:>13} {:>9}  {:>11}  {:>13} {:>9}  {:>11}\n", "", "true", "static KF", "1σ", "(error)", "exact LSQ", "1σ", "(error)");
         s.push_str("\nangles (phase errors in arcsec of phase):\n");
         s.push_str(&header);
