@@ -77,7 +77,7 @@ fn write_err(e: impl std::fmt::Display) -> ExportError {
 }
 
 /// Writes the log set of `params` into the new folder `out`.
-pub fn export_log(params: &Params, out: &Path, format: LogFormat, stop: &AtomicBool) -> Result<ExportedLog, ExportError> {
+pub fn export_log(params: &Params, out: &Path, format: LogFormat, aligned: bool, stop: &AtomicBool) -> Result<ExportedLog, ExportError> {
     if out.exists() {
         return Err(ExportError::Exists(out.display().to_string()));
     }
@@ -94,7 +94,7 @@ pub fn export_log(params: &Params, out: &Path, format: LogFormat, stop: &AtomicB
         _ => ExportError::Write(format!("{}: {e}", partial.display())),
     })?;
     crate::io::files::unfinished_dir(&partial);
-    let result = write_files(params, &partial, format, stop);
+    let result = write_files(params, &partial, format, aligned, stop);
     crate::io::files::finished_dir(&partial);
     match result {
         Ok(samples) => {
@@ -114,7 +114,7 @@ fn logged_imu(params: &Params) -> InsParams {
     params.ins.clone().unwrap_or_else(|| InsParams::ideal(params.step_hz, crate::ins::coning::Algorithm::TwoSampleP1))
 }
 
-fn write_files(params: &Params, dir: &Path, format: LogFormat, stop: &AtomicBool) -> Result<u64, ExportError> {
+fn write_files(params: &Params, dir: &Path, format: LogFormat, aligned: bool, stop: &AtomicBool) -> Result<u64, ExportError> {
     let ext = format.extension();
     let ins_params = logged_imu(params);
     let mut ins = crate::ins::pipeline::InsRun::new(&ins_params, params.site, params.meta.seed, params.table_model());
@@ -162,7 +162,7 @@ fn write_files(params: &Params, dir: &Path, format: LogFormat, stop: &AtomicBool
     let table = RawTable {
         recording: r.recording.clone(),
         site: r.site.clone(),
-        turntable: r.turntable.clone(),
+        turntable: Some(r.turntable.clone()),
         compensation: r.compensation.clone(),
         imu: Some(r.imu.clone().unwrap_or_default()),
         navigation: r.navigation.clone(),
@@ -182,12 +182,14 @@ fn write_files(params: &Params, dir: &Path, format: LogFormat, stop: &AtomicBool
             ),
             table: "table.toml".into(),
             seed: Some(params.meta.seed),
+            from_s: None,
+            to_s: None,
         },
         imu: RawImuFile {
             file: format!("imu.{ext}"),
             layout: layout.into(),
             kind: Some("increments".into()),
-            rate_hz: params.step_hz,
+            rate_hz: Some(params.step_hz),
             frame: Some(RawFrame::Named("rfu".into())),
             time: (format == LogFormat::Npy).then(|| "s".into()),
             topic: None,
@@ -196,7 +198,9 @@ fn write_files(params: &Params, dir: &Path, format: LogFormat, stop: &AtomicBool
         },
         encoders: Some(RawEncoderFile { file: format!("encoders.{ext}"), latch_delay_ms: 0.0, gap_policy: "refuse".into() }),
         reference: Some(RawReference { source: Some("the simulation's truth".into()), file: Some(format!("reference.{ext}")), attitude_deg: None }),
-        initial: RawInitial { imu_quaternion_wxyz: Some([q.w, q.i, q.j, q.k]), body_attitude_deg: None, alignment_s: None },
+        // Exact: the INS starts from the truth. Aligned: the manifest says nothing and the replay
+        // aligns on the data, as it would on a real log.
+        initial: if aligned { RawInitial::default() } else { RawInitial { imu_quaternion_wxyz: Some([q.w, q.i, q.j, q.k]), ..RawInitial::default() } },
     };
     let table_text = format!(
         "# The table description of the log set (the [site], [turntable], [compensation], [imu], [navigation],\n# [calibration] and [recording] sections of the scenario `{}`, resolved). docs/logs.md.\n{}",

@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::playback::{Gap, Playback, PlaybackError};
+use super::playback::{AlignmentReport, Gap, Playback, PlaybackError};
 use super::run::{NavSummary, RmsPeak};
 use crate::ins::pipeline::InsView;
 use crate::math::attitude::{Attitude, AttitudeError};
@@ -31,6 +31,16 @@ pub struct ReplaySummary {
     pub log: String,
     /// What the errors are measured against.
     pub reference: String,
+    /// A strapdown IMU (no table): only the INS is reported.
+    pub strapdown: bool,
+    /// The IMU file's clock at the replay's t = 0, s (every time in the recording and the export is
+    /// seconds after it).
+    pub t0_file_clock_s: f64,
+    /// The alignment, when the INS was aligned on the data.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub alignment: Option<AlignmentReport>,
+    /// What was said once about the data (a reference that starts late, a trimmed span, ...).
+    pub notes: Vec<String>,
     /// IMU samples replayed (after the pre-roll / alignment).
     pub samples: u64,
     /// Replayed time, s.
@@ -43,10 +53,16 @@ pub struct ReplaySummary {
     pub interrupted: bool,
     /// `[demodulation][axis]`: "nominal" and "compensated" table, against the reference (the primary
     /// algorithm at the output instants); without a reference, "nominal" is nominal − compensated.
+    /// Empty for a strapdown IMU.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     pub attitude_error_arcsec: BTreeMap<String, BTreeMap<String, RmsPeak>>,
-    /// `[algorithm][axis]`: each algorithm's compensated body attitude against the reference.
+    /// `[algorithm][axis]`: each algorithm's body attitude against the reference (empty without one).
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     pub ins_attitude_error_arcsec: BTreeMap<String, BTreeMap<String, RmsPeak>>,
-    /// Navigation errors relative to the start site (a resting log), when navigating.
+    /// Updates compared with the reference (those inside its span).
+    pub compared_updates: u64,
+    /// The position relative to the start, when navigating: an error only if the vehicle stayed at
+    /// rest.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub navigation: Option<NavSummary>,
     /// Gaps in the IMU data the replay carried the attitude across.
@@ -107,7 +123,15 @@ impl ReplaySummary {
             if self.interrupted { " — INTERRUPTED" } else { "" },
             self.reference
         );
-        s.push_str("attitude error, arcsec     pitch rms  pitch peak    roll rms   roll peak  heading rms heading peak\n");
+        if let Some(a) = &self.alignment {
+            s.push_str(&a.text());
+        }
+        for n in &self.notes {
+            s.push_str(&format!("note: {n}\n"));
+        }
+        if !self.attitude_error_arcsec.is_empty() || !self.ins_attitude_error_arcsec.is_empty() {
+            s.push_str("attitude error, arcsec     pitch rms  pitch peak    roll rms   roll peak  heading rms heading peak\n");
+        }
         let rows = |s: &mut String, label: &str, t: &BTreeMap<String, BTreeMap<String, RmsPeak>>| {
             for (name, row) in t {
                 s.push_str(&format!("{:<24}", format!("{label}{name}")));
@@ -119,13 +143,21 @@ impl ReplaySummary {
             }
         };
         rows(&mut s, "", &self.attitude_error_arcsec);
-        if self.ins_attitude_error_arcsec.len() > 1 {
+        if self.strapdown && !self.ins_attitude_error_arcsec.is_empty() {
+            rows(&mut s, "", &self.ins_attitude_error_arcsec);
+        } else if self.ins_attitude_error_arcsec.len() > 1 {
             s.push_str("by algorithm (compensated)\n");
             rows(&mut s, "  ", &self.ins_attitude_error_arcsec);
         }
+        let f = &self.final_state;
+        s.push_str(&format!("final IMU attitude: pitch {:.4}°, roll {:.4}°, heading {:.4}° at {:.3} s", f.imu_pitch_deg, f.imu_roll_deg, f.imu_heading_deg.rem_euclid(360.0), f.t_s));
+        if let (Some(lat), Some(lon), Some(h), Some(v)) = (f.latitude_deg, f.longitude_deg, f.height_m, f.velocity_enu_mps) {
+            s.push_str(&format!("; position {lat:.6}°, {lon:.6}°, {h:.1} m; velocity E {:.3} N {:.3} U {:.3} m/s", v[0], v[1], v[2]));
+        }
+        s.push('\n');
         if let Some(n) = &self.navigation {
             s.push_str(&format!(
-                "navigation: radial position error peak {:.1} m, final {:.1} m (east {:.1} m, north {:.1} m)\n",
+                "position relative to the start (an error if the vehicle stayed at rest): peak {:.1} m, final {:.1} m (east {:.1} m, north {:.1} m)\n",
                 n.peak_radial_m, n.final_radial_m, n.final_east_m, n.final_north_m
             ));
         }
@@ -183,6 +215,8 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
     // Each update's errors, one per algorithm (the buffer kept: an allocation per update was a
     // tenth of a replay's time); a recorded row takes a copy.
     let mut errors: Vec<AttitudeError> = Vec::with_capacity(algorithms.len());
+    let has_reference = !matches!(log.reference, Reference::None);
+    let mut compared = 0u64;
     while let Some(s) = pb.step()? {
         i += 1;
         t_end = s.t_s;
@@ -227,6 +261,11 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
             }
         }
         let Some((t_repr, encoder, corrected, body, body_nominal, reference)) = primary else { continue };
+        // Outside the reference's span (it starts late or ends early) nothing is compared.
+        if has_reference && reference.is_none() {
+            continue;
+        }
+        compared += 1;
         let truth = reference.unwrap_or(body);
         let table_errors = [body_nominal.error_from(&truth), body.error_from(&truth)];
         for (v, e) in table_errors.iter().enumerate() {
@@ -279,21 +318,28 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
         }
     }
     let reference = match &log.reference {
+        Reference::None if log.table.strapdown => "none: the INS's own solution (give [reference] to compare it with one)".to_owned(),
         Reference::None => "none: the compensated demodulation (the \"nominal\" row is nominal − compensated)".to_owned(),
         Reference::Static(a) => format!("a static attitude (pitch {:.4}°, roll {:.4}°, heading {:.4}°)", a.pitch_rad.to_degrees(), a.roll_rad.to_degrees(), a.heading_rad.to_degrees()),
         Reference::File(p) => format!("the attitude in {}", p.display()),
     };
     let wall = started.elapsed().as_secs_f64();
+    let strapdown = log.table.strapdown;
     let summary = ReplaySummary {
         log: log.name.clone(),
         reference,
+        strapdown,
+        t0_file_clock_s: pb.file_time_s(0.0),
+        alignment: pb.alignment.clone(),
+        notes: pb.notes.clone(),
+        compared_updates: compared,
         samples: pb.samples,
         duration_s: t_end,
         wall_time_s: wall,
         samples_per_second: pb.samples as f64 / wall.max(1e-9),
         interrupted,
-        attitude_error_arcsec: table(&["nominal".to_owned(), "compensated".to_owned()], &stats),
-        ins_attitude_error_arcsec: table(&algorithms, &ins_stats),
+        attitude_error_arcsec: if strapdown { BTreeMap::new() } else { table(&["nominal".to_owned(), "compensated".to_owned()], &stats) },
+        ins_attitude_error_arcsec: if has_reference { table(&algorithms, &ins_stats) } else { BTreeMap::new() },
         navigation: nav,
         gaps: pb.gaps.clone(),
         final_state: final_state(&pb),
@@ -305,6 +351,12 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
         let rerun = |e: crate::record::RecordError| PlaybackError::Data(format!("rerun: {e}"));
         for g in &summary.gaps {
             r.event(g.to_s, &format!("gap in the IMU data from {:.3} s to {:.3} s: the attitude was carried across", g.from_s, g.to_s), "WARN").map_err(rerun)?;
+        }
+        if let Some(a) = &summary.alignment {
+            r.event(0.0, &format!("alignment:\n{}", a.text()), if a.warnings.is_empty() { "INFO" } else { "WARN" }).map_err(rerun)?;
+        }
+        for n in &summary.notes {
+            r.event(0.0, n, "INFO").map_err(rerun)?;
         }
         let end = if interrupted { format!("replay interrupted by the user at {t_end:.3} s; the recording holds everything replayed until then") } else { format!("replay finished at {t_end:.3} s") };
         r.event(t_end, &end, if interrupted { "WARN" } else { "INFO" }).map_err(rerun)?;

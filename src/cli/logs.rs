@@ -10,7 +10,7 @@ use crate::app::replay::replay as replay_log;
 use crate::app::terminate::stop_flag;
 use crate::record::Recorder;
 use crate::scenario::logset::{self, RawImuFile, RawInitial, RawLogInfo, RawManifest, RawReference, RawTable};
-use crate::scenario::{presets, ConfigError};
+use crate::scenario::presets;
 
 impl From<crate::app::playback::PlaybackError> for Failure {
     fn from(e: crate::app::playback::PlaybackError) -> Self {
@@ -23,7 +23,7 @@ pub(super) fn export_log(args: &ExportLogArgs) -> Result<(), Failure> {
     let params = args.source.load(presets::DEFAULT_SCENARIO)?;
     let format = LogFormat::parse(&args.format).map_err(|e| Failure::input(format!("--format {e}")))?;
     let stop = stop_flag();
-    let written = write_log_set(&params, &args.out, format, &stop).map_err(|e| match e {
+    let written = write_log_set(&params, &args.out, format, args.no_initial_attitude, &stop).map_err(|e| match e {
         crate::app::export_log::ExportError::Interrupted => Failure::interrupted(format!("export-log: {e}")),
         other => Failure::input(format!("export-log: {other}")),
     })?;
@@ -40,32 +40,73 @@ pub(super) fn export_log(args: &ExportLogArgs) -> Result<(), Failure> {
     Ok(())
 }
 
+fn triple(v: Option<&Vec<f64>>) -> Option<[f64; 3]> {
+    match v {
+        Some(v) if v.len() == 3 => Some([v[0], v[1], v[2]]),
+        _ => None,
+    }
+}
+
+/// The command line's start, span and reference over a manifest (they win over its keys).
+fn apply_overrides(raw: &mut RawManifest, args: &ReplayArgs) {
+    let i = &mut raw.initial;
+    if let Some(a) = triple(args.attitude_deg.as_ref()) {
+        *i = RawInitial { body_attitude_deg: Some(a), ..i.clone() };
+        i.imu_quaternion_wxyz = None;
+        i.alignment_s = None;
+    }
+    if let Some(s) = args.align_s {
+        i.alignment_s = Some(s);
+        i.imu_quaternion_wxyz = None;
+        i.body_attitude_deg = None;
+    }
+    if let Some(v) = triple(args.velocity_enu_mps.as_ref()) {
+        i.velocity_enu_mps = Some(v);
+    }
+    if let Some(p) = triple(args.position.as_ref()) {
+        i.position = Some(p);
+    }
+    if let Some(a) = triple(args.reference_attitude_deg.as_ref()) {
+        raw.reference = Some(RawReference { source: Some("--reference-attitude-deg".into()), file: None, attitude_deg: Some(a) });
+    }
+    if args.from.is_some() {
+        raw.log.from_s = args.from;
+    }
+    if args.to.is_some() {
+        raw.log.to_s = args.to;
+    }
+}
+
 /// The log set of `args`: a folder with a manifest, or one IMU file described by the flags.
 fn load_log(args: &ReplayArgs) -> Result<logset::LogSet, Failure> {
     if let Some(dir) = &args.dir {
-        return Ok(logset::load(dir)?);
+        return Ok(logset::load_overridden(dir, |raw| apply_overrides(raw, args))?);
     }
-    let (Some(imu), Some(rate_hz), Some(table)) = (&args.imu, args.rate_hz, &args.table) else {
-        return Err(Failure::input("replay: give a log set's folder, or --imu FILE with --rate-hz and --table"));
+    let Some(imu) = &args.imu else {
+        return Err(Failure::input("replay: give a log set's folder, or --imu FILE"));
     };
-    let ext = imu.extension().and_then(|e| e.to_str()).unwrap_or("");
-    let layout = args.imu_layout.clone().unwrap_or_else(|| match ext {
-        "npy" => "npy7".into(),
-        "mcap" => "ros2".into(),
-        _ => "rinscope".into(),
-    });
-    let name: String = imu.file_stem().and_then(|s| s.to_str()).unwrap_or("replay").chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '_' }).collect();
-    let attitude = match &args.attitude_deg {
-        Some(v) if v.len() == 3 => Some([v[0], v[1], v[2]]),
-        _ => None,
+    let file = std::path::absolute(imu).unwrap_or_else(|_| imu.clone());
+    let layout = match &args.imu_layout {
+        Some(l) => l.clone(),
+        None => crate::io::guess_layout(&file).map_err(|e| Failure::input(format!("replay: {e}")))?.to_owned(),
     };
-    let manifest = RawManifest {
-        log: RawLogInfo { name, description: format!("`{}` replayed with the table {}", imu.display(), table.display()), table: table.display().to_string(), seed: None },
+    let mut manifest = RawManifest {
+        log: RawLogInfo {
+            name: imu.file_stem().and_then(|s| s.to_str()).unwrap_or("replay").chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '_' }).collect(),
+            description: match &args.table {
+                Some(t) => format!("`{}` replayed with the table {}", imu.display(), t.display()),
+                None => format!("`{}` replayed as a strapdown IMU", imu.display()),
+            },
+            table: args.table.as_ref().map_or_else(|| "table.toml".into(), |t| t.display().to_string()),
+            seed: None,
+            from_s: None,
+            to_s: None,
+        },
         imu: RawImuFile {
-            file: std::path::absolute(imu).unwrap_or_else(|_| imu.clone()).display().to_string(),
+            file: file.display().to_string(),
             layout,
             kind: args.imu_kind.clone(),
-            rate_hz,
+            rate_hz: args.rate_hz,
             frame: args.imu_frame.clone().map(logset::RawFrame::Named),
             time: None,
             topic: None,
@@ -73,13 +114,16 @@ fn load_log(args: &ReplayArgs) -> Result<logset::LogSet, Failure> {
             gap_factor: 3.0,
         },
         encoders: args.encoders.as_ref().map(|e| logset::RawEncoderFile { file: std::path::absolute(e).unwrap_or_else(|_| e.clone()).display().to_string(), latch_delay_ms: 0.0, gap_policy: "interpolate".into() }),
-        reference: attitude.map(|a| RawReference { source: Some("--attitude-deg".into()), file: None, attitude_deg: Some(a) }),
-        initial: RawInitial { alignment_s: attitude.is_none().then_some(60.0), ..RawInitial::default() },
+        reference: None,
+        initial: RawInitial::default(),
     };
-    let text = crate::scenario::read_text(table)?;
-    let raw_table: RawTable = toml::from_str(&text).map_err(|e| ConfigError::Parse { origin: table.display().to_string(), message: e.to_string().trim_end().to_owned() })?;
+    apply_overrides(&mut manifest, args);
+    let (raw_table, table_origin) = match &args.table {
+        Some(t) => logset::read_table(t)?,
+        None => (RawTable::strapdown(), "(no --table: a strapdown IMU)".to_owned()),
+    };
     let cwd = PathBuf::from(".");
-    Ok(logset::validate_manifest(&cwd, &manifest, "the command line (--imu ...)", &raw_table, &table.display().to_string())?)
+    Ok(logset::validate_manifest(&cwd, &manifest, "the command line (--imu ...)", &raw_table, &table_origin)?)
 }
 
 /// `rinscope replay`.
@@ -146,6 +190,9 @@ pub(super) fn replay(args: &ReplayArgs) -> Result<(), Failure> {
 /// `rinscope calibrate --log DIR`.
 pub(super) fn calibrate_log(args: &CalibrateArgs, dir: &Path) -> Result<(), Failure> {
     let log = logset::load(dir)?;
+    if log.table.strapdown {
+        return Err(Failure::input(format!("calibrate --log: {} has no table description with [turntable] (log.table): there is no table to calibrate", dir.display())));
+    }
     check_output_dir("--json", args.json.as_deref())?;
     let stop = stop_flag();
     let started = std::time::Instant::now();

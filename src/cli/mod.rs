@@ -270,6 +270,10 @@ struct ExportLogArgs {
     /// File format: csv, npy or parquet.
     #[arg(long, default_value = "csv")]
     format: String,
+    /// Leave the initial attitude out of the manifest: the replay aligns on the data (as on a real
+    /// log) instead of starting from the simulation's truth.
+    #[arg(long)]
+    no_initial_attitude: bool,
 }
 
 #[derive(Args)]
@@ -286,10 +290,11 @@ struct ReplayArgs {
     /// description's [compensation].
     #[arg(long, value_name = "FILE")]
     compensation: Option<PathBuf>,
-    /// Without a log set: an IMU file (.csv, .txt, .npy, .parquet, .mcap).
-    #[arg(long, requires_all = ["rate_hz", "table"])]
+    /// Without a log set: an IMU file (.csv, .txt, .npy, .parquet, .mcap, PSINS .imu).
+    #[arg(long)]
     imu: Option<PathBuf>,
-    /// --imu: its layout: rinscope, psins, kf-gins, kalibr, npy7, ros2 (default from the extension).
+    /// --imu: its layout: rinscope, psins, psins-imu, kf-gins, kalibr, npy7, ros2 (default from the
+    /// extension and the content).
     #[arg(long, requires = "imu")]
     imu_layout: Option<String>,
     /// --imu: increments or rates.
@@ -298,19 +303,40 @@ struct ReplayArgs {
     /// --imu: the file's axes (rfu, frd, flu, ...).
     #[arg(long, requires = "imu")]
     imu_frame: Option<String>,
-    /// --imu: the sample rate, Hz.
+    /// --imu: the sample rate, Hz (default: a PSINS header's, else what the time stamps say).
     #[arg(long, requires = "imu")]
     rate_hz: Option<f64>,
-    /// --imu: the table description (the [site], [turntable], [imu], ... sections of a scenario).
+    /// --imu: the table description (the [site], [turntable], [imu], ... sections of a scenario);
+    /// without one the IMU is strapdown (its axes are the body's).
     #[arg(long, requires = "imu")]
     table: Option<PathBuf>,
     /// --imu: an encoder file (t_s and <axis>_deg columns).
     #[arg(long, requires = "imu")]
     encoders: Option<PathBuf>,
-    /// --imu: the body attitude at rest [pitch, roll, heading], deg, as reference and start (else a
-    /// 60 s coarse alignment).
-    #[arg(long, requires = "imu", num_args = 3, value_names = ["PITCH", "ROLL", "HEADING"], allow_negative_numbers = true)]
+    /// The body attitude at the start [pitch, roll, heading], deg: the INS starts from it instead
+    /// of aligning (a moving start, or a known attitude).
+    #[arg(long, num_args = 3, value_names = ["PITCH", "ROLL", "HEADING"], allow_negative_numbers = true)]
     attitude_deg: Option<Vec<f64>>,
+    /// A constant reference attitude of the body [pitch, roll, heading], deg, to measure the errors
+    /// against (a vehicle at rest whose attitude is known); also the start, unless --attitude-deg.
+    #[arg(long, num_args = 3, value_names = ["PITCH", "ROLL", "HEADING"], allow_negative_numbers = true)]
+    reference_attitude_deg: Option<Vec<f64>>,
+    /// The velocity at the start [East, North, Up], m/s (a moving start; needs --attitude-deg).
+    #[arg(long, num_args = 3, value_names = ["EAST", "NORTH", "UP"], allow_negative_numbers = true)]
+    velocity_enu_mps: Option<Vec<f64>>,
+    /// The position at the start [latitude deg, longitude deg, height m] (the site).
+    #[arg(long, num_args = 3, value_names = ["LAT_DEG", "LON_DEG", "HEIGHT_M"], allow_negative_numbers = true)]
+    position: Option<Vec<f64>>,
+    /// Replay from this time on the IMU file's clock (as written in its time column), s.
+    #[arg(long, value_name = "T_S", allow_negative_numbers = true)]
+    from: Option<f64>,
+    /// Replay up to this time on the IMU file's clock, s.
+    #[arg(long, value_name = "T_S", allow_negative_numbers = true)]
+    to: Option<f64>,
+    /// Align over the first this many seconds, declared at rest (default: the rest the data show,
+    /// at most 300 s).
+    #[arg(long, value_name = "SECONDS")]
+    align_s: Option<f64>,
 }
 
 #[derive(Args)]

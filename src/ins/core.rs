@@ -176,6 +176,13 @@ impl InsCore {
         self.earth.site
     }
 
+    /// Sets the navigation's velocity (East, North, Up), m/s: a start in motion.
+    pub fn set_velocity(&mut self, v_enu_mps: Vector3<f64>) {
+        if let Some(nav) = self.nav.as_mut() {
+            nav.state.v_n = v_enu_mps;
+        }
+    }
+
     /// Replaces the primary attitude.
     pub fn set_primary_attitude(&mut self, n_from_s: Rot<N, S>) {
         if let Some(i) = self.integrators.first_mut() {

@@ -2,6 +2,7 @@
 //! white noise and the IEEE 952/1293 stochastic terms), dither and its FIR, coning-compensated
 //! attitude algorithms, strapdown navigation, position resets.
 
+pub mod align;
 pub mod allan;
 pub mod closed_form;
 pub mod coning;

@@ -106,6 +106,11 @@ impl InsRun {
         &self.pre_roll
     }
 
+    /// The true C_s^n at `t_s` (what an alignment or a log's reference is checked against).
+    pub fn true_n_from_s(&mut self, t_s: f64) -> Rot<N, S> {
+        self.truth.n_from_s(t_s)
+    }
+
     /// The computer's initial C_s^n (the truth at −d with the alignment error applied).
     #[must_use]
     pub fn start_attitude(&self) -> Rot<N, S> {

@@ -319,6 +319,8 @@ pub struct ImuReader {
     read_error: Option<LogError>,
     prev: Option<(f64, RawStamp)>,
     nominal_dt_s: Option<f64>,
+    /// The median of the first intervals (None: fewer than two samples).
+    measured_dt_s: Option<f64>,
     held: Option<ImuSample>,
     done: bool,
     gap_policy: GapPolicy,
@@ -403,6 +405,7 @@ impl ImuReader {
             read_error: None,
             prev: None,
             nominal_dt_s: options.nominal_dt_s,
+            measured_dt_s: None,
             held: None,
             done: false,
             gap_policy: options.gap_policy,
@@ -419,16 +422,17 @@ impl ImuReader {
                 }
             }
         }
+        let mut dts: Vec<f64> = this
+            .lookahead
+            .iter()
+            .zip(this.lookahead.iter().skip(1))
+            .map(|(a, b)| b.sample.t_s - a.sample.t_s)
+            .filter(|dt| *dt > 0.0)
+            .collect();
+        dts.sort_by(f64::total_cmp);
+        this.measured_dt_s = dts.get(dts.len() / 2).copied();
         if this.nominal_dt_s.is_none() {
-            let mut dts: Vec<f64> = this
-                .lookahead
-                .iter()
-                .zip(this.lookahead.iter().skip(1))
-                .map(|(a, b)| b.sample.t_s - a.sample.t_s)
-                .filter(|dt| *dt > 0.0)
-                .collect();
-            dts.sort_by(f64::total_cmp);
-            this.nominal_dt_s = dts.get(dts.len() / 2).copied();
+            this.nominal_dt_s = this.measured_dt_s;
         }
         Ok(this)
     }
@@ -494,6 +498,13 @@ impl ImuReader {
     #[must_use]
     pub fn nominal_dt_s(&self) -> Option<f64> {
         self.nominal_dt_s
+    }
+
+    /// The median of the first eight sampling intervals, s (what the stamps say, whatever was
+    /// declared).
+    #[must_use]
+    pub fn measured_dt_s(&self) -> Option<f64> {
+        self.measured_dt_s
     }
 
     /// The first time stamp as written in the file (known once a row has been read).

@@ -18,6 +18,7 @@ pub mod files;
 mod cdr;
 mod error;
 mod frames;
+mod guess;
 mod imu;
 mod layout;
 mod mcap_imu;
@@ -32,6 +33,7 @@ mod writer;
 
 pub use error::{FrameError, Location, LogError, Result};
 pub use frames::{Frame, frame_matrix};
+pub use guess::guess_layout;
 pub use imu::{
     BlockEnd, GPS_WEEK_S, GapPolicy, ImuEvent, ImuOptions, ImuReader, ImuSample, Layout, SampleKind,
     StartTime, StaticCheck, TimeUnit,

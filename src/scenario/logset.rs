@@ -53,6 +53,12 @@ pub struct RawLogInfo {
     /// Seed of the simulation that wrote the log (export-log), for the record.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seed: Option<u64>,
+    /// Replay from this time on the IMU file's clock (as written in its time column), s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub from_s: Option<f64>,
+    /// Replay up to this time on the IMU file's clock, s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub to_s: Option<f64>,
 }
 
 fn default_table() -> String {
@@ -71,8 +77,9 @@ pub struct RawImuFile {
     /// "increments" or "rates" (checked against the layout's own).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kind: Option<String>,
-    /// Nominal sample rate, Hz (must match the time stamps).
-    pub rate_hz: f64,
+    /// Nominal sample rate, Hz (must match the time stamps; absent: what the stamps say).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rate_hz: Option<f64>,
     /// The IMU axes in the file: "rfu" (rinscope's), "frd", "flu", ... (three letters of r/l, f/b,
     /// u/d) or a 3×3 matrix C with v_rfu = C · v_file, row by row.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -147,7 +154,8 @@ pub struct RawReference {
     pub attitude_deg: Option<[f64; 3]>,
 }
 
-/// `[initial]`: at most one of the three.
+/// `[initial]`: the attitude (at most one of the first three; none: an alignment over the rest the
+/// data show at the start), velocity and position, and what the alignment may assume.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawInitial {
@@ -158,9 +166,28 @@ pub struct RawInitial {
     /// the first encoder reading.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub body_attitude_deg: Option<[f64; 3]>,
-    /// Coarse alignment over the first this many seconds (the vehicle must be at rest), s.
+    /// Align over the first this many seconds, declared at rest (absent: the rest the data show,
+    /// at most 300 s), s.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub alignment_s: Option<f64>,
+    /// Velocity at the start [East, North, Up], m/s (a moving start; default at rest).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub velocity_enu_mps: Option<[f64; 3]>,
+    /// Position at the start [latitude deg, longitude deg, height m] (default: the table
+    /// description's [site]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub position: Option<[f64; 3]>,
+    /// Alignment: the gyro bias 1σ before alignment, °/h (default: the table description's [imu],
+    /// else assumed from the measured noise and said so).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gyro_bias_deg_per_h: Option<f64>,
+    /// Alignment: the accelerometer bias 1σ, µg (default as the gyro's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub accel_bias_ug: Option<f64>,
+    /// Alignment: one-second means of the specific force that change by more mark motion, m/s²
+    /// (default 0.05).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rest_threshold_mps2: Option<f64>,
 }
 
 /// `table.toml`: the scenario sections that describe the instrument, not its motion.
@@ -173,8 +200,10 @@ pub struct RawTable {
     /// Where on Earth.
     #[serde(default)]
     pub site: RawSite,
-    /// The gimbal chain as the user knows it (nominal axes and the errors believed).
-    pub turntable: RawTurntable,
+    /// The gimbal chain as the user knows it (nominal axes and the errors believed); absent: a
+    /// strapdown IMU (its axes are the body's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub turntable: Option<RawTurntable>,
     /// What the compensated demodulation assumes (each key defaults to the turntable's value).
     #[serde(default)]
     pub compensation: RawCompensation,
@@ -196,11 +225,26 @@ pub enum Initial {
     ImuQuaternion([f64; 4]),
     /// A body attitude, demodulated through the compensated table at the first encoder reading.
     BodyAttitude(Attitude),
-    /// Coarse alignment over the first seconds.
+    /// Alignment at rest at the start.
     Alignment {
-        /// Length of the static interval, s.
-        duration_s: f64,
+        /// The window declared at rest, s (None: the rest the data show, at most
+        /// [`DEFAULT_ALIGNMENT_S`]).
+        duration_s: Option<f64>,
     },
+}
+
+/// The longest alignment window taken when the data decide, s.
+pub const DEFAULT_ALIGNMENT_S: f64 = 300.0;
+
+/// What the alignment may assume (SI; None: from the table description or the data).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AlignPriors {
+    /// Gyro bias 1σ, rad/s.
+    pub gyro_bias_rad_per_s: Option<f64>,
+    /// Accelerometer bias 1σ, m/s².
+    pub accel_bias_mps2: Option<f64>,
+    /// Motion threshold of the rest scan, m/s².
+    pub rest_threshold_mps2: f64,
 }
 
 /// The reference attitude of the body.
@@ -265,6 +309,9 @@ pub struct TableDescription {
     pub recording: RecordingParams,
     /// The table description as resolved, TOML (shown in the recording).
     pub resolved_toml: String,
+    /// No turntable: a strapdown IMU whose axes are the body's (`chain` is a stand-in axis that
+    /// never turns; nothing of a table is shown or exported).
+    pub strapdown: bool,
 }
 
 /// A validated log set.
@@ -286,6 +333,12 @@ pub struct LogSet {
     pub reference: Reference,
     /// How the INS starts.
     pub initial: Initial,
+    /// Velocity at the start (East, North, Up), m/s, if given (a moving start).
+    pub initial_velocity_enu_mps: Option<[f64; 3]>,
+    /// What the alignment may assume.
+    pub align: AlignPriors,
+    /// The part of the log replayed: from, to, on the IMU file's clock, s.
+    pub span_s: (Option<f64>, Option<f64>),
     /// The table.
     pub table: TableDescription,
     /// The table description as written (for the recording's scenario view and `--compensation`).
@@ -297,15 +350,49 @@ pub const MANIFEST: &str = "log.toml";
 
 /// Reads and validates the log set in `dir`.
 pub fn load(dir: &Path) -> Result<LogSet, ConfigError> {
+    load_overridden(dir, |_| {})
+}
+
+/// Reads the log set in `dir`, lets `edit` change its manifest (the command line's overrides), and
+/// validates it.
+pub fn load_overridden(dir: &Path, edit: impl FnOnce(&mut RawManifest)) -> Result<LogSet, ConfigError> {
     let manifest_path = dir.join(MANIFEST);
     let text = super::read_text(&manifest_path)?;
     let origin = manifest_path.display().to_string();
-    let raw: RawManifest = toml::from_str(&text).map_err(|e| ConfigError::Parse { origin: origin.clone(), message: e.to_string().trim_end().to_owned() })?;
+    let mut raw: RawManifest = toml::from_str(&text).map_err(|e| ConfigError::Parse { origin: origin.clone(), message: e.to_string().trim_end().to_owned() })?;
+    edit(&mut raw);
     let table_path = dir.join(&raw.log.table);
-    let table_text = super::read_text(&table_path)?;
-    let table_origin = table_path.display().to_string();
-    let raw_table: RawTable = toml::from_str(&table_text).map_err(|e| ConfigError::Parse { origin: table_origin.clone(), message: e.to_string().trim_end().to_owned() })?;
+    // A strapdown log needs no table description: the default name may be absent.
+    if raw.log.table == default_table() && !table_path.exists() {
+        return validate_manifest(dir, &raw, &origin, &RawTable::strapdown(), "(no table.toml: a strapdown IMU)");
+    }
+    let (raw_table, table_origin) = read_table(&table_path)?;
     validate_manifest(dir, &raw, &origin, &raw_table, &table_origin)
+}
+
+/// Reads a table description file.
+pub fn read_table(path: &Path) -> Result<(RawTable, String), ConfigError> {
+    let text = super::read_text(path)?;
+    let origin = path.display().to_string();
+    let raw: RawTable = toml::from_str(&text).map_err(|e| ConfigError::Parse { origin: origin.clone(), message: e.to_string().trim_end().to_owned() })?;
+    Ok((raw, origin))
+}
+
+impl RawTable {
+    /// The description of a strapdown IMU: no turntable, navigation on with the vertical channel
+    /// held, everything else at its default.
+    #[must_use]
+    pub fn strapdown() -> Self {
+        Self {
+            recording: RawRecording::default(),
+            site: RawSite::default(),
+            turntable: None,
+            compensation: RawCompensation::default(),
+            imu: None,
+            navigation: Some(RawNavigation { vertical: "held".into(), velocity_damping: false, initial_attitude_error_arcmin: [0.0; 3] }),
+            calibration: None,
+        }
+    }
 }
 
 /// Validates a manifest and its table description (`origin`s name the files in errors).
@@ -316,7 +403,40 @@ pub fn validate_manifest(dir: &Path, raw: &RawManifest, origin: &str, raw_table:
         return Err(c.invalid("log.name", format!("\"{name}\" must be non-empty and use only letters, digits, '-' and '_' (it names the recording)")));
     }
     let imu = imu_file(&c, dir, &raw.imu)?;
-    let table = table_description(&Checker { origin: table_origin }, raw_table, imu.rate_hz)?;
+    let mut table = table_description(&Checker { origin: table_origin }, raw_table, imu.rate_hz)?;
+    let i = &raw.initial;
+    if let Some([lat, lon, h]) = i.position {
+        table.site = crate::model::earth::Site {
+            latitude_rad: c.range("initial.position[0]", lat, "deg", -89.0, 89.0, "latitude")? * RAD_PER_DEG,
+            longitude_rad: c.range("initial.position[1]", lon, "deg", -360.0, 360.0, "longitude")? * RAD_PER_DEG,
+            height_m: c.range("initial.position[2]", h, "m", -12_000.0, 100_000.0, "height")?,
+        };
+    } else if table.strapdown {
+        return Err(c.invalid("initial.position", "a strapdown log without a table description needs its start position: [initial] position = [latitude_deg, longitude_deg, height_m] (or --position, or a table.toml with [site])"));
+    }
+    let initial_velocity_enu_mps = match i.velocity_enu_mps {
+        None => None,
+        Some(v) => {
+            for (k, x) in v.iter().enumerate() {
+                c.range(&format!("initial.velocity_enu_mps[{k}]"), *x, "m/s", -3000.0, 3000.0, "")?;
+            }
+            Some(v)
+        }
+    };
+    let align = AlignPriors {
+        gyro_bias_rad_per_s: i.gyro_bias_deg_per_h.map(|b| c.positive("initial.gyro_bias_deg_per_h", b, "°/h", 1e5)).transpose()?.map(|b| b * crate::math::units::RAD_PER_S_PER_DEG_PER_H),
+        accel_bias_mps2: i.accel_bias_ug.map(|b| c.positive("initial.accel_bias_ug", b, "µg", 1e6)).transpose()?.map(|b| b * crate::math::units::MPS2_PER_UG),
+        rest_threshold_mps2: i.rest_threshold_mps2.map_or(Ok(crate::ins::align::REST_THRESHOLD_MPS2), |t| c.positive("initial.rest_threshold_mps2", t, "m/s²", 10.0))?,
+    };
+    let span_s = (
+        raw.log.from_s.map(|t| c.finite("log.from_s", t, "s")).transpose()?,
+        raw.log.to_s.map(|t| c.finite("log.to_s", t, "s")).transpose()?,
+    );
+    if let (Some(a), Some(b)) = span_s
+        && b <= a
+    {
+        return Err(c.invalid("log.to_s", format!("{b} s is not after log.from_s = {a} s")));
+    }
     let encoders = match &raw.encoders {
         None => None,
         Some(e) => Some(EncoderFile {
@@ -337,7 +457,6 @@ pub fn validate_manifest(dir: &Path, raw: &RawManifest, origin: &str, raw_table:
             _ => return Err(c.invalid("reference", "give either `file` or `attitude_deg`")),
         },
     };
-    let i = &raw.initial;
     let initial = match (i.imu_quaternion_wxyz, i.body_attitude_deg, i.alignment_s) {
         (Some(q), None, None) => {
             for (k, x) in q.iter().enumerate() {
@@ -350,15 +469,35 @@ pub fn validate_manifest(dir: &Path, raw: &RawManifest, origin: &str, raw_table:
             Initial::ImuQuaternion(q)
         }
         (None, Some(a), None) => Initial::BodyAttitude(attitude(&c, "initial.body_attitude_deg", a)?),
-        (None, None, Some(s)) => Initial::Alignment { duration_s: c.positive("initial.alignment_s", s, "s", 86_400.0)? },
+        (None, None, Some(s)) => Initial::Alignment { duration_s: Some(c.positive("initial.alignment_s", s, "s", 86_400.0)?) },
         (None, None, None) => match &reference {
             // A static reference is the initial body attitude too.
             Reference::Static(a) => Initial::BodyAttitude(*a),
-            _ => Initial::Alignment { duration_s: 60.0 },
+            _ => Initial::Alignment { duration_s: None },
         },
         _ => return Err(c.invalid("initial", "give one of imu_quaternion_wxyz, body_attitude_deg or alignment_s")),
     };
-    Ok(LogSet { dir: dir.to_path_buf(), name: name.clone(), description: raw.log.description.clone(), seed: raw.log.seed, imu, encoders, reference, initial, table, raw_table: raw_table.clone() })
+    if matches!(initial, Initial::Alignment { .. }) && initial_velocity_enu_mps.is_some_and(|v| v.iter().any(|x| *x != 0.0)) {
+        return Err(c.invalid("initial.velocity_enu_mps", "a moving start cannot be aligned at rest: give its attitude too (initial.body_attitude_deg or imu_quaternion_wxyz)"));
+    }
+    if table.strapdown && encoders.is_some() {
+        return Err(c.invalid("encoders", "an encoder file needs a table description with [turntable] (log.table)"));
+    }
+    Ok(LogSet {
+        dir: dir.to_path_buf(),
+        name: name.clone(),
+        description: raw.log.description.clone(),
+        seed: raw.log.seed,
+        imu,
+        encoders,
+        reference,
+        initial,
+        initial_velocity_enu_mps,
+        align,
+        span_s,
+        table,
+        raw_table: raw_table.clone(),
+    })
 }
 
 fn attitude(c: &Checker<'_>, key: &str, a: [f64; 3]) -> Result<Attitude, ConfigError> {
@@ -370,7 +509,6 @@ fn attitude(c: &Checker<'_>, key: &str, a: [f64; 3]) -> Result<Attitude, ConfigE
 }
 
 fn imu_file(c: &Checker<'_>, dir: &Path, raw: &RawImuFile) -> Result<ImuFile, ConfigError> {
-    let rate_hz = c.range("imu.rate_hz", raw.rate_hz, "Hz", 1.0, 100_000.0, "")?;
     let time = match raw.time.as_deref().unwrap_or("s") {
         "s" => TimeUnit::Seconds,
         "ms" => TimeUnit::Milliseconds,
@@ -409,8 +547,23 @@ fn imu_file(c: &Checker<'_>, dir: &Path, raw: &RawImuFile) -> Result<ImuFile, Co
         "split" => GapPolicy::Split,
         other => return Err(c.invalid("imu.gap_policy", format!("\"{other}\" is not a policy; use \"refuse\" or \"split\""))),
     };
+    let path = dir.join(&raw.file);
+    let rate_hz = match raw.rate_hz {
+        Some(r) => c.range("imu.rate_hz", r, "Hz", 1.0, 100_000.0, "")?,
+        None => {
+            // What the stamps say (the median of the first intervals).
+            let mut options = crate::io::ImuOptions::new(layout.clone());
+            options.frame = frame.clone();
+            options.topic = raw.topic.clone();
+            let dt = crate::io::ImuReader::open(&path, &options).map_err(|e| c.invalid("imu.rate_hz", format!("absent, and the rate cannot be read from the stamps: {e}")))?.measured_dt_s();
+            let Some(dt) = dt else {
+                return Err(c.invalid("imu.rate_hz", "absent, and the file has too few samples to measure it"));
+            };
+            c.range("imu.rate_hz (from the time stamps)", 1.0 / dt, "Hz", 1.0, 100_000.0, "")?
+        }
+    };
     Ok(ImuFile {
-        path: dir.join(&raw.file),
+        path,
         layout,
         kind,
         rate_hz,
@@ -424,8 +577,9 @@ fn imu_file(c: &Checker<'_>, dir: &Path, raw: &RawImuFile) -> Result<ImuFile, Co
 /// Validates a table description for an IMU at `rate_hz`.
 fn table_description(c: &Checker<'_>, raw: &RawTable, rate_hz: f64) -> Result<TableDescription, ConfigError> {
     let site = validate::site(c, &raw.site)?;
-    let (chain, stated) = validate::turntable(c, &raw.turntable)?;
-    let (compensation, resolved_comp) = validate::validate_compensation(c, &raw.compensation, &raw.turntable, &chain, &stated)?;
+    let turntable = raw.turntable.clone().unwrap_or_else(RawTurntable::strapdown);
+    let (chain, stated) = validate::turntable(c, &turntable)?;
+    let (compensation, resolved_comp) = validate::validate_compensation(c, &raw.compensation, &turntable, &chain, &stated)?;
     let ins = instruments::validate_ins(c, Some(&raw.imu.clone().unwrap_or_default()), raw.navigation.as_ref(), rate_hz)?.unwrap_or_else(|| InsParams::ideal(rate_hz, crate::ins::coning::Algorithm::TwoSampleP1));
     // The calibration allows for the INS error the [imu] section states (a datasheet's), if any.
     let calibration = instruments::validate_calibration(c, &raw.calibration.clone().unwrap_or_default(), &stated, raw.imu.is_some().then_some(&ins))?;
@@ -435,7 +589,7 @@ fn table_description(c: &Checker<'_>, raw: &RawTable, rate_hz: f64) -> Result<Ta
     let mut resolved = raw.clone();
     resolved.compensation = resolved_comp;
     let resolved_toml = toml::to_string_pretty(&resolved).unwrap_or_else(|e| format!("# could not serialise: {e}"));
-    Ok(TableDescription { site, chain, stated, compensation, ins, calibration, recording, resolved_toml })
+    Ok(TableDescription { site, chain, stated, compensation, ins, calibration, recording, resolved_toml, strapdown: raw.turntable.is_none() })
 }
 
 impl LogSet {
@@ -450,7 +604,7 @@ impl LogSet {
             recording: t.recording.clone(),
             site: t.site.clone(),
             vehicle: RawVehicle::default(),
-            turntable: t.turntable.clone(),
+            turntable: t.turntable.clone().unwrap_or_else(RawTurntable::strapdown),
             scheme: RawScheme { kind: "static".into(), rate: Vec::new(), initial_dwell_s: None, repeat: None, step: Vec::new() },
             compensation: t.compensation.clone(),
             live: RawLive::default(),
@@ -474,7 +628,8 @@ pub fn compensation_from_calibration(table: &RawTable, json_text: &str, origin: 
     }
     let parsed: WithCompensation = serde_json::from_str(json_text).map_err(|e| ConfigError::Parse { origin: origin.to_owned(), message: format!("not a calibration of `rinscope calibrate --json` ({e})") })?;
     let c = Checker { origin };
-    let (chain, stated) = validate::turntable(&c, &table.turntable)?;
+    let turntable = table.turntable.clone().unwrap_or_else(RawTurntable::strapdown);
+    let (chain, stated) = validate::turntable(&c, &turntable)?;
     let mut merged = table.compensation.clone();
     let given = parsed.estimated_compensation;
     merged.enabled = given.enabled.or(merged.enabled);
@@ -485,5 +640,5 @@ pub fn compensation_from_calibration(table: &RawTable, json_text: &str, origin: 
         ($($f:ident),*) => { $( if given.$f.is_some() { merged.$f = given.$f; } )* };
     }
     take!(installation_x_arcsec, installation_y_arcsec, installation_z_arcsec, imu_mount_x_arcsec, imu_mount_y_arcsec, imu_mount_z_arcsec);
-    Ok(validate::validate_compensation(&c, &merged, &table.turntable, &chain, &stated)?.0)
+    Ok(validate::validate_compensation(&c, &merged, &turntable, &chain, &stated)?.0)
 }

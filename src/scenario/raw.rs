@@ -512,6 +512,34 @@ pub struct RawTurntable {
     pub axis: Vec<RawAxis>,
 }
 
+impl RawTurntable {
+    /// The stand-in of a strapdown IMU: one axis about z that never turns, no errors (b_from_s is
+    /// the identity); a log set without `[turntable]` uses it and shows nothing of a table.
+    #[must_use]
+    pub fn strapdown() -> Self {
+        Self {
+            installation_x_arcsec: 0.0,
+            installation_y_arcsec: 0.0,
+            installation_z_arcsec: 0.0,
+            imu_mount_x_arcsec: 0.0,
+            imu_mount_y_arcsec: 0.0,
+            imu_mount_z_arcsec: 0.0,
+            axis: vec![RawAxis {
+                name: "strapdown".into(),
+                axis: "z".into(),
+                initial_angle_deg: 0.0,
+                swing_half_angle_arcsec: 0.0,
+                swing_phase_deg: 0.0,
+                non_orthogonality_arcsec: 0.0,
+                encoder_offset_arcsec: 0.0,
+                encoder_scale_ppm: 0.0,
+                encoder_delay_ms: 0.0,
+                encoder_noise_arcsec: 0.0,
+            }],
+        }
+    }
+}
+
 /// `[[turntable.axis]]`
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

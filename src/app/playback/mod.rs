@@ -1,0 +1,470 @@
+//! A log set played back: the IMU samples feed the navigation computer (`ins::core`, the one the
+//! simulation uses), the encoder and reference files are looked up at the instants the computer asks
+//! for. `replay` and `calibrate --log` both drive it. Memory stays flat in the log's length: the
+//! files stream, the tracks keep a few readings around the instant asked for.
+//!
+//! Time: every instant is seconds after the end of the pre-roll (the first `pre` samples that fill
+//! the FIR and give the algorithms their previous samples), or after the alignment window
+//! ([`Playback::file_time_s`] turns it back into the file's clock).
+
+mod start;
+mod track;
+
+use std::collections::VecDeque;
+
+use nalgebra::Vector3;
+
+pub use start::AlignmentReport;
+use track::{open_track, Track};
+
+use crate::ins::core::{InsCore, SampleOut};
+use crate::io::{BlockEnd, ImuEvent, ImuOptions, ImuReader, ImuSample, LogError, SampleKind, StartTime};
+use crate::math::attitude::Attitude;
+use crate::math::frames::{Rot, S};
+use crate::model::gimbal::TableErrors;
+use crate::model::scheme::{AxisValues, MAX_AXES};
+use crate::scenario::logset::{Initial, LogSet, Reference};
+use crate::sim::{demodulate, DemodState};
+
+/// A problem with a log set's data, naming the file and where.
+#[derive(Debug, thiserror::Error)]
+pub enum PlaybackError {
+    /// A file could not be read or holds bad data (the message names file, row, column, value).
+    #[error("{0}")]
+    Log(#[from] LogError),
+    /// The data do not fit together (clocks, lengths, the vehicle moving during alignment...).
+    #[error("{0}")]
+    Data(String),
+}
+
+fn data_err(message: impl Into<String>) -> PlaybackError {
+    PlaybackError::Data(message.into())
+}
+
+/// A gap in the IMU data that the replay carried the attitude across.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct Gap {
+    /// Last sample before it, s.
+    pub from_s: f64,
+    /// First sample after it, s.
+    pub to_s: f64,
+}
+
+/// The IMU file read on a thread of its own, in blocks: parsing the file overlaps the navigation.
+struct ImuStream {
+    rx: crossbeam_channel::Receiver<Block>,
+    samples: std::vec::IntoIter<ImuSample>,
+}
+
+/// What the reading thread sends.
+enum Block {
+    Samples(Vec<ImuSample>),
+    Gap(ImuEvent),
+    Error(LogError),
+}
+
+/// Samples per block handed from the reading thread.
+const IMU_BLOCK: usize = 4096;
+
+impl ImuStream {
+    fn spawn(mut reader: ImuReader) -> Result<Self, PlaybackError> {
+        let (tx, rx) = crossbeam_channel::bounded(4);
+        std::thread::Builder::new()
+            .name("imu-reader".into())
+            .spawn(move || {
+                loop {
+                    let mut samples = Vec::with_capacity(IMU_BLOCK);
+                    let end = reader.next_samples(&mut samples, IMU_BLOCK);
+                    if !samples.is_empty() && tx.send(Block::Samples(samples)).is_err() {
+                        return;
+                    }
+                    let next = match end {
+                        Ok(BlockEnd::Full) => continue,
+                        Ok(BlockEnd::Gap(g)) => Block::Gap(g),
+                        Ok(BlockEnd::End) => return,
+                        Err(e) => Block::Error(e),
+                    };
+                    let last = matches!(next, Block::Error(_));
+                    if tx.send(next).is_err() || last {
+                        return;
+                    }
+                }
+            })
+            .map_err(|e| data_err(format!("cannot start the IMU reader: {e}")))?;
+        Ok(Self { rx, samples: Vec::new().into_iter() })
+    }
+
+    fn next(&mut self) -> Option<Result<ImuEvent, LogError>> {
+        loop {
+            if let Some(s) = self.samples.next() {
+                return Some(Ok(ImuEvent::Sample(s)));
+            }
+            match self.rx.recv().ok()? {
+                Block::Samples(v) => self.samples = v.into_iter(),
+                Block::Gap(g) => return Some(Ok(g)),
+                Block::Error(e) => return Some(Err(e)),
+            }
+        }
+    }
+}
+
+/// One IMU sample as the computer gets it, with its instant.
+#[derive(Debug, Clone, Copy)]
+struct Sample {
+    t_s: f64,
+    dtheta: Vector3<f64>,
+    dv: Vector3<f64>,
+}
+
+/// A log set being played back through the navigation computer.
+pub struct Playback {
+    /// The navigation computer.
+    pub core: InsCore,
+    imu: ImuSamples,
+    origin_s: f64,
+    /// The IMU file's first stamp on its own clock, s (times out are `file_clock_s + origin_s + t`).
+    file_start_s: f64,
+    encoders: Option<Track>,
+    initial_angles: AxisValues,
+    reference: ReferenceTrack,
+    /// Samples read ahead of the computer (the second of motion that ended an alignment window).
+    pending: VecDeque<Sample>,
+    /// The end of the span replayed, s after the IMU's first stamp.
+    until_s: f64,
+    /// IMU samples fed to the computer (after the pre-roll).
+    pub samples: u64,
+    /// Gaps carried across.
+    pub gaps: Vec<Gap>,
+    /// The alignment, when the INS was aligned on the data.
+    pub alignment: Option<AlignmentReport>,
+    /// Things said once about the data (a reference that starts late, a trimmed span...).
+    pub notes: Vec<String>,
+    /// Whether the last reference lookup found the reference inside its file's span.
+    reference_inside: Option<bool>,
+}
+
+enum ReferenceTrack {
+    None,
+    Static(Attitude),
+    File(Box<Track>),
+}
+
+/// The file-clock seconds of a first stamp.
+fn clock_s(start: StartTime) -> f64 {
+    match start {
+        StartTime::Seconds(s) | StartTime::GpsSecondsOfWeek(s) => s,
+        StartTime::Nanoseconds(ns) => ns as f64 * 1e-9,
+    }
+}
+
+impl Playback {
+    /// Opens `log` (its IMU file, tracks, pre-roll and initial attitude); `compensation` is the table
+    /// model a body-attitude start is demodulated with.
+    pub fn open(log: &LogSet, compensation: &TableErrors) -> Result<Self, PlaybackError> {
+        let cfg = &log.table.ins;
+        let f = &log.imu;
+        let (imu, start) = ImuSamples::open_checked(log)?;
+        let nominal_s = 1.0 / f.rate_hz;
+        let axis_names: Vec<String> = log.table.chain.axes().iter().map(|a| a.name.clone()).collect();
+        let mut initial_angles = [0.0; MAX_AXES];
+        for (k, a) in log.table.chain.axes().iter().enumerate() {
+            initial_angles[k] = a.initial_angle_rad;
+        }
+        let encoders = match &log.encoders {
+            None => None,
+            Some(e) => {
+                let mut t = open_track(&e.path, "encoder", &axis_names, vec![true; axis_names.len()], start, nominal_s)?;
+                t.shift_s = -e.latch_delay_s;
+                t.interpolate_gaps = e.interpolate_gaps;
+                Some(t)
+            }
+        };
+        let reference = match &log.reference {
+            Reference::None => ReferenceTrack::None,
+            Reference::Static(a) => ReferenceTrack::Static(*a),
+            Reference::File(p) => {
+                let names = ["pitch", "roll", "heading"].map(String::from);
+                let mut t = open_track(p, "reference attitude", &names, vec![false, true, true], start, nominal_s)?;
+                // A reference that starts late or ends early: the comparison covers its span.
+                t.clip = true;
+                ReferenceTrack::File(Box::new(t))
+            }
+        };
+        let file_start_s = clock_s(start);
+        let (from_rel, until_s) = (log.span_s.0.map(|t| t - file_start_s), log.span_s.1.map_or(f64::INFINITY, |t| t - file_start_s));
+        let mut me = Self {
+            core: InsCore::new(cfg, log.table.site, Rot::identity(), &[]),
+            imu,
+            origin_s: 0.0,
+            file_start_s,
+            encoders,
+            initial_angles,
+            reference,
+            pending: VecDeque::new(),
+            until_s,
+            samples: 0,
+            gaps: Vec::new(),
+            alignment: None,
+            notes: Vec::new(),
+            reference_inside: None,
+        };
+        if let Some(from) = from_rel {
+            let mut skipped = 0u64;
+            loop {
+                let Some(s) = me.read()? else {
+                    return Err(data_err(format!("{}: log.from_s = {:.6} s is after the file's last sample", f.path.display(), from + file_start_s)));
+                };
+                if s.t_s >= from - 0.5 * nominal_s {
+                    me.pending.push_back(s);
+                    break;
+                }
+                skipped += 1;
+            }
+            me.notes.push(format!("replayed from {:.6} s on the file's clock ({skipped} samples before it skipped)", from + file_start_s));
+        }
+        if until_s.is_finite() {
+            me.notes.push(format!("replayed up to {:.6} s on the file's clock", until_s + file_start_s));
+        }
+        let pre = InsCore::pre_roll_samples(cfg);
+        let (start_attitude, pre_roll) = match log.initial {
+            Initial::Alignment { duration_s } => {
+                let (attitude, pre_roll, report) = start::aligned(&mut me, log, compensation, duration_s, pre)?;
+                me.alignment = Some(report);
+                (attitude, pre_roll)
+            }
+            _ => {
+                let mut window = Vec::with_capacity(pre);
+                while window.len() < pre {
+                    let Some(s) = me.read()? else {
+                        return Err(data_err(format!("{}: the log ends before the pre-roll ({pre} samples)", f.path.display())));
+                    };
+                    window.push(s);
+                }
+                me.origin_s = window.last().map_or(0.0, |w| w.t_s);
+                let pre_roll: Vec<(Vector3<f64>, Vector3<f64>)> = window.iter().map(|s| (s.dtheta, s.dv)).collect();
+                let attitude = match log.initial {
+                    Initial::ImuQuaternion([w, x, y, z]) => {
+                        // FRAME: the manifest states C_s^n at the end of the pre-roll.
+                        Rot::from_quaternion(nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(w, x, y, z)))
+                    }
+                    Initial::BodyAttitude(att) => att.n_from_b() * me.table_b_from_s(log, compensation, -me.core.fir_delay_s)?,
+                    Initial::Alignment { .. } => unreachable!("handled above"),
+                };
+                (attitude, pre_roll)
+            }
+        };
+        me.core = InsCore::new(cfg, log.table.site, start_attitude, &pre_roll);
+        if let Some(v) = log.initial_velocity_enu_mps {
+            me.core.set_velocity(Vector3::from(v));
+        }
+        Ok(me)
+    }
+
+    /// C_b^s... as `b_from_s`: the compensated table's rotation at instant `t_s` (seconds after the
+    /// origin), from the encoder reading then.
+    fn table_b_from_s(&mut self, log: &LogSet, compensation: &TableErrors, t_s: f64) -> Result<Rot<crate::math::frames::B, S>, PlaybackError> {
+        let enc = self.encoders_at(t_s)?;
+        let corrected = DemodState::default().correct(compensation, t_s, &enc);
+        Ok(log.table.chain.b_from_s(&log.table.chain.error_rotations(compensation), &corrected))
+    }
+
+    /// An instant (seconds after the replay's origin) on the IMU file's own clock, s.
+    #[must_use]
+    pub fn file_time_s(&self, t_s: f64) -> f64 {
+        self.file_start_s + self.origin_s + t_s
+    }
+
+    /// The next IMU sample through the computer; None at the end of the log.
+    pub fn step(&mut self) -> Result<Option<SampleOut>, PlaybackError> {
+        let Some(s) = self.read()? else { return Ok(None) };
+        if s.t_s > self.until_s + 1e-9 {
+            return Ok(None);
+        }
+        self.samples += 1;
+        Ok(Some(self.core.push(s.t_s - self.origin_s, s.dtheta, s.dv)))
+    }
+
+    /// The raw encoder angles at instant `t_s` (the table's initial angles without an encoder file).
+    pub fn encoders_at(&mut self, t_s: f64) -> Result<AxisValues, PlaybackError> {
+        match self.encoders.as_mut() {
+            None => Ok(self.initial_angles),
+            Some(track) => Ok(track.at(t_s + self.origin_s)?.unwrap_or(self.initial_angles)),
+        }
+    }
+
+    /// The reference body attitude at instant `t_s`, if the log has one.
+    pub fn reference_at(&mut self, t_s: f64) -> Result<Option<Attitude>, PlaybackError> {
+        Ok(match &mut self.reference {
+            ReferenceTrack::None => None,
+            ReferenceTrack::Static(a) => Some(*a),
+            ReferenceTrack::File(track) => {
+                let v = track.at(t_s + self.origin_s)?;
+                let inside = v.is_some();
+                if self.reference_inside != Some(inside) {
+                    let first = self.reference_inside.is_none();
+                    let (from, to) = (track.span_seen.0.unwrap_or(0.0), track.span_seen.1);
+                    let clock = |t: f64| self.file_start_s + t;
+                    match (first, inside) {
+                        (true, true) => {}
+                        (true, false) => self.notes.push(format!("the reference in {} starts at {:.6} s (file clock), after the replay's start at {:.6} s: the comparison starts there", track.path.display(), clock(from), clock(t_s + self.origin_s))),
+                        (false, true) => {}
+                        (false, false) => self.notes.push(format!("the reference in {} ends at {:.6} s (file clock): the comparison stops there", track.path.display(), clock(to))),
+                    }
+                    self.reference_inside = Some(inside);
+                }
+                v.map(|v| Attitude { pitch_rad: v[0], roll_rad: v[1], heading_rad: v[2] })
+            }
+        })
+    }
+
+    /// The body attitude the computer's integrator `k` gives through the table rotation of `corrected`
+    /// encoder angles with errors `rot` of `errors`, at its latest output.
+    #[must_use]
+    pub fn body_attitude(&self, k: usize, chain: &crate::model::gimbal::Chain, rot: &crate::model::gimbal::ErrorRotations, angles: &AxisValues) -> Attitude {
+        self.body_attitude_through(k, chain.b_from_s(rot, angles))
+    }
+
+    /// The body attitude integrator `k` gives through the table rotation C_b^s... as `b_from_s`.
+    #[must_use]
+    pub fn body_attitude_through(&self, k: usize, b_from_s: crate::math::frames::Rot<crate::math::frames::B, crate::math::frames::S>) -> Attitude {
+        let (_, n_from_s) = self.core.output_attitude(k);
+        demodulate(n_from_s, b_from_s)
+    }
+
+    /// One sample as increments in the RFU sensor frame, or None at the end (gaps recorded).
+    fn read(&mut self) -> Result<Option<Sample>, PlaybackError> {
+        if let Some(s) = self.pending.pop_front() {
+            return Ok(Some(s));
+        }
+        loop {
+            match self.imu.next_item()? {
+                None => return Ok(None),
+                Some(ImuItem::Gap { from_s, to_s }) => self.gaps.push(Gap { from_s: from_s - self.origin_s, to_s: to_s - self.origin_s }),
+                Some(ImuItem::Sample { t_s, dtheta, dv }) => return Ok(Some(Sample { t_s, dtheta, dv })),
+            }
+        }
+    }
+}
+
+/// What a log set's IMU file yields, in order.
+#[derive(Debug, Clone, Copy)]
+pub enum ImuItem {
+    /// One sample as increments in the RFU sensor frame: its stamp (s, the file's clock),
+    /// Δθ (rad) and Δv (m/s).
+    Sample {
+        /// Stamp, s.
+        t_s: f64,
+        /// Angle increment, rad.
+        dtheta: Vector3<f64>,
+        /// Velocity increment, m/s.
+        dv: Vector3<f64>,
+    },
+    /// A gap in the samples (the file's clock), s.
+    Gap {
+        /// Last stamp before it.
+        from_s: f64,
+        /// First stamp after it.
+        to_s: f64,
+    },
+}
+
+/// The IMU samples of a log set without the navigation computer (what `rinscope allan` reads):
+/// increments in the RFU sensor frame (rates held over their interval), gaps reported, not bridged.
+pub struct ImuSamples {
+    imu: ImuStream,
+    kind: SampleKind,
+    nominal_s: f64,
+    last_t: Option<f64>,
+    pending_gap: bool,
+}
+
+impl ImuSamples {
+    /// Opens `log`'s IMU file as its manifest describes it.
+    pub fn open(log: &LogSet) -> Result<Self, PlaybackError> {
+        Ok(Self::open_checked(log)?.0)
+    }
+
+    /// The reader options of `log`'s IMU file.
+    fn options(log: &LogSet) -> ImuOptions {
+        let f = &log.imu;
+        let mut options = ImuOptions::new(f.layout.clone());
+        options.frame = f.frame.clone();
+        options.topic = f.topic.clone();
+        options.gap_policy = f.gap_policy;
+        options.gap_factor = f.gap_factor;
+        options.nominal_dt_s = Some(1.0 / f.rate_hz);
+        options
+    }
+
+    /// Opens it, checks the declared rate against the stamps; also returns the first stamp.
+    fn open_checked(log: &LogSet) -> Result<(Self, StartTime), PlaybackError> {
+        let f = &log.imu;
+        let imu = ImuReader::open(&f.path, &Self::options(log))?;
+        // A declared rate the stamps contradict would integrate every increment over the wrong
+        // interval (or hold every rate over it) without a word: refused, naming both.
+        if let Some(measured) = imu.measured_dt_s()
+            && ((measured * f.rate_hz) - 1.0).abs() > RATE_TOLERANCE
+        {
+            return Err(data_err(format!(
+                "{}: imu.rate_hz = {} Hz is declared, but the time stamps ({}) step by {:.6} s = {:.4} Hz (median of the first intervals): correct rate_hz (or --rate-hz) or the time column's unit",
+                f.path.display(),
+                f.rate_hz,
+                imu.columns().first().map_or("time", String::as_str),
+                measured,
+                1.0 / measured
+            )));
+        }
+        if imu.kind() != f.kind {
+            return Err(data_err(format!(
+                "{}: the file holds {} (its columns {}), the manifest says kind = \"{}\"",
+                f.path.display(),
+                kind_name(imu.kind()),
+                imu.columns().join(", "),
+                kind_name(f.kind)
+            )));
+        }
+        let kind = imu.kind();
+        let start = imu.start_time().ok_or_else(|| data_err(format!("{}: no IMU samples", f.path.display())))?;
+        let imu = ImuStream::spawn(imu)?;
+        Ok((Self { imu, kind, nominal_s: 1.0 / f.rate_hz, last_t: None, pending_gap: false }, start))
+    }
+
+    /// The next sample or gap; None at the end of the file.
+    pub fn next_item(&mut self) -> Result<Option<ImuItem>, PlaybackError> {
+        let Some(event) = self.imu.next() else { return Ok(None) };
+        match event? {
+            ImuEvent::Gap { t_before_s, t_after_s, .. } => {
+                self.pending_gap = true;
+                Ok(Some(ImuItem::Gap { from_s: t_before_s, to_s: t_after_s }))
+            }
+            ImuEvent::Sample(s) => {
+                let (dtheta, dv) = match self.kind {
+                    SampleKind::Increments => (s.gyro, s.accel),
+                    SampleKind::Rates => {
+                        // A rate held over its interval; across a gap, over one nominal interval
+                        // (the gap itself is not integrated).
+                        let dt = match self.last_t {
+                            Some(t) if !self.pending_gap => s.t_s - t,
+                            _ => self.nominal_s,
+                        };
+                        (s.gyro * dt, s.accel * dt)
+                    }
+                };
+                self.pending_gap = false;
+                self.last_t = Some(s.t_s);
+                Ok(Some(ImuItem::Sample { t_s: s.t_s, dtheta, dv }))
+            }
+        }
+    }
+}
+
+/// The largest relative difference accepted between the declared rate and the stamps' (jittery
+/// clocks and PSINS's dither stay well inside 2 %; a wrong unit or rate is off by factors).
+pub const RATE_TOLERANCE: f64 = 0.02;
+
+fn kind_name(k: SampleKind) -> &'static str {
+    match k {
+        SampleKind::Increments => "increments",
+        SampleKind::Rates => "rates",
+    }
+}
