@@ -149,6 +149,24 @@ enum ReferenceTrack {
     File(Box<Track>),
 }
 
+/// The units check of a segment at rest (an alignment window, or a log whose reference declares the
+/// body at rest): gravity's size in the accelerometers and, when no encoder file says the table
+/// turns, at most a small rate in the gyros — rates declared as increments, degrees as radians, g as
+/// m/s² are named. Over the first `span_s`: the whole alignment window, so that a vehicle rocking
+/// back and forth nets out in the mean rate (5 s of it need not).
+fn check_units_at_rest(log: &LogSet, span_s: f64) -> Result<(), PlaybackError> {
+    let options = ImuSamples::options(log);
+    let mut check = crate::io::StaticCheck { duration_s: span_s, ..crate::io::StaticCheck::default() };
+    if log.encoders.is_some() {
+        check.max_gyro_rad_per_s = f64::INFINITY;
+    }
+    let report = crate::io::check_static(&log.imu.path, &options, &check)?;
+    if report.problems.is_empty() {
+        return Ok(());
+    }
+    Err(PlaybackError::Log(LogError::Implausible { file: log.imu.path.clone(), message: report.problems.join("; ") }))
+}
+
 /// The file-clock seconds of a first stamp.
 fn clock_s(start: StartTime) -> f64 {
     match start {
@@ -224,6 +242,9 @@ impl Playback {
         }
         if until_s.is_finite() {
             me.notes.push(format!("replayed up to {:.6} s on the file's clock", until_s + file_start_s));
+        }
+        if matches!(log.reference, Reference::Static(_)) {
+            check_units_at_rest(log, 5.0)?;
         }
         let pre = InsCore::pre_roll_samples(cfg);
         let (start_attitude, pre_roll) = match log.initial {

@@ -226,17 +226,7 @@ pub(super) fn aligned(pb: &mut Playback, log: &LogSet, compensation: &TableError
     if ring.len() < pre {
         return Err(data_err(format!("{}: the log ends before the pre-roll ({pre} samples)", f.path.display())));
     }
-    // At rest and not turning (no encoder file): the declared units must give gravity and at most a
-    // small rate (rates declared as increments, degrees as radians...).
-    if log.encoders.is_none() {
-        let mut options = super::ImuSamples::options(log);
-        options.static_check = None;
-        let check = crate::io::StaticCheck { duration_s: span.min(5.0), ..crate::io::StaticCheck::default() };
-        let report = crate::io::check_static(&f.path, &options, &check)?;
-        if !report.problems.is_empty() {
-            return Err(PlaybackError::Log(crate::io::LogError::Implausible { file: f.path.clone(), message: report.problems.join("; ") }));
-        }
-    }
+    super::check_units_at_rest(log, span)?;
     let imu_spec = &log.table.ins.errors;
     let cfg = AlignConfig {
         latitude_rad: log.table.site.latitude_rad,
