@@ -150,7 +150,7 @@ impl ReplaySummary {
             rows(&mut s, "  ", &self.ins_attitude_error_arcsec);
         }
         let f = &self.final_state;
-        s.push_str(&format!("final IMU attitude: pitch {:.4}°, roll {:.4}°, heading {:.4}° at {:.3} s", f.imu_pitch_deg, f.imu_roll_deg, f.imu_heading_deg.rem_euclid(360.0), f.t_s));
+        s.push_str(&format!("final IMU attitude: pitch {:.4}°, roll {:.4}°, heading {:.4}° at {:.3} s", f.imu_pitch_deg, f.imu_roll_deg, crate::math::units::heading_deg_0_360(f.imu_heading_deg.to_radians()), f.t_s));
         if let (Some(lat), Some(lon), Some(h), Some(v)) = (f.latitude_deg, f.longitude_deg, f.height_m, f.velocity_enu_mps) {
             s.push_str(&format!("; position {lat:.6}°, {lon:.6}°, {h:.1} m; velocity E {:.3} N {:.3} U {:.3} m/s", v[0], v[1], v[2]));
         }

@@ -29,6 +29,13 @@ pub const MPS2_PER_SQRT_S_PER_UG_PER_SQRT_H: f64 = MPS2_PER_UG / 60.0;
 /// m/s³ per µg/h (an accelerometer's acceleration ramp R).
 pub const MPS3_PER_UG_PER_H: f64 = MPS2_PER_UG / 3600.0;
 
+/// A heading in degrees as people write it: [0, 360), with −0.00001° shown as 0, not 359.99999.
+#[must_use]
+pub fn heading_deg_0_360(heading_rad: f64) -> f64 {
+    let h = heading_rad.to_degrees().rem_euclid(360.0);
+    if h >= 360.0 - 5e-7 { 0.0 } else { h }
+}
+
 /// Wraps an angle difference into (-pi, pi].
 #[must_use]
 pub fn wrap_pi(angle_rad: f64) -> f64 {

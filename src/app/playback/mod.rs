@@ -298,9 +298,6 @@ impl Playback {
     /// The next IMU sample through the computer; None at the end of the log.
     pub fn step(&mut self) -> Result<Option<SampleOut>, PlaybackError> {
         let Some(s) = self.read()? else { return Ok(None) };
-        if s.t_s > self.until_s + 1e-9 {
-            return Ok(None);
-        }
         self.samples += 1;
         Ok(Some(self.core.push(s.t_s - self.origin_s, s.dtheta, s.dv)))
     }
@@ -360,6 +357,8 @@ impl Playback {
         loop {
             match self.imu.next_item()? {
                 None => return Ok(None),
+                // The end of the span replayed (--to): the rest of the file is not read.
+                Some(ImuItem::Sample { t_s, .. }) if t_s > self.until_s + 1e-9 => return Ok(None),
                 Some(ImuItem::Gap { from_s, to_s }) => self.gaps.push(Gap { from_s: from_s - self.origin_s, to_s: to_s - self.origin_s }),
                 Some(ImuItem::Sample { t_s, dtheta, dv }) => return Ok(Some(Sample { t_s, dtheta, dv })),
             }

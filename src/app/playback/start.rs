@@ -13,7 +13,7 @@ use crate::ins::align::{self, AlignConfig, Increment, RestScanner};
 use crate::ins::sensor::Spec;
 use crate::math::attitude::Attitude;
 use crate::math::frames::{Rot, N, S};
-use crate::math::units::{MPS2_PER_UG, MPS_PER_SQRT_S_PER_UG_PER_SQRT_HZ, RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H, RAD_PER_S_PER_DEG_PER_H};
+use crate::math::units::{heading_deg_0_360, MPS2_PER_UG, MPS_PER_SQRT_S_PER_UG_PER_SQRT_HZ, RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H, RAD_PER_S_PER_DEG_PER_H};
 use crate::model::gimbal::TableErrors;
 use crate::scenario::logset::{LogSet, DEFAULT_ALIGNMENT_S};
 
@@ -285,10 +285,10 @@ pub(super) fn aligned(pb: &mut Playback, log: &LogSet, compensation: &TableError
         velocity_residual_rms_mps: a.velocity_residual_rms_mps,
         imu_pitch_deg: deg(att.pitch_rad),
         imu_roll_deg: deg(att.roll_rad),
-        imu_heading_deg: deg(att.heading_rad).rem_euclid(360.0),
+        imu_heading_deg: heading_deg_0_360(att.heading_rad),
         sigma_deg: sigma.map(deg),
-        body_attitude_deg: [deg(body.pitch_rad), deg(body.roll_rad), deg(body.heading_rad).rem_euclid(360.0)],
-        coarse_heading_deg: deg(coarse.heading_rad).rem_euclid(360.0),
+        body_attitude_deg: [deg(body.pitch_rad), deg(body.roll_rad), heading_deg_0_360(body.heading_rad)],
+        coarse_heading_deg: heading_deg_0_360(coarse.heading_rad),
         gyro_bias_deg_per_h: per_h(a.gyro_bias_rad_per_s.0),
         gyro_bias_sigma_deg_per_h: per_h(a.gyro_bias_rad_per_s.1),
         accel_bias_ug: ug(a.accel_bias_mps2.0),

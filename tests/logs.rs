@@ -1,0 +1,197 @@
+//! Logs as they come from the field, through `rinscope replay`: a strapdown IMU without a table,
+//! a car that is already moving when the log starts (with a reference that starts a second late),
+//! a declared rate the stamps contradict, `--from`/`--to`, a parked vehicle aligned on its own data.
+//! The moving car's increments are computed here from the WGS84 navigation equations (written
+//! out in this file, not taken from rinscope), so the replay is checked against an independent model.
+
+use std::f64::consts::PI;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn rinscope() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_rinscope"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("rinscope-logs-{}-{name}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn ok(o: &Output) {
+    assert!(o.status.success(), "exit {:?}: {}{}", o.status.code(), stderr(o), stdout(o));
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(path).expect("json file")).expect("valid json")
+}
+
+// WGS84 (NIMA TR8350.2): semi-major axis, first eccentricity squared, rotation rate; normal gravity
+// by Somigliana's formula with the free-air gradient.
+const A: f64 = 6_378_137.0;
+const E2: f64 = 0.006_694_379_990_14;
+const OMEGA: f64 = 7.292_115e-5;
+
+fn gravity(lat: f64, h: f64) -> f64 {
+    let s2 = lat.sin().powi(2);
+    9.780_325_335_9 * (1.0 + 0.001_931_852_652_41 * s2) / (1.0 - E2 * s2).sqrt() - 3.086e-6 * h
+}
+
+fn radii(lat: f64) -> (f64, f64) {
+    let d = 1.0 - E2 * lat.sin().powi(2);
+    (A * (1.0 - E2) / d.powf(1.5), A / d.sqrt())
+}
+
+/// A car driving due North, level, its IMU axes right-forward-up: v_N(t) = v0 + ∫a. Returns the
+/// samples (t, Δθ, Δv) at `hz` for `seconds` and the final (latitude rad, v_N m/s). With the body
+/// frame equal to ENU at every instant, ω_ib^b = ω_ie^n + ω_en^n and f^b = v̇ + (2ω_ie + ω_en) × v − g,
+/// integrated with 20 midpoint sub-steps per sample.
+fn drive_north(lat0: f64, h: f64, v0: f64, accel: impl Fn(f64) -> f64, hz: f64, seconds: f64) -> (Vec<(f64, [f64; 3], [f64; 3])>, f64, f64) {
+    let dt = 1.0 / hz;
+    let sub = 20;
+    let ds = dt / sub as f64;
+    let (mut lat, mut v, mut t) = (lat0, v0, 0.0);
+    let mut out = Vec::new();
+    for _ in 0..(seconds * hz).round() as usize {
+        let (mut g, mut f) = ([0.0; 3], [0.0; 3]);
+        for _ in 0..sub {
+            let tm = t + 0.5 * ds;
+            let a = accel(tm);
+            let vm = v + 0.5 * a * ds;
+            let (rm, _) = radii(lat);
+            let w_ie = [0.0, OMEGA * lat.cos(), OMEGA * lat.sin()];
+            let w_en = [-vm / (rm + h), 0.0, 0.0];
+            let w = [w_ie[0] + w_en[0], w_ie[1] + w_en[1], w_ie[2] + w_en[2]];
+            // (2ω_ie + ω_en) × (0, v, 0) = (−(2ω_ie,z)·v, 0, (2ω_ie,x + ω_en,x)·v).
+            let cor = [-(2.0 * w_ie[2] + w_en[2]) * vm, 0.0, (2.0 * w_ie[0] + w_en[0]) * vm];
+            let fs = [cor[0], a + cor[1], cor[2] + gravity(lat, h)];
+            for k in 0..3 {
+                g[k] += w[k] * ds;
+                f[k] += fs[k] * ds;
+            }
+            lat += vm / (rm + h) * ds;
+            v += a * ds;
+            t += ds;
+        }
+        out.push((t, g, f));
+    }
+    (out, lat, v)
+}
+
+fn write_imu_csv(path: &Path, t0: f64, samples: &[(f64, [f64; 3], [f64; 3])]) {
+    let mut s = String::from("t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n");
+    for (t, g, f) in samples {
+        writeln!(s, "{:.6},{:.15e},{:.15e},{:.15e},{:.15e},{:.15e},{:.15e}", t0 + t, g[0], g[1], g[2], f[0], f[1], f[2]).expect("write");
+    }
+    std::fs::write(path, s).expect("imu csv");
+}
+
+const LAT0_DEG: f64 = 34.0;
+const LON0_DEG: f64 = 108.9;
+const H0: f64 = 380.0;
+
+#[test]
+fn a_car_already_moving_is_navigated_from_the_start_it_is_given_and_refused_without_one() {
+    let dir = scratch("moving");
+    // Starts at 12 m/s, speeds up and slows down (±0.8 m/s² over 20 s periods): 2 minutes, 100 Hz.
+    let accel = |t: f64| 0.8 * (2.0 * PI * t / 20.0).sin();
+    let (samples, lat_end, v_end) = drive_north(LAT0_DEG.to_radians(), H0, 12.0, accel, 100.0, 120.0);
+    // The file's clock starts at 5000 s (a logger's time of day).
+    write_imu_csv(&dir.join("car.csv"), 5000.0, &samples);
+    // A reference attitude (level, heading North) from a second after the IMU's first sample.
+    let mut r = String::from("t_s,pitch_deg,roll_deg,heading_deg\n");
+    for k in 100..=12_000 {
+        writeln!(r, "{:.2},0,0,0", 5000.0 + k as f64 * 0.01).expect("write");
+    }
+    std::fs::write(dir.join("reference.csv"), r).expect("reference");
+    std::fs::write(
+        dir.join("log.toml"),
+        "[log]\nname = \"car\"\n[imu]\nfile = \"car.csv\"\nrate_hz = 100.0\n[reference]\nfile = \"reference.csv\"\n",
+    )
+    .expect("manifest");
+    // Without a start: the IMU alone cannot align a car in motion; the message says so (not "units").
+    let o = rinscope().arg("replay").arg(&dir).args(["--position", "34", "108.9", "380", "--save"]).arg(dir.join("x.rrd")).output().expect("replay");
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("not at rest at the start") && stderr(&o).contains("--velocity-enu-mps"), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("degrees declared as radians"), "{}", stderr(&o));
+    assert!(!dir.join("x.rrd").exists());
+    // With its attitude, velocity and position: navigated, compared from the reference's start.
+    let summary = dir.join("s.json");
+    let o = rinscope()
+        .arg("replay")
+        .arg(&dir)
+        .args(["--attitude-deg", "0", "0", "0", "--velocity-enu-mps", "0", "12", "0", "--position", "34", "108.9", "380", "--save"])
+        .arg(dir.join("car.rrd"))
+        .arg("--summary-json")
+        .arg(&summary)
+        .output()
+        .expect("replay");
+    ok(&o);
+    let s = json(&summary);
+    let notes = s["notes"].as_array().expect("notes");
+    assert!(notes.iter().any(|n| n.as_str().is_some_and(|n| n.contains("starts at 5001.000000 s") && n.contains("comparison starts there"))), "{notes:?}");
+    assert!((s["t0_file_clock_s"].as_f64().expect("t0") - 5000.0).abs() < 0.1, "{}", s["t0_file_clock_s"]);
+    let f = &s["final_state"];
+    // Ideal sensors: what is left is the navigation's numerical error over 2 minutes, a fraction of
+    // a metre and cm/s (the car moved 1.4 km).
+    let (rm, _) = radii(lat_end);
+    let north_err_m = (f["latitude_deg"].as_f64().expect("lat").to_radians() - lat_end) * (rm + H0);
+    let v_err = f["velocity_enu_mps"][1].as_f64().expect("vn") - v_end;
+    assert!(north_err_m.abs() < 0.5, "north position error {north_err_m} m");
+    assert!(v_err.abs() < 0.01, "north velocity error {v_err} m/s");
+    assert!((f["longitude_deg"].as_f64().expect("lon") - LON0_DEG).abs() * 111e3 * 0.83 < 0.5, "east drift");
+    let heading_peak = s["ins_attitude_error_arcsec"]["two-sample-p1"]["heading"]["peak_arcsec"].as_f64().unwrap_or(f64::NAN);
+    assert!(heading_peak < 1.0, "heading error against the level reference {heading_peak}″: {s}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_declared_rate_the_stamps_contradict_is_refused_naming_both() {
+    let dir = scratch("rate");
+    let (samples, _, _) = drive_north(LAT0_DEG.to_radians(), H0, 0.0, |_| 0.0, 100.0, 20.0);
+    write_imu_csv(&dir.join("imu.csv"), 0.0, &samples);
+    std::fs::write(dir.join("log.toml"), "[log]\nname = \"r\"\n[imu]\nfile = \"imu.csv\"\nrate_hz = 20.0\n[initial]\nposition = [34.0, 108.9, 380.0]\n").expect("manifest");
+    let o = rinscope().arg("replay").arg(&dir).args(["--save"]).arg(dir.join("x.rrd")).output().expect("replay");
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("rate_hz = 20 Hz") && stderr(&o).contains("100.0000 Hz"), "{}", stderr(&o));
+    assert!(!dir.join("x.rrd").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_parked_strapdown_imu_is_aligned_on_its_own_data_and_trimmed_on_its_clock() {
+    // 150 s at rest (ideal sensors) at 34° N, heading North, level; then --from/--to trim it. The
+    // alignment's heading is the exact one (0°) to within its 1σ, and it is reported with its window.
+    let dir = scratch("parked");
+    let (samples, _, _) = drive_north(LAT0_DEG.to_radians(), H0, 0.0, |_| 0.0, 100.0, 150.0);
+    write_imu_csv(&dir.join("imu.csv"), 100.0, &samples);
+    std::fs::write(dir.join("log.toml"), "[log]\nname = \"parked\"\n[imu]\nfile = \"imu.csv\"\n[initial]\nposition = [34.0, 108.9, 380.0]\n").expect("manifest");
+    let summary = dir.join("s.json");
+    let o = rinscope().arg("replay").arg(&dir).args(["--from", "110", "--to", "240", "--save"]).arg(dir.join("p.rrd")).arg("--summary-json").arg(&summary).output().expect("replay");
+    ok(&o);
+    let s = json(&summary);
+    let a = &s["alignment"];
+    assert_eq!(s["strapdown"], true);
+    let heading = a["imu_heading_deg"].as_f64().expect("heading");
+    let sigma = a["sigma_deg"][2].as_f64().expect("σ");
+    let off = (heading + 180.0).rem_euclid(360.0) - 180.0;
+    assert!(off.abs() < 3.0 * sigma.max(1e-4), "heading {heading}° ± {sigma}°");
+    assert!((a["window_from_s"].as_f64().expect("from") - 110.0).abs() < 0.05, "{a}");
+    assert!(a["warnings"].as_array().expect("warnings").is_empty(), "{a}");
+    // Ran from 110 s to 240 s on the file's clock: the window (130 s at rest) and nothing after 240 s.
+    assert!(s["duration_s"].as_f64().expect("duration") < 0.05, "{s}");
+    // No table in a strapdown summary.
+    assert!(s.get("attitude_error_arcsec").is_none(), "{s}");
+    assert!(stdout(&o).contains("alignment") && !stdout(&o).contains("nominal"), "{}", stdout(&o));
+    std::fs::remove_dir_all(&dir).ok();
+}
