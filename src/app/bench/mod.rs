@@ -1,6 +1,7 @@
 //! `rinscope bench`: simulation speed without recording, and a full recorded run's speed and size;
 //! `bench --peer pyins` (peer.rs) against another INS.
 
+mod logs;
 pub mod peer;
 
 use std::sync::atomic::AtomicBool;
@@ -70,7 +71,7 @@ fn check(stop: &AtomicBool) -> anyhow::Result<()> {
 }
 
 /// The benchmark sections, in the order they run (`bench --only`).
-pub const SECTIONS: [&str; 7] = ["simulation", "strapdown", "pipeline", "navigation", "recorded", "calibration", "allan"];
+pub const SECTIONS: [&str; 8] = ["simulation", "strapdown", "pipeline", "navigation", "logs", "recorded", "calibration", "allan"];
 
 /// Runs the benchmarks (the sections in `only`; all when it is empty), prints their numbers and
 /// returns them; an error as soon as `stop` is set.
@@ -86,6 +87,7 @@ pub fn run_benchmarks(steps: u64, only: &[String], stop: &AtomicBool) -> anyhow:
             navigation_speed(&crate::scenario::parse(CONING_2KHZ, "bench")?, f);
             Ok(())
         }),
+        Box::new(|f| logs::log_speed(f, stop)),
         Box::new(|f| recorded_in_scratch(f, stop)),
         Box::new(|f| calibration_speed(f, stop)),
         Box::new(|f| allan_speed(f, stop)),
