@@ -49,10 +49,12 @@ fn load_log(args: &ReplayArgs) -> Result<logset::LogSet, Failure> {
         return Err(Failure::input("replay: give a log set's folder, or --imu FILE with --rate-hz and --table"));
     };
     let ext = imu.extension().and_then(|e| e.to_str()).unwrap_or("");
+    // An empty layout: the log set's default (psins-imu for a PSINS SIMU file, else rinscope).
     let layout = args.imu_layout.clone().unwrap_or_else(|| match ext {
         "npy" => "npy7".into(),
         "mcap" => "ros2".into(),
-        _ => "rinscope".into(),
+        "imu" => "psins-imu".into(),
+        _ => String::new(),
     });
     let name: String = imu.file_stem().and_then(|s| s.to_str()).unwrap_or("replay").chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '_' }).collect();
     let attitude = match &args.attitude_deg {

@@ -286,10 +286,12 @@ struct ReplayArgs {
     /// description's [compensation].
     #[arg(long, value_name = "FILE")]
     compensation: Option<PathBuf>,
-    /// Without a log set: an IMU file (.csv, .txt, .npy, .parquet, .mcap).
+    /// Without a log set: an IMU file (.csv, .txt, .npy, .parquet, .mcap, PSINS .imu).
     #[arg(long, requires_all = ["rate_hz", "table"])]
     imu: Option<PathBuf>,
-    /// --imu: its layout: rinscope, psins, kf-gins, kalibr, npy7, ros2 (default from the extension).
+    /// --imu: its layout: rinscope, psins, psins-imu, kf-gins, kalibr, npy7, ros2 (default from the
+    /// extension: .npy npy7, .mcap ros2, .imu psins-imu; else psins-imu for a file whose first line
+    /// names PSINS and SIMU, rinscope otherwise).
     #[arg(long, requires = "imu")]
     imu_layout: Option<String>,
     /// --imu: increments or rates.

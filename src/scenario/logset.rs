@@ -63,10 +63,12 @@ fn default_table() -> String {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawImuFile {
-    /// The file, relative to the folder (.csv, .txt, .npy, .parquet, .mcap).
+    /// The file, relative to the folder (.csv, .txt, .npy, .parquet, .mcap, PSINS .imu).
     pub file: String,
-    /// "rinscope" (units in the column names), "psins", "kf-gins", "kalibr", "npy7", "ros2".
-    #[serde(default = "default_layout")]
+    /// "rinscope" (units in the column names), "psins", "psins-imu", "kf-gins", "kalibr", "npy7",
+    /// "ros2"; empty (absent): "psins-imu" for a PSINS SIMU file (its first line names PSINS and
+    /// SIMU), else "rinscope".
+    #[serde(default, skip_serializing_if = "String::is_empty")]
     pub layout: String,
     /// "increments" or "rates" (checked against the layout's own).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -92,9 +94,6 @@ pub struct RawImuFile {
     pub gap_factor: f64,
 }
 
-fn default_layout() -> String {
-    "rinscope".into()
-}
 fn default_refuse() -> String {
     "refuse".into()
 }
@@ -379,14 +378,18 @@ fn imu_file(c: &Checker<'_>, dir: &Path, raw: &RawImuFile) -> Result<ImuFile, Co
         "gps_sow" => TimeUnit::GpsSecondsOfWeek,
         other => return Err(c.invalid("imu.time", format!("\"{other}\" is not a time unit; use \"s\", \"ms\", \"us\", \"ns\" or \"gps_sow\""))),
     };
+    let path = dir.join(&raw.file);
     let layout = match raw.layout.as_str() {
-        "rinscope" => Layout::Rinscope,
+        // No layout: the file's first line tells a PSINS SIMU file (an unreadable file is reported when read).
+        "" if matches!(crate::io::detect_format(&path), Ok(crate::io::Format::PsinsImu)) => Layout::PsinsImu,
+        "" | "rinscope" => Layout::Rinscope,
         "psins" => Layout::Psins,
+        "psins-imu" => Layout::PsinsImu,
         "kf-gins" => Layout::KfGins,
         "kalibr" => Layout::Kalibr,
         "npy7" => Layout::Npy7 { time },
         "ros2" => Layout::Ros2,
-        other => return Err(c.invalid("imu.layout", format!("\"{other}\" is not a layout; use \"rinscope\", \"psins\", \"kf-gins\", \"kalibr\", \"npy7\" or \"ros2\""))),
+        other => return Err(c.invalid("imu.layout", format!("\"{other}\" is not a layout; use \"rinscope\", \"psins\", \"psins-imu\", \"kf-gins\", \"kalibr\", \"npy7\" or \"ros2\""))),
     };
     if raw.time.is_some() && !matches!(layout, Layout::Npy7 { .. }) {
         return Err(c.invalid("imu.time", "is read by the npy7 layout only (the others say their time unit themselves)"));
@@ -410,7 +413,7 @@ fn imu_file(c: &Checker<'_>, dir: &Path, raw: &RawImuFile) -> Result<ImuFile, Co
         other => return Err(c.invalid("imu.gap_policy", format!("\"{other}\" is not a policy; use \"refuse\" or \"split\""))),
     };
     Ok(ImuFile {
-        path: dir.join(&raw.file),
+        path,
         layout,
         kind,
         rate_hz,
@@ -486,4 +489,35 @@ pub fn compensation_from_calibration(table: &RawTable, json_text: &str, origin: 
     }
     take!(installation_x_arcsec, installation_y_arcsec, installation_z_arcsec, imu_mount_x_arcsec, imu_mount_y_arcsec, imu_mount_z_arcsec);
     Ok(validate::validate_compensation(&c, &merged, &table.turntable, &chain, &stated)?.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn raw_imu(file: &str, layout: &str) -> RawImuFile {
+        RawImuFile { file: file.into(), layout: layout.into(), kind: None, rate_hz: 100.0, frame: None, time: None, topic: None, gap_policy: "refuse".into(), gap_factor: 3.0 }
+    }
+
+    #[test]
+    fn psins_imu_by_name_and_when_no_layout_is_given() {
+        let dir = std::env::temp_dir().join(format!("rinscope-logset-psins-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("scratch dir");
+        // imufile.m's first line; the reader checks the rest.
+        std::fs::write(dir.join("trj.txt"), "% PSINS-format SIMU log file. (DO NOT MODIFY!)\n").expect("write");
+        std::fs::write(dir.join("imu.csv"), "t_s,dtheta_x_rad\n").expect("write");
+        let c = Checker { origin: "log.toml" };
+        let layout = |file: &str, name: &str| imu_file(&c, &dir, &raw_imu(file, name)).map(|f| f.layout);
+        assert_eq!(layout("trj.txt", "psins-imu").ok(), Some(Layout::PsinsImu));
+        assert_eq!(layout("trj.txt", "").ok(), Some(Layout::PsinsImu));
+        assert_eq!(layout("imu.csv", "").ok(), Some(Layout::Rinscope));
+        assert_eq!(layout("missing.csv", "").ok(), Some(Layout::Rinscope));
+        let e = layout("trj.txt", "psins-simu").expect_err("not a layout").to_string();
+        assert!(e.contains("\"psins-imu\""), "{e}");
+        // An absent key is the empty layout, and is not written back.
+        let raw: RawImuFile = toml::from_str("file = \"trj.txt\"\nrate_hz = 100.0\n").expect("parse");
+        assert_eq!(raw.layout, "");
+        assert!(!toml::to_string(&raw).expect("serialise").contains("layout"));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }
