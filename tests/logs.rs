@@ -195,3 +195,70 @@ fn a_parked_strapdown_imu_is_aligned_on_its_own_data_and_trimmed_on_its_clock() 
     assert!(stdout(&o).contains("alignment") && !stdout(&o).contains("nominal"), "{}", stdout(&o));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[path = "io/psins_writer.rs"]
+#[allow(dead_code)]
+mod psins_writer;
+
+/// A PSINS SIMU file (as `imufile.m` writes it) of `samples` (t, Δθ, Δv) with header `avp0` =
+/// [pitch, roll, yaw (deg; PSINS's yaw is counter-clockwise), VE, VN, VU, lat, lon (deg), h, t0].
+fn write_psins(path: &Path, samples: &[(f64, [f64; 3], [f64; 3])], avp0: [f64; 10], ts: f64) {
+    let imu: Vec<[f64; 7]> = samples.iter().map(|(t, g, f)| [g[0], g[1], g[2], f[0], f[1], f[2], avp0[9] + t]).collect();
+    // A ring-laser gyro's 0.01″ pulses and 1 µg·s accelerometer pulses (PSINS's own defaults are 0.1″, 125 µg·s).
+    let input = psins_writer::SimuInput { imu, avp0, ts, scales: [0.01, 0.01, 0.01, 1.0, 1.0, 1.0] };
+    std::fs::write(path, psins_writer::imufile_text(&input)).expect("psins file");
+}
+
+/// An IMU fixed on the Earth at `lat` with body attitude (pitch, roll, heading clockwise), exact:
+/// ω^b = C_n^b ω_ie^n, f^b = C_n^b (0, 0, g), C_b^n = Rz(−heading) Rx(pitch) Ry(roll) (ENU, RFU).
+fn parked(lat: f64, h: f64, pitch: f64, roll: f64, heading: f64, hz: f64, seconds: f64) -> Vec<(f64, [f64; 3], [f64; 3])> {
+    use nalgebra::{Rotation3, Vector3};
+    let c_bn = Rotation3::from_axis_angle(&Vector3::z_axis(), -heading) * Rotation3::from_axis_angle(&Vector3::x_axis(), pitch) * Rotation3::from_axis_angle(&Vector3::y_axis(), roll);
+    let w = c_bn.inverse() * Vector3::new(0.0, OMEGA * lat.cos(), OMEGA * lat.sin());
+    let f = c_bn.inverse() * Vector3::new(0.0, 0.0, gravity(lat, h));
+    let dt = 1.0 / hz;
+    // The body turns with the Earth in inertial space (ω^b constant), so the increments are ω·dt, f·dt
+    // up to second-order terms of (Ω dt)² ~ 5e-13.
+    (1..=(seconds * hz).round() as usize).map(|k| (k as f64 * dt, (w * dt).into(), (f * dt).into())).collect()
+}
+
+#[test]
+fn a_psins_imu_file_replays_with_nothing_else_and_is_aligned_on_its_data() {
+    // `rinscope replay --imu run.imu` alone: the header gives the rate, the site and a (deliberately
+    // 2° wrong) heading; the vehicle is parked, so the INS aligns on the data and finds the true one.
+    let dir = scratch("psins");
+    let (lat, heading) = (34.246_048_f64, 90.6_f64);
+    let samples = parked(lat.to_radians(), 380.0, 0.3_f64.to_radians(), -0.2_f64.to_radians(), heading.to_radians(), 100.0, 600.0);
+    // PSINS yaw = −heading; the header says −92.6 (heading 92.6°).
+    write_psins(&dir.join("run.imu"), &samples, [0.3, -0.2, -92.6, 0.0, 0.0, 0.0, lat, 108.909_664, 380.0, 0.0], 0.01);
+    let summary = dir.join("s.json");
+    let o = rinscope().arg("replay").arg("--imu").arg(dir.join("run.imu")).arg("--save").arg(dir.join("r.rrd")).arg("--summary-json").arg(&summary).output().expect("replay");
+    ok(&o);
+    let s = json(&summary);
+    let a = &s["alignment"];
+    assert!((a["latitude_site_deg"].as_f64().expect("lat") - lat).abs() < 1e-6, "the site is the header's: {a}");
+    let (h, sigma) = (a["imu_heading_deg"].as_f64().expect("heading"), a["sigma_deg"][2].as_f64().expect("σ"));
+    assert!((h - heading).abs() < 3.0 * sigma + 0.01, "heading {h}° ± {sigma}° vs the true {heading}°");
+    assert!((h - heading).abs() < 0.5, "heading {h}° vs the true {heading}° (the header's 92.6° was not taken)");
+    assert!(stdout(&o).contains("PSINS header") && stdout(&o).contains("92.6"), "the header's heading is compared: {}", stdout(&o));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_psins_imu_file_that_starts_moving_starts_from_its_header() {
+    let dir = scratch("psins-moving");
+    let accel = |t: f64| 0.8 * (2.0 * PI * t / 20.0).sin();
+    let (samples, lat_end, v_end) = drive_north(LAT0_DEG.to_radians(), H0, 12.0, accel, 100.0, 60.0);
+    write_psins(&dir.join("car.imu"), &samples, [0.0, 0.0, 0.0, 0.0, 12.0, 0.0, LAT0_DEG, LON0_DEG, H0, 0.0], 0.01);
+    let summary = dir.join("s.json");
+    let o = rinscope().arg("replay").arg("--imu").arg(dir.join("car.imu")).arg("--save").arg(dir.join("c.rrd")).arg("--summary-json").arg(&summary).output().expect("replay");
+    ok(&o);
+    let s = json(&summary);
+    assert!(s["notes"].to_string().contains("moves at the start") && s["notes"].to_string().contains("PSINS header"), "{}", s["notes"]);
+    let f = &s["final_state"];
+    let (rm, _) = radii(lat_end);
+    let north_err_m = (f["latitude_deg"].as_f64().expect("lat").to_radians() - lat_end) * (rm + H0);
+    assert!(north_err_m.abs() < 1.0, "north {north_err_m} m");
+    assert!((f["velocity_enu_mps"][1].as_f64().expect("vn") - v_end).abs() < 0.02);
+    std::fs::remove_dir_all(&dir).ok();
+}

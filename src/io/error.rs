@@ -18,6 +18,8 @@ pub struct Location {
 impl fmt::Display for Location {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self.line {
+            // Not at a data row: a header line.
+            Some(line) if self.row == 0 => write!(f, "line {line}"),
             Some(line) => write!(f, "data row {} (line {line})", self.row),
             None => write!(f, "data row {}", self.row),
         }
@@ -130,6 +132,21 @@ pub enum LogError {
         column: String,
         /// The value as text ("NaN", "inf", "null").
         value: String,
+    },
+    /// A number that cannot stand where it is (a PSINS count with a fraction, a sampling interval
+    /// that is not positive, ...).
+    #[error("{}: {at}, column {column}: {value:?} {problem}", .file.display())]
+    BadValue {
+        /// The file.
+        file: PathBuf,
+        /// Row and line (row 0: a header line).
+        at: Location,
+        /// Column name.
+        column: String,
+        /// The cell text (cut to 40 characters).
+        value: String,
+        /// Why it cannot be, and what is expected.
+        problem: String,
     },
     /// A row with a different number of fields than the header (or the first row).
     #[error("{}: {at}: {found} fields where the {reference} has {expected}{}", .file.display(), if *.truncated_last_line { "; this is the last line and it has no line end: the file looks truncated (cut off while being written?)" } else { "" })]
@@ -293,6 +310,7 @@ impl LogError {
             | Self::MissingColumn { file, .. }
             | Self::NonNumeric { file, .. }
             | Self::NonFinite { file, .. }
+            | Self::BadValue { file, .. }
             | Self::FieldCount { file, .. }
             | Self::NpyDtype { file, .. }
             | Self::Shape { file, .. }

@@ -21,11 +21,11 @@ pub fn guess_layout(path: &Path) -> Result<&'static str> {
         Some(Format::Parquet) => return Ok("rinscope"),
         _ => {}
     }
-    let head = read_head(path)?;
-    let lines: Vec<&str> = head.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
-    if lines.first().is_some_and(|l| l.contains("PSINS") && l.contains("SIMU")) {
+    if crate::io::sniff::detect_format(path)? == Format::PsinsImu {
         return Ok("psins-imu");
     }
+    let head = read_head(path)?;
+    let lines: Vec<&str> = head.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
     let data: Vec<&str> = lines.iter().copied().filter(|l| !l.starts_with('%') && !l.starts_with("//")).collect();
     let Some(first) = data.first() else {
         return Err(layout_error(path, "it has no data lines to tell its layout from".into()));
@@ -62,7 +62,6 @@ fn layout_error(path: &Path, why: String) -> LogError {
 }
 
 fn read_head(path: &Path) -> Result<String> {
-    crate::io::sniff::detect_format(path)?;
     let file = std::fs::File::open(path).map_err(|e| LogError::io(path, "cannot open", e))?;
     let mut buf = Vec::new();
     file.take(HEAD_BYTES).read_to_end(&mut buf).map_err(|e| LogError::io(path, "cannot read", e))?;

@@ -19,6 +19,16 @@
 //! "Outputs: imu = \[wm,vm,t\]" (PSINS toolbox by Gongmin Yan, NWPU, `base/base1/ap2imu.m`);
 //! its body frame is right-front-up (its `imurfu` turns other axis orders into RFU). Default frame RFU.
 //!
+//! **PSINS SIMU file** ([`Layout::PsinsImu`], `psins-imu`): the `.imu` text that PSINS's
+//! `imufile.m` writes: `%` comment lines (the first names PSINS and SIMU), three header rows —
+//! initial pitch, roll, yaw (deg), velocity E, N, U (m/s); latitude, longitude (deg), height (m),
+//! t0 (s), sampling interval (ms), g (m/s²); gyro scale factors (arcsec) and accelerometer ones
+//! (µg·s) — then one row of integer counts per sample, with an optional 7th column of time dither
+//! (µs). Increments are count × scale; sample k (from 1) is at t0 + k·ts (+ Σ dither·1e-6), so
+//! [`ImuReader::start_time`] is t0 + ts. The header: [`ImuReader::psins_header`],
+//! [`crate::io::read_psins_header`]; the details: the `psins_imu` module. Found by its first
+//! line whatever the extension; other layouts refuse it. Default frame RFU.
+//!
 //! **KF-GINS** ([`Layout::KfGins`]): text without a header, fields separated by spaces, tabs or
 //! commas, 7 (or more; extra columns ignored) columns: GNSS seconds of week (s), X-Y-Z incremental
 //! angles (rad), X-Y-Z incremental velocity (m/s) — the "IMU text file format" table in KF-GINS's
@@ -52,6 +62,7 @@
 use crate::io::error::{Location, LogError, Result};
 use crate::io::frames::Frame;
 use crate::io::layout::{plan_for, read_options};
+use crate::io::psins_imu::PsinsHeader;
 use crate::io::table::ColumnReader;
 use nalgebra::{Matrix3, Vector3};
 use std::collections::VecDeque;
@@ -131,6 +142,8 @@ pub enum Layout {
     Rinscope,
     /// PSINS `[wm vm t]`.
     Psins,
+    /// PSINS SIMU file (`.imu`) as PSINS's `imufile.m` writes it: header and integer counts.
+    PsinsImu,
     /// KF-GINS IMU text file `(t_gps_sow, dtheta_xyz, dv_xyz)`.
     KfGins,
     /// Kalibr / EuRoC `imu0.csv`.
@@ -188,7 +201,8 @@ pub struct ImuOptions {
     pub gap_policy: GapPolicy,
     /// An interval longer than this many nominal intervals is a gap (default 3).
     pub gap_factor: f64,
-    /// The nominal sampling interval, s; `None` estimates it from the first intervals.
+    /// The nominal sampling interval, s; `None` takes a PSINS SIMU file's header interval, or
+    /// estimates it from the first intervals.
     pub nominal_dt_s: Option<f64>,
     /// Run the static plausibility check when opening.
     pub static_check: Option<StaticCheck>,
@@ -326,6 +340,8 @@ pub struct ImuReader {
     gap_policy: GapPolicy,
     gap_factor: f64,
     time_column: String,
+    /// A PSINS SIMU file's header.
+    psins: Option<PsinsHeader>,
     /// The frame conversion is the identity (skip the products).
     c_identity: bool,
     /// Formats without exact integers are read in blocks of rows (row-major).
@@ -384,6 +400,7 @@ impl ImuReader {
         })?;
         let reader = ColumnReader::open(path, &plan.cols, &read_options(options, plan.header))?;
         let time_column = reader.columns().first().cloned().unwrap_or_default();
+        let psins = reader.psins_header().cloned();
         let mut this = Self {
             path: path.to_path_buf(),
             reader,
@@ -404,8 +421,9 @@ impl ImuReader {
             block_first_row: 1,
             read_error: None,
             prev: None,
-            nominal_dt_s: options.nominal_dt_s,
+            nominal_dt_s: options.nominal_dt_s.or(psins.as_ref().map(|h| h.interval_s)),
             measured_dt_s: None,
+            psins,
             held: None,
             done: false,
             gap_policy: options.gap_policy,
@@ -511,6 +529,12 @@ impl ImuReader {
     #[must_use]
     pub fn start_time(&self) -> Option<StartTime> {
         self.clock.start()
+    }
+
+    /// The header of a PSINS SIMU file ([`Layout::PsinsImu`]); `None` for other layouts.
+    #[must_use]
+    pub fn psins_header(&self) -> Option<&PsinsHeader> {
+        self.psins.as_ref()
     }
 
     #[inline]

@@ -2,6 +2,8 @@
 
 use crate::io::error::{LogError, Result};
 use crate::io::imu::{ImuOptions, Layout, SampleKind, TimeUnit};
+use crate::io::psins_imu::{first_line, not_psins};
+use crate::io::sniff::{Format, detect_format};
 use crate::io::table::{Col, ColumnReader, HeaderMode, ReadOptions};
 use crate::io::units::{Quantity, split_unit, suffixes_for};
 use std::path::Path;
@@ -36,11 +38,51 @@ fn fixed(
     }
 }
 
+impl Layout {
+    /// The layout's name in a log set's `[imu] layout` and in `--imu-layout`.
+    #[must_use]
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Rinscope => "rinscope",
+            Self::Psins => "psins",
+            Self::PsinsImu => "psins-imu",
+            Self::KfGins => "kf-gins",
+            Self::Kalibr => "kalibr",
+            Self::Npy7 { .. } => "npy7",
+            Self::Ros2 => "ros2",
+        }
+    }
+}
+
+/// A PSINS SIMU file is read by the psins-imu layout only, and that layout reads nothing else.
+fn check_psins(path: &Path, layout: &Layout) -> Result<()> {
+    let format = detect_format(path)?;
+    let layout_error = |problem: String| LogError::Layout {
+        file: path.to_path_buf(),
+        problem,
+    };
+    match (layout, format) {
+        (Layout::PsinsImu, Format::PsinsImu) => Ok(()),
+        (Layout::PsinsImu, Format::Text) => Err(not_psins(path, first_line(path)?.as_deref())),
+        (Layout::PsinsImu, other) => Err(layout_error(format!(
+            "layout psins-imu reads PSINS SIMU text files (imufile.m), and this is {}",
+            other.describe()
+        ))),
+        (other, Format::PsinsImu) => Err(layout_error(format!(
+            "this is a PSINS .imu file (its first line names PSINS and SIMU: PSINS's imufile.m wrote it), not the {} layout: its integer counts are scaled by its header; use layout = \"psins-imu\" (or give no layout: a file that starts so is read as psins-imu)",
+            other.name()
+        ))),
+        _ => Ok(()),
+    }
+}
+
 pub(crate) fn plan_for(path: &Path, options: &ImuOptions) -> Result<Plan> {
     use HeaderMode::{Absent, Auto};
     use SampleKind::{Increments, Rates};
+    check_psins(path, &options.layout)?;
     Ok(match &options.layout {
-        Layout::Psins => fixed(
+        // imufile.m's [wm vm t], decoded by the PSINS source (`psins_imu`).
+        Layout::Psins | Layout::PsinsImu => fixed(
             TimeUnit::Seconds,
             Increments,
             [6, 0, 1, 2, 3, 4, 5],
@@ -64,7 +106,7 @@ pub(crate) fn plan_for(path: &Path, options: &ImuOptions) -> Result<Plan> {
         Layout::Npy7 { time } => fixed(*time, Increments, [0, 1, 2, 3, 4, 5, 6], None, Auto),
         Layout::Rinscope | Layout::Ros2 => {
             let probe = ColumnReader::open(path, &[], &read_options(options, Auto))?;
-            let is_mcap = probe.format() == crate::io::sniff::Format::Mcap;
+            let is_mcap = probe.format() == Format::Mcap;
             if options.layout == Layout::Ros2 && !is_mcap {
                 return Err(LogError::Layout {
                     file: path.to_path_buf(),

@@ -1,6 +1,7 @@
-//! Layer 0, files: tabular logs in and out — streaming column readers for CSV, NumPy .npy, Parquet
-//! and MCAP (ROS 2 `sensor_msgs/msg/Imu`), IMU layouts with checked units and frames, atomic table
-//! writers — and outputs that a reader never sees half-written ([`files`]).
+//! Layer 0, files: tabular logs in and out — streaming column readers for CSV, NumPy .npy, Parquet,
+//! MCAP (ROS 2 `sensor_msgs/msg/Imu`) and PSINS SIMU `.imu` text ([`read_psins_header`]), IMU
+//! layouts with checked units and frames, atomic table writers — and outputs that a reader never
+//! sees half-written ([`files`]).
 //!
 //! * [`ColumnReader`] reads chosen columns of any supported file as f64 rows, one at a time, with
 //!   memory that does not grow with the file. The format comes from the extension and is checked
@@ -25,6 +26,7 @@ mod mcap_imu;
 mod npy;
 mod parquet_io;
 mod plausibility;
+mod psins_imu;
 mod sniff;
 mod table;
 mod text;
@@ -40,6 +42,7 @@ pub use imu::{
 };
 pub use mcap_imu::MCAP_IMU_COLUMNS;
 pub use plausibility::{EARTH_RATE_RAD_PER_S, StaticReport, check_static};
+pub use psins_imu::{PsinsHeader, read_psins_header};
 pub use sniff::{Format, detect_format};
 pub use table::{Col, ColumnReader, HeaderMode, ReadOptions};
 pub use writer::TableWriter;

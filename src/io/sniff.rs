@@ -17,6 +17,10 @@ pub enum Format {
     /// Delimited text: comma-separated with a header, or whitespace/comma-separated without
     /// (`.csv`, `.txt`, `.tsv`, `.dat`, `.imu`, `.log`).
     Text,
+    /// A PSINS SIMU file as PSINS's `imufile.m` writes it: text (usually `.imu`, any text
+    /// extension) told from other text by its first line, a `%` comment naming PSINS and SIMU.
+    /// Read as the columns `imufile.m` returns, `dtheta_{x,y,z}_rad, dv_{x,y,z}_mps, t_s`.
+    PsinsImu,
     /// NumPy `.npy` (v1, v2, v3), 2-D, float64 or float32.
     Npy,
     /// Apache Parquet (`.parquet`, `.pq`).
@@ -39,9 +43,10 @@ impl Format {
         })
     }
 
-    fn describe(self) -> &'static str {
+    pub(crate) fn describe(self) -> &'static str {
         match self {
             Self::Text => "a text table (.csv/.txt)",
+            Self::PsinsImu => "a PSINS SIMU file (imufile.m)",
             Self::Npy => "a NumPy .npy file",
             Self::Parquet => "a Parquet file",
             Self::Mcap => "an MCAP file",
@@ -79,13 +84,18 @@ fn classify(head: &[u8]) -> (Option<Format>, String) {
             Err(e) => e.error_len().is_none(),
         };
     if text_like {
-        let first_line: String = String::from_utf8_lossy(head)
-            .lines()
-            .next()
-            .unwrap_or("")
+        let line = head.split(|&b| b == b'\n').next().unwrap_or(head);
+        let first_line: String = String::from_utf8_lossy(line)
+            .trim_end_matches('\r')
             .chars()
             .take(60)
             .collect();
+        if crate::io::psins_imu::names_psins_simu(line) {
+            return (
+                Some(Format::PsinsImu),
+                format!("its first line {first_line:?} is a PSINS SIMU file's (imufile.m)"),
+            );
+        }
         return (
             Some(Format::Text),
             format!("its content is text (first line {first_line:?})"),
@@ -103,7 +113,8 @@ fn classify(head: &[u8]) -> (Option<Format>, String) {
 
 /// The format of `path`: from its extension, checked against its first bytes.
 ///
-/// A file without a known extension is classified by content alone.
+/// A file without a known extension is classified by content alone. A text file whose first line
+/// is a `%` comment naming PSINS and SIMU is [`Format::PsinsImu`], whatever its text extension.
 ///
 /// # Errors
 /// [`LogError::Io`] if the file cannot be read, [`LogError::NotTheFormat`] if the content does not
@@ -124,6 +135,8 @@ pub fn detect_format(path: &Path) -> Result<Format> {
     };
     match (expected, found) {
         (Some(e), Some(f)) if e == f => {}
+        // A PSINS SIMU file is text: its first line tells it from other text.
+        (Some(Format::Text), Some(Format::PsinsImu)) => return Ok(Format::PsinsImu),
         (Some(e), _) => return Err(not_the_format(e.describe(), description)),
         (None, Some(_)) => {}
         (None, None) => return Err(not_the_format("a log (unknown extension)", description)),
@@ -175,5 +188,11 @@ mod tests {
         assert_eq!(classify(b"").0, None);
         // "é" (c3 a9) cut after its first byte is still text.
         assert_eq!(classify(b"t_s,caf\xc3").0, Some(Format::Text));
+        // imufile.m's first line; PSINS and SIMU on a later line do not count.
+        assert_eq!(
+            classify(b"% PSINS-format SIMU log file. (DO NOT MODIFY!)\r\n% 2024-01-01\n").0,
+            Some(Format::PsinsImu)
+        );
+        assert_eq!(classify(b"% a log\n% PSINS-format SIMU log file.\n").0, Some(Format::Text));
     }
 }

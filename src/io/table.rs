@@ -1,6 +1,7 @@
 //! The streaming column reader: open a file, name the columns wanted, get rows of f64 one at a time.
 
 use crate::io::error::{Location, LogError, Result};
+use crate::io::psins_imu::PsinsHeader;
 use crate::io::sniff::{Format, detect_format};
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -90,6 +91,10 @@ pub(crate) trait Source {
     fn never_exact(&self) -> bool {
         false
     }
+    /// A PSINS SIMU file's header.
+    fn psins_header(&self) -> Option<&PsinsHeader> {
+        None
+    }
 }
 
 /// Reads selected columns of a table as f64 rows, streaming: memory does not grow with the file.
@@ -145,7 +150,8 @@ impl ColumnReader {
     /// An empty `columns` opens the file only to look at [`Self::all_columns`].
     ///
     /// For MCAP the columns are fixed: `t_ns, gyro_x_rad_per_s, gyro_y_rad_per_s, gyro_z_rad_per_s,
-    /// accel_x_mps2, accel_y_mps2, accel_z_mps2` (see the `mcap_imu` module).
+    /// accel_x_mps2, accel_y_mps2, accel_z_mps2` (see the `mcap_imu` module); for a PSINS SIMU file
+    /// they are `imufile.m`'s `[wm vm t]`: `dtheta_{x,y,z}_rad, dv_{x,y,z}_mps, t_s` (absolute).
     ///
     /// # Errors
     /// Unreadable file, content not of the extension's format, a malformed header, or a missing
@@ -159,6 +165,7 @@ impl ColumnReader {
                     as Box<dyn Source + Send>,
                 Format::Npy => Box::new(crate::io::npy::NpySource::open(path)?),
                 Format::Parquet => Box::new(crate::io::parquet_io::ParquetSource::open(path)?),
+                Format::PsinsImu => Box::new(crate::io::psins_imu::PsinsSource::open(path)?),
                 Format::Mcap => Box::new(crate::io::mcap_imu::McapImuSource::open(
                     path,
                     options.topic.as_deref(),
@@ -312,6 +319,12 @@ impl ColumnReader {
             });
         }
         Ok(n)
+    }
+
+    /// The header of a PSINS SIMU file ([`Format::PsinsImu`]); `None` for other formats.
+    #[must_use]
+    pub fn psins_header(&self) -> Option<&PsinsHeader> {
+        self.source.psins_header()
     }
 
     /// True when the format never carries exact integers (rows can be read in blocks).

@@ -22,24 +22,88 @@ use std::path::{Path, PathBuf};
 const MAX_LINE_BYTES: u64 = 1 << 20;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Delimiter {
+pub(crate) enum Delimiter {
     Comma,
     Whitespace,
 }
 
 /// One line read from the file.
-struct Line {
-    bytes: Vec<u8>,
-    number: u64,
+pub(crate) struct Line {
+    /// The line without its `\r\n` or `\n` (and without a UTF-8 byte-order mark on line 1).
+    pub bytes: Vec<u8>,
+    /// 1-based line number.
+    pub number: u64,
     /// The line ended with `\n` (false only for the file's last line).
-    terminated: bool,
+    pub terminated: bool,
 }
 
-pub(crate) struct TextSource {
+/// A text file's lines, one at a time (at most [`MAX_LINE_BYTES`] each), numbered from 1.
+pub(crate) struct LineReader {
     path: PathBuf,
     reader: BufReader<File>,
     line_number: u64,
     first_line: bool,
+}
+
+impl LineReader {
+    pub(crate) fn open(path: &Path) -> Result<Self> {
+        let file = File::open(path).map_err(|e| LogError::io(path, "cannot open", e))?;
+        crate::io::files::note_input(path);
+        Ok(Self {
+            path: path.to_path_buf(),
+            reader: BufReader::with_capacity(1 << 16, file),
+            line_number: 0,
+            first_line: true,
+        })
+    }
+
+    /// Reads the next line into `bytes` (cleared first: pass a used buffer to reuse it); `None`
+    /// at end of file.
+    pub(crate) fn next_line(&mut self, mut bytes: Vec<u8>) -> Result<Option<Line>> {
+        bytes.clear();
+        let n = (&mut self.reader)
+            .take(MAX_LINE_BYTES)
+            .read_until(b'\n', &mut bytes)
+            .map_err(|e| LogError::io(&self.path, "cannot read", e))?;
+        if n == 0 {
+            return Ok(None);
+        }
+        self.line_number += 1;
+        let terminated = bytes.last() == Some(&b'\n');
+        if !terminated && n as u64 == MAX_LINE_BYTES {
+            return Err(LogError::corrupt(
+                &self.path,
+                format!(
+                    "line {} is longer than {MAX_LINE_BYTES} bytes: this is not a line-oriented text table",
+                    self.line_number
+                ),
+            ));
+        }
+        while matches!(bytes.last(), Some(b'\n' | b'\r')) {
+            bytes.pop();
+        }
+        if self.first_line {
+            self.first_line = false;
+            if bytes.starts_with(b"\xEF\xBB\xBF") {
+                bytes.drain(..3);
+            }
+        }
+        Ok(Some(Line {
+            bytes,
+            number: self.line_number,
+            terminated,
+        }))
+    }
+
+    /// The number of the last line read (0 before the first).
+    pub(crate) fn line_number(&self) -> u64 {
+        self.line_number
+    }
+}
+
+pub(crate) struct TextSource {
+    path: PathBuf,
+    lines: LineReader,
     delimiter: Delimiter,
     names: Vec<String>,
     has_header: bool,
@@ -51,7 +115,7 @@ pub(crate) struct TextSource {
     row: u64,
 }
 
-fn is_blank(s: &[u8]) -> bool {
+pub(crate) fn is_blank(s: &[u8]) -> bool {
     s.iter().all(|b| b.is_ascii_whitespace())
 }
 
@@ -68,7 +132,7 @@ fn trim(s: &[u8]) -> &[u8] {
 }
 
 /// Field spans of `line` (byte ranges, trimmed).
-fn split(line: &[u8], delimiter: Delimiter, spans: &mut Vec<(usize, usize)>) {
+pub(crate) fn split(line: &[u8], delimiter: Delimiter, spans: &mut Vec<(usize, usize)>) {
     spans.clear();
     match delimiter {
         Delimiter::Comma => {
@@ -111,7 +175,7 @@ fn split(line: &[u8], delimiter: Delimiter, spans: &mut Vec<(usize, usize)>) {
     }
 }
 
-fn field(line: &[u8], span: (usize, usize)) -> &[u8] {
+pub(crate) fn field(line: &[u8], span: (usize, usize)) -> &[u8] {
     line.get(span.0..span.1).unwrap_or(&[])
 }
 
@@ -143,13 +207,9 @@ pub(crate) fn parse_cell(text: &[u8]) -> Option<(f64, Option<i64>)> {
 
 impl TextSource {
     pub(crate) fn open(path: &Path, header: HeaderMode) -> Result<Self> {
-        let file = File::open(path).map_err(|e| LogError::io(path, "cannot open", e))?;
-        crate::io::files::note_input(path);
         let mut source = Self {
             path: path.to_path_buf(),
-            reader: BufReader::with_capacity(1 << 16, file),
-            line_number: 0,
-            first_line: true,
+            lines: LineReader::open(path)?,
             delimiter: Delimiter::Comma,
             names: Vec::new(),
             has_header: false,
@@ -168,47 +228,10 @@ impl TextSource {
         Ok(source)
     }
 
-    /// Reads the next line into a fresh buffer; `None` at end of file.
-    fn read_line(&mut self, mut bytes: Vec<u8>) -> Result<Option<Line>> {
-        bytes.clear();
-        let n = (&mut self.reader)
-            .take(MAX_LINE_BYTES)
-            .read_until(b'\n', &mut bytes)
-            .map_err(|e| LogError::io(&self.path, "cannot read", e))?;
-        if n == 0 {
-            return Ok(None);
-        }
-        self.line_number += 1;
-        let terminated = bytes.last() == Some(&b'\n');
-        if !terminated && n as u64 == MAX_LINE_BYTES {
-            return Err(LogError::corrupt(
-                &self.path,
-                format!(
-                    "line {} is longer than {MAX_LINE_BYTES} bytes: this is not a line-oriented text table",
-                    self.line_number
-                ),
-            ));
-        }
-        while matches!(bytes.last(), Some(b'\n' | b'\r')) {
-            bytes.pop();
-        }
-        if self.first_line {
-            self.first_line = false;
-            if bytes.starts_with(b"\xEF\xBB\xBF") {
-                bytes.drain(..3);
-            }
-        }
-        Ok(Some(Line {
-            bytes,
-            number: self.line_number,
-            terminated,
-        }))
-    }
-
     fn read_preamble(&mut self, mode: HeaderMode) -> Result<()> {
         let mut last_comment: Option<Vec<u8>> = None;
         let first = loop {
-            let Some(line) = self.read_line(Vec::new())? else {
+            let Some(line) = self.lines.next_line(Vec::new())? else {
                 break None;
             };
             if is_blank(&line.bytes) {
@@ -308,7 +331,7 @@ impl Source for TextSource {
                 Some(line) => Some(line),
                 None => {
                     let reuse = std::mem::take(&mut self.current.bytes);
-                    self.read_line(reuse)?
+                    self.lines.next_line(reuse)?
                 }
             };
             let Some(line) = next else { return Ok(false) };

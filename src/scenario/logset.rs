@@ -69,10 +69,12 @@ fn default_table() -> String {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawImuFile {
-    /// The file, relative to the folder (.csv, .txt, .npy, .parquet, .mcap).
+    /// The file, relative to the folder (.csv, .txt, .npy, .parquet, .mcap, PSINS .imu).
     pub file: String,
-    /// "rinscope" (units in the column names), "psins", "kf-gins", "kalibr", "npy7", "ros2".
-    #[serde(default = "default_layout")]
+    /// "rinscope" (units in the column names), "psins", "psins-imu", "kf-gins", "kalibr", "npy7",
+    /// "ros2"; empty (absent): "psins-imu" for a PSINS SIMU file (its first line names PSINS and
+    /// SIMU), else "rinscope".
+    #[serde(default, skip_serializing_if = "String::is_empty")]
     pub layout: String,
     /// "increments" or "rates" (checked against the layout's own).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -99,9 +101,6 @@ pub struct RawImuFile {
     pub gap_factor: f64,
 }
 
-fn default_layout() -> String {
-    "rinscope".into()
-}
 fn default_refuse() -> String {
     "refuse".into()
 }
@@ -233,6 +232,17 @@ pub enum Initial {
     },
 }
 
+/// A start stated by the IMU file itself.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HeaderStart {
+    /// Where it comes from, for people ("the PSINS header of run.imu").
+    pub source: String,
+    /// The attitude.
+    pub attitude: Attitude,
+    /// The velocity (East, North, Up), m/s.
+    pub velocity_enu_mps: [f64; 3],
+}
+
 /// The longest alignment window taken when the data decide, s.
 pub const DEFAULT_ALIGNMENT_S: f64 = 300.0;
 
@@ -337,6 +347,9 @@ pub struct LogSet {
     pub initial_velocity_enu_mps: Option<[f64; 3]>,
     /// What the alignment may assume.
     pub align: AlignPriors,
+    /// The start the IMU file's own header states (a PSINS .imu): used when the vehicle moves at
+    /// the start and nothing else is given.
+    pub header_start: Option<HeaderStart>,
     /// The part of the log replayed: from, to, on the IMU file's clock, s.
     pub span_s: (Option<f64>, Option<f64>),
     /// The table.
@@ -405,7 +418,21 @@ pub fn validate_manifest(dir: &Path, raw: &RawManifest, origin: &str, raw_table:
     let imu = imu_file(&c, dir, &raw.imu)?;
     let mut table = table_description(&Checker { origin: table_origin }, raw_table, imu.rate_hz)?;
     let i = &raw.initial;
-    if let Some([lat, lon, h]) = i.position {
+    // A PSINS .imu states its start: the position is the site unless [initial] gives one, the
+    // attitude and velocity serve a start in motion ("maybe inaccurate", its writer says).
+    let psins = if imu.layout == Layout::PsinsImu { Some(crate::io::read_psins_header(&imu.path).map_err(|e| c.invalid("imu.file", e.to_string()))?) } else { None };
+    let header_start = psins.as_ref().map(|h| HeaderStart {
+        source: format!("the PSINS header of {}", imu.path.display()),
+        attitude: Attitude { pitch_rad: h.pitch_deg * RAD_PER_DEG, roll_rad: h.roll_deg * RAD_PER_DEG, heading_rad: h.heading_deg() * RAD_PER_DEG },
+        velocity_enu_mps: h.velocity_enu_mps,
+    });
+    if let (Some(h), None) = (&psins, i.position) {
+        table.site = crate::model::earth::Site {
+            latitude_rad: c.range("the PSINS header's latitude", h.latitude_deg, "deg", -89.0, 89.0, "latitude")? * RAD_PER_DEG,
+            longitude_rad: h.longitude_deg * RAD_PER_DEG,
+            height_m: h.height_m,
+        };
+    } else if let Some([lat, lon, h]) = i.position {
         table.site = crate::model::earth::Site {
             latitude_rad: c.range("initial.position[0]", lat, "deg", -89.0, 89.0, "latitude")? * RAD_PER_DEG,
             longitude_rad: c.range("initial.position[1]", lon, "deg", -360.0, 360.0, "longitude")? * RAD_PER_DEG,
@@ -494,6 +521,7 @@ pub fn validate_manifest(dir: &Path, raw: &RawManifest, origin: &str, raw_table:
         initial,
         initial_velocity_enu_mps,
         align,
+        header_start,
         span_s,
         table,
         raw_table: raw_table.clone(),
@@ -517,14 +545,26 @@ fn imu_file(c: &Checker<'_>, dir: &Path, raw: &RawImuFile) -> Result<ImuFile, Co
         "gps_sow" => TimeUnit::GpsSecondsOfWeek,
         other => return Err(c.invalid("imu.time", format!("\"{other}\" is not a time unit; use \"s\", \"ms\", \"us\", \"ns\" or \"gps_sow\""))),
     };
-    let layout = match raw.layout.as_str() {
+    let path = dir.join(&raw.file);
+    // No layout: the file's content tells it where that is unambiguous (an unreadable file is
+    // reported when read; an ambiguous one here, with the candidates).
+    let guessed = match raw.layout.as_str() {
+        "" => match crate::io::guess_layout(&path) {
+            Ok(name) => name,
+            Err(e @ crate::io::LogError::Layout { .. }) => return Err(c.invalid("imu.layout", e.to_string())),
+            Err(_) => "rinscope",
+        },
+        given => given,
+    };
+    let layout = match guessed {
         "rinscope" => Layout::Rinscope,
         "psins" => Layout::Psins,
+        "psins-imu" => Layout::PsinsImu,
         "kf-gins" => Layout::KfGins,
         "kalibr" => Layout::Kalibr,
         "npy7" => Layout::Npy7 { time },
         "ros2" => Layout::Ros2,
-        other => return Err(c.invalid("imu.layout", format!("\"{other}\" is not a layout; use \"rinscope\", \"psins\", \"kf-gins\", \"kalibr\", \"npy7\" or \"ros2\""))),
+        other => return Err(c.invalid("imu.layout", format!("\"{other}\" is not a layout; use \"rinscope\", \"psins\", \"psins-imu\", \"kf-gins\", \"kalibr\", \"npy7\" or \"ros2\""))),
     };
     if raw.time.is_some() && !matches!(layout, Layout::Npy7 { .. }) {
         return Err(c.invalid("imu.time", "is read by the npy7 layout only (the others say their time unit themselves)"));
@@ -641,4 +681,35 @@ pub fn compensation_from_calibration(table: &RawTable, json_text: &str, origin: 
     }
     take!(installation_x_arcsec, installation_y_arcsec, installation_z_arcsec, imu_mount_x_arcsec, imu_mount_y_arcsec, imu_mount_z_arcsec);
     Ok(validate::validate_compensation(&c, &merged, &turntable, &chain, &stated)?.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn raw_imu(file: &str, layout: &str) -> RawImuFile {
+        RawImuFile { file: file.into(), layout: layout.into(), kind: None, rate_hz: Some(100.0), frame: None, time: None, topic: None, gap_policy: "refuse".into(), gap_factor: 3.0 }
+    }
+
+    #[test]
+    fn psins_imu_by_name_and_when_no_layout_is_given() {
+        let dir = std::env::temp_dir().join(format!("rinscope-logset-psins-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("scratch dir");
+        // imufile.m's first line; the reader checks the rest.
+        std::fs::write(dir.join("trj.txt"), "% PSINS-format SIMU log file. (DO NOT MODIFY!)\n").expect("write");
+        std::fs::write(dir.join("imu.csv"), "t_s,dtheta_x_rad\n").expect("write");
+        let c = Checker { origin: "log.toml" };
+        let layout = |file: &str, name: &str| imu_file(&c, &dir, &raw_imu(file, name)).map(|f| f.layout);
+        assert_eq!(layout("trj.txt", "psins-imu").ok(), Some(Layout::PsinsImu));
+        assert_eq!(layout("trj.txt", "").ok(), Some(Layout::PsinsImu));
+        assert_eq!(layout("imu.csv", "").ok(), Some(Layout::Rinscope));
+        assert_eq!(layout("missing.csv", "").ok(), Some(Layout::Rinscope));
+        let e = layout("trj.txt", "psins-simu").expect_err("not a layout").to_string();
+        assert!(e.contains("\"psins-imu\""), "{e}");
+        // An absent key is the empty layout, and is not written back.
+        let raw: RawImuFile = toml::from_str("file = \"trj.txt\"\nrate_hz = 100.0\n").expect("parse");
+        assert_eq!(raw.layout, "");
+        assert!(!toml::to_string(&raw).expect("serialise").contains("layout"));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

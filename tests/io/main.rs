@@ -10,5 +10,8 @@ mod formats;
 mod garbage;
 mod large;
 mod numpy_golden;
+mod psins;
+mod psins_writer;
+mod psins_bad;
 mod time_frames;
 mod writers;

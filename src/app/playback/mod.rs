@@ -247,38 +247,59 @@ impl Playback {
             check_units_at_rest(log, 5.0)?;
         }
         let pre = InsCore::pre_roll_samples(cfg);
+        let mut velocity = log.initial_velocity_enu_mps;
         let (start_attitude, pre_roll) = match log.initial {
-            Initial::Alignment { duration_s } => {
-                let (attitude, pre_roll, report) = start::aligned(&mut me, log, compensation, duration_s, pre)?;
-                me.alignment = Some(report);
-                (attitude, pre_roll)
-            }
-            _ => {
-                let mut window = Vec::with_capacity(pre);
-                while window.len() < pre {
-                    let Some(s) = me.read()? else {
-                        return Err(data_err(format!("{}: the log ends before the pre-roll ({pre} samples)", f.path.display())));
-                    };
-                    window.push(s);
+            Initial::Alignment { duration_s } => match start::aligned(&mut me, log, compensation, duration_s, pre)? {
+                Some((attitude, pre_roll, report)) => {
+                    me.alignment = Some(report);
+                    (attitude, pre_roll)
                 }
-                me.origin_s = window.last().map_or(0.0, |w| w.t_s);
-                let pre_roll: Vec<(Vector3<f64>, Vector3<f64>)> = window.iter().map(|s| (s.dtheta, s.dv)).collect();
-                let attitude = match log.initial {
-                    Initial::ImuQuaternion([w, x, y, z]) => {
-                        // FRAME: the manifest states C_s^n at the end of the pre-roll.
-                        Rot::from_quaternion(nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(w, x, y, z)))
-                    }
-                    Initial::BodyAttitude(att) => att.n_from_b() * me.table_b_from_s(log, compensation, -me.core.fir_delay_s)?,
-                    Initial::Alignment { .. } => unreachable!("handled above"),
-                };
-                (attitude, pre_roll)
-            }
+                // Moving at the start, and the file's header says how it started (a PSINS .imu).
+                None => {
+                    let h = log.header_start.as_ref().ok_or_else(|| data_err("internal: no header start"))?;
+                    me.notes.push(format!(
+                        "the vehicle moves at the start: the INS starts from {}'s attitude (pitch {:.4}°, roll {:.4}°, heading {:.4}°) and velocity (E {:.3}, N {:.3}, U {:.3} m/s), not from an alignment",
+                        h.source,
+                        h.attitude.pitch_rad.to_degrees(),
+                        h.attitude.roll_rad.to_degrees(),
+                        h.attitude.heading_rad.to_degrees(),
+                        h.velocity_enu_mps[0],
+                        h.velocity_enu_mps[1],
+                        h.velocity_enu_mps[2]
+                    ));
+                    velocity.get_or_insert(h.velocity_enu_mps);
+                    me.given_start(log, compensation, &Initial::BodyAttitude(h.attitude), pre)?
+                }
+            },
+            given => me.given_start(log, compensation, &given, pre)?,
         };
         me.core = InsCore::new(cfg, log.table.site, start_attitude, &pre_roll);
-        if let Some(v) = log.initial_velocity_enu_mps {
+        if let Some(v) = velocity {
             me.core.set_velocity(Vector3::from(v));
         }
         Ok(me)
+    }
+
+    /// A start whose attitude is given: the pre-roll read, C_s^n at its end.
+    fn given_start(&mut self, log: &LogSet, compensation: &TableErrors, given: &Initial, pre: usize) -> Result<(Rot<crate::math::frames::N, S>, Vec<(Vector3<f64>, Vector3<f64>)>), PlaybackError> {
+        let mut window = Vec::with_capacity(pre);
+        while window.len() < pre {
+            let Some(s) = self.read()? else {
+                return Err(data_err(format!("{}: the log ends before the pre-roll ({pre} samples)", log.imu.path.display())));
+            };
+            window.push(s);
+        }
+        self.origin_s = window.last().map_or(0.0, |w| w.t_s);
+        let pre_roll: Vec<(Vector3<f64>, Vector3<f64>)> = window.iter().map(|s| (s.dtheta, s.dv)).collect();
+        let attitude = match *given {
+            Initial::ImuQuaternion([w, x, y, z]) => {
+                // FRAME: the manifest states C_s^n at the end of the pre-roll.
+                Rot::from_quaternion(nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(w, x, y, z)))
+            }
+            Initial::BodyAttitude(att) => att.n_from_b() * self.table_b_from_s(log, compensation, -self.core.fir_delay_s)?,
+            Initial::Alignment { .. } => return Err(data_err("internal: an alignment is not a given start")),
+        };
+        Ok((attitude, pre_roll))
     }
 
     /// C_b^s... as `b_from_s`: the compensated table's rotation at instant `t_s` (seconds after the

@@ -67,6 +67,10 @@ pub struct AlignmentReport {
     pub latitude_site_deg: f64,
     /// The latitude the data imply, deg, and its 1σ (None: too short a window).
     pub latitude_implied_deg: Option<(f64, f64)>,
+    /// The attitude the IMU file's header states [pitch, roll, heading], deg, and where from (a PSINS
+    /// .imu; "maybe inaccurate", its writer says): shown beside the alignment's.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub header_attitude_deg: Option<([f64; 3], String)>,
     /// Where the data contradict rest or the site, or leave something undetermined.
     pub warnings: Vec<String>,
 }
@@ -104,6 +108,10 @@ impl AlignmentReport {
             self.accel_bias_prior_ug.0,
             given(self.accel_bias_prior_ug.1)
         ));
+        if let Some(([p, r, h], from)) = &self.header_attitude_deg {
+            let dh = (self.body_attitude_deg[2] - h + 540.0).rem_euclid(360.0) - 180.0;
+            s.push_str(&format!("  {from} says pitch {p:.4}°, roll {r:.4}°, heading {h:.4}°: the alignment's body heading differs by {dh:+.4}°\n"));
+        }
         if let Some((lat, sigma)) = self.latitude_implied_deg {
             s.push_str(&format!("  latitude: site {:.4}°, the data imply {lat:.3}° ± {sigma:.3}°\n", self.latitude_site_deg));
         }
@@ -142,12 +150,17 @@ fn spec_sigma(s: Spec) -> Option<f64> {
     (v > 0.0).then_some(v)
 }
 
+/// The samples kept to give back to the INS when the start moves: 10 s at up to 10 kHz.
+const HEAD_SAMPLES: usize = 100_000;
+
 /// Samples of the alignment input at most this rate, Hz (summed in groups above it: the alignment
 /// needs no more, and its memory stays a few MB for any IMU).
 const ALIGN_MAX_HZ: f64 = 400.0;
 
 /// Reads the window at rest, aligns, reports: (C_s^n at the window's end, the pre-roll, the report).
-pub(super) fn aligned(pb: &mut Playback, log: &LogSet, compensation: &TableErrors, declared_s: Option<f64>, pre: usize) -> Result<(Rot<N, S>, Vec<Increment>, AlignmentReport), PlaybackError> {
+/// None: the vehicle moves at the start and the log's header gives a start (the samples read are put
+/// back for the INS).
+pub(super) fn aligned(pb: &mut Playback, log: &LogSet, compensation: &TableErrors, declared_s: Option<f64>, pre: usize) -> Result<Option<(Rot<N, S>, Vec<Increment>, AlignmentReport)>, PlaybackError> {
     let f = &log.imu;
     let h = 1.0 / f.rate_hz;
     let per_block = align::block_samples(h);
@@ -162,6 +175,8 @@ pub(super) fn aligned(pb: &mut Playback, log: &LogSet, compensation: &TableError
     let mut last_t = 0.0;
     let mut motion: Option<(f64, f64)> = None;
     let mut ended_by_motion = false;
+    // The first seconds as read, to give them back to the INS if the start moves.
+    let mut head: Vec<Sample> = Vec::new();
     loop {
         let s = pb.read()?;
         let done = match s {
@@ -193,6 +208,9 @@ pub(super) fn aligned(pb: &mut Playback, log: &LogSet, compensation: &TableError
             motion.get_or_insert((at, change));
         }
         for s in block.drain(..) {
+            if head.len() < HEAD_SAMPLES {
+                head.push(s);
+            }
             acc.0 += s.dtheta;
             acc.1 += s.dv;
             acc.2 += 1;
@@ -214,6 +232,11 @@ pub(super) fn aligned(pb: &mut Playback, log: &LogSet, compensation: &TableError
     let span = last_t - t0 + h;
     let file_start_s = pb.file_start_s;
     let clock = |t: f64| file_start_s + t;
+    if ended_by_motion && span < 10.0 && log.header_start.is_some() && head.len() < HEAD_SAMPLES {
+        let moving: Vec<Sample> = pb.pending.drain(..).collect();
+        pb.pending.extend(head.into_iter().chain(moving));
+        return Ok(None);
+    }
     if ended_by_motion && span < 10.0 {
         let (at, change) = motion.unwrap_or((t0, 0.0));
         return Err(data_err(format!(
@@ -277,7 +300,8 @@ pub(super) fn aligned(pb: &mut Playback, log: &LogSet, compensation: &TableError
     let ug = |v: Vector3<f64>| (v / MPS2_PER_UG).into();
     let report = AlignmentReport {
         method: "inertial-frame coarse + 12-state Kalman filter on zero velocity".into(),
-        window_from_s: clock(t0) - h,
+        // The start of the window's first sample's interval (the exact zero of a clock shows as 0).
+        window_from_s: if (clock(t0) - h).abs() < 1e-9 { 0.0 } else { clock(t0) - h },
         window_to_s: clock(last_t),
         window_source: if declared_s.is_some() { "declared: initial.alignment_s".into() } else { format!("detected rest{}", if ended_by_motion { ", ended by motion" } else if span >= max_s - h { ", 300 s at most" } else { ", the whole log" }) },
         rest_threshold_mps2: log.align.rest_threshold_mps2,
@@ -299,7 +323,8 @@ pub(super) fn aligned(pb: &mut Playback, log: &LogSet, compensation: &TableError
         accel_white_noise_ug_per_sqrt_hz: (a.random_walk.1.value / MPS_PER_SQRT_S_PER_UG_PER_SQRT_HZ, a.random_walk.1.given),
         latitude_site_deg: deg(cfg.latitude_rad),
         latitude_implied_deg: lat.map(|l| (deg(l.latitude_rad), deg(l.sigma_rad))),
+        header_attitude_deg: log.header_start.as_ref().map(|h| ([deg(h.attitude.pitch_rad), deg(h.attitude.roll_rad), heading_deg_0_360(h.attitude.heading_rad)], h.source.clone())),
         warnings,
     };
-    Ok((a.n_from_s, pre_roll, report))
+    Ok(Some((a.n_from_s, pre_roll, report)))
 }
