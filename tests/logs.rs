@@ -262,3 +262,43 @@ fn a_psins_imu_file_that_starts_moving_starts_from_its_header() {
     assert!((f["velocity_enu_mps"][1].as_f64().expect("vn") - v_end).abs() < 0.02);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_headerless_file_is_described_column_by_column_instead_of_rewritten() {
+    // A MEMS logger's text: time in ms, a counter, accelerometers in g then gyros in °/s, axes
+    // forward-right-down, no header, no rate declared. [imu.columns] says which column is what.
+    let dir = scratch("columns");
+    let (lat, heading) = (LAT0_DEG, 30.0_f64);
+    let samples = parked(lat.to_radians(), H0, 0.0, 0.0, heading.to_radians(), 50.0, 120.0);
+    let mut text = String::new();
+    for (k, (t, g, f)) in samples.iter().enumerate() {
+        // RFU → FRD: (y, x, −z); increments over 0.02 s → rates.
+        let (w, a) = ([g[1], g[0], -g[2]].map(|x| x / 0.02), [f[1], f[0], -f[2]].map(|x| x / 0.02));
+        let deg = |x: f64| x.to_degrees();
+        let gee = |x: f64| x / 9.806_65;
+        writeln!(text, "{:.3} {k} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e}", 1000.0 * (1.0 + t), gee(a[0]), gee(a[1]), gee(a[2]), deg(w[0]), deg(w[1]), deg(w[2])).expect("write");
+    }
+    std::fs::write(dir.join("mems.txt"), text).expect("file");
+    let columns = "[imu.columns]\ntime = { column = 0, unit = \"ms\" }\n\
+        accel_x = { column = 2, unit = \"g\" }\naccel_y = { column = 3, unit = \"g\" }\naccel_z = { column = 4, unit = \"g\" }\n\
+        gyro_x = { column = 5, unit = \"deg_per_s\" }\ngyro_y = { column = 6, unit = \"deg_per_s\" }\ngyro_z = { column = 7, unit = \"deg_per_s\" }\n";
+    let manifest = |frame: &str| format!("[log]\nname = \"mems\"\n[imu]\nfile = \"mems.txt\"\n{frame}[initial]\nposition = [{LAT0_DEG}, {LON0_DEG}, {H0}]\n{columns}");
+    // No frame: the message asks for it by key.
+    std::fs::write(dir.join("log.toml"), manifest("")).expect("manifest");
+    let o = rinscope().arg("replay").arg(&dir).arg("--save").arg(dir.join("x.rrd")).output().expect("replay");
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("imu.frame"), "{}", stderr(&o));
+    std::fs::write(dir.join("log.toml"), manifest("frame = \"frd\"\n")).expect("manifest");
+    let summary = dir.join("s.json");
+    let o = rinscope().arg("replay").arg(&dir).arg("--save").arg(dir.join("m.rrd")).arg("--summary-json").arg(&summary).output().expect("replay");
+    ok(&o);
+    let a = &json(&summary)["alignment"];
+    let (h, sigma) = (a["imu_heading_deg"].as_f64().expect("heading"), a["sigma_deg"][2].as_f64().expect("σ"));
+    assert!((h - heading).abs() < (3.0 * sigma).max(0.01), "heading {h}° ± {sigma}° vs {heading}°: the columns, units and frame were read as described");
+    // A unit of the wrong quantity is named with its key.
+    std::fs::write(dir.join("log.toml"), manifest("frame = \"frd\"\n").replace("column = 5, unit = \"deg_per_s\"", "column = 5, unit = \"mps2\"")).expect("manifest");
+    let o = rinscope().arg("replay").arg(&dir).arg("--save").arg(dir.join("y.rrd")).output().expect("replay");
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("imu.columns.gyro_x") && stderr(&o).contains("mps2"), "{}", stderr(&o));
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -193,6 +193,7 @@ fn write_files(params: &Params, dir: &Path, format: LogFormat, aligned: bool, st
             frame: Some(RawFrame::Named("rfu".into())),
             time: (format == LogFormat::Npy).then(|| "s".into()),
             topic: None,
+            columns: None,
             gap_policy: "refuse".into(),
             gap_factor: 3.0,
         },

@@ -110,6 +110,7 @@ fn load_log(args: &ReplayArgs) -> Result<logset::LogSet, Failure> {
             frame: args.imu_frame.clone().map(logset::RawFrame::Named),
             time: None,
             topic: None,
+            columns: None,
             gap_policy: "refuse".into(),
             gap_factor: 3.0,
         },

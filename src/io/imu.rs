@@ -155,6 +155,20 @@ pub enum Layout {
     },
     /// MCAP with ROS 2 `sensor_msgs/msg/Imu`.
     Ros2,
+    /// Any table, its columns described one by one (`[imu.columns]` of a log set).
+    Columns(ColumnMap),
+}
+
+/// The columns of a foreign or headerless file, as a log set's `[imu.columns]` describes them:
+/// each by header name or 0-based position, with its unit (the suffixes of [`crate::io::units`]:
+/// `deg_per_s`, `rad`, `g`, `mps`, ...). Angle and velocity units make increments, rate and
+/// acceleration units rates; the two triads must agree.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ColumnMap {
+    /// The time column and its unit.
+    pub time: (crate::io::table::Col, TimeUnit),
+    /// Gyro x, y, z then accelerometer x, y, z: the column and its unit suffix.
+    pub sensors: [(crate::io::table::Col, String); 6],
 }
 
 /// What to do with a gap in the time stamps.

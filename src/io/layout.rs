@@ -1,7 +1,7 @@
 //! Resolving a [`Layout`] to the columns, units, kind and default frame of a file.
 
 use crate::io::error::{LogError, Result};
-use crate::io::imu::{ImuOptions, Layout, SampleKind, TimeUnit};
+use crate::io::imu::{ColumnMap, ImuOptions, Layout, SampleKind, TimeUnit};
 use crate::io::psins_imu::{first_line, not_psins};
 use crate::io::sniff::{Format, detect_format};
 use crate::io::table::{Col, ColumnReader, HeaderMode, ReadOptions};
@@ -50,6 +50,7 @@ impl Layout {
             Self::Kalibr => "kalibr",
             Self::Npy7 { .. } => "npy7",
             Self::Ros2 => "ros2",
+            Self::Columns(_) => "columns",
         }
     }
 }
@@ -104,6 +105,7 @@ pub(crate) fn plan_for(path: &Path, options: &ImuOptions) -> Result<Plan> {
             Auto,
         ),
         Layout::Npy7 { time } => fixed(*time, Increments, [0, 1, 2, 3, 4, 5, 6], None, Auto),
+        Layout::Columns(map) => columns_plan(path, map)?,
         Layout::Rinscope | Layout::Ros2 => {
             let probe = ColumnReader::open(path, &[], &read_options(options, Auto))?;
             let is_mcap = probe.format() == Format::Mcap;
@@ -183,6 +185,42 @@ fn quantity_phrase(q: Quantity) -> &'static str {
         Quantity::Length => "a length",
         Quantity::Dimensionless => "a pure number",
     }
+}
+
+/// The plan of a file whose columns `[imu.columns]` describes.
+fn columns_plan(path: &Path, map: &ColumnMap) -> Result<Plan> {
+    const NAMES: [&str; 6] = ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"];
+    let unit_error = |i: usize, problem: String| LogError::Unit {
+        file: path.to_path_buf(),
+        column: format!("imu.columns.{} ({})", NAMES[i], map.sensors[i].0),
+        problem,
+    };
+    let mut scale = [1.0; 6];
+    let mut kinds = [SampleKind::Rates; 6];
+    for (i, (_, suffix)) in map.sensors.iter().enumerate() {
+        let gyro = i < 3;
+        let (rate, increment) = if gyro { (Quantity::AngularRate, Quantity::Angle) } else { (Quantity::Acceleration, Quantity::Velocity) };
+        let Some((_, unit)) = split_unit(&format!("x_{suffix}")).filter(|(b, _)| *b == "x") else {
+            return Err(unit_error(i, format!("unknown unit {suffix:?}; use one of {} (rates) or {} (increments)", suffixes_for(rate), suffixes_for(increment))));
+        };
+        kinds[i] = match unit.quantity {
+            q if q == rate => SampleKind::Rates,
+            q if q == increment => SampleKind::Increments,
+            _ => {
+                return Err(unit_error(i, format!("{suffix:?} is {}; a {} column takes one of {} (rates) or {} (increments)", quantity_phrase(unit.quantity), if gyro { "gyro" } else { "accelerometer" }, suffixes_for(rate), suffixes_for(increment))));
+            }
+        };
+        scale[i] = unit.to_si;
+    }
+    if kinds.iter().any(|k| *k != kinds[0]) {
+        return Err(LogError::Layout {
+            file: path.to_path_buf(),
+            problem: format!("[imu.columns] mixes rates and increments ({}): give all six as rates (deg_per_s, mps2, ...) or all as increments (rad, mps, ...)", NAMES.iter().zip(kinds).map(|(n, k)| format!("{n} {k:?}")).collect::<Vec<_>>().join(", ")),
+        });
+    }
+    let by_name = std::iter::once(&map.time.0).chain(map.sensors.iter().map(|(c, _)| c)).any(|c| matches!(c, Col::Name(_)));
+    let [a, b, c, d, e, f] = map.sensors.clone().map(|(col, _)| col);
+    Ok(Plan { cols: [map.time.0.clone(), a, b, c, d, e, f], time: map.time.1, scale, kind: kinds[0], frame: None, header: if by_name { HeaderMode::Present } else { HeaderMode::Auto } })
 }
 
 fn rinscope_plan(path: &Path, names: &[String]) -> Result<Plan> {

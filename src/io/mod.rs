@@ -37,7 +37,7 @@ pub use error::{FrameError, Location, LogError, Result};
 pub use frames::{Frame, frame_matrix};
 pub use guess::guess_layout;
 pub use imu::{
-    BlockEnd, GPS_WEEK_S, GapPolicy, ImuEvent, ImuOptions, ImuReader, ImuSample, Layout, SampleKind,
+    BlockEnd, ColumnMap, GPS_WEEK_S, GapPolicy, ImuEvent, ImuOptions, ImuReader, ImuSample, Layout, SampleKind,
     StartTime, StaticCheck, TimeUnit,
 };
 pub use mcap_imu::MCAP_IMU_COLUMNS;

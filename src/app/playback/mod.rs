@@ -455,13 +455,15 @@ impl ImuSamples {
                 1.0 / measured
             )));
         }
-        if imu.kind() != f.kind {
+        if let Some(declared) = f.kind
+            && imu.kind() != declared
+        {
             return Err(data_err(format!(
                 "{}: the file holds {} (its columns {}), the manifest says kind = \"{}\"",
                 f.path.display(),
                 kind_name(imu.kind()),
                 imu.columns().join(", "),
-                kind_name(f.kind)
+                kind_name(declared)
             )));
         }
         let kind = imu.kind();

@@ -6,216 +6,22 @@
 
 use std::path::{Path, PathBuf};
 
-use serde::{Deserialize, Serialize};
+use serde::Deserialize;
 
-use super::raw::{RawCalibration, RawCompensation, RawImu, RawNavigation, RawRecording, RawSite, RawTurntable};
+use super::raw::{RawCompensation, RawNavigation, RawRecording, RawSite, RawTurntable};
 use super::validate::{self, Checker};
 use super::{instruments, ConfigError, RecordingParams};
 use crate::calib::CalibConfig;
 use crate::ins::InsParams;
-use crate::io::{Frame, GapPolicy, Layout, SampleKind, TimeUnit};
+use crate::io::{Frame, GapPolicy, Layout, SampleKind};
 use crate::math::attitude::Attitude;
 use crate::math::units::RAD_PER_DEG;
 use crate::model::earth::Site;
 use crate::model::gimbal::{Chain, TableErrors};
 
-/// `log.toml` as written.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RawManifest {
-    /// What the log is.
-    pub log: RawLogInfo,
-    /// The IMU file.
-    pub imu: RawImuFile,
-    /// The encoder file (absent: the gimbals stand at their initial angles).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub encoders: Option<RawEncoderFile>,
-    /// A reference attitude of the body (absent: the compensated demodulation is the reference).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub reference: Option<RawReference>,
-    /// The INS's initial attitude: given, or from a static alignment interval.
-    #[serde(default)]
-    pub initial: RawInitial,
-}
+mod manifest;
 
-/// `[log]`
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RawLogInfo {
-    /// Identifier, also the recording's name (letters, digits, '-' and '_').
-    pub name: String,
-    /// Markdown shown beside the scene in the viewer.
-    #[serde(default)]
-    pub description: String,
-    /// The table description, relative to the folder (default "table.toml").
-    #[serde(default = "default_table")]
-    pub table: String,
-    /// Seed of the simulation that wrote the log (export-log), for the record.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub seed: Option<u64>,
-    /// Replay from this time on the IMU file's clock (as written in its time column), s.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub from_s: Option<f64>,
-    /// Replay up to this time on the IMU file's clock, s.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub to_s: Option<f64>,
-}
-
-fn default_table() -> String {
-    "table.toml".into()
-}
-
-/// `[imu]`
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RawImuFile {
-    /// The file, relative to the folder (.csv, .txt, .npy, .parquet, .mcap, PSINS .imu).
-    pub file: String,
-    /// "rinscope" (units in the column names), "psins", "psins-imu", "kf-gins", "kalibr", "npy7",
-    /// "ros2"; empty (absent): "psins-imu" for a PSINS SIMU file (its first line names PSINS and
-    /// SIMU), else "rinscope".
-    #[serde(default, skip_serializing_if = "String::is_empty")]
-    pub layout: String,
-    /// "increments" or "rates" (checked against the layout's own).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub kind: Option<String>,
-    /// Nominal sample rate, Hz (must match the time stamps; absent: what the stamps say).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub rate_hz: Option<f64>,
-    /// The IMU axes in the file: "rfu" (rinscope's), "frd", "flu", ... (three letters of r/l, f/b,
-    /// u/d) or a 3×3 matrix C with v_rfu = C · v_file, row by row.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub frame: Option<RawFrame>,
-    /// Time unit of the npy7 layout's first column: "s", "ms", "us", "ns", "gps_sow".
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub time: Option<String>,
-    /// MCAP: the topic (default: the only sensor_msgs/msg/Imu topic).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub topic: Option<String>,
-    /// A gap longer than `gap_factor` nominal intervals: "refuse" or "split" (carry the attitude
-    /// across, report the gap).
-    #[serde(default = "default_refuse")]
-    pub gap_policy: String,
-    /// Nominal intervals beyond which an interval is a gap (default 3).
-    #[serde(default = "default_gap_factor")]
-    pub gap_factor: f64,
-}
-
-fn default_refuse() -> String {
-    "refuse".into()
-}
-fn default_gap_factor() -> f64 {
-    3.0
-}
-
-/// A frame: a name or a matrix.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
-pub enum RawFrame {
-    /// "frd", "rfu", ...
-    Named(String),
-    /// Rows of C (v_rfu = C · v_file).
-    Matrix([[f64; 3]; 3]),
-}
-
-/// `[encoders]`: time and one angle column per table axis, named `<axis>_deg`, `<axis>_rad` or
-/// `<axis>_arcsec` (the axis names of the table description).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RawEncoderFile {
-    /// The file, relative to the folder (.csv, .npy with columns t_s then the axes in table order, .parquet).
-    pub file: String,
-    /// The readings were latched this long before their time stamps, ms (shifts the stamps).
-    #[serde(default)]
-    pub latch_delay_ms: f64,
-    /// A gap in the encoder stamps: "interpolate" (linear between the readings around it) or "refuse".
-    #[serde(default = "default_interpolate")]
-    pub gap_policy: String,
-}
-
-fn default_interpolate() -> String {
-    "interpolate".into()
-}
-
-/// `[reference]`: the true body attitude, from a file (`t_s, pitch_deg, roll_deg, heading_deg`), or
-/// constant (a static site attitude).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RawReference {
-    /// Where it comes from, for people: "turntable controller", "reference INS", "static site attitude".
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub source: Option<String>,
-    /// The file, relative to the folder.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub file: Option<String>,
-    /// A constant attitude [pitch, roll, heading], deg.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub attitude_deg: Option<[f64; 3]>,
-}
-
-/// `[initial]`: the attitude (at most one of the first three; none: an alignment over the rest the
-/// data show at the start), velocity and position, and what the alignment may assume.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RawInitial {
-    /// C_s^n at the end of the pre-roll as a quaternion (w, x, y, z): exact (export-log writes it).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub imu_quaternion_wxyz: Option<[f64; 4]>,
-    /// The body attitude [pitch, roll, heading], deg, demodulated through the compensated table at
-    /// the first encoder reading.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub body_attitude_deg: Option<[f64; 3]>,
-    /// Align over the first this many seconds, declared at rest (absent: the rest the data show,
-    /// at most 300 s), s.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub alignment_s: Option<f64>,
-    /// Velocity at the start [East, North, Up], m/s (a moving start; default at rest).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub velocity_enu_mps: Option<[f64; 3]>,
-    /// Position at the start [latitude deg, longitude deg, height m] (default: the table
-    /// description's [site]).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub position: Option<[f64; 3]>,
-    /// Alignment: the gyro bias 1σ before alignment, °/h (default: the table description's [imu],
-    /// else assumed from the measured noise and said so).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub gyro_bias_deg_per_h: Option<f64>,
-    /// Alignment: the accelerometer bias 1σ, µg (default as the gyro's).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub accel_bias_ug: Option<f64>,
-    /// Alignment: one-second means of the specific force that change by more mark motion, m/s²
-    /// (default 0.05).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub rest_threshold_mps2: Option<f64>,
-}
-
-/// `table.toml`: the scenario sections that describe the instrument, not its motion.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RawTable {
-    /// Output rates and drawing of the replay's recording.
-    #[serde(default)]
-    pub recording: RawRecording,
-    /// Where on Earth.
-    #[serde(default)]
-    pub site: RawSite,
-    /// The gimbal chain as the user knows it (nominal axes and the errors believed); absent: a
-    /// strapdown IMU (its axes are the body's).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub turntable: Option<RawTurntable>,
-    /// What the compensated demodulation assumes (each key defaults to the turntable's value).
-    #[serde(default)]
-    pub compensation: RawCompensation,
-    /// The navigation computer (algorithm, FIR, zero-order hold, Δt); sensor-error keys are ignored.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub imu: Option<RawImu>,
-    /// Navigation of velocity and position.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub navigation: Option<RawNavigation>,
-    /// `calibrate --log`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub calibration: Option<RawCalibration>,
-}
+pub use manifest::*;
 
 /// How the INS starts.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -275,8 +81,8 @@ pub struct ImuFile {
     pub path: PathBuf,
     /// Layout.
     pub layout: Layout,
-    /// Increments or rates.
-    pub kind: SampleKind,
+    /// Increments or rates, if declared (checked against the file's own).
+    pub kind: Option<SampleKind>,
     /// Nominal sample rate, Hz.
     pub rate_hz: f64,
     /// The file's axes.
@@ -537,18 +343,14 @@ fn attitude(c: &Checker<'_>, key: &str, a: [f64; 3]) -> Result<Attitude, ConfigE
 }
 
 fn imu_file(c: &Checker<'_>, dir: &Path, raw: &RawImuFile) -> Result<ImuFile, ConfigError> {
-    let time = match raw.time.as_deref().unwrap_or("s") {
-        "s" => TimeUnit::Seconds,
-        "ms" => TimeUnit::Milliseconds,
-        "us" => TimeUnit::Microseconds,
-        "ns" => TimeUnit::Nanoseconds,
-        "gps_sow" => TimeUnit::GpsSecondsOfWeek,
-        other => return Err(c.invalid("imu.time", format!("\"{other}\" is not a time unit; use \"s\", \"ms\", \"us\", \"ns\" or \"gps_sow\""))),
-    };
+    let time = time_unit(c, "imu.time", raw.time.as_deref().unwrap_or("s"))?;
     let path = dir.join(&raw.file);
     // No layout: the file's content tells it where that is unambiguous (an unreadable file is
     // reported when read; an ambiguous one here, with the candidates).
     let guessed = match raw.layout.as_str() {
+        "" | "columns" if raw.columns.is_some() => "columns",
+        "columns" => return Err(c.invalid("imu.layout", "\"columns\" needs the [imu.columns] table that describes them")),
+        _ if raw.columns.is_some() => return Err(c.invalid("imu.columns", format!("describes a file of no named layout; drop layout = \"{}\" (or the [imu.columns] table)", raw.layout))),
         "" => match crate::io::guess_layout(&path) {
             Ok(name) => name,
             Err(e @ crate::io::LogError::Layout { .. }) => return Err(c.invalid("imu.layout", e.to_string())),
@@ -564,14 +366,26 @@ fn imu_file(c: &Checker<'_>, dir: &Path, raw: &RawImuFile) -> Result<ImuFile, Co
         "kalibr" => Layout::Kalibr,
         "npy7" => Layout::Npy7 { time },
         "ros2" => Layout::Ros2,
+        "columns" => {
+            let Some(m) = &raw.columns else { return Err(c.invalid("imu.columns", "missing")) };
+            if raw.frame.is_none() {
+                return Err(c.invalid("imu.frame", "a file described by [imu.columns] has no standard axes: give frame = \"rfu\" (x right, y forward, z up), \"frd\", \"flu\", ... or a 3×3 matrix"));
+            }
+            let sensor = |r: &RawColumn| (r.column.col(), r.unit.clone());
+            Layout::Columns(crate::io::ColumnMap {
+                time: (m.time.column.col(), time_unit(c, "imu.columns.time.unit", &m.time.unit)?),
+                sensors: [sensor(&m.gyro_x), sensor(&m.gyro_y), sensor(&m.gyro_z), sensor(&m.accel_x), sensor(&m.accel_y), sensor(&m.accel_z)],
+            })
+        }
         other => return Err(c.invalid("imu.layout", format!("\"{other}\" is not a layout; use \"rinscope\", \"psins\", \"psins-imu\", \"kf-gins\", \"kalibr\", \"npy7\" or \"ros2\""))),
     };
     if raw.time.is_some() && !matches!(layout, Layout::Npy7 { .. }) {
         return Err(c.invalid("imu.time", "is read by the npy7 layout only (the others say their time unit themselves)"));
     }
     let kind = match raw.kind.as_deref() {
-        None | Some("increments") => SampleKind::Increments,
-        Some("rates") => SampleKind::Rates,
+        None => None,
+        Some("increments") => Some(SampleKind::Increments),
+        Some("rates") => Some(SampleKind::Rates),
         Some(other) => return Err(c.invalid("imu.kind", format!("\"{other}\" is not a kind; use \"increments\" or \"rates\""))),
     };
     let frame = match &raw.frame {
@@ -688,7 +502,7 @@ mod tests {
     use super::*;
 
     fn raw_imu(file: &str, layout: &str) -> RawImuFile {
-        RawImuFile { file: file.into(), layout: layout.into(), kind: None, rate_hz: Some(100.0), frame: None, time: None, topic: None, gap_policy: "refuse".into(), gap_factor: 3.0 }
+        RawImuFile { file: file.into(), layout: layout.into(), kind: None, rate_hz: Some(100.0), frame: None, time: None, topic: None, columns: None, gap_policy: "refuse".into(), gap_factor: 3.0 }
     }
 
     #[test]
