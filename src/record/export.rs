@@ -144,6 +144,19 @@ impl Exporter {
         Ok(())
     }
 
+    /// Writes the whole table `name` (its file named like an entity's) that is not a time series:
+    /// `columns`, the first one its key (`tau_s`, `axis`), and `rows` (see
+    /// [`TableWriter::create_keyed`]).
+    pub fn write_table(&mut self, name: &str, columns: &[String], rows: &[Vec<f64>]) -> Result<(), LogError> {
+        let refs: Vec<&str> = columns.iter().map(String::as_str).collect();
+        let mut writer = TableWriter::create_keyed(self.dir.join(self.file_name(name)), &refs)?;
+        for row in rows {
+            writer.write_row(row)?;
+        }
+        self.tables.insert(name.to_owned(), writer);
+        Ok(())
+    }
+
     /// The file of the table of `entity`.
     fn file_name(&self, entity: &str) -> String {
         format!("{}.{}", entity.trim_start_matches('/').replace('/', "__").replace('.', "_"), self.format.extension())
