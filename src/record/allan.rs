@@ -218,8 +218,8 @@ pub fn log(stream: &Stream, r: &ImuAllan, description: &str) -> RecordingStreamR
 /// configured noise's when known) in the sensor's unit (°/h, µg), the equivalent degrees of
 /// freedom and the number of second differences; per sensor (`allan__gyro_fit`, ...) one row per
 /// axis (`axis` 0, 1, 2 = x, y, z) of the fitted coefficients with their 1σ in their conventional
-/// units and whether the fit found each (`found` 1 or 0: else the value is 0 and the 1σ is the
-/// detection limit), and the fit's χ²/dof.
+/// units and whether the fit found each (`found` 1 or 0: a dropped term's value is 0 and its 1σ
+/// the detection limit), and the fit's χ²/dof.
 ///
 /// # Errors
 /// A table that cannot be written.
