@@ -283,6 +283,9 @@ fn export_tables_read_back_and_say_their_units() {
     assert_eq!(cols[0], "t_s");
     assert_eq!(cols.len(), 6, "{cols:?}");
     assert!(cols[1..].iter().all(|c| c.ends_with("_arcsec")), "{cols:?}");
+    // An INS run's layout (five algorithms, the coning log plot, the drift dial) shows only what it holds.
+    let c = rinscope::record::read::contents(&dir.join("x.rrd")).expect("recording");
+    assert!(c.empty_views().is_empty(), "views of entities the recording lacks: {:?}", c.empty_views());
     std::fs::remove_dir_all(&dir).ok();
 }
 
