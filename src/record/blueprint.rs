@@ -96,7 +96,7 @@ impl Recorder {
                 let primary = layout.algorithms.first().map_or("", String::as_str);
                 let solution: Vec<Node> = [
                     (rows::BODY_ATTITUDE_PATH, format!("INS body attitude (deg), {primary} — red pitch, green roll, blue heading")),
-                    (rows::VELOCITY_PATH, "INS velocity (m/s) — red east, green north, blue up".to_owned()),
+                    (rows::VELOCITY_PATH, format!("INS velocity (m/s) — red east, green north{}", if self.series_names(rows::VELOCITY_PATH).len() > 2 { ", blue up" } else { "" })),
                     (rows::POSITION_PATH, "INS position from the start (m) — red east, green north".to_owned()),
                     (rows::LAT_LON_PATH, "INS latitude, longitude (deg) — red latitude, green longitude".to_owned()),
                     (rows::HEIGHT_PATH, "INS height (m)".to_owned()),
