@@ -125,6 +125,10 @@ fn a_run_writes_a_complete_recording_and_a_consistent_summary() {
     // RRD files start with the magic "RRF2".
     assert_eq!(&bytes[..4], b"RRF2", "an RRD file");
     assert!(!dir.join("short.rrd.partial").exists());
+    // Its layout shows only entities it holds.
+    let c = rinscope::record::read::contents(&rrd).expect("readable");
+    assert!(c.entities.contains("world/vehicle") && c.view_origins.contains("world"), "{c:?}");
+    assert!(c.empty_views().is_empty(), "views of entities the recording lacks: {:?}", c.empty_views());
 
     let summary: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).expect("summary")).expect("json");
     assert_eq!(summary["steps"], 40 * 200 + 1);

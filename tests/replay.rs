@@ -1,6 +1,7 @@
 //! Logged data through rinscope: `export-log` then `replay` reproduces the in-loop run, `calibrate
 //! --log` the in-loop calibration, every log format gives the same result, `--export` writes
-//! readable tables, and every kind of bad input is one clear message, exit code 2, nothing written.
+//! readable tables, a strapdown log (no table) records and exports the INS alone, and every kind of
+//! bad input is one clear message, exit code 2, nothing written.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -79,20 +80,33 @@ fn export_then_replay_reproduces_the_in_loop_run_and_the_calibration() {
         }
     }
     assert_eq!(compared, 6);
-    // Every output instant, through the export tables (t_s, then one column per algorithm).
+    // Every output instant, through the export tables (t_s, then one column per algorithm; the
+    // replay's also t_file_s, the file's clock, after t_s).
     for axis in ["pitch", "roll", "heading"] {
         let name = format!("ins__attitude_error_arcsec__{axis}.csv");
-        let (x, y) = (std::fs::read_to_string(run_tables.join(&name)).expect("run table"), std::fs::read_to_string(replay_tables.join(&name)).expect("replay table"));
-        let rows = |t: &str| t.lines().skip(1).map(|l| l.split(',').map(|v| v.parse::<f64>().expect("number")).collect::<Vec<f64>>()).collect::<Vec<_>>();
-        let (x, y) = (rows(&x), rows(&y));
+        let ((hx, x), (hy, y)) = (csv_table(&run_tables.join(&name)), csv_table(&replay_tables.join(&name)));
+        let column = format!("two_sample_p1_{axis}_error_arcsec");
+        let (kx, ky) = (hx.iter().position(|c| *c == column).expect("run column"), hy.iter().position(|c| *c == column).expect("replay column"));
+        assert_eq!(hy[1], "t_file_s", "{hy:?}");
         assert_eq!(x.len(), y.len(), "{axis}: same output instants");
         assert!(x.len() >= 1_900, "{} rows (10 Hz over 200 s)", x.len());
-        let peak = x.iter().map(|r| r[1].abs()).fold(0.0, f64::max);
+        let peak = x.iter().map(|r| r[kx].abs()).fold(0.0, f64::max);
         for (rx, ry) in x.iter().zip(&y) {
             assert!((rx[0] - ry[0]).abs() < 1e-9, "time {} vs {}", rx[0], ry[0]);
-            assert!((rx[1] - ry[1]).abs() <= 1e-9 * peak, "{axis} at {} s: {} vs {}", rx[0], rx[1], ry[1]);
+            assert!((rx[kx] - ry[ky]).abs() <= 1e-9 * peak, "{axis} at {} s: {} vs {}", rx[0], rx[kx], ry[ky]);
         }
     }
+    // The replay's export has no all-NaN column (the closed form is not replayed) and its layout
+    // shows only what its recording holds.
+    for name in std::fs::read_dir(&replay_tables).expect("tables").flatten().map(|e| e.path()) {
+        let (header, rows) = csv_table(&name);
+        for (k, c) in header.iter().enumerate() {
+            assert!(rows.iter().any(|r| r[k].is_finite()), "{}: {c} has no finite value", name.display());
+        }
+    }
+    let c = rinscope::record::read::contents(&dir.join("replay.rrd")).expect("recording");
+    assert!(c.entities.contains("world/vehicle") && c.entities.contains("ins/body_attitude_deg"), "{:?}", c.entities);
+    assert!(c.empty_views().is_empty(), "views of entities the recording lacks: {:?}", c.empty_views());
     // calibrate --log on the exported log: the in-loop calibration's estimates (issue: 1e-6″).
     let (loop_cal, log_cal) = (dir.join("cal-loop.json"), dir.join("cal-log.json"));
     ok(&rinscope().args(["calibrate", "--no-recording", "--json"]).arg(&loop_cal).output().expect("calibrate"));
@@ -269,5 +283,137 @@ fn export_tables_read_back_and_say_their_units() {
     assert_eq!(cols[0], "t_s");
     assert_eq!(cols.len(), 6, "{cols:?}");
     assert!(cols[1..].iter().all(|c| c.ends_with("_arcsec")), "{cols:?}");
+    // An INS run's layout (five algorithms, the coning log plot, the drift dial) shows only what it holds.
+    let c = rinscope::record::read::contents(&dir.join("x.rrd")).expect("recording");
+    assert!(c.empty_views().is_empty(), "views of entities the recording lacks: {:?}", c.empty_views());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The columns of a csv table and its rows.
+fn csv_table(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header = lines.next().expect("header").split(',').map(String::from).collect();
+    let rows = lines.map(|l| l.split(',').map(|v| v.parse::<f64>().expect("number")).collect()).collect();
+    (header, rows)
+}
+
+/// Every column of every table in `dir` has at least two distinct finite values (the issue: no
+/// all-NaN or always-equal columns); returns the tables' file names.
+fn every_column_varies(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir).expect("tables").flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    for name in &names {
+        let (header, rows) = csv_table(&dir.join(name));
+        for (k, column) in header.iter().enumerate() {
+            let distinct: std::collections::BTreeSet<u64> = rows.iter().map(|r| r[k]).filter(|v| v.is_finite()).map(f64::to_bits).collect();
+            assert!(distinct.len() >= 2, "{name}: column {column} has {} distinct finite values", distinct.len());
+        }
+    }
+    names
+}
+
+/// A strapdown log set written by the test: 60 s of a vehicle turning (heading 10° → 100° at 3°/s
+/// from 5 s) and rolling (3°, 0.2 Hz), seed 000's Table 1 IMU, exported by `export-log` and then
+/// stripped of its table (no table.toml, no encoders) with its start position added, as a log of
+/// a plain strapdown IMU is written.
+fn strapdown_log(dir: &Path) -> PathBuf {
+    let scenario = dir.join("moving.toml");
+    std::fs::write(
+        &scenario,
+        "[scenario]\nname = \"moving-imu\"\ntitle = \"t\"\nseed = 7\n[simulation]\nduration_s = 60.0\nstep_hz = 200.0\n[site]\nlatitude_deg = 34.0\n\
+         [vehicle]\nheading_deg = 10.0\n[[vehicle.ramp]]\nangle = \"heading\"\nstart_s = 5.0\ntarget_deg = 100.0\nrate_deg_per_s = 3.0\n\
+         [[vehicle.wobble]]\nangle = \"roll\"\namplitude_deg = 3.0\nfrequency_hz = 0.2\n\
+         [turntable]\n[[turntable.axis]]\nname = \"table\"\naxis = \"z\"\n[scheme]\nkind = \"static\"\n[imu]\npreset = \"jiang2017-table1\"\n",
+    )
+    .expect("scenario");
+    let log = dir.join("strapdown");
+    ok(&rinscope().args(["export-log", "--config"]).arg(&scenario).arg("--out").arg(&log).output().expect("export-log"));
+    std::fs::remove_file(log.join("table.toml")).expect("table.toml");
+    std::fs::remove_file(log.join("encoders.csv")).expect("encoders.csv");
+    let manifest = std::fs::read_to_string(log.join("log.toml")).expect("manifest");
+    let mut kept = Vec::new();
+    let mut in_encoders = false;
+    for line in manifest.lines() {
+        if line.starts_with('[') {
+            in_encoders = line == "[encoders]";
+        }
+        if !in_encoders && !line.starts_with("table = ") {
+            kept.push(line.to_owned());
+        }
+        if line == "[initial]" {
+            kept.push("position = [34.0, 0.0, 0.0]".to_owned());
+        }
+    }
+    std::fs::write(log.join("log.toml"), kept.join("\n") + "\n").expect("manifest");
+    log
+}
+
+#[test]
+fn a_strapdown_replay_records_and_exports_the_ins_alone() {
+    // Issue "Numbers out" / "Strapdown logs without a table": with no table the recording, the
+    // summary and the export hold the INS and nothing of a table; the export is the INS's own
+    // solution on the file's clock and, with a reference, its errors, named from the algorithm.
+    let dir = scratch("strapdown");
+    let log = strapdown_log(&dir);
+    let (rrd, tables, summary) = (dir.join("sd.rrd"), dir.join("sd-tables"), dir.join("sd.json"));
+    ok(&rinscope().arg("replay").arg(&log).arg("--save").arg(&rrd).arg("--summary-json").arg(&summary).args(["--export-format", "csv", "--export"]).arg(&tables).output().expect("replay"));
+    let s = json(&summary);
+    assert_eq!(s["strapdown"], true);
+    assert!(s.get("attitude_error_arcsec").is_none(), "no table rows in the summary: {s}");
+    // The recording: the IMU's (body) axes and the reference's, the INS's plots; no gimbal, table,
+    // swing, vehicle or trace entity; and its layout shows only what it holds.
+    let c = rinscope::record::read::contents(&rrd).expect("recording");
+    for table_entity in ["world/vehicle", "world/ins_trace", "gimbal_angle_deg", "swing_arcsec", "attitude_error_", "closed_form", "vehicle_attitude_deg"] {
+        assert!(!c.entities.iter().any(|e| e.starts_with(table_entity)), "{table_entity}: {:?}", c.entities);
+    }
+    for wanted in ["world/ins_body", "world/reference_body", "ins/body_attitude_deg", "ins/attitude_error_arcsec/heading", "ins/velocity_enu_mps", "ins/position_from_start_m", "ins/latitude_longitude_deg"] {
+        assert!(c.entities.contains(wanted), "{wanted}: {:?}", c.entities);
+    }
+    assert!(c.empty_views().is_empty(), "views of entities the recording lacks: {:?}", c.empty_views());
+    // The export: these tables, every column with two distinct finite values or more.
+    let names = every_column_varies(&tables);
+    let expected = [
+        "ins__attitude_error_arcsec__heading.csv",
+        "ins__attitude_error_arcsec__pitch.csv",
+        "ins__attitude_error_arcsec__roll.csv",
+        "ins__body_attitude_deg.csv",
+        "ins__gyro_raw_deg_per_s.csv",
+        "ins__latitude_longitude_deg.csv",
+        "ins__position_from_start_m.csv",
+        "ins__velocity_enu_mps.csv",
+    ];
+    assert_eq!(names, expected);
+    let (header, rows) = csv_table(&tables.join("ins__attitude_error_arcsec__heading.csv"));
+    assert_eq!(header, ["t_s", "t_file_s", "two_sample_p1_heading_error_arcsec"]);
+    // Started from the exact attitude, seed 000's gyros keep the heading within arcseconds in 60 s.
+    let peak = rows.iter().map(|r| r[2].abs()).fold(0.0, f64::max);
+    assert!(peak < 60.0, "heading error {peak}″");
+    // Times: t_file_s is the IMU file's clock, t_s + the summary's t0_file_clock_s.
+    let t0 = s["t0_file_clock_s"].as_f64().expect("t0");
+    assert!(rows.iter().all(|r| (r[1] - r[0] - t0).abs() < 1e-9), "t_file_s = t_s + {t0}");
+    let (header, rows) = csv_table(&tables.join("ins__body_attitude_deg.csv"));
+    assert_eq!(header, ["t_s", "t_file_s", "pitch_deg", "roll_deg", "heading_deg"]);
+    // The INS's attitude (not a copy of the reference: its error above is not zero) follows the
+    // turn from 10° to 100° and the 3° roll.
+    let heading: Vec<f64> = rows.iter().map(|r| r[4]).collect();
+    assert!(heading.iter().copied().fold(f64::INFINITY, f64::min) < 10.5 && heading.iter().copied().fold(f64::NEG_INFINITY, f64::max) > 99.5, "heading {heading:?}");
+    assert!(rows.iter().map(|r| r[3].abs()).fold(0.0, f64::max) > 2.9, "roll");
+    assert_eq!(csv_table(&tables.join("ins__velocity_enu_mps.csv")).0, ["t_s", "t_file_s", "east_mps", "north_mps"], "held vertical channel: no up column");
+    assert_eq!(csv_table(&tables.join("ins__latitude_longitude_deg.csv")).0, ["t_s", "t_file_s", "latitude_deg", "longitude_deg"]);
+
+    // Without a reference: no errors anywhere (they would be zero), no reference axes.
+    let manifest = std::fs::read_to_string(log.join("log.toml")).expect("manifest");
+    let cut = manifest.replace("[reference]\nsource = \"the simulation's truth\"\nfile = \"reference.csv\"\n", "");
+    assert_ne!(cut, manifest, "the reference section was removed");
+    std::fs::write(log.join("log.toml"), cut).expect("manifest");
+    let (rrd, tables) = (dir.join("noref.rrd"), dir.join("noref-tables"));
+    ok(&rinscope().arg("replay").arg(&log).arg("--save").arg(&rrd).args(["--export-format", "csv", "--export"]).arg(&tables).output().expect("replay"));
+    let c = rinscope::record::read::contents(&rrd).expect("recording");
+    assert!(!c.entities.iter().any(|e| e.contains("attitude_error") || e.starts_with("world/reference_body") || e.starts_with("world/vehicle")), "{:?}", c.entities);
+    assert!(c.entities.contains("world/ins_body"), "{:?}", c.entities);
+    assert!(c.empty_views().is_empty(), "views of entities the recording lacks: {:?}", c.empty_views());
+    let names = every_column_varies(&tables);
+    assert_eq!(names, expected[3..]);
     std::fs::remove_dir_all(&dir).ok();
 }

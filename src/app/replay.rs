@@ -20,7 +20,7 @@ use crate::math::stats::RunningStat;
 use crate::math::timeline::decimation;
 use crate::math::units::ARCSEC_PER_RAD;
 use crate::model::gimbal::TableErrors;
-use crate::record::Recorder;
+use crate::record::{Recorder, Solution};
 use crate::scenario::logset::{LogSet, Reference};
 use crate::sim::{DemodState, StepOutput, ERROR_AXES};
 
@@ -191,6 +191,10 @@ fn final_state(pb: &Playback) -> FinalState {
 pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mut Recorder>, stop: &AtomicBool, bar: Option<&indicatif::ProgressBar>) -> Result<ReplaySummary, PlaybackError> {
     let started = Instant::now();
     let mut pb = Playback::open(log, compensation)?;
+    let rerun = |e: crate::record::RecordError| PlaybackError::Data(format!("rerun: {e}"));
+    if let Some(r) = recorder.as_deref_mut() {
+        r.set_file_clock(pb.file_time_s(0.0)).map_err(rerun)?;
+    }
     let chain = &log.table.chain;
     let nominal = TableErrors::zero(chain.axes().len());
     let (nominal_rot, comp_rot) = (chain.error_rotations(&nominal), chain.error_rotations(compensation));
@@ -232,7 +236,7 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
         if s.t_s <= window
             && let Some(r) = recorder.as_deref_mut()
         {
-            r.push_signal(&s).map_err(|e| PlaybackError::Data(format!("rerun: {e}")))?;
+            r.push_signal(&s).map_err(rerun)?;
         }
         if !s.updated {
             continue;
@@ -261,27 +265,30 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
             }
         }
         let Some((t_repr, encoder, corrected, body, body_nominal, reference)) = primary else { continue };
-        // Outside the reference's span (it starts late or ends early) nothing is compared.
-        if has_reference && reference.is_none() {
-            continue;
-        }
-        compared += 1;
+        // Outside the reference's span (it starts late or ends early) nothing is compared (the
+        // errors recorded there are NaN); the INS's own solution is recorded all along.
+        let compare = !(has_reference && reference.is_none());
         let truth = reference.unwrap_or(body);
-        let table_errors = [body_nominal.error_from(&truth), body.error_from(&truth)];
-        for (v, e) in table_errors.iter().enumerate() {
-            for (a, x) in e.as_array().into_iter().enumerate() {
-                stats[v][a].add(x);
-            }
-        }
-        for (k, e) in errors.iter().enumerate() {
-            for (a, x) in e.as_array().into_iter().enumerate() {
-                ins_stats[k][a].add(x);
-            }
-        }
+        let table_errors = if compare { [body_nominal.error_from(&truth), body.error_from(&truth)] } else { [nan; 2] };
         let nav_error = pb.core.nav_error();
-        if let Some(e) = nav_error {
-            let peak = nav.map_or(0.0, |n| n.peak_radial_m).max(e.radial_m);
-            nav = Some(NavSummary { peak_radial_m: peak, final_radial_m: e.radial_m, final_east_m: e.east_m, final_north_m: e.north_m });
+        if compare {
+            compared += 1;
+            for (v, e) in table_errors.iter().enumerate() {
+                for (a, x) in e.as_array().into_iter().enumerate() {
+                    stats[v][a].add(x);
+                }
+            }
+            for (k, e) in errors.iter().enumerate() {
+                for (a, x) in e.as_array().into_iter().enumerate() {
+                    ins_stats[k][a].add(x);
+                }
+            }
+            if let Some(e) = nav_error {
+                let peak = nav.map_or(0.0, |n| n.peak_radial_m).max(e.radial_m);
+                nav = Some(NavSummary { peak_radial_m: peak, final_radial_m: e.radial_m, final_east_m: e.east_m, final_north_m: e.north_m });
+            }
+        } else {
+            errors.iter_mut().for_each(|e| *e = nan);
         }
         if !(want_series || want_scene) || recorder.is_none() {
             next_series = if want_series { i.saturating_add(series_every) } else { next_series };
@@ -307,13 +314,14 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
         if want_series {
             next_series = i.saturating_add(series_every);
             if let Some(r) = recorder.as_deref_mut() {
-                r.push_row(&out, Some(&view)).map_err(|e| PlaybackError::Data(format!("rerun: {e}")))?;
+                let solution = Solution { body, nav: pb.core.nav_state().copied() };
+                r.push_replay_row(&out, &view, &solution).map_err(rerun)?;
             }
         }
         if want_scene {
             next_scene = i.saturating_add(scene_every);
             if let Some(r) = recorder.as_deref_mut() {
-                r.push_scene_row(&out, Some(&view)).map_err(|e| PlaybackError::Data(format!("rerun: {e}")))?;
+                r.push_scene_row(&out, Some(&view)).map_err(rerun)?;
             }
         }
     }
@@ -348,7 +356,6 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
         recording_bytes: None,
     };
     if let Some(r) = recorder {
-        let rerun = |e: crate::record::RecordError| PlaybackError::Data(format!("rerun: {e}"));
         for g in &summary.gaps {
             r.event(g.to_s, &format!("gap in the IMU data from {:.3} s to {:.3} s: the attitude was carried across", g.from_s, g.to_s), "WARN").map_err(rerun)?;
         }

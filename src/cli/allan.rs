@@ -3,10 +3,11 @@
 
 use std::sync::atomic::Ordering;
 
-use super::commands::{check_output_dir, default_recording, open_sinks, print_saved, write_json};
+use super::commands::{check_output_dir, default_recording, open_sinks, print_saved, print_tables, write_json};
 use super::{AllanArgs, Failure};
 use crate::app::allan::{self, AllanRequest, AllanRunError};
 use crate::app::terminate::stop_flag;
+use crate::record::export::Exporter;
 use crate::scenario::{self, logset};
 
 /// The preset `rinscope allan` simulates when given neither a log set nor a scenario.
@@ -24,9 +25,6 @@ impl From<AllanRunError> for Failure {
 
 /// `rinscope allan`.
 pub(super) fn allan(args: &AllanArgs) -> Result<(), Failure> {
-    if args.sinks.export.is_some() {
-        return Err(Failure::input("allan: --export writes time series; the Allan curves, their bounds and the fit are in --json FILE"));
-    }
     check_output_dir("--json", args.json.as_deref())?;
     if args.errors_only && args.dir.is_some() {
         return Err(Failure::input("allan: --errors-only needs the truth, which only a simulation has (give --scenario or --config)"));
@@ -39,7 +37,7 @@ pub(super) fn allan(args: &AllanArgs) -> Result<(), Failure> {
     }
     let (source, name, description) = match &args.dir {
         Some(dir) => {
-            let log = logset::load(dir)?;
+            let log = logset::load_imu(dir)?;
             let (name, description) = (log.name.clone(), log.description.clone());
             (Source::Log(Box::new(log)), name, description)
         }
@@ -56,7 +54,18 @@ pub(super) fn allan(args: &AllanArgs) -> Result<(), Failure> {
             (Source::Scenario(Box::new(params)), name, description)
         }
     };
-    let sinks = if args.no_recording { None } else { Some(open_sinks(args.sinks.request(default_recording(&format!("{name}-allan")))?, &format!("{name}-allan"))?) };
+    // --export: the curves and the fits as tables (written here, not from the recording's series).
+    let mut exporter = match args.sinks.export_request()? {
+        None => None,
+        Some((dir, format)) => Some(Exporter::new(&dir, format).map_err(|e| Failure::input(format!("--export {}: {e}", dir.display())))?),
+    };
+    let sinks = if args.no_recording {
+        None
+    } else {
+        let mut request = args.sinks.request(default_recording(&format!("{name}-allan")))?;
+        request.export = None;
+        Some(open_sinks(request, &format!("{name}-allan"))?)
+    };
     let stop = stop_flag();
     let bar = std::io::IsTerminal::is_terminal(&std::io::stderr()).then(|| {
         let bar = indicatif::ProgressBar::new_spinner();
@@ -94,6 +103,10 @@ pub(super) fn allan(args: &AllanArgs) -> Result<(), Failure> {
     outln!("({:.1} s gathering the samples, {:.2} s for the analysis)", result.gather_s, result.analysis_s);
     if let Some(path) = &args.json {
         write_json("--json", path, &result.json())?;
+    }
+    if let Some(e) = exporter.as_mut() {
+        let written = crate::record::allan::export(e, &result).and_then(|()| e.finish()).map_err(|e| Failure::run(format!("--export: {e}")))?;
+        print_tables(&written);
     }
     if let Some(sinks) = sinks {
         if let Err(e) = crate::record::allan::log(&sinks.stream(), &result, &description) {

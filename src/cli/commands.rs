@@ -239,9 +239,14 @@ pub(super) fn kept(saved: &sink::Saved) -> Result<(), Failure> {
 
 /// The line that tells where the export tables are.
 pub(super) fn print_exported(saved: &sink::Saved) {
-    if let Some(first) = saved.exported.first() {
+    print_tables(&saved.exported);
+}
+
+/// The line that tells where the tables `written` are.
+pub(super) fn print_tables(written: &[std::path::PathBuf]) {
+    if let Some(first) = written.first() {
         let dir = first.parent().map_or_else(|| ".".into(), |d| d.display().to_string());
-        outln!("exported {} tables to {dir} (pandas: pd.read_parquet(path); MATLAB: parquetread(path); docs/export.md)", saved.exported.len());
+        outln!("exported {} tables to {dir} (pandas: pd.read_parquet(path); MATLAB: parquetread(path); docs/export.md)", written.len());
     }
 }
 

@@ -8,7 +8,7 @@ use crate::app::calibrate::{self as calibration, estimated_compensation, Calibra
 use crate::app::export_log::{export_log as write_log_set, LogFormat};
 use crate::app::replay::replay as replay_log;
 use crate::app::terminate::stop_flag;
-use crate::record::Recorder;
+use crate::record::{Recorder, ReplayKind};
 use crate::scenario::logset::{self, RawImuFile, RawInitial, RawLogInfo, RawManifest, RawReference, RawTable};
 use crate::scenario::presets;
 
@@ -142,7 +142,8 @@ pub(super) fn replay(args: &ReplayArgs) -> Result<(), Failure> {
     let default_save = PathBuf::from("recordings").join(format!("{}-replay.rrd", log.name));
     let sinks = open_sinks(args.sinks.request(default_save)?, &format!("{}-replay", log.name))?;
     let stop = stop_flag();
-    let mut recorder = match Recorder::new_replay(sinks.stream(), &params) {
+    let kind = ReplayKind { table: !log.table.strapdown, reference: !matches!(log.reference, logset::Reference::None) };
+    let mut recorder = match Recorder::new_replay(sinks.stream(), &params, kind) {
         Ok(r) => r,
         Err(e) => {
             sinks.abandon();

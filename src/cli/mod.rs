@@ -134,8 +134,9 @@ struct SinkArgs {
     /// 0.0.0.0 shares the session with the whole network, without authentication).
     #[arg(long, value_name = "ADDR")]
     bind: Option<std::net::IpAddr>,
-    /// Also write every recorded time series as tables into this folder (one file per plot, a
-    /// t_s column, units in the column names; docs/export.md).
+    /// Also write the numbers as tables into this folder: every recorded time series (one file per
+    /// plot, a t_s column — a replay's also t_file_s, the IMU file's clock —, units in the column
+    /// names); allan: its curves and fits (docs/export.md).
     #[arg(long, value_name = "DIR")]
     export: Option<PathBuf>,
     /// Table format of --export: parquet or csv.
@@ -149,13 +150,18 @@ impl SinkArgs {
         self.spawn || self.connect.is_some() || self.serve.is_some() || self.serve_web.is_some()
     }
 
+    /// `--export DIR` and its format, if asked for.
+    fn export_request(&self) -> Result<Option<(PathBuf, ExportFormat)>, Failure> {
+        match &self.export {
+            None => Ok(None),
+            Some(dir) => Ok(Some((dir.clone(), ExportFormat::parse(&self.export_format).map_err(|e| Failure::input(format!("--export-format {e}")))?))),
+        }
+    }
+
     /// The request, with `default_save` when no viewer was asked for.
     fn request(&self, default_save: PathBuf) -> Result<SinkRequest, Failure> {
         let save = self.save.clone().or_else(|| (!self.viewer_asked()).then_some(default_save));
-        let export = match &self.export {
-            None => None,
-            Some(dir) => Some((dir.clone(), ExportFormat::parse(&self.export_format).map_err(|e| Failure::input(format!("--export-format {e}")))?)),
-        };
+        let export = self.export_request()?;
         if self.bind.is_some() && self.serve.is_none() && self.serve_web.is_none() {
             return Err(Failure::input("--bind ADDR goes with --serve or --serve-web"));
         }

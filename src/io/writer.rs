@@ -53,13 +53,23 @@ impl std::fmt::Debug for TableWriter {
     }
 }
 
-fn check_columns(path: &Path, columns: &[&str]) -> Result<()> {
+/// What a table's columns must be.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Shape {
+    /// A time series: `t_s` first, every name with a unit.
+    TimeSeries,
+    /// Any table (an Allan curve against τ, fitted coefficients): names only checked for their
+    /// characters and repeats (coefficient units such as °/√h are not units `io` converts).
+    Keyed,
+}
+
+fn check_columns(path: &Path, columns: &[&str], shape: Shape) -> Result<()> {
     let bad = |column: &str, problem: String| LogError::Unit {
         file: path.to_path_buf(),
         column: column.to_owned(),
         problem,
     };
-    if columns.first() != Some(&"t_s") {
+    if columns.is_empty() || (shape == Shape::TimeSeries && columns.first() != Some(&"t_s")) {
         return Err(LogError::Layout {
             file: path.to_path_buf(),
             problem: format!("the first column must be t_s (got {:?})", columns.first()),
@@ -72,7 +82,7 @@ fn check_columns(path: &Path, columns: &[&str]) -> Result<()> {
                 "a column name is ASCII letters, digits and _".into(),
             ));
         }
-        if split_unit(c).is_none() {
+        if shape == Shape::TimeSeries && split_unit(c).is_none() {
             return Err(bad(c, "the name carries no unit: end it with _<unit>, e.g. _rad, _deg_per_h, _mps2, _m, _s".into()));
         }
         if columns.get(..i).is_some_and(|before| before.contains(c)) {
@@ -100,7 +110,20 @@ impl TableWriter {
     /// Unknown extension or an MCAP one, bad column names, `PATH.partial` locked by another writer
     /// (or a symlink), `PATH` a symlink or directory, or the partial cannot be created.
     pub fn create(path: impl AsRef<Path>, columns: &[&str]) -> Result<Self> {
-        let path = path.as_ref();
+        Self::create_shaped(path.as_ref(), columns, Shape::TimeSeries)
+    }
+
+    /// A writer for a table that is not a time series (an Allan curve against `tau_s`, one row of
+    /// fitted coefficients per axis): any first column; names of ASCII letters, digits and `_`,
+    /// each once (they need not end in a unit `io` knows).
+    ///
+    /// # Errors
+    /// As [`Self::create`].
+    pub fn create_keyed(path: impl AsRef<Path>, columns: &[&str]) -> Result<Self> {
+        Self::create_shaped(path.as_ref(), columns, Shape::Keyed)
+    }
+
+    fn create_shaped(path: &Path, columns: &[&str], shape: Shape) -> Result<Self> {
         let format = Format::from_extension(path);
         let output = |problem: String| LogError::Output {
             file: path.to_path_buf(),
@@ -114,7 +137,7 @@ impl TableWriter {
                 ));
             }
         };
-        check_columns(path, columns)?;
+        check_columns(path, columns, shape)?;
         if std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink()) {
             return Err(output("the output path is a symlink; refusing to write through it".into()));
         }

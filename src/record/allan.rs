@@ -2,15 +2,18 @@
 //! below), the fitted slope lines of the IEEE terms over the data, the configured truth dotted, the
 //! coefficients as a table. Rerun plots against a timeline and has no logarithmic axis, so the
 //! curves are logged as log10 values on a timeline `log10_tau_s` whose "seconds" are log10(τ / 1 s),
-//! and the entity paths and the documents say so.
+//! and the entity paths and the documents say so. `--export` writes the curves and the fits as
+//! tables ([`export`]).
 
 use rerun::blueprint::components::ContainerKind;
 use rerun::{RecordingStreamResult, TimeColumn};
 
+use super::export::Exporter;
 use super::layout::{self, LegendCorner, Node};
 use super::palette::rgb;
 use super::{Stream, APPLICATION_ID};
-use crate::ins::allan::{Channel, ImuAllan, AXES};
+use crate::ins::allan::{Channel, ImuAllan, Sensor, AXES};
+use crate::io::LogError;
 use crate::math::allan::TERMS;
 
 /// The x axis: a duration timeline whose value in seconds is log10(τ / 1 s).
@@ -176,7 +179,6 @@ fn about(r: &ImuAllan, description: &str) -> String {
 
 /// Logs the analysis with its documents and a layout; `description` explains the source (markdown).
 pub fn log(stream: &Stream, r: &ImuAllan, description: &str) -> RecordingStreamResult<()> {
-    use crate::ins::allan::Sensor;
     let rec = stream.rec();
     rec.send_recording_name(format!("rinscope allan: {}", r.source))?;
     rec.log_static("docs/allan", &rerun::TextDocument::from_markdown(about(r, description)))?;
@@ -209,4 +211,63 @@ pub fn log(stream: &Stream, r: &ImuAllan, description: &str) -> RecordingStreamR
     );
     let root = Node::container(ContainerKind::Vertical, vec![row(Sensor::Gyro), row(Sensor::Accel), docs], &[1.0, 1.0, 0.62]);
     layout::send(rec, APPLICATION_ID, &root, &layout::Playback { timeline: LOG10_TAU_TIMELINE, speed: 1.0, follow: true })
+}
+
+/// `allan --export`: per channel (`allan__gyro_x`, ...) its curve against `tau_s` — the Allan
+/// deviation, its lower and upper confidence bounds, the fitted model's deviation (and the
+/// configured noise's when known) in the sensor's unit (°/h, µg), the equivalent degrees of
+/// freedom and the number of second differences; per sensor (`allan__gyro_fit`, ...) one row per
+/// axis (`axis` 0, 1, 2 = x, y, z) of the fitted coefficients with their 1σ in their conventional
+/// units and whether the fit found each (`found` 1 or 0: a dropped term's value is 0 and its 1σ
+/// the detection limit), and the fit's χ²/dof.
+///
+/// # Errors
+/// A table that cannot be written.
+pub fn export(exporter: &mut Exporter, r: &ImuAllan) -> Result<(), LogError> {
+    for c in &r.channels {
+        let u = c.sensor.adev_unit();
+        let rep = &c.report;
+        let mut columns: Vec<String> = ["tau_s", "adev", "adev_lower", "adev_upper", "fit_adev"].iter().enumerate().map(|(i, n)| if i == 0 { (*n).to_owned() } else { format!("{n}_{}", u.key) }).collect();
+        columns.extend(["edf".to_owned(), "second_differences_count".to_owned()]);
+        if c.truth.is_some() {
+            columns.push(format!("configured_adev_{}", u.key));
+        }
+        let rows: Vec<Vec<f64>> = (0..rep.taus_s.len())
+            .map(|j| {
+                let tau = rep.taus_s[j];
+                let mut row = vec![tau, rep.adev_si[j] / u.si, rep.adev_lower_si[j] / u.si, rep.adev_upper_si[j] / u.si, rep.fit.avar(tau).sqrt() / u.si, rep.edf[j], rep.n_terms[j] as f64];
+                if let Some(t) = c.truth {
+                    row.push(t.avar(tau).sqrt() / u.si);
+                }
+                row
+            })
+            .collect();
+        exporter.write_table(&path(c), &columns, &rows)?;
+    }
+    for sensor in Sensor::ALL {
+        let chans: Vec<&Channel> = r.channels.iter().filter(|c| c.sensor == sensor).collect();
+        if chans.is_empty() {
+            continue;
+        }
+        let mut columns = vec!["axis".to_owned()];
+        for term in TERMS {
+            let (letter, unit) = (term.letter().to_lowercase(), sensor.unit(term).key);
+            columns.extend([format!("{letter}_{unit}"), format!("{letter}_sigma_{unit}"), format!("{letter}_found")]);
+        }
+        columns.push("fit_chi2_per_dof".to_owned());
+        let rows: Vec<Vec<f64>> = chans
+            .iter()
+            .map(|c| {
+                let mut row = vec![c.axis as f64];
+                for term in TERMS {
+                    let e = c.fitted(term);
+                    row.extend([e.value, e.sigma, f64::from(u8::from(e.significant))]);
+                }
+                row.push(c.report.fit_chi2_per_dof);
+                row
+            })
+            .collect();
+        exporter.write_table(&format!("allan/{}_fit", sensor.name()), &columns, &rows)?;
+    }
+    Ok(())
 }

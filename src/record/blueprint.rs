@@ -1,10 +1,13 @@
 //! The layout a run's recording opens with: the 3D scene and its documents on the left, the error
-//! plots on the right (the INS's when it is in the loop, the table-only ones in tabs).
+//! plots on the right (the INS's when it is in the loop, the table-only ones in tabs; a replay
+//! without a reference leads with the INS's own solution). Only entities the recording has are
+//! laid out.
 
 use rerun::blueprint::components::ContainerKind;
 use rerun::RecordingStreamResult;
 
 use super::layout::{self, Node};
+use super::rows::{self, Quantity};
 use super::{CustomLayout, Recorder, APPLICATION_ID, TIMELINE};
 use crate::scenario::Params;
 use crate::sim::ERROR_AXES;
@@ -23,19 +26,24 @@ impl Recorder {
         };
         let table_peak = |a: usize| self.ranges.map(|r| super::floored_peak(r.table_peak_rad, a) * unit.per_rad());
         // The legend would sit over the data: the title says which line is which.
-        let key = if self.replay { "red: nominal table, green: compensated" } else { "red: uncompensated, blue: closed form, green: compensated" };
+        let key = match self.replay {
+            None => "red: uncompensated, blue: closed form, green: compensated",
+            Some(k) if k.reference => "red: nominal table, green: compensated",
+            Some(_) => "nominal − compensated table",
+        };
         let error_view = |a: usize, axis: &str| {
             framed(plot(format!("{axis} error ({}) — {key}", unit.suffix()), &super::error_path(unit, axis)), table_peak(a)).with_property("PlotLegend", &layout::no_legend())
         };
         let x = p.recording.exaggeration;
         let own = super::own_factors(&self.factors, x);
         let scale = if own.is_empty() { format!("errors ×{x}") } else { format!("errors ×{x}, {}", own.join(", ")) };
-        let scene = Node::view("3D", format!("3D: gimbal chain ({scale})"), "world")
-            .with_property(
-                "EyeControls3D",
-                // With an INS, the trace stands beside the table: step back to frame both.
-                &if self.ins.is_some() { layout::eye([3.6, -1.7, 1.5], [0.7, 0.7, -0.3]) } else { layout::eye([2.6, -1.1, 0.95], [0.0, 0.1, -0.2]) },
-            );
+        let scene = match (&self.body, &self.ins) {
+            (Some(_), _) => Node::view("3D", format!("3D: the IMU (body) axes at the INS attitude{}", if self.replay.is_some_and(|k| k.reference) { "; grey: the reference" } else { "" }), "world")
+                .with_property("EyeControls3D", &layout::eye([2.4, -2.6, 1.5], [0.0, 0.1, -0.1])),
+            // With an INS, the trace stands beside the table: step back to frame both.
+            (None, Some(_)) => Node::view("3D", format!("3D: gimbal chain ({scale})"), "world").with_property("EyeControls3D", &layout::eye([3.6, -1.7, 1.5], [0.7, 0.7, -0.3])),
+            (None, None) => Node::view("3D", format!("3D: gimbal chain ({scale})"), "world").with_property("EyeControls3D", &layout::eye([2.6, -1.1, 0.95], [0.0, 0.1, -0.2])),
+        };
         let (custom_right, mut doc_tabs) = match custom {
             Some(c) => (Some(c.right), c.docs),
             None => (None, Vec::new()),
@@ -48,17 +56,21 @@ impl Recorder {
         let docs = Node::container(ContainerKind::Tabs, doc_tabs, &[]);
         let left = Node::container(ContainerKind::Vertical, vec![scene, docs], &[3.0, 1.3]);
         let mut more = Vec::new();
-        if self.closed_form_series.is_some() {
+        if self.has_series(super::CLOSED_FORM_PATH) {
             let peak = self.ranges.map(|r| r.closed_form_peak_rad.iter().fold(0.0_f64, |m, x| m.max(*x)) * crate::math::units::ARCSEC_PER_RAD);
             more.push(
                 framed(plot("closed form − exact (arcsec) — red pitch, green roll, blue heading".into(), super::CLOSED_FORM_PATH), peak).with_property("PlotLegend", &layout::no_legend()),
             );
         }
-        more.extend([
-            plot("gimbal angles (deg)".into(), "gimbal_angle_deg"),
-            plot("vehicle attitude (deg)".into(), "vehicle_attitude_deg"),
-            plot("swing angles (arcsec)".into(), "swing_arcsec"),
-        ]);
+        for (title, path) in [("gimbal angles (deg)", "gimbal_angle_deg"), ("vehicle attitude (deg)", "vehicle_attitude_deg")] {
+            if self.has_series(path) {
+                more.push(plot(title.into(), path));
+            }
+        }
+        if self.series.iter().any(|s| matches!(s.what, Quantity::Swing(_))) {
+            more.push(plot("swing angles (arcsec)".into(), "swing_arcsec"));
+        }
+        let has_table_errors = self.has_series(&super::error_path(unit, "pitch"));
         let right = match (&self.ins, custom_right) {
             (_, Some(right)) => right,
             (None, None) => {
@@ -66,7 +78,8 @@ impl Recorder {
                 Node::container(ContainerKind::Vertical, vec![error_view(0, "pitch"), error_view(1, "roll"), error_view(2, "heading"), more], &[])
             }
             (Some(layout), None) => {
-                // The INS in the loop leads; the turntable-only (ideal-INS) plots go into the tabs.
+                // The INS leads (its errors, else its own solution); the turntable-only (ideal-INS)
+                // plots go into the tabs.
                 let ins_peak = |a: usize| self.ranges.and_then(|r| r.ins_peak_rad).map(|p| super::floored_peak(p, a) * crate::math::units::ARCSEC_PER_RAD);
                 // The legend would sit over the data: the first plot's title gives each
                 // algorithm's colour (short, so that it is not cut), the others refer to it.
@@ -79,7 +92,29 @@ impl Recorder {
                     };
                     framed(plot(title, &format!("ins/attitude_error_arcsec/{axis}")), ins_peak(a)).with_property("PlotLegend", &layout::no_legend())
                 };
-                let mut tabs = Vec::new();
+                // A replay's own solution, keyed in the titles (a legend would cover the curves).
+                let primary = layout.algorithms.first().map_or("", String::as_str);
+                let solution: Vec<Node> = [
+                    (rows::BODY_ATTITUDE_PATH, format!("INS body attitude (deg), {primary} — red pitch, green roll, blue heading")),
+                    (rows::VELOCITY_PATH, format!("INS velocity (m/s) — red east, green north{}", if self.series_names(rows::VELOCITY_PATH).len() > 2 { ", blue up" } else { "" })),
+                    (rows::POSITION_PATH, "INS position from the start (m) — red east, green north".to_owned()),
+                    (rows::LAT_LON_PATH, "INS latitude, longitude (deg) — red latitude, green longitude".to_owned()),
+                    (rows::HEIGHT_PATH, "INS height (m)".to_owned()),
+                ]
+                .into_iter()
+                .filter(|(path, _)| self.has_series(path))
+                .map(|(path, title)| plot(title, path).with_property("PlotLegend", &layout::no_legend()))
+                .collect();
+                let (lead, mut tabs): (Vec<Node>, Vec<Node>) = if layout.errors {
+                    (vec![ins_view(0, "pitch"), ins_view(1, "roll"), ins_view(2, "heading")], solution)
+                } else if has_table_errors {
+                    (vec![error_view(0, "pitch"), error_view(1, "roll"), error_view(2, "heading")], solution)
+                } else {
+                    // A strapdown IMU without a reference: its attitude, velocity and position lead.
+                    let mut s = solution;
+                    let rest = s.split_off(s.len().min(3));
+                    (s, rest)
+                };
                 if let Some((_, rates)) = &layout.coning_log {
                     // Whole decades, from a tenth of the run (the lines' left part is their steep
                     // start) to the end, of the slowest to the fastest analytic drift.
@@ -89,7 +124,7 @@ impl Recorder {
                         .with_property("PlotLegend", &layout::no_legend());
                     tabs.push(if lo.is_finite() { view.with_property("ScalarAxis", &layout::scalar_range((lo - 1.0).floor(), hi.ceil())) } else { view });
                 }
-                if layout.nav {
+                if self.has_series("ins/position_error_m") {
                     // Keyed in the titles: a legend would cover the curves.
                     tabs.push(plot("position error (m) — red east, green north, blue radial".into(), "ins/position_error_m").with_property("PlotLegend", &layout::no_legend()));
                     tabs.push(plot("velocity error (m/s) — red east, green north, blue up".into(), "ins/velocity_error_mps").with_property("PlotLegend", &layout::no_legend()));
@@ -100,16 +135,20 @@ impl Recorder {
                 let peaks = layout.signal_peak_deg_per_s;
                 let gyro = |name: String, origin: &str, k: usize| framed(window(&name, origin), self.ranges.map(|_| peaks[k])).with_property("PlotLegend", &layout::no_legend());
                 let first = format!("the first {} s", layout.signal_window_s);
-                tabs.push(gyro(format!("gyro raw (deg/s), {first} — red x, green y, blue z"), "ins/gyro_raw_deg_per_s", 0));
-                tabs.push(gyro(format!("gyro after FIR (deg/s), {first} — red x, green y, blue z"), "ins/gyro_filtered_deg_per_s", 1));
+                tabs.push(gyro(format!("gyro raw (deg/s), {first} — red x, green y, blue z"), super::ins_view::GYRO_RAW_PATH, 0));
                 if layout.fir_taps.len() > 1 {
+                    tabs.push(gyro(format!("gyro after FIR (deg/s), {first} — red x, green y, blue z"), super::ins_view::GYRO_FILTERED_PATH, 1));
                     tabs.push(Node::view("2D", "FIR response (x: Hz, y: −5·dB)", "ins/fir_response"));
                 }
-                for (a, axis) in ERROR_AXES.iter().enumerate() {
-                    tabs.push(framed(plot(format!("table only: {axis} ({})", unit.suffix()), &super::error_path(unit, axis)), table_peak(a)));
+                if has_table_errors && layout.errors {
+                    for (a, axis) in ERROR_AXES.iter().enumerate() {
+                        tabs.push(framed(plot(format!("table only: {axis} ({})", unit.suffix()), &super::error_path(unit, axis)), table_peak(a)));
+                    }
                 }
                 tabs.append(&mut more);
-                Node::container(ContainerKind::Vertical, vec![ins_view(0, "pitch"), ins_view(1, "roll"), ins_view(2, "heading"), Node::container(ContainerKind::Tabs, tabs, &[])], &[])
+                let mut column = lead;
+                column.push(Node::container(ContainerKind::Tabs, tabs, &[]));
+                Node::container(ContainerKind::Vertical, column, &[])
             }
         };
         let root = Node::container(ContainerKind::Horizontal, vec![left, right], &[1.1, 1.0]);

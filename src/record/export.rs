@@ -43,6 +43,8 @@ pub struct Exporter {
     tables: BTreeMap<String, TableWriter>,
     /// The first write that failed: the recording goes on, the run reports it at the end.
     failed: Option<LogError>,
+    /// A replay's t = 0 on the IMU file's clock, s: every table then has `t_file_s` after `t_s`.
+    file_clock_s: Option<f64>,
 }
 
 /// An exporter shared by the recorders of one run.
@@ -55,13 +57,18 @@ pub fn unit_of(entity: &str) -> Option<&'static str> {
     entity.rsplit('/').find_map(|seg| crate::io::units::split_unit(seg).map(|(_, u)| u.suffix))
 }
 
-/// A series name as a column name: lower-case letters, digits and `_` (`+3σ` → `plus_3_sigma`).
+/// A series name as a column name: lower-case letters, digits and `_` (`+3σ` → `plus_3_sigma`,
+/// `two-sample-p1` → `two_sample_p1`: a hyphen between letters or digits joins a name, elsewhere
+/// `-` is a minus).
 #[must_use]
 pub fn column_base(name: &str) -> String {
     let mut out = String::new();
-    for ch in name.chars() {
+    let chars: Vec<char> = name.chars().collect();
+    for (i, &ch) in chars.iter().enumerate() {
+        let joins = |j: Option<usize>| j.and_then(|j| chars.get(j)).is_some_and(char::is_ascii_alphanumeric);
         let piece = match ch {
             '+' => "_plus_".to_owned(),
+            '-' if joins(i.checked_sub(1)) && joins(Some(i + 1)) => "_".to_owned(),
             '−' | '-' => "_minus_".to_owned(),
             'σ' => "_sigma_".to_owned(),
             'α' => "_alpha_".to_owned(),
@@ -80,7 +87,14 @@ impl Exporter {
     /// Tables into `dir` (created if needed).
     pub fn new(dir: &Path, format: ExportFormat) -> std::io::Result<Self> {
         std::fs::create_dir_all(dir)?;
-        Ok(Self { dir: dir.to_path_buf(), format, tables: BTreeMap::new(), failed: None })
+        Ok(Self { dir: dir.to_path_buf(), format, tables: BTreeMap::new(), failed: None, file_clock_s: None })
+    }
+
+    /// A replay's t = 0 on the IMU file's clock, s: the tables created from now on have a
+    /// `t_file_s` column (t_s + this) after `t_s`.
+    pub fn set_file_clock(&mut self, t0_file_s: f64) {
+        debug_assert!(self.tables.is_empty(), "the file clock is set before the first row");
+        self.file_clock_s = Some(t0_file_s);
     }
 
     /// Appends rows to the table of `entity` (see [`Self::try_write`]); a failure is kept for
@@ -98,8 +112,11 @@ impl Exporter {
     pub fn try_write(&mut self, entity: &str, unit: &str, names: &[String], times: &[f64], values: &[f64]) -> Result<(), LogError> {
         let width = names.len();
         if !self.tables.contains_key(entity) {
-            let file = format!("{}.{}", entity.trim_start_matches('/').replace('/', "__").replace('.', "_"), self.format.extension());
+            let file = self.file_name(entity);
             let mut columns = vec!["t_s".to_owned()];
+            if self.file_clock_s.is_some() {
+                columns.push("t_file_s".to_owned());
+            }
             for name in names {
                 let mut c = format!("{}_{unit}", column_base(name));
                 while columns.contains(&c) {
@@ -112,13 +129,37 @@ impl Exporter {
             self.tables.insert(entity.to_owned(), writer);
         }
         let Some(writer) = self.tables.get_mut(entity) else { return Ok(()) };
-        let mut row = vec![0.0; width + 1];
+        // The file clock's column if this table has it (a table created before the clock was set has not).
+        let clock = self.file_clock_s.filter(|_| writer.columns().get(1).is_some_and(|c| c == "t_file_s"));
+        let first = 1 + usize::from(clock.is_some());
+        let mut row = vec![0.0; width + first];
         for (i, t) in times.iter().enumerate() {
             row[0] = *t;
-            row[1..].copy_from_slice(&values[i * width..(i + 1) * width]);
+            if let Some(t0) = clock {
+                row[1] = t0 + t;
+            }
+            row[first..].copy_from_slice(&values[i * width..(i + 1) * width]);
             writer.write_row(&row)?;
         }
         Ok(())
+    }
+
+    /// Writes the whole table `name` (its file named like an entity's) that is not a time series:
+    /// `columns`, the first one its key (`tau_s`, `axis`), and `rows` (see
+    /// [`TableWriter::create_keyed`]).
+    pub fn write_table(&mut self, name: &str, columns: &[String], rows: &[Vec<f64>]) -> Result<(), LogError> {
+        let refs: Vec<&str> = columns.iter().map(String::as_str).collect();
+        let mut writer = TableWriter::create_keyed(self.dir.join(self.file_name(name)), &refs)?;
+        for row in rows {
+            writer.write_row(row)?;
+        }
+        self.tables.insert(name.to_owned(), writer);
+        Ok(())
+    }
+
+    /// The file of the table of `entity`.
+    fn file_name(&self, entity: &str) -> String {
+        format!("{}.{}", entity.trim_start_matches('/').replace('/', "__").replace('.', "_"), self.format.extension())
     }
 
     /// Finishes every table; returns their paths (the first failed write, if any, instead: the
@@ -130,7 +171,7 @@ impl Exporter {
         }
         let mut out = Vec::new();
         for (entity, writer) in tables {
-            let file = format!("{}.{}", entity.trim_start_matches('/').replace('/', "__").replace('.', "_"), self.format.extension());
+            let file = self.file_name(&entity);
             writer.finish()?;
             out.push(self.dir.join(file));
         }
@@ -150,5 +191,9 @@ mod tests {
         assert_eq!(column_base("+3σ"), "plus_3_sigma");
         assert_eq!(column_base("exact LSQ (final)"), "exact_lsq_final");
         assert_eq!(column_base("closed form"), "closed_form");
+        // Algorithm names keep their words; a minus is still a minus.
+        assert_eq!(column_base("two-sample-p1 heading error"), "two_sample_p1_heading_error");
+        assert_eq!(column_base("-3σ"), "minus_3_sigma");
+        assert_eq!(column_base("nominal − compensated table"), "nominal_minus_compensated_table");
     }
 }

@@ -5,7 +5,7 @@
 use rerun::RecordingStreamResult;
 
 use super::palette::{colors, rgb, rgba};
-use super::{Recorder, SERIES_CHUNK_ROWS};
+use super::{rows, Recorder, SERIES_CHUNK_ROWS};
 use crate::ins::core::SampleOut;
 use crate::math::units::DEG_PER_RAD;
 use crate::sim::ERROR_AXES;
@@ -13,9 +13,10 @@ use crate::sim::ERROR_AXES;
 /// What a run with an IMU in the loop adds to the recording.
 pub(crate) struct InsLayout {
     pub(crate) algorithms: Vec<String>,
-    pub(crate) nav: bool,
-    /// Index in `Recorder::series` of the first INS entity.
-    pub(crate) first_series: usize,
+    /// The attitude errors per algorithm are recorded (a simulation, a replay with a reference).
+    pub(crate) errors: bool,
+    /// The trace of the true and computed IMU axes beside the table (not for a strapdown IMU).
+    pub(crate) trace: bool,
     pub(crate) signal_t: Vec<f64>,
     pub(crate) raw: Vec<f64>,
     pub(crate) filtered: Vec<f64>,
@@ -52,6 +53,11 @@ pub(crate) fn dial_path(name: &str) -> String {
 /// The log10 plot of the coning drift: each algorithm's |heading error| beside its analytic rate × t.
 pub(crate) const CONING_LOG_PATH: &str = "ins/coning_drift_log10_arcsec";
 
+/// The raw gyro signal of the first moments.
+pub(crate) const GYRO_RAW_PATH: &str = "ins/gyro_raw_deg_per_s";
+/// The gyro signal after the FIR (with a FIR only).
+pub(crate) const GYRO_FILTERED_PATH: &str = "ins/gyro_filtered_deg_per_s";
+
 /// The gyro signals' lines.
 const GYRO_NAMES: [&str; 3] = ["gyro x", "gyro y", "gyro z"];
 
@@ -80,8 +86,11 @@ impl Recorder {
         }
         let times = std::mem::take(&mut layout.signal_t);
         let names = GYRO_NAMES.map(String::from);
-        for (path, values) in [("ins/gyro_raw_deg_per_s", std::mem::take(&mut layout.raw)), ("ins/gyro_filtered_deg_per_s", std::mem::take(&mut layout.filtered))] {
-            self.stream.send_series(path, &names, &times, values, 3)?;
+        let (raw, filtered) = (std::mem::take(&mut layout.raw), std::mem::take(&mut layout.filtered));
+        self.stream.send_series(GYRO_RAW_PATH, &names, &times, raw, 3)?;
+        // Without a FIR the filtered signal is the raw one.
+        if layout.fir_taps.len() > 1 {
+            self.stream.send_series(GYRO_FILTERED_PATH, &names, &times, filtered, 3)?;
         }
         Ok(())
     }
@@ -92,7 +101,7 @@ impl Recorder {
         let rec = &self.rec;
         // Each algorithm keeps its colour in every recording (by identity, not by position).
         let algo_colors: Vec<rerun::Color> = layout.algorithms.iter().map(|name| rgb(colors::algorithm(name))).collect();
-        for axis in ERROR_AXES {
+        for axis in ERROR_AXES.iter().filter(|_| layout.errors) {
             let path = format!("ins/attitude_error_arcsec/{axis}");
             rec.log_static(path.as_str(), &rerun::SeriesLines::new().with_colors(algo_colors.clone()).with_names(self.series_names(&path)))?;
         }
@@ -102,10 +111,13 @@ impl Recorder {
             let widths: Vec<f32> = layout.algorithms.iter().flat_map(|_| [2.5, 1.0]).collect();
             rec.log_static(CONING_LOG_PATH, &rerun::SeriesLines::new().with_colors(colors).with_widths(widths).with_names(self.series_names(CONING_LOG_PATH)))?;
         }
-        for path in ["ins/position_error_m", "ins/velocity_error_mps"] {
-            rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors::EULER.map(rgb)).with_names(self.series_names(path)))?;
+        // Pitch/roll/heading and east/north/up: red, green, blue.
+        let three = ["ins/position_error_m", "ins/velocity_error_mps", rows::BODY_ATTITUDE_PATH, rows::VELOCITY_PATH, rows::POSITION_PATH, rows::LAT_LON_PATH, rows::HEIGHT_PATH];
+        for path in three.into_iter().filter(|p| self.has_series(p)) {
+            let names = self.series_names(path);
+            rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors::EULER[..names.len()].iter().map(|c| rgb(*c))).with_names(names))?;
         }
-        for path in ["ins/gyro_raw_deg_per_s", "ins/gyro_filtered_deg_per_s"] {
+        for path in [GYRO_RAW_PATH, GYRO_FILTERED_PATH].into_iter().take(if layout.fir_taps.len() > 1 { 2 } else { 1 }) {
             rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors::SENSOR.map(rgb)).with_names(GYRO_NAMES))?;
         }
         // FIR amplitude response, dB, drawn in a 2D view: x = frequency (Hz), y = 5 × dB (so that
@@ -156,6 +168,9 @@ impl Recorder {
                 "world/drift_dial/labels",
                 &rerun::Points3D::new(items.iter().map(|(p, _)| *p)).with_labels(items.iter().map(|(_, t)| t.as_str())).with_colors(colors).with_radii([0.012]),
             )?;
+        }
+        if !layout.trace {
+            return Ok(());
         }
         // The INS trace: true IMU axes (grey) and computed (coloured, error ×N), beside the table.
         let ins_label = format!("INS IMU axes (error ×{})", layout.exaggeration);

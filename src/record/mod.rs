@@ -6,6 +6,8 @@
 //! - `attitude_error_arcsec/{pitch,roll,heading}`: three series each (uncompensated, compensated, closed form);
 //! - `gimbal_angle_deg` (one series per axis), `vehicle_attitude_deg` (pitch, roll, heading),
 //!   `swing_arcsec/<axis>` (the swing rotation vector's two components);
+//! - a replay: the INS's own solution (`ins/body_attitude_deg`, `ins/velocity_enu_mps`, ...); a
+//!   strapdown replay nothing of a table, its axes at `world/ins_body` (`rows`, `body_view`);
 //!
 //! Series that share a plot share an entity (one `Scalars` of several values per row): a third of
 //! the time and row-id columns of one entity per line.
@@ -18,6 +20,7 @@ use layout::Node;
 
 pub mod allan;
 mod blueprint;
+mod body_view;
 mod cone;
 pub mod calibration;
 pub mod export;
@@ -26,18 +29,20 @@ mod layout;
 pub mod modulation;
 mod palette;
 pub mod read;
+mod rows;
 mod scene;
 pub mod sink;
 pub mod tpr;
 
-use crate::ins::core::NavError;
 use crate::ins::pipeline::InsView;
 use crate::math::rotvec;
-use crate::math::units::{ARCSEC_PER_RAD, DEG_PER_RAD};
+use crate::math::units::ARCSEC_PER_RAD;
 use crate::model::gimbal::{Chain, ClassFactors, ErrorRotations, TableErrors};
 use crate::scenario::Params;
-use crate::sim::{StepOutput, DEMODULATIONS, ERROR_AXES};
+use crate::sim::{StepOutput, ERROR_AXES};
 use ins_view::{InsLayout, TRACE_OFFSET};
+use rows::Series;
+pub use rows::Solution;
 use export::SharedExporter;
 use scene::ChainPaths;
 
@@ -47,13 +52,32 @@ use scene::ChainPaths;
 pub struct Stream {
     rec: RecordingStream,
     export: Option<SharedExporter>,
+    /// A replay's t = 0 on the IMU file's clock, s (its series then also go on [`FILE_CLOCK_TIMELINE`]).
+    file_clock_s: Option<f64>,
 }
 
 impl Stream {
     /// A stream into `rec`, its series also into `export`.
     #[must_use]
     pub(crate) fn new(rec: RecordingStream, export: Option<SharedExporter>) -> Self {
-        Self { rec, export }
+        Self { rec, export, file_clock_s: None }
+    }
+
+    /// A replay's t = 0 on the IMU file's clock, s (see [`Recorder::set_file_clock`]).
+    fn set_file_clock(&mut self, t0_file_s: f64) {
+        self.file_clock_s = Some(t0_file_s);
+        if let Some(export) = &self.export {
+            export.lock().unwrap_or_else(std::sync::PoisonError::into_inner).set_file_clock(t0_file_s);
+        }
+    }
+
+    /// The time columns of rows at `times` (s on [`TIMELINE`]): that timeline, and a replay's file clock.
+    pub(crate) fn time_columns(&self, times: &[f64]) -> Vec<TimeColumn> {
+        let mut columns = vec![TimeColumn::new_duration_secs(TIMELINE, times.iter().copied())];
+        if let Some(t0) = self.file_clock_s {
+            columns.push(TimeColumn::new_duration_secs(FILE_CLOCK_TIMELINE, times.iter().map(|t| t0 + t)));
+        }
+        columns
     }
 
     /// The Rerun stream.
@@ -70,8 +94,7 @@ impl Stream {
             let mut e = export.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
             e.write(path, unit, names, times, &values);
         }
-        let time = TimeColumn::new_duration_secs(TIMELINE, times.iter().copied());
-        self.rec.send_columns(path, [time], rerun::Scalars::new(values).columns(std::iter::repeat_n(width, times.len()))?)?;
+        self.rec.send_columns(path, self.time_columns(times), rerun::Scalars::new(values).columns(std::iter::repeat_n(width, times.len()))?)?;
         Ok(())
     }
 
@@ -84,8 +107,7 @@ impl Stream {
             path.as_str(),
             &rerun::SeriesPoints::new().with_markers([rerun::components::MarkerShape::Down]).with_marker_sizes([7.0]).with_colors([palette::rgb(palette::colors::EVENT)]).with_names([label]),
         )?;
-        let time = TimeColumn::new_duration_secs(TIMELINE, times.iter().copied());
-        self.rec.send_columns(path, [time], rerun::Scalars::new(vec![y; times.len()]).columns_of_unit_batches()?)?;
+        self.rec.send_columns(path, self.time_columns(times), rerun::Scalars::new(vec![y; times.len()]).columns_of_unit_batches()?)?;
         Ok(())
     }
 }
@@ -136,8 +158,22 @@ pub type RecordError = rerun::RecordingStreamError;
 /// Application id of every rinscope recording (the viewer keys layouts by it).
 pub const APPLICATION_ID: &str = "rinscope";
 
-/// Name of the timeline every temporal value is logged on, seconds of simulated time.
+/// Name of the timeline every temporal value is logged on, seconds of simulated time (a replay:
+/// seconds after its start).
 pub const TIMELINE: &str = "sim_time";
+
+/// A replay's second timeline: the same instants on the IMU file's own clock, s.
+pub const FILE_CLOCK_TIMELINE: &str = "file_clock";
+
+/// What a replayed log has; it decides what its recording holds (and so its layout).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ReplayKind {
+    /// A turntable; false: a strapdown IMU, and nothing of a table is recorded (no gimbals, no
+    /// table errors, no swing): its axes, the INS's attitude and navigation.
+    pub table: bool,
+    /// A reference attitude: the INS's attitude errors are plotted against it.
+    pub reference: bool,
+}
 
 /// Rows buffered per series before one `send_columns` call.
 const SERIES_CHUNK_ROWS: usize = 8192;
@@ -149,24 +185,6 @@ const MAX_CHUNKS_IN_FLIGHT: usize = 24;
 #[must_use]
 pub fn to_rerun_quaternion(q: &UnitQuaternion<f64>) -> rerun::Quaternion {
     rerun::Quaternion::from_xyzw([q.i as f32, q.j as f32, q.k as f32, q.w as f32])
-}
-
-/// One entity of `width` plotted series, buffered row-major.
-struct Series {
-    path: String,
-    /// The names of its lines (the legend, and the export's columns).
-    names: Vec<String>,
-    values: Vec<f64>,
-}
-
-impl Series {
-    fn new(path: String, names: Vec<String>) -> Self {
-        Self { path, names, values: Vec::new() }
-    }
-
-    fn width(&self) -> usize {
-        self.names.len()
-    }
 }
 
 /// Streams a run into a Rerun recording.
@@ -194,14 +212,14 @@ pub struct Recorder {
     chunks_in_flight: usize,
     /// Live mode: geometry on the timeline instead of static.
     live: bool,
-    /// A replayed log: the demodulations are the nominal and the compensated table (no closed form).
-    replay: bool,
+    /// A replayed log (None: a simulation): what it has decides the series and the scene.
+    replay: Option<ReplayKind>,
     /// With an IMU in the loop.
     ins: Option<InsLayout>,
+    /// A strapdown IMU: its (body) axes at the INS's attitude, instead of a table.
+    body: Option<body_view::BodyScene>,
     /// Unit of the attitude-error plots.
     error_unit: crate::math::units::AngleUnit,
-    /// Index of the closed form − exact series (not in a replay).
-    closed_form_series: Option<usize>,
     /// Symmetric half-ranges of the error plots once known (table per axis, in `error_unit`; INS
     /// per axis, arcsec).
     ranges: Option<PlotRanges>,
@@ -251,89 +269,22 @@ impl Recorder {
     }
 
     fn build(stream: Stream, params: &Params, live: bool, custom: Option<CustomLayout>) -> RecordingStreamResult<Self> {
-        Self::build_with(stream, params, live, false, custom)
+        Self::build_with(stream, params, live, None, custom)
     }
 
-    fn build_with(stream: Stream, params: &Params, live: bool, replay: bool, custom: Option<CustomLayout>) -> RecordingStreamResult<Self> {
+    fn build_with(stream: Stream, params: &Params, live: bool, replay: Option<ReplayKind>, custom: Option<CustomLayout>) -> RecordingStreamResult<Self> {
         let rec = stream.rec.clone();
         let chain = params.table.chain.clone();
         let factors = drawing_factors(&params.table.truth, params.recording.exaggeration);
         let drawing = chain.error_rotations(&params.table.truth.exaggerated(&factors));
         let axis_names: Vec<String> = params.table.chain.axes().iter().map(|a| a.name.clone()).collect();
         let paths = ChainPaths::new(&axis_names);
-        let demodulations: Vec<String> = if replay {
-            vec!["nominal table".into(), "compensated table".into(), "(no closed form in a replay)".into()]
-        } else {
-            DEMODULATIONS.iter().map(|v| v.replace('_', " ")).collect()
-        };
         let unit = params.recording.error_unit;
-        let mut series: Vec<Series> = ERROR_AXES.iter().map(|axis| Series::new(error_path(unit, axis), demodulations.clone())).collect();
-        series.push(Series::new("gimbal_angle_deg".into(), axis_names.clone()));
-        series.push(Series::new("vehicle_attitude_deg".into(), ERROR_AXES.map(String::from).to_vec()));
-        for (name, g) in axis_names.iter().zip(chain.axes()) {
-            let about = |v: &nalgebra::Vector3<f64>| format!("{name} swing about {}", scene::axis_letter(v));
-            series.push(Series::new(format!("swing_arcsec/{name}"), vec![about(&g.e1), about(&g.e2)]));
-        }
-        // The closed form's residual against the exact chain, where the two lines lie on each other.
-        let closed_form_series = (!replay).then(|| {
-            series.push(Series::new(CLOSED_FORM_PATH.into(), ERROR_AXES.map(String::from).to_vec()));
-            series.len() - 1
-        });
-        let ins = params.ins.as_ref().map(|cfg| {
-            let algorithms: Vec<String> = cfg.algorithms().iter().map(|a| a.name().to_owned()).collect();
-            let n_algorithms = algorithms.len();
-            let first_series = series.len();
-            for axis in ERROR_AXES {
-                series.push(Series::new(format!("ins/attitude_error_arcsec/{axis}"), algorithms.clone()));
-            }
-            if cfg.navigation.is_some() {
-                series.push(Series::new("ins/position_error_m".into(), ["east", "north", "radial"].map(String::from).to_vec()));
-                series.push(Series::new("ins/velocity_error_mps".into(), ["east", "north", "up"].map(String::from).to_vec()));
-            }
-            // Pure coning on a table at rest: the drifts span decades, a log10 plot with the
-            // analytic rates shows each algorithm on its line.
-            let coning_log = params.table.vehicle.pure_coning().filter(|_| params.table.scheme.max_rate() == 0.0).map(|cone| {
-                let names = algorithms.iter().flat_map(|a| [format!("{a}: log10 |heading error|"), format!("{a}: analytic coning drift")]).collect();
-                series.push(Series::new(ins_view::CONING_LOG_PATH.into(), names));
-                let rates: Vec<f64> = cfg
-                    .algorithms()
-                    .iter()
-                    .map(|a| crate::ins::coning::coning_drift_rate(*a, cone.half_angle_rad, cone.omega_rad_per_s / std::f64::consts::TAU, 1.0 / params.step_hz).abs() * ARCSEC_PER_RAD)
-                    .collect();
-                (series.len() - 1, rates)
-            });
-            // The INS trace and the drift dial draw the INS's error ×N: where the largest error of
-            // the run is known in advance (pure coning: the analytic drifts), N is lowered to the
-            // largest 1-2-5 factor that keeps it under 150°, so the picture never wraps round.
-            let exaggeration = coning_log.as_ref().map_or(params.recording.exaggeration, |(_, rates)| {
-                let worst_rad = rates.iter().fold(0.0_f64, |m, r| m.max(*r)) * params.duration_s / ARCSEC_PER_RAD;
-                let limit = 150.0 * crate::math::units::RAD_PER_DEG;
-                if worst_rad * params.recording.exaggeration <= limit {
-                    return params.recording.exaggeration;
-                }
-                crate::math::units::nice_at_most(limit / worst_rad).max(1e-3)
-            });
-            InsLayout {
-                algorithms,
-                nav: cfg.navigation.is_some(),
-                first_series,
-                signal_t: Vec::new(),
-                raw: Vec::new(),
-                filtered: Vec::new(),
-                trace_true: Vec::new(),
-                dial: if n_algorithms >= 2 { vec![Vec::new(); n_algorithms] } else { Vec::new() },
-                dial_t: Vec::new(),
-                dial_next_t: f64::NEG_INFINITY,
-                trace_ins: Vec::new(),
-                exaggeration,
-                fir_taps: cfg.fir_taps.clone(),
-                rate_hz: params.step_hz,
-                signal_window_s: cfg.signal_window_s.max(0.01),
-                coning_log,
-                signal_peak_deg_per_s: [0.0; 2],
-            }
-        });
-        let n = axis_names.len();
+        let mut series = rows::table_series(&chain, replay, unit);
+        let ins = rows::ins_layout(params, replay, &mut series);
+        // A strapdown IMU: its axes are drawn as the body, nothing of the stand-in table.
+        let body = replay.filter(|k| !k.table).map(|k| body_view::BodyScene::new(k.reference));
+        let n = if body.is_some() { 0 } else { axis_names.len() };
         let mut me = Self {
             rec,
             stream,
@@ -353,8 +304,8 @@ impl Recorder {
             live,
             replay,
             ins,
+            body,
             error_unit: unit,
-            closed_form_series,
             ranges: None,
             custom: custom.clone(),
         };
@@ -369,10 +320,20 @@ impl Recorder {
         Ok(me)
     }
 
-    /// A recorder for a replayed log: the same scene and plots, the demodulations named for what they
-    /// are (the nominal and the compensated table, against the log's reference).
-    pub fn new_replay(stream: Stream, params: &Params) -> RecordingStreamResult<Self> {
-        Self::build_with(stream, params, false, true, None)
+    /// A recorder for a replayed log of `kind`: through a table, the same scene and plots as a run,
+    /// the demodulations named for what they are (the nominal and the compensated table, against
+    /// the log's reference); a strapdown IMU, its axes at the INS's attitude and the INS's plots
+    /// only. Both add the INS's own solution (attitude, velocity, position).
+    pub fn new_replay(stream: Stream, params: &Params, kind: ReplayKind) -> RecordingStreamResult<Self> {
+        Self::build_with(stream, params, false, Some(kind), None)
+    }
+
+    /// A replay's t = 0 on the IMU file's own clock, s: the series also go on the timeline
+    /// [`FILE_CLOCK_TIMELINE`], and the export tables get a `t_file_s` column. Call it before the
+    /// first row.
+    pub fn set_file_clock(&mut self, t0_file_s: f64) -> RecordingStreamResult<()> {
+        self.stream.set_file_clock(t0_file_s);
+        self.event(0.0, &format!("t = 0 is {t0_file_s:.6} s on the IMU file's clock (the timeline `{FILE_CLOCK_TIMELINE}` shows the file's times; the export has them as t_file_s)"), "INFO")
     }
 
     /// A recorder for live mode: everything that a reload can change is logged on the timeline.
@@ -411,8 +372,10 @@ impl Recorder {
         };
         for (a, axis) in ERROR_AXES.iter().enumerate() {
             let y = top(ranges.table_peak_rad, a, self.error_unit.per_rad());
-            self.stream.mark_events(&error_path(self.error_unit, axis), "moves", "scheme moves", &starts, y)?;
-            if let Some(ins) = ranges.ins_peak_rad.filter(|_| self.ins.is_some()) {
+            if self.has_series(&error_path(self.error_unit, axis)) {
+                self.stream.mark_events(&error_path(self.error_unit, axis), "moves", "scheme moves", &starts, y)?;
+            }
+            if let Some(ins) = ranges.ins_peak_rad.filter(|_| self.ins.as_ref().is_some_and(|l| l.errors)) {
                 self.stream.mark_events(&format!("ins/attitude_error_arcsec/{axis}"), "moves", "scheme moves", &starts, top(ins, a, ARCSEC_PER_RAD))?;
             }
         }
@@ -440,7 +403,7 @@ impl Recorder {
         // Where the parameters changed, on every error plot (at 0: the plots' range is not known).
         for axis in ERROR_AXES {
             self.stream.mark_events(&error_path(self.error_unit, axis), "reloads", "config reloaded", &[t_s], 0.0)?;
-            if self.ins.is_some() {
+            if self.ins.as_ref().is_some_and(|l| l.errors) {
                 self.stream.mark_events(&format!("ins/attitude_error_arcsec/{axis}"), "reloads", "config reloaded", &[t_s], 0.0)?;
             }
         }
@@ -471,51 +434,17 @@ impl Recorder {
 
     /// Buffers one row: the turntable-only variants and, with an IMU in the loop, the INS's view.
     pub fn push_row(&mut self, out: &StepOutput, ins: Option<&InsView>) -> RecordingStreamResult<()> {
-        let per_rad = self.error_unit.per_rad();
-        for a in 0..3 {
-            for e in &out.errors {
-                self.series[a].values.push(e.as_array()[a] * per_rad);
-            }
-        }
-        if let Some(i) = self.closed_form_series {
-            let (exact, closed) = (out.errors[0].as_array(), out.errors[2].as_array());
-            self.series[i].values.extend((0..3).map(|a| (closed[a] - exact[a]) * ARCSEC_PER_RAD));
-        }
-        let n = self.axis_names.len();
-        self.series[3].values.extend(out.gimbal_rad[..n].iter().map(|x| x * DEG_PER_RAD));
-        self.series[4].values.extend([out.attitude.pitch_rad, out.attitude.roll_rad, out.attitude.heading_rad].map(|x| x * DEG_PER_RAD));
-        for k in 0..n {
-            let g = &self.chain.axes()[k];
-            let s = self.chain.swing_vector(k, &self.truth.axes[k], out.gimbal_rad[k]);
-            self.series[5 + k].values.extend([s.dot(&g.e1) * ARCSEC_PER_RAD, s.dot(&g.e2) * ARCSEC_PER_RAD]);
-        }
-        if let Some(layout) = &self.ins {
-            let i0 = layout.first_series;
-            let width = layout.algorithms.len();
-            for a in 0..3 {
-                let values = &mut self.series[i0 + a].values;
-                match ins {
-                    Some(v) => values.extend(v.errors.iter().map(|e| e.as_array()[a] * ARCSEC_PER_RAD)),
-                    None => values.extend(std::iter::repeat_n(f64::NAN, width)),
-                }
-            }
-            if let Some((k, rates)) = &layout.coning_log {
-                let log10 = |x: f64| if x > 0.0 && x.is_finite() { x.log10() } else { f64::NAN };
-                let t = out.t_s;
-                let values = &mut self.series[*k].values;
-                for (j, rate) in rates.iter().enumerate() {
-                    let measured = ins.map_or(f64::NAN, |v| log10(v.errors[j].heading_rad.abs() * ARCSEC_PER_RAD));
-                    values.extend([measured, log10(rate * t)]);
-                }
-            }
-            if layout.nav {
-                let nan = NavError { east_m: f64::NAN, north_m: f64::NAN, radial_m: f64::NAN, velocity_enu_mps: Vector3::repeat(f64::NAN) };
-                let e = ins.and_then(|v| v.nav).unwrap_or(nan);
-                let vel = e.velocity_enu_mps;
-                self.series[i0 + 3].values.extend([e.east_m, e.north_m, e.radial_m]);
-                self.series[i0 + 4].values.extend([vel.x, vel.y, vel.z]);
-            }
-        }
+        self.push_row_with(out, ins, None)
+    }
+
+    /// Buffers one row of a replay: the table's step (if it has a table), the INS's view and its
+    /// own solution.
+    pub fn push_replay_row(&mut self, out: &StepOutput, ins: &InsView, solution: &Solution) -> RecordingStreamResult<()> {
+        self.push_row_with(out, Some(ins), Some(solution))
+    }
+
+    fn push_row_with(&mut self, out: &StepOutput, ins: Option<&InsView>, solution: Option<&Solution>) -> RecordingStreamResult<()> {
+        self.push_values(out, ins, solution);
         self.series_t.push(out.t_s);
         if self.series_t.len() >= SERIES_CHUNK_ROWS {
             self.flush_series()?;
@@ -531,21 +460,28 @@ impl Recorder {
     /// Buffers one scene frame with, if any, the INS trace (true and computed IMU axes, the
     /// computed one's error exaggerated).
     pub fn push_scene_row(&mut self, out: &StepOutput, ins: Option<&InsView>) -> RecordingStreamResult<()> {
-        let links = self.chain.link_rotations(&self.drawing, &out.gimbal_rad);
         self.scene_t.push(out.t_s);
-        self.scene_vehicle.push(to_rerun_quaternion(out.n_from_b.quaternion()));
+        match self.body.as_mut() {
+            Some(body) => body.push(ins),
+            None => {
+                let links = self.chain.link_rotations(&self.drawing, &out.gimbal_rad);
+                self.scene_vehicle.push(to_rerun_quaternion(out.n_from_b.quaternion()));
+                for (k, col) in self.scene_gimbals.iter_mut().enumerate() {
+                    col.push(to_rerun_quaternion(&links.gimbal[k]));
+                }
+            }
+        }
         if let Some(c) = self.cone.as_mut() {
             c.push(&out.n_from_b);
         }
-        for (k, col) in self.scene_gimbals.iter_mut().enumerate() {
-            col.push(to_rerun_quaternion(&links.gimbal[k]));
-        }
-        if let Some(layout) = self.ins.as_mut() {
+        if let Some(layout) = self.ins.as_mut().filter(|l| l.trace || !l.dial.is_empty()) {
             // Without an INS view (or without its truth) the trace stands still at the identity.
-            let (t, c) = ins.and_then(|v| Some((*v.imu_true?.quaternion(), *v.imu_ins.quaternion()))).unwrap_or((UnitQuaternion::identity(), UnitQuaternion::identity()));
-            let err = rotvec::log(&(c * t.inverse())) * layout.exaggeration;
-            layout.trace_true.push(to_rerun_quaternion(&t));
-            layout.trace_ins.push(to_rerun_quaternion(&(rotvec::exp(&err) * t)));
+            if layout.trace {
+                let (t, c) = ins.and_then(|v| Some((*v.imu_true?.quaternion(), *v.imu_ins.quaternion()))).unwrap_or((UnitQuaternion::identity(), UnitQuaternion::identity()));
+                let err = rotvec::log(&(c * t.inverse())) * layout.exaggeration;
+                layout.trace_true.push(to_rerun_quaternion(&t));
+                layout.trace_ins.push(to_rerun_quaternion(&(rotvec::exp(&err) * t)));
+            }
             // The needles turn clockwise by the size of each algorithm's attitude error (whichever
             // axis it is on: heading for a cone about z, pitch for seed 001's wobble), ×N.
             let due = !layout.dial.is_empty() && out.t_s >= layout.dial_next_t;
@@ -599,30 +535,38 @@ impl Recorder {
         }
         self.throttle(1 + self.scene_gimbals.len());
         let times = std::mem::take(&mut self.scene_t);
-        let time = || TimeColumn::new_duration_secs(TIMELINE, times.iter().copied());
+        let time = || self.stream.time_columns(&times);
         let vehicle = std::mem::take(&mut self.scene_vehicle);
         if let Some(c) = self.cone.as_mut() {
             c.flush(&self.rec, &times)?;
         }
-        self.rec.send_columns(
-            self.paths.vehicle.as_str(),
-            [time()],
-            rerun::Transform3D::update_fields().with_many_quaternion(vehicle).columns_of_unit_batches()?,
-        )?;
+        if let Some(body) = self.body.as_mut() {
+            body.flush(&self.stream, &times)?;
+        }
+        if !vehicle.is_empty() {
+            self.rec.send_columns(
+                self.paths.vehicle.as_str(),
+                time(),
+                rerun::Transform3D::update_fields().with_many_quaternion(vehicle).columns_of_unit_batches()?,
+            )?;
+        }
         for k in 0..self.scene_gimbals.len() {
             let q = std::mem::take(&mut self.scene_gimbals[k]);
             self.rec.send_columns(
                 self.paths.gimbals[k].as_str(),
-                [time()],
+                time(),
                 rerun::Transform3D::update_fields().with_many_quaternion(q).columns_of_unit_batches()?,
             )?;
         }
         if let Some(layout) = self.ins.as_mut() {
             for (path, q) in [("world/ins_trace/true", std::mem::take(&mut layout.trace_true)), ("world/ins_trace/ins", std::mem::take(&mut layout.trace_ins))] {
                 let n = q.len();
+                if n == 0 {
+                    continue;
+                }
                 self.rec.send_columns(
                     path,
-                    [time()],
+                    self.stream.time_columns(&times),
                     rerun::Transform3D::update_fields()
                         .with_many_translation(std::iter::repeat_n(TRACE_OFFSET, n))
                         .with_many_quaternion(q)
@@ -632,8 +576,7 @@ impl Recorder {
             let dial_t = std::mem::take(&mut layout.dial_t);
             for (k, name) in layout.algorithms.iter().enumerate().take(layout.dial.len()) {
                 let q = std::mem::take(&mut layout.dial[k]);
-                let time = TimeColumn::new_duration_secs(TIMELINE, dial_t.iter().copied());
-                self.rec.send_columns(ins_view::dial_path(name).as_str(), [time], rerun::Transform3D::update_fields().with_many_quaternion(q).columns_of_unit_batches()?)?;
+                self.rec.send_columns(ins_view::dial_path(name).as_str(), self.stream.time_columns(&dial_t), rerun::Transform3D::update_fields().with_many_quaternion(q).columns_of_unit_batches()?)?;
             }
         }
         Ok(())
@@ -642,6 +585,9 @@ impl Recorder {
     /// A text-log entry at simulated time `t_s`.
     pub fn event(&self, t_s: f64, text: &str, level: &str) -> RecordingStreamResult<()> {
         self.rec.set_duration_secs(TIMELINE, t_s);
+        if let Some(t0) = self.stream.file_clock_s {
+            self.rec.set_duration_secs(FILE_CLOCK_TIMELINE, t0 + t_s);
+        }
         self.rec.log("events", &rerun::TextLog::new(text).with_level(level))
     }
 

@@ -1,6 +1,9 @@
 //! Reading a recording back: the text-log entries of `events`, so a user (and the tests) can list
-//! what happened in a saved session — reloads, errors, the end — without opening the viewer.
+//! what happened in a saved session — reloads, errors, the end — without opening the viewer; and
+//! what it holds (its entities, the views of its layout), so a test can check that a recording has
+//! what it should and that its layout shows nothing it lacks.
 
+use std::collections::BTreeSet;
 use std::io::BufReader;
 use std::path::Path;
 
@@ -50,5 +53,49 @@ pub fn events(path: &Path) -> anyhow::Result<Vec<Event>> {
         }
     }
     out.sort_by(|a, b| a.t_s.unwrap_or(-1.0).total_cmp(&b.t_s.unwrap_or(-1.0)));
+    Ok(out)
+}
+
+/// The entities a recording holds and the space origins of its layout's views (paths without the
+/// leading `/`).
+#[derive(Debug, Clone, Default)]
+pub struct Contents {
+    /// Every entity with data in the recording store.
+    pub entities: BTreeSet<String>,
+    /// Every view's space origin in its blueprints.
+    pub view_origins: BTreeSet<String>,
+}
+
+impl Contents {
+    /// The view origins under which the recording has no entity (a layout pointing at nothing).
+    #[must_use]
+    pub fn empty_views(&self) -> Vec<String> {
+        self.view_origins.iter().filter(|o| !self.entities.iter().any(|e| e == *o || e.starts_with(&format!("{o}/")))).cloned().collect()
+    }
+}
+
+/// What the recording at `path` holds (see [`Contents`]).
+pub fn contents(path: &Path) -> anyhow::Result<Contents> {
+    use rerun::external::re_sdk_types::blueprint::{archetypes::ViewBlueprint, components::ViewOrigin};
+    let file = std::fs::File::open(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let decoder = DecoderApp::decode_eager(BufReader::new(file)).map_err(|e| anyhow::anyhow!("{}: not a readable .rrd: {e}", path.display()))?;
+    let origin_component = ViewBlueprint::descriptor_space_origin().component;
+    let mut out = Contents::default();
+    for msg in decoder {
+        let msg = msg.map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        let LogMsg::ArrowMsg(store_id, arrow_msg) = msg else { continue };
+        let chunk = Chunk::from_arrow_msg(&arrow_msg)?;
+        let entity = chunk.entity_path().to_string().trim_start_matches('/').to_owned();
+        match store_id.kind() {
+            StoreKind::Recording => {
+                out.entities.insert(entity);
+            }
+            StoreKind::Blueprint => {
+                for origins in chunk.iter_component::<ViewOrigin>(origin_component) {
+                    out.view_origins.extend(origins.iter().map(|o| o.0.0.as_str().trim_start_matches('/').to_owned()));
+                }
+            }
+        }
+    }
     Ok(out)
 }

@@ -6,11 +6,11 @@ use nalgebra::{UnitQuaternion, Vector3};
 use rerun::RecordingStreamResult;
 
 use super::palette::{albedo, colors, p3, rgb, rgba};
-use super::{to_rerun_quaternion, Recorder, TIMELINE};
+use super::rows::Quantity;
+use super::{to_rerun_quaternion, Recorder, ReplayKind, TIMELINE};
 use crate::math::units::{fmt_angle, ARCSEC_PER_RAD, DEG_PER_RAD};
 use crate::model::gimbal::AxisGeometry;
 use crate::scenario::Params;
-use crate::sim::ERROR_AXES;
 
 /// Entity paths of the chain.
 #[derive(Debug, Clone)]
@@ -55,50 +55,42 @@ impl Recorder {
                 .with_component::<rerun::components::Text>("version", [env!("CARGO_PKG_VERSION").to_owned()]),
         )?;
 
-        // Series styles, once.
-        for axis in ERROR_AXES {
-            let path = super::error_path(self.error_unit, axis);
-            // Uncompensated wide and translucent under the closed form's thin bright line, so both
-            // read where they coincide; their difference has its own plot.
-            let [u, c, f] = colors::VARIANT;
-            rec.log_static(
-                path.as_str(),
-                &rerun::SeriesLines::new().with_colors([rgba(u, 140), rgb(c), rgb(f)]).with_names(self.series_names(&path)).with_widths([5.0, 2.0, 1.5]),
-            )?;
-        }
-        if self.closed_form_series.is_some() {
-            rec.log_static(
-                super::CLOSED_FORM_PATH,
-                &rerun::SeriesLines::new().with_colors(colors::EULER.map(rgb)).with_names(self.series_names(super::CLOSED_FORM_PATH)),
-            )?;
-        }
-        rec.log_static(
-            "vehicle_attitude_deg",
-            &rerun::SeriesLines::new().with_colors(colors::EULER.map(rgb)).with_names(self.series_names("vehicle_attitude_deg")),
-        )?;
-        let n = self.axis_names.len();
-        rec.log_static(
-            "gimbal_angle_deg",
-            &rerun::SeriesLines::new().with_colors(colors::AXES[..n].iter().map(|c| rgb(*c))).with_names(self.series_names("gimbal_angle_deg")),
-        )?;
-        for (k, name) in self.axis_names.iter().enumerate() {
-            let light = colors::AXES[k].map(|c| c / 2 + 60);
-            let path = format!("swing_arcsec/{name}");
-            rec.log_static(
-                path.as_str(),
-                &rerun::SeriesLines::new().with_colors([rgb(colors::AXES[k]), rgb(light)]).with_names(self.series_names(&path)),
-            )?;
+        // Series styles, once (the INS's: `log_ins_once`).
+        for series in &self.series {
+            let names = series.names.clone();
+            let path = series.path.as_str();
+            match series.what {
+                Quantity::TableError(_) => {
+                    // Uncompensated wide and translucent under the closed form's thin bright line, so
+                    // both read where they coincide; their difference has its own plot.
+                    let [u, c, f] = colors::VARIANT;
+                    let n = names.len();
+                    rec.log_static(path, &rerun::SeriesLines::new().with_colors([rgba(u, 140), rgb(c), rgb(f)].into_iter().take(n)).with_names(names).with_widths([5.0, 2.0, 1.5].into_iter().take(n)))?;
+                }
+                Quantity::ClosedForm | Quantity::VehicleAttitude => rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors::EULER.map(rgb)).with_names(names))?,
+                Quantity::GimbalAngles => rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors::AXES[..names.len()].iter().map(|c| rgb(*c))).with_names(names))?,
+                Quantity::Swing(k) => {
+                    let light = colors::AXES[k].map(|c| c / 2 + 60);
+                    rec.log_static(path, &rerun::SeriesLines::new().with_colors([rgb(colors::AXES[k]), rgb(light)]).with_names(names))?;
+                }
+                _ => {}
+            }
         }
 
         rec.log_static("world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
+        // East and North on the floor: under the table's deck, or just under a strapdown IMU's case.
+        let floor = if self.body.is_some() { -0.4 } else { -1.4 };
         rec.log_static(
             "world/compass",
             &rerun::Arrows3D::from_vectors([[1.6, 0.0, 0.0], [0.0, 1.6, 0.0]])
-                .with_origins([[0.0, 0.0, -1.4]; 2])
+                .with_origins([[0.0, 0.0, floor]; 2])
                 .with_colors([rgba([120, 120, 120], 160); 2])
                 .with_radii([0.006]),
         )?;
-        self.label(None, "world/compass/labels", &[([1.7, 0.0, -1.4], "E"), ([0.0, 1.7, -1.4], "N")])?;
+        self.label(None, "world/compass/labels", &[([1.7, 0.0, floor], "E"), ([0.0, 1.7, floor], "N")])?;
+        if self.body.is_some() {
+            return self.log_body_once();
+        }
         // Vehicle: a deck plate under the table and the body axes.
         rec.log_static(
             format!("{}/deck", self.paths.vehicle),
@@ -196,22 +188,40 @@ impl Recorder {
     pub(crate) fn log_error_geometry(&self, p: &Params, at: Option<f64>) -> RecordingStreamResult<()> {
         // Documents: the scenario explains itself; the resolved config makes the run reproducible.
         let mut doc = format!("# {}\n\n*{}*\n\n{}\n", p.meta.name, p.meta.title, p.meta.description.trim());
-        let plots = if self.replay {
-            "Plots (a replayed log): red = the INS attitude demodulated through the nominal table, green = through the compensated table, \
-             each against the log's reference attitude (without one, the compensated demodulation is the reference)."
-        } else {
-            "Plots: red = uncompensated (nominal table model), green = compensated (`[compensation]` parameters), \
+        let replayed = "The INS's own solution is in `ins/body_attitude_deg` (the primary algorithm's body attitude, heading in (−180°, 180°]) \
+             and, navigating, `ins/velocity_enu_mps`, `ins/position_from_start_m` and `ins/latitude_longitude_deg`. \
+             Time: seconds after the replay's start on `sim_time`, the IMU file's own clock on the timeline `file_clock` (docs/export.md).";
+        let plots = match self.replay {
+            None => "Plots: red = uncompensated (nominal table model), green = compensated (`[compensation]` parameters), \
              blue = closed form (first-order theory, docs/closed-form.md)."
+                .to_owned(),
+            Some(ReplayKind { table: false, reference }) => format!(
+                "A replayed **strapdown** IMU (no table): the 3D view shows its axes (= the body's: x right, y forward, z up) turning with the INS's attitude{}. {}",
+                if reference { ", the reference's in grey; the error plots are the INS's attitude against the reference, per algorithm" } else { " (no reference: nothing to compare it with)" },
+                replayed
+            ),
+            Some(ReplayKind { reference, .. }) => format!(
+                "Plots (a replayed log): {} {replayed}",
+                if reference {
+                    "red = the INS attitude demodulated through the nominal table, green = through the compensated table, each against the log's reference attitude."
+                } else {
+                    "no reference: the table error plots show the nominal − the compensated demodulation."
+                }
+            ),
         };
-        doc.push_str(&format!(
-            "\n---\nError angles in the 3D view are drawn **×{}**. {plots} Seed {}.\n",
-            p.recording.exaggeration, p.meta.seed
-        ));
-        if !self.replay {
+        if self.body.is_some() {
+            doc.push_str(&format!("\n---\n{plots}\n"));
+        } else {
+            doc.push_str(&format!("\n---\nError angles in the 3D view are drawn **×{}**. {plots} Seed {}.\n", p.recording.exaggeration, p.meta.seed));
+        }
+        if self.replay.is_none() {
             doc.push_str(&errors_in_force(p, at));
         }
         self.put(at, "docs/scenario", &rerun::TextDocument::from_markdown(doc))?;
         self.put(at, "docs/config", &rerun::TextDocument::from_markdown(format!("```toml\n{}\n```\n", p.resolved_toml)))?;
+        if self.body.is_some() {
+            return Ok(());
+        }
 
         let x = p.recording.exaggeration;
         let f = self.factors;

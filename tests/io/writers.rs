@@ -184,5 +184,13 @@ fn column_names_are_checked() {
         TableWriter::create(dir.join("x.mcap"), &["t_s"]).is_err(),
         "no MCAP writer"
     );
+    // A table that is not a time series (an Allan curve, fitted coefficients): any key first, any
+    // names, but still plain characters, each once.
+    let keyed = dir.join("k.csv");
+    assert!(TableWriter::create_keyed(&keyed, &["axis", "n_deg_per_sqrt_h", "edf"]).is_ok_and(|w| w.finish().is_ok()));
+    assert_eq!(std::fs::read_to_string(&keyed).expect("written"), "axis,n_deg_per_sqrt_h,edf\n");
+    assert!(TableWriter::create_keyed(&p, &["tau s"]).is_err(), "bad character");
+    assert!(TableWriter::create_keyed(&p, &["tau_s", "edf", "edf"]).is_err(), "duplicate");
+    assert!(TableWriter::create_keyed(&p, &[]).is_err(), "no column");
     assert!(!dir.join("x.csv.partial").exists());
 }

@@ -175,6 +175,17 @@ pub fn load(dir: &Path) -> Result<LogSet, ConfigError> {
 /// Reads the log set in `dir`, lets `edit` change its manifest (the command line's overrides), and
 /// validates it.
 pub fn load_overridden(dir: &Path, edit: impl FnOnce(&mut RawManifest)) -> Result<LogSet, ConfigError> {
+    load_for(dir, edit, true)
+}
+
+/// Reads and validates the log set in `dir` for what reads its IMU file only (`allan`): a
+/// strapdown log's start position may be absent (nothing navigates; the site is then the default,
+/// unused).
+pub fn load_imu(dir: &Path) -> Result<LogSet, ConfigError> {
+    load_for(dir, |_| {}, false)
+}
+
+fn load_for(dir: &Path, edit: impl FnOnce(&mut RawManifest), navigates: bool) -> Result<LogSet, ConfigError> {
     let manifest_path = dir.join(MANIFEST);
     let text = super::read_text(&manifest_path)?;
     let origin = manifest_path.display().to_string();
@@ -183,10 +194,10 @@ pub fn load_overridden(dir: &Path, edit: impl FnOnce(&mut RawManifest)) -> Resul
     let table_path = dir.join(&raw.log.table);
     // A strapdown log needs no table description: the default name may be absent.
     if raw.log.table == default_table() && !table_path.exists() {
-        return validate_manifest(dir, &raw, &origin, &RawTable::strapdown(), "(no table.toml: a strapdown IMU)");
+        return validate_manifest_for(dir, &raw, &origin, &RawTable::strapdown(), "(no table.toml: a strapdown IMU)", navigates);
     }
     let (raw_table, table_origin) = read_table(&table_path)?;
-    validate_manifest(dir, &raw, &origin, &raw_table, &table_origin)
+    validate_manifest_for(dir, &raw, &origin, &raw_table, &table_origin, navigates)
 }
 
 /// Reads a table description file.
@@ -216,6 +227,11 @@ impl RawTable {
 
 /// Validates a manifest and its table description (`origin`s name the files in errors).
 pub fn validate_manifest(dir: &Path, raw: &RawManifest, origin: &str, raw_table: &RawTable, table_origin: &str) -> Result<LogSet, ConfigError> {
+    validate_manifest_for(dir, raw, origin, raw_table, table_origin, true)
+}
+
+/// [`validate_manifest`]; `navigates`: the log will be navigated (a strapdown log needs its start position).
+fn validate_manifest_for(dir: &Path, raw: &RawManifest, origin: &str, raw_table: &RawTable, table_origin: &str, navigates: bool) -> Result<LogSet, ConfigError> {
     let c = Checker { origin };
     let name = &raw.log.name;
     if name.trim().is_empty() || !name.chars().all(|ch| ch.is_ascii_alphanumeric() || ch == '-' || ch == '_') {
@@ -244,7 +260,7 @@ pub fn validate_manifest(dir: &Path, raw: &RawManifest, origin: &str, raw_table:
             longitude_rad: c.range("initial.position[1]", lon, "deg", -360.0, 360.0, "longitude")? * RAD_PER_DEG,
             height_m: c.range("initial.position[2]", h, "m", -12_000.0, 100_000.0, "height")?,
         };
-    } else if table.strapdown {
+    } else if table.strapdown && navigates {
         return Err(c.invalid("initial.position", "a strapdown log without a table description needs its start position: [initial] position = [latitude_deg, longitude_deg, height_m] (or --position, or a table.toml with [site])"));
     }
     let initial_velocity_enu_mps = match i.velocity_enu_mps {
