@@ -469,7 +469,7 @@ impl LogSet {
         use super::raw::{RawLive, RawScenario, RawScheme, RawSimulation, RawVehicle};
         let t = &self.raw_table;
         let raw = super::RawConfig {
-            scenario: RawScenario { name: self.name.clone(), title: format!("replay of the log set {}", self.dir.display()), description: self.description.clone(), seed: self.seed.unwrap_or(0) },
+            scenario: RawScenario { name: self.name.clone(), title: if self.dir == Path::new(".") { format!("replay of {}", self.imu.path.display()) } else { format!("replay of the log set {}", self.dir.display()) }, description: self.description.clone(), seed: self.seed.unwrap_or(0) },
             simulation: RawSimulation { duration_s: duration_s.max(1.0 / self.imu.rate_hz), step_hz: self.imu.rate_hz },
             recording: t.recording.clone(),
             site: t.site.clone(),
