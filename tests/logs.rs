@@ -302,3 +302,21 @@ fn a_headerless_file_is_described_column_by_column_instead_of_rewritten() {
     assert!(stderr(&o).contains("imu.columns.gyro_x") && stderr(&o).contains("mps2"), "{}", stderr(&o));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn data_from_another_latitude_than_the_site_s_are_warned_about() {
+    // A parked IMU at 42° N declared at 34° N: gravity turns with the Earth at Ω cos 42°, not cos 34°;
+    // the alignment says so (and the heading it finds is then not to be trusted).
+    let dir = scratch("latitude");
+    let samples = parked(42.0_f64.to_radians(), H0, 0.0, 0.0, 1.0, 100.0, 300.0);
+    write_imu_csv(&dir.join("imu.csv"), 0.0, &samples);
+    let summary = dir.join("s.json");
+    let o = rinscope().arg("replay").arg("--imu").arg(dir.join("imu.csv")).args(["--position", "34", "108.9", "380", "--save"]).arg(dir.join("l.rrd")).arg("--summary-json").arg(&summary).output().expect("replay");
+    ok(&o);
+    let a = &json(&summary)["alignment"];
+    let (lat, sigma) = (a["latitude_implied_deg"][0].as_f64().expect("lat"), a["latitude_implied_deg"][1].as_f64().expect("σ"));
+    assert!((lat - 42.0).abs() < 3.0 * sigma + 0.1, "implied {lat}° ± {sigma}°");
+    assert!(a["warnings"].to_string().contains("imply a latitude"), "{a}");
+    assert!(stdout(&o).contains("WARNING"), "{}", stdout(&o));
+    std::fs::remove_dir_all(&dir).ok();
+}
