@@ -23,6 +23,7 @@
 
 use serde::{Deserialize, Serialize};
 
+pub mod estimators;
 mod fit;
 #[cfg(test)]
 mod tests;
