@@ -227,3 +227,42 @@ fn a_strapdown_log_set_is_analysed_and_exported() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_rocked_parked_imu_is_warned_about_and_no_false_term_is_claimed() {
+    // A navigation-grade IMU (ARW 0.001 °/√h, 10 µg/√Hz, no B, K, R, Q) on a vehicle rocked at 0.7 and
+    // 1.3 Hz: the rocking is no IEEE term. Before issue 21 the fit claimed K and R up to 10⁵× above the
+    // measured curve; now every reported term stays under the curve's bound and the disturbed axes
+    // carry a warning that names the τ range.
+    let dir = scratch("rocked");
+    let cfg = dir.join("rocked.toml");
+    std::fs::write(
+        &cfg,
+        "[scenario]\nname = \"rocked\"\ntitle = \"t\"\nseed = 7\n[simulation]\nduration_s = 600.0\nstep_hz = 100.0\n[site]\nlatitude_deg = 34.0\n\
+         [vehicle]\npitch_deg = 1.2\nroll_deg = -0.7\n[[vehicle.wobble]]\nangle = \"pitch\"\namplitude_deg = 0.05\nfrequency_hz = 0.7\n\
+         [[vehicle.wobble]]\nangle = \"roll\"\namplitude_deg = 0.08\nfrequency_hz = 1.3\n\
+         [turntable]\n[[turntable.axis]]\nname = \"azimuth\"\naxis = \"z\"\n[scheme]\nkind = \"static\"\n\
+         [imu]\n[imu.gyro]\narw_deg_per_sqrt_h = 0.001\n[imu.accel]\nvrw_ug_per_sqrt_hz = 10.0\n",
+    )
+    .expect("config");
+    let out = dir.join("adev.json");
+    let o = rinscope().args(["allan", "--config"]).arg(&cfg).args(["--json"]).arg(&out).arg("--save").arg(dir.join("a.rrd")).output().expect("run");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j = json(&out);
+    let text = String::from_utf8_lossy(&o.stdout);
+    for (sensor, keys) in [("gyro", ["b_deg_per_h", "k_deg_per_h_per_sqrt_h", "r_deg_per_h2", "q_arcsec"]), ("accel", ["b_ug", "k_ug_per_sqrt_h", "r_ug_per_h", "q_mps"])] {
+        for ch in j[sensor].as_array().expect("channels") {
+            let axis = ch["axis"].as_str().unwrap_or("?");
+            for key in keys {
+                assert!(!fitted(ch, key).1, "{sensor} {axis}: {key} claimed on a rocked IMU with none configured");
+            }
+        }
+    }
+    // The rocked gyros (x: pitch, y: roll) are warned about, in the JSON and in the terminal.
+    for k in 0..2 {
+        let w = j["gyro"][k]["fit_warnings"].as_array().expect("warnings");
+        assert!(!w.is_empty(), "gyro {k}: no warning");
+    }
+    assert!(text.contains("WARNING gyro x") && text.contains("χ²/dof"), "{text}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -317,6 +317,17 @@ impl ImuAllan {
                 s = s.trim_end().to_owned();
                 s.push('\n');
             }
+            s += &format!("{:<w$}", "χ²/dof of the fit");
+            for c in &chans {
+                s += &format!("{:<cw$}", sig(c.report.fit_chi2_per_dof, 3));
+            }
+            s = s.trim_end().to_owned();
+            s.push('\n');
+            for c in &chans {
+                for w in &c.report.fit_contradictions {
+                    s += &format!("WARNING {} {}: {}\n", sensor.name(), AXES[c.axis], w.text());
+                }
+            }
             if let Some(t) = truth.filter(Truth::has_markov) {
                 s += &format!(
                     "also configured: a Gauss-Markov bias of σ {} {}, T {} s (not an IEEE term: its curve peaks at 0.62σ near τ = 1.9 T)\n",
@@ -409,6 +420,8 @@ fn channel_json(c: &Channel) -> Value {
     m.insert("second_differences".into(), json!(r.n_terms));
     m.insert("dominant".into(), json!(r.dominant.iter().map(|t| t.letter()).collect::<Vec<_>>()));
     m.insert("fit_chi2_per_dof".into(), json!(r.fit_chi2_per_dof));
+    // A fit is a claim: where the data contradict a term or the whole model, said in words.
+    m.insert("fit_warnings".into(), json!(r.fit_contradictions.iter().map(crate::math::allan::Contradiction::text).collect::<Vec<_>>()));
     let mut fitted = Map::new();
     let mut readings = Map::new();
     for term in TERMS {

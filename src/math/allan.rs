@@ -28,7 +28,7 @@ mod fit;
 #[cfg(test)]
 mod tests;
 
-pub use fit::{fit_noise_model, slope_readings, NoiseFit, SlopeReading, SlopeReadings, SIGNIFICANCE_Z, SLOPE_MATCH_TOLERANCE};
+pub use fit::{check_claims, fit_noise_model, slope_readings, Contradiction, NoiseFit, CLAIM_Z, SlopeReading, SlopeReadings, SIGNIFICANCE_Z, SLOPE_MATCH_TOLERANCE};
 
 /// Fewest samples [`allan_curve`] accepts.
 pub const MIN_SAMPLES: usize = 16;
@@ -488,6 +488,9 @@ pub struct AllanReport {
     pub fit: NoiseCoefficients,
     /// Weighted residual sum of squares per degree of freedom of the fit.
     pub fit_chi2_per_dof: f64,
+    /// Where the data contradict a term (then not reported as found) or every IEEE combination.
+    #[serde(default)]
+    pub fit_contradictions: Vec<Contradiction>,
     /// Slope-line readings (the secondary estimate).
     pub slope: SlopeReadings,
 }
@@ -514,6 +517,7 @@ pub fn analyze(phase: &Phase, tau0_s: f64, opts: &AllanOptions) -> Result<AllanR
         dominant: fit.dominant,
         fit: fit.coefficients,
         fit_chi2_per_dof: fit.chi2_per_dof,
+        fit_contradictions: fit.contradictions,
         slope,
     })
 }

@@ -161,7 +161,13 @@ fn about(r: &ImuAllan, description: &str) -> String {
         .iter()
         .map(|t| format!("| {} | {} / {} | {} |\n", t.letter(), crate::ins::allan::Sensor::Gyro.term_name(*t), crate::ins::allan::Sensor::Accel.term_name(*t), t.slope_text()))
         .collect();
-    let notes: String = r.notes.iter().map(|n| format!("\n*Note:* {n}\n")).collect();
+    let mut notes: String = r.notes.iter().map(|n| format!("\n*Note:* {n}\n")).collect();
+    // A fit is a claim: where the data contradict a term or every IEEE combination, said here too.
+    for c in &r.channels {
+        for w in &c.report.fit_contradictions {
+            notes += &format!("\n**WARNING** {} {}: {} (χ²/dof {:.3})\n", c.sensor.name(), crate::ins::allan::AXES[c.axis], w.text(), c.report.fit_chi2_per_dof);
+        }
+    }
     format!(
         "# Allan deviation\n\n{}\n{notes}\n**How to read the plots.** Rerun has no logarithmic axis, so both axes carry **log10 values**: \
          the horizontal axis is the timeline `{LOG10_TAU_TIMELINE}`, whose \"seconds\" are **log10(τ / 1 s)** (−2 is 10 ms, 0 is \

@@ -23,6 +23,114 @@ pub struct NoiseFit {
     pub dominant: Vec<NoiseTerm>,
     /// Weighted residual sum of squares / (points − active terms).
     pub chi2_per_dof: f64,
+    /// Where the data contradict a term or every IEEE combination (see [`check_claims`]).
+    #[serde(default)]
+    pub contradictions: Vec<Contradiction>,
+}
+
+/// A τ range where the measured curve contradicts a fitted term (its asymptote lies above the
+/// curve's upper bound: a term can never exceed the total it is part of) or the fitted model as a
+/// whole (the curve leaves the model's interval: not a stationary record of IEEE terms there).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Contradiction {
+    /// The term, or None for the model as a whole.
+    pub term: Option<NoiseTerm>,
+    /// The first cluster time of the range, s.
+    pub tau_from_s: f64,
+    /// The last, s.
+    pub tau_to_s: f64,
+    /// The largest factor between the two deviations in the range (≥ 1).
+    pub worst_factor: f64,
+}
+
+impl Contradiction {
+    /// One sentence for people.
+    #[must_use]
+    pub fn text(&self) -> String {
+        match self.term {
+            Some(t) => format!(
+                "{} would lie up to {:.1}× above the measured curve between τ = {:.4} s and {:.4} s (beyond its {:.0}σ bound): not reported as found",
+                t.letter(),
+                self.worst_factor,
+                self.tau_from_s,
+                self.tau_to_s,
+                CLAIM_Z
+            ),
+            None if self.worst_factor.is_infinite() => format!(
+                "between τ = {:.4} s and {:.4} s no IEEE term the data allow describes the curve: not a stationary record of IEEE noise there (a trend, a disturbance, a periodic signal?); the slope readings are still shown",
+                self.tau_from_s, self.tau_to_s
+            ),
+            None => format!(
+                "between τ = {:.4} s and {:.4} s the curve leaves every IEEE combination fitted (up to {:.1}× outside the model's {:.0}σ band): not a stationary record of these terms there (a trend, a disturbance, a periodic signal?)",
+                self.tau_from_s, self.tau_to_s, self.worst_factor, CLAIM_Z
+            ),
+        }
+    }
+}
+
+/// How far (in σ of the χ² interval) a term's asymptote or the model may lie from the measured
+/// curve before the data are said to contradict it.
+pub const CLAIM_Z: f64 = 3.0;
+
+/// The runs of consecutive points where `factor(j)` exceeds 1, as contradictions of `term`.
+fn runs(taus: &[f64], term: Option<NoiseTerm>, factor: impl Fn(usize) -> f64) -> Vec<Contradiction> {
+    let mut out: Vec<Contradiction> = Vec::new();
+    let mut open = false;
+    for (j, tau) in taus.iter().enumerate() {
+        let f = factor(j);
+        if f > 1.0 {
+            match out.last_mut().filter(|_| open) {
+                Some(c) => {
+                    c.tau_to_s = *tau;
+                    c.worst_factor = c.worst_factor.max(f);
+                }
+                None => out.push(Contradiction { term, tau_from_s: *tau, tau_to_s: *tau, worst_factor: f }),
+            }
+            open = true;
+        } else {
+            open = false;
+        }
+    }
+    out
+}
+
+/// A fit is a claim: every term reported as found must stay under the measured curve's upper
+/// bound (at [`CLAIM_Z`]σ, with the point's EDF) at every τ — each term is a part of the total —,
+/// and the model as a whole must pass through the curve's intervals; where not, say so.
+/// Returns the terms' contradictions and the model's.
+#[must_use]
+pub fn check_claims(curve: &AllanCurve, fit: &NoiseFit) -> (Vec<Contradiction>, Vec<Contradiction>) {
+    let np = curve.taus_s.len().min(fit.edf.len());
+    let taus = &curve.taus_s[..np];
+    let bounds: Vec<(f64, f64)> = (0..np).map(|j| super::adev_confidence(curve.avar_si[j].sqrt(), fit.edf[j], CLAIM_Z)).collect();
+    let mut terms = Vec::new();
+    for t in TERMS {
+        let e = fit.coefficients.get(t);
+        if !e.significant {
+            continue;
+        }
+        // The coefficient at its own 2σ low end: a term contradicted only by its fit's scatter is not.
+        let low = (e.value - 2.0 * e.sigma).max(0.0);
+        terms.extend(runs(taus, Some(t), |j| t.avar(low, taus[j]).sqrt() / bounds[j].1.max(f64::MIN_POSITIVE)));
+    }
+    let model = runs(taus, None, |j| {
+        let m = fit.coefficients.avar(taus[j]).sqrt();
+        let (lo, hi) = bounds[j];
+        // No term left at all: every point with signal is outside (a factor shown as the curve's
+        // lower bound over the tiniest fitted level, i.e. "infinitely").
+        if m > hi {
+            m / hi.max(f64::MIN_POSITIVE)
+        } else if m < lo {
+            if m > 0.0 { lo / m } else { f64::INFINITY }
+        } else {
+            0.0
+        }
+    });
+    // The model's band is two-sided at 3σ on ~40 correlated points per curve: a lone point just
+    // outside is what chance gives about once per report; a contradiction is a run of points, or
+    // one point well outside.
+    let model = model.into_iter().filter(|c| c.worst_factor >= 1.1 && (c.tau_to_s > c.tau_from_s || c.worst_factor >= 1.5)).collect();
+    (terms, model)
 }
 
 /// Non-negative least squares min ‖Ax − b‖, x ≥ 0 (Lawson & Hanson 1974, ch. 23
@@ -117,15 +225,41 @@ fn nnls(a: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {
 pub fn fit_noise_model(curve: &AllanCurve) -> NoiseFit {
     let mut allowed = [true; 5];
     let mut fit = fit_pass(curve, allowed);
-    for _ in 0..5 {
+    let mut refuted: Vec<Contradiction> = Vec::new();
+    for _ in 0..8 {
         let keep = TERMS.map(|t| fit.coefficients.get(t).significant);
+        // A term the data contradict is dropped like an insignificant one, and said.
+        let (against, _) = check_claims(curve, &fit);
+        let keep: [bool; 5] = std::array::from_fn(|k| keep[k] && !against.iter().any(|c| c.term == Some(TERMS[k])));
+        refuted.extend(against);
         if keep == allowed || !keep.contains(&true) {
             break;
         }
         allowed = keep;
         fit = fit_pass(curve, allowed);
     }
+    for c in &refuted {
+        if let Some(t) = c.term {
+            let e = fit.coefficients.get(t);
+            if e.significant {
+                set_significant(&mut fit.coefficients, t, false);
+            }
+        }
+    }
+    let (_, model) = check_claims(curve, &fit);
+    fit.contradictions = refuted.into_iter().chain(model).collect();
     fit
+}
+
+fn set_significant(c: &mut NoiseCoefficients, t: NoiseTerm, found: bool) {
+    let e = match t {
+        NoiseTerm::Quantization => &mut c.q_si,
+        NoiseTerm::RandomWalk => &mut c.n_si,
+        NoiseTerm::BiasInstability => &mut c.b_si,
+        NoiseTerm::RateRandomWalk => &mut c.k_si,
+        NoiseTerm::RateRamp => &mut c.r_si,
+    };
+    e.significant = found;
 }
 
 /// One weighted NNLS fit restricted to the `allowed` terms (see [`fit_noise_model`]).
@@ -233,6 +367,7 @@ fn fit_pass(curve: &AllanCurve, allowed: [bool; 5]) -> NoiseFit {
         edf,
         dominant,
         chi2_per_dof,
+        contradictions: Vec::new(),
     }
 }
 
