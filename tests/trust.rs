@@ -598,6 +598,8 @@ fn a_closed_or_broken_stderr_does_not_silence_the_signals() {
             }
         }
     }
+    // The log set and the recordings are a few hundred MB.
+    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
