@@ -4,7 +4,7 @@
 //! `tests/layers.rs`), and only `record` imports Rerun:
 //!
 //! 0. [`math`], [`io`] — frames and typed rotations, units, attitude, noise, statistics, the
-//!    sampling rule; atomic output files.
+//!    sampling rule; atomic output files and the one rule for opening inputs (`io::files`).
 //! 1. [`model`] — the gimbal chain with its exact errors, rotation schemes, vehicle motion, Earth.
 //! 2. [`sim`] — the turntable step: truth, encoders, three demodulations (pure).
 //! 3. [`ins`], [`calib`] — the INS in the loop (IMU truth, sensors, algorithms, navigation,
@@ -23,6 +23,17 @@ macro_rules! out {
 /// `println!` for what a command outputs (see [`out!`]).
 macro_rules! outln {
     ($($t:tt)*) => { $crate::app::terminate::write_stdout(format_args!("{}\n", format_args!($($t)*))) };
+}
+
+/// `eprintln!` that never fails: a message to stderr is dropped when stderr cannot take it (a
+/// pipe whose reader went away, a terminal that hung up: EPIPE, EIO), where `eprintln!` would
+/// panic — in the signal thread, ending the only thread that answers SIGTERM and SIGINT; in the
+/// main thread, turning a command's exit code into 101.
+macro_rules! errln {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        std::io::stderr().lock().write_fmt(format_args!("{}\n", format_args!($($t)*))).ok();
+    }};
 }
 
 pub mod app;

@@ -127,3 +127,53 @@ fn the_checker_sees_what_it_must_refuse() {
     let long = "let x = 1;\n".repeat(MAX_LINES + 1);
     assert_eq!(violations("math/x.rs", Some("math"), &long).len(), 1);
 }
+
+/// Files allowed to open a file without `io::files::open_input`: the function itself (and the
+/// output side), the recording writer reading back its own partial, the benchmarks' own scratch
+/// files and /proc.
+const OPENS_ALLOWED: &[&str] = &["io/files.rs", "record/sink/file.rs", "app/bench/"];
+
+/// Ways of opening a file for reading that bypass the opening rule.
+const RAW_OPENS: &[&str] = &["File::open(", "fs::read_to_string(", "fs::read(", "OpenOptions::new()"];
+
+/// Issue 20: every input a command reads is opened by `io::files::open_input` (no blocking open,
+/// regular files only), and stderr is written with `errln!` (a closed pipe or a hung-up terminal
+/// must not panic the signal thread); the places that did otherwise hung or died.
+fn opening_violations(file: &str, text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let allowed = OPENS_ALLOWED.iter().any(|a| file.starts_with(a));
+    for (n, line) in shipped(text).lines().enumerate() {
+        let l = line.trim_start();
+        if l.starts_with("//") {
+            continue;
+        }
+        if !allowed && let Some(p) = RAW_OPENS.iter().find(|p| l.contains(**p)) {
+            out.push(format!("{file}:{}: opens a file with {p}: inputs go through io::files::open_input: {l}", n + 1));
+        }
+        if l.contains("eprintln!(") || l.contains("eprint!(") {
+            out.push(format!("{file}:{}: eprintln! panics when stderr is gone: use errln!: {l}", n + 1));
+        }
+    }
+    out
+}
+
+#[test]
+fn every_input_is_opened_by_one_function_and_stderr_never_panics() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    let mut all = Vec::new();
+    for path in &files {
+        let rel = path.strip_prefix(&src).expect("under src").to_string_lossy().replace('\\', "/");
+        if rel.ends_with("/tests.rs") || rel == "lib.rs" {
+            continue;
+        }
+        all.extend(opening_violations(&rel, &std::fs::read_to_string(path).expect("readable")));
+    }
+    assert!(all.is_empty(), "{}", all.join("\n"));
+    // The check can fail: a raw open and an eprintln! are each reported, test code is not.
+    assert_eq!(opening_violations("io/text.rs", "let f = File::open(path)?;\n").len(), 1);
+    assert_eq!(opening_violations("cli/x.rs", "eprintln!(\"x\");\n").len(), 1);
+    assert_eq!(opening_violations("io/files.rs", "let d = File::open(dir);\n").len(), 0);
+    assert_eq!(opening_violations("io/text.rs", "#[cfg(test)]\nlet f = File::open(path)?;\n").len(), 0);
+}

@@ -374,3 +374,258 @@ fn serve_web_serves_the_viewer_page_on_loopback_and_ends_cleanly() {
     assert_eq!(code, Some(0), "{err}");
     verify_recording(&dir.join("x.rrd")).expect("complete");
 }
+
+// ---- Issue 20 ("Trust, round 2"): one opening rule for every input, signals that always reach
+// the process, one exit-code policy.
+
+/// A command's outcome, the process killed (and the test failed) if it has not ended in 10 s:
+/// before, a FIFO named as a log file blocked `open` for ever.
+fn bounded(cmd: &mut Command) -> Output {
+    let mut child = cmd.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("rinscope runs");
+    let started = Instant::now();
+    while child.try_wait().expect("wait").is_none() {
+        if started.elapsed() > Duration::from_secs(10) {
+            child.kill().ok();
+            let out = child.wait_with_output().expect("wait");
+            panic!("still running after 10 s (killed): {}", stderr(&out));
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.wait_with_output().expect("wait")
+}
+
+/// A static calibration log set (turntable, encoders, reference file), exported once per test.
+fn calibration_log_set(dir: &Path) -> PathBuf {
+    let out = dir.join("base");
+    let o = rinscope().args(["export-log", "--scenario", "jiang2017-calibration", "--out"]).arg(&out).output().expect("export-log");
+    assert!(o.status.success(), "{}", stderr(&o));
+    out
+}
+
+/// A copy of the log set `base` in `dir/name`.
+fn copy_log_set(base: &Path, dir: &Path, name: &str) -> PathBuf {
+    let to = dir.join(name);
+    std::fs::create_dir_all(&to).expect("dir");
+    for e in std::fs::read_dir(base).expect("base").flatten() {
+        std::fs::copy(e.path(), to.join(e.file_name())).expect("copy");
+    }
+    to
+}
+
+fn mkfifo(p: &Path) {
+    std::fs::remove_file(p).ok();
+    assert!(Command::new("mkfifo").arg(p).status().expect("mkfifo").success(), "mkfifo {}", p.display());
+}
+
+#[test]
+fn every_input_that_is_not_a_regular_file_is_refused_at_once() {
+    // Before: a FIFO as the [imu] or [encoders] file hung `replay` and `calibrate` in `open` for
+    // ever (a 0-byte .partial left when killed); only table.toml was refused. Now every file a
+    // command reads is opened by one function (io::files::open_input): exit 2 at once, the path
+    // named, nothing written.
+    let dir = scratch("inputs");
+    let base = calibration_log_set(&dir);
+    let rec = dir.join("out.rrd");
+    let save = |c: &mut Command| {
+        c.arg("--save").arg(&rec);
+    };
+    type Case = (&'static str, &'static str, &'static [&'static str]);
+    // (file replaced by a FIFO, command, arguments before the log set's folder)
+    let cases: &[Case] = &[
+        ("imu.csv", "replay", &[]),
+        ("encoders.csv", "replay", &[]),
+        ("reference.csv", "replay", &[]),
+        ("table.toml", "replay", &[]),
+        ("log.toml", "replay", &[]),
+        ("imu.csv", "calibrate", &["--log"]),
+        ("encoders.csv", "calibrate", &["--log"]),
+        ("imu.csv", "allan", &[]),
+    ];
+    for (i, (file, command, before)) in cases.iter().enumerate() {
+        let set = copy_log_set(&base, &dir, &format!("set{i}"));
+        let fifo = set.join(file);
+        mkfifo(&fifo);
+        let mut c = rinscope();
+        c.arg(command).args(*before).arg(&set);
+        save(&mut c);
+        let out = bounded(&mut c);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{command} with a FIFO as {file}: {err}");
+        assert!(err.contains(&fifo.display().to_string()) && err.contains("not a regular file"), "{command}, {file}: names the path and why: {err}");
+        assert!(!rec.exists() && partials(&dir).is_empty(), "{command}, {file}: nothing written");
+    }
+    // Files named on the command line: --compensation, --imu (a PSINS .imu, its layout guessed
+    // from the content or given), --table, --encoders, `events`, a Monte Carlo shard; a device
+    // and a directory as well as a FIFO.
+    let fifo = dir.join("f.imu");
+    mkfifo(&fifo);
+    let psins = ["--position", "30", "110", "0"];
+    let flag_cases: Vec<(Vec<std::ffi::OsString>, PathBuf)> = vec![
+        (vec!["replay".into(), base.clone().into(), "--compensation".into(), fifo.clone().into()], fifo.clone()),
+        (vec!["replay".into(), base.clone().into(), "--compensation".into(), "/dev/zero".into()], "/dev/zero".into()),
+        (vec!["replay".into(), "--imu".into(), fifo.clone().into()].into_iter().chain(psins.iter().map(Into::into)).collect(), fifo.clone()),
+        (vec!["replay".into(), "--imu".into(), fifo.clone().into(), "--imu-layout".into(), "psins-imu".into()].into_iter().chain(psins.iter().map(Into::into)).collect(), fifo.clone()),
+        (vec!["replay".into(), "--imu".into(), base.join("imu.csv").into(), "--table".into(), fifo.clone().into()], fifo.clone()),
+        (vec!["replay".into(), "--imu".into(), base.join("imu.csv").into(), "--table".into(), base.join("table.toml").into(), "--encoders".into(), fifo.clone().into()], fifo.clone()),
+        (vec!["replay".into(), "--imu".into(), dir.clone().into()].into_iter().chain(psins.iter().map(Into::into)).collect(), dir.clone()),
+        (vec!["events".into(), fifo.clone().into()], fifo.clone()),
+        (vec!["montecarlo".into(), "merge".into(), fifo.clone().into()], fifo.clone()),
+    ];
+    for (args, named) in flag_cases {
+        let mut c = rinscope();
+        c.args(&args);
+        if args[0] == "replay" {
+            save(&mut c);
+        }
+        let out = bounded(&mut c);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(&named.display().to_string()) && err.contains("not a regular file"), "{args:?}: names the path and why: {err}");
+        assert!(!rec.exists() && partials(&dir).is_empty(), "{args:?}: nothing written");
+    }
+}
+
+#[test]
+fn the_same_bad_log_gives_the_same_exit_code_and_message_in_every_command() {
+    // Before: `calibrate --log` exited 1 (the code of a failed output) where `replay` and `allan`
+    // exited 2 with the same message, and `allan` exited 1 on "1 samples given".
+    let dir = scratch("policy");
+    let base = calibration_log_set(&dir);
+    let bad = copy_log_set(&base, &dir, "bad");
+    let imu = bad.join("imu.csv");
+    let text = std::fs::read_to_string(&imu).expect("imu.csv");
+    let mut lines: Vec<String> = text.lines().map(str::to_owned).collect();
+    let mut cells: Vec<String> = lines[100].split(',').map(str::to_owned).collect();
+    cells[2] = "abc".into();
+    lines[100] = cells.join(",");
+    std::fs::write(&imu, lines.join("\n") + "\n").expect("write");
+    let commands: [(&str, &[&str]); 3] = [("replay", &[]), ("calibrate --log", &["calibrate", "--log"]), ("allan", &[])];
+    let mut messages = Vec::new();
+    for (name, args) in commands {
+        let mut c = rinscope();
+        if args.is_empty() {
+            c.arg(name);
+        } else {
+            c.args(args);
+        }
+        c.arg(&bad).arg("--save").arg(dir.join("x.rrd"));
+        let out = bounded(&mut c);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{name}: bad data is bad input: {err}");
+        let line = err.lines().find(|l| l.starts_with(&format!("rinscope: {name}: "))).unwrap_or_else(|| panic!("{name}: one message: {err}"));
+        messages.push(line.trim_start_matches(&format!("rinscope: {name}: ")).to_owned());
+    }
+    assert!(messages[0].contains(&imu.display().to_string()) && messages[0].contains("abc"), "{}", messages[0]);
+    assert!(messages.iter().all(|m| *m == messages[0]), "the same message: {messages:#?}");
+    assert!(partials(&dir).is_empty() && !dir.join("x.rrd").exists());
+    // Too few samples: two rows (one update of the INS at most) — allan and calibrate --log
+    // refuse the data, exit 2 (calibrate said "give the log set a [reference]", which it has).
+    let few = copy_log_set(&base, &dir, "few");
+    std::fs::write(few.join("imu.csv"), text.lines().take(3).collect::<Vec<_>>().join("\n") + "\n").expect("write");
+    for (args, expected) in [(&["allan"][..], "samples given"), (&["calibrate", "--log"][..], "too few samples")] {
+        let out = bounded(rinscope().args(args).arg(&few).arg("--no-recording"));
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(expected), "{args:?}: {}", stderr(&out));
+    }
+}
+
+/// `rinscope replay` of a log long enough to be interrupted (an hour at 200 Hz, every sample
+/// recorded: seconds of work), spawned by `spawn`.
+fn long_replay_set(dir: &Path) -> PathBuf {
+    let cfg = tempconfig(dir, "jiang2017-dual-axis", "duration_s = 360.0", "duration_s = 3600.0");
+    let out = dir.join("long");
+    let o = rinscope().args(["export-log", "--format", "npy", "--config"]).arg(&cfg).arg("--out").arg(&out).output().expect("export-log");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let table = out.join("table.toml");
+    let text = std::fs::read_to_string(&table).expect("table.toml");
+    let text = text.replacen("series_hz = 10.0", "series_hz = 200.0", 1).replacen("scene_hz = 10.0", "scene_hz = 200.0", 1);
+    std::fs::write(&table, text).expect("table.toml");
+    out
+}
+
+#[test]
+fn a_closed_or_broken_stderr_does_not_silence_the_signals() {
+    // Before: with stderr a pipe whose reader had gone (or a terminal that hung up), the first
+    // signal's message panicked the signal thread — SIGTERM and SIGINT were ignored from then
+    // on — and the next message on the main thread ended the command with 101.
+    let dir = scratch("stderr");
+    let set = long_replay_set(&dir);
+    let bin = env!("CARGO_BIN_EXE_rinscope");
+    for how in ["closed (2>&-)", "a pipe without a reader"] {
+        for twice in [false, true] {
+            let save = dir.join("r.rrd");
+            std::fs::remove_file(&save).ok();
+            let mut cmd = if how.starts_with("closed") {
+                let mut c = Command::new("sh");
+                c.arg("-c").arg("exec \"$0\" \"$@\" 2>&-").arg(bin);
+                c
+            } else {
+                Command::new(bin)
+            };
+            cmd.env_remove("DISPLAY").env_remove("WAYLAND_DISPLAY").arg("replay").arg(&set).arg("--save").arg(&save).stdout(Stdio::null());
+            if how.starts_with("closed") {
+                cmd.stderr(Stdio::null());
+            } else {
+                let (reader, writer) = std::io::pipe().expect("pipe");
+                drop(reader);
+                cmd.stderr(writer);
+            }
+            let mut child = cmd.spawn().expect("runs");
+            wait_for_file(&dir.join("r.rrd.partial"));
+            std::thread::sleep(Duration::from_millis(300));
+            signal(&child, "-TERM");
+            if twice {
+                std::thread::sleep(Duration::from_millis(150));
+                if child.try_wait().expect("wait").is_none() {
+                    signal(&child, "-TERM");
+                }
+            }
+            let started = Instant::now();
+            let status = loop {
+                if let Some(s) = child.try_wait().expect("wait") {
+                    break s;
+                }
+                if started.elapsed() > Duration::from_secs(10) {
+                    child.kill().ok();
+                    panic!("stderr {how}: still running 10 s after SIGTERM (the signals went unanswered)");
+                }
+                std::thread::sleep(Duration::from_millis(20));
+            };
+            assert_eq!(status.code(), Some(143), "stderr {how}, twice: {twice}: {status:?}");
+            assert!(partials(&dir).is_empty(), "stderr {how}: {:?}", partials(&dir));
+            if !twice {
+                verify_recording(&save).unwrap_or_else(|e| panic!("stderr {how}: {e}"));
+            }
+        }
+    }
+    // The log set and the recordings are a few hundred MB.
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_killed_run_leaves_nothing_that_blocks_the_next_one() {
+    // SIGKILL cannot be answered: the partial stays. The next run writing the same file takes it
+    // over (its lock died with the process) instead of failing, and leaves none.
+    let dir = scratch("killed");
+    let save = dir.join("x.rrd");
+    let mut child = long_run(&save);
+    wait_for_file(&dir.join("x.rrd.partial"));
+    child.kill().expect("SIGKILL");
+    child.wait().expect("wait");
+    assert_eq!(partials(&dir).len(), 1, "a killed run leaves its partial");
+    let out = bounded(rinscope().args(["run", "--duration-s", "60", "--save"]).arg(&save));
+    assert!(out.status.success(), "{}", stderr(&out));
+    verify_recording(&save).expect("complete");
+    assert!(partials(&dir).is_empty(), "{:?}", partials(&dir));
+    // export-log writes a folder: one a killed export left (unlocked, half full) is taken over;
+    // before, every later export to that name was refused.
+    let out_dir = dir.join("set");
+    let stale = dir.join("set.partial");
+    std::fs::create_dir(&stale).expect("stale folder");
+    std::fs::write(stale.join("imu.csv"), "t_s,dtheta_x_rad\n0,").expect("half a file");
+    let out = bounded(rinscope().args(["export-log", "--scenario", "jiang2017-calibration", "--out"]).arg(&out_dir));
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!stale.exists() && out_dir.join("log.toml").exists());
+    let text = std::fs::read_to_string(out_dir.join("imu.csv")).expect("imu.csv");
+    assert!(text.lines().count() > 1000, "written afresh");
+}

@@ -145,7 +145,8 @@ pub fn calibrate_scenario(params: &Params, history: bool, stop: &AtomicBool) -> 
     let (data, validation) = std::thread::scope(|scope| {
         let v = scope.spawn(|| collect(params, seed.wrapping_add(1), stop));
         let d = collect(params, seed, stop);
-        (d, v.join().unwrap_or(Err(CalibError::Data("the validation run's thread panicked".into()))))
+        // A panic is a bug, not bad data: it goes on as a panic (CalibError::Data is the data's).
+        (d, v.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)))
     });
     let (data, validation) = (data?, validation?);
     let cfg = &params.calibration;
@@ -243,6 +244,9 @@ pub fn collect_from_log(log: &LogSet, known: &TableErrors, stop: &AtomicBool) ->
         CalibError::Interrupted => LogCalibrationError::Interrupted,
         other => LogCalibrationError::Calibration(other),
     })?;
+    if samples.is_empty() {
+        return Err(LogCalibrationError::NoMeasurements(log.imu.path.display().to_string()));
+    }
     let attitude = found.lock().unwrap_or_else(std::sync::PoisonError::into_inner).ok_or(LogCalibrationError::NoReference)?;
     // τ ∈ [−1, 1] over the test, as the simulation's calibration has it.
     let duration_s = samples.last_t_s().max(1e-9);
@@ -258,6 +262,9 @@ pub enum LogCalibrationError {
     /// No known body attitude.
     #[error("calibration needs the body's attitude at rest: give the log set a [reference] (attitude_deg = [pitch, roll, heading], or a file)")]
     NoReference,
+    /// The IMU file ends before the INS's first update: nothing to calibrate on.
+    #[error("{0}: too few samples: the log ends before the INS's first update, so there is no measurement to calibrate on")]
+    NoMeasurements(String),
     /// The reference attitude changes.
     #[error("the reference attitude changes by {arcsec:.3}″ at {t_s:.3} s: a static calibration needs the vehicle at rest")]
     Moves {

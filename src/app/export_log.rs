@@ -64,6 +64,9 @@ pub enum ExportError {
     /// The target exists.
     #[error("{0} exists; export-log writes a new folder (choose another --out or remove it)")]
     Exists(String),
+    /// The folder's partial cannot be used (another export is writing it, a symlink, a file).
+    #[error("{0}")]
+    Refused(String),
     /// A file could not be written.
     #[error("{0}")]
     Write(String),
@@ -82,16 +85,14 @@ pub fn export_log(params: &Params, out: &Path, format: LogFormat, aligned: bool,
         return Err(ExportError::Exists(out.display().to_string()));
     }
     let partial = crate::io::files::partial_path(out);
-    if partial.exists() {
-        return Err(ExportError::Exists(partial.display().to_string()));
-    }
     if let Some(parent) = partial.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent).map_err(|e| ExportError::Write(format!("{}: {e}", parent.display())))?;
     }
-    // create_dir, not create_dir_all: a second export racing for the same folder is refused.
-    std::fs::create_dir(&partial).map_err(|e| match e.kind() {
-        std::io::ErrorKind::AlreadyExists => ExportError::Exists(partial.display().to_string()),
-        _ => ExportError::Write(format!("{}: {e}", partial.display())),
+    // Locked while written: a second export of the same folder is refused, one that a killed
+    // export left is taken over.
+    let _lock = crate::io::files::create_partial_dir(out).map_err(|e| match e {
+        crate::io::files::OutputError::Io { .. } => ExportError::Write(e.to_string()),
+        other => ExportError::Refused(other.to_string()),
     })?;
     crate::io::files::unfinished_dir(&partial);
     let result = write_files(params, &partial, format, aligned, stop);

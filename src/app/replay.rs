@@ -191,7 +191,7 @@ fn final_state(pb: &Playback) -> FinalState {
 pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mut Recorder>, stop: &AtomicBool, bar: Option<&indicatif::ProgressBar>) -> Result<ReplaySummary, PlaybackError> {
     let started = Instant::now();
     let mut pb = Playback::open(log, compensation)?;
-    let rerun = |e: crate::record::RecordError| PlaybackError::Data(format!("rerun: {e}"));
+    let rerun = |e: crate::record::RecordError| PlaybackError::Record(e.to_string());
     if let Some(r) = recorder.as_deref_mut() {
         r.set_file_clock(pb.file_time_s(0.0)).map_err(rerun)?;
     }

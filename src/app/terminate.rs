@@ -5,7 +5,14 @@
 //! partial file it was writing.
 //!
 //! The signals reach a thread through signal-hook's self-pipe: nothing runs inside a signal
-//! handler but signal-hook's own async-signal-safe write.
+//! handler but signal-hook's own async-signal-safe write. That thread must outlive anything that
+//! can happen to the terminal: it writes to stderr with `errln!`, which drops a message stderr
+//! cannot take (a pipe whose reader went away, a terminal that hung up) — `eprintln!` panicked
+//! there, ending the thread, after which SIGTERM and SIGINT were caught and ignored.
+//!
+//! The first signal is answered at the command's next check, so nothing a command waits on may
+//! block for ever: every input is opened without blocking and must be a regular file
+//! (`io::files::open_input`).
 
 use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
 use std::sync::{Arc, OnceLock};
@@ -38,19 +45,19 @@ pub fn stop_flag() -> Arc<AtomicBool> {
                     for signal in signals.forever() {
                         if FIRST_SIGNAL.compare_exchange(0, signal, Ordering::SeqCst, Ordering::SeqCst).is_ok() {
                             flag.store(true, Ordering::SeqCst);
-                            eprintln!("\nrinscope: {}: finishing what was simulated (send it again to stop at once)", name(signal));
+                            errln!("\nrinscope: {}: finishing what was simulated (send it again to stop at once)", name(signal));
                         } else {
                             crate::io::files::remove_unfinished();
-                            eprintln!("\nrinscope: {} again: stopped at once; unfinished files removed", name(signal));
+                            errln!("\nrinscope: {} again: stopped at once; unfinished files removed", name(signal));
                             std::process::exit(128 + signal);
                         }
                     }
                 });
                 if let Err(e) = spawned {
-                    eprintln!("rinscope: cannot watch for signals ({e}); Ctrl-C ends the process without finishing the recording");
+                    errln!("rinscope: cannot watch for signals ({e}); Ctrl-C ends the process without finishing the recording");
                 }
             }
-            Err(e) => eprintln!("rinscope: cannot watch for signals ({e}); Ctrl-C ends the process without finishing the recording"),
+            Err(e) => errln!("rinscope: cannot watch for signals ({e}); Ctrl-C ends the process without finishing the recording"),
         }
         stop
     }))
@@ -87,7 +94,7 @@ pub fn write_stdout(args: std::fmt::Arguments<'_>) {
         }
         static REPORTED: AtomicBool = AtomicBool::new(false);
         if !REPORTED.swap(true, Ordering::Relaxed) {
-            eprintln!("rinscope: cannot write to stdout: {e}");
+            errln!("rinscope: cannot write to stdout: {e}");
         }
     }
 }

@@ -16,8 +16,8 @@ const DEFAULT_SCENARIO: &str = "static-imu-10h";
 impl From<AllanRunError> for Failure {
     fn from(e: AllanRunError) -> Self {
         match e {
-            AllanRunError::Config(_) | AllanRunError::Data(_) => Self::input(format!("allan: {e}")),
-            AllanRunError::Analysis(_) => Self::run(format!("allan: {e}")),
+            // Every channel error is of the data: too few samples, a non-finite value, a bad rate.
+            AllanRunError::Config(_) | AllanRunError::Data(_) | AllanRunError::Analysis(_) => Self::input(format!("allan: {e}")),
             AllanRunError::Interrupted(_) => Self::interrupted(format!("allan: {e}")),
         }
     }
@@ -79,11 +79,11 @@ pub(super) fn allan(args: &AllanArgs) -> Result<(), Failure> {
     };
     let result = match &source {
         Source::Log(log) => {
-            eprintln!("rinscope: reading {} ...", log.imu.path.display());
+            errln!("rinscope: reading {} ...", log.imu.path.display());
             allan::log_set(log, &request, &stop, &progress)
         }
         Source::Scenario(p) => {
-            eprintln!("rinscope: simulating {:.2} h of {} at {} Hz, then the Allan analysis of 6 channels ...", p.duration_s / 3600.0, p.meta.name, p.step_hz);
+            errln!("rinscope: simulating {:.2} h of {} at {} Hz, then the Allan analysis of 6 channels ...", p.duration_s / 3600.0, p.meta.name, p.step_hz);
             allan::simulate(p, &request, &stop, &progress)
         }
     };

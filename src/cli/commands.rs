@@ -10,7 +10,6 @@ use crate::calib::montecarlo::{self, Shard, ShardFile};
 use crate::app::run::run_recorded;
 use crate::app::terminate::stop_flag;
 use crate::app::{live, modulation, reproduce, tpr};
-use crate::calib::CalibError;
 use crate::ins::reset::sweep_text;
 use crate::io::files::write_atomically;
 use crate::math::units::RAD_PER_ARCSEC;
@@ -76,7 +75,7 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
             let name = name.as_deref().unwrap_or(presets::DEFAULT_SCENARIO);
             presets::load(name)?; // a clear error for an unknown name
             let (path, created) = live::ensure_preset_copy(name).map_err(|e| Failure::input(format!("{e:#}")))?;
-            eprintln!("rinscope live: {} {} — edit it, or move the sliders", if created { "wrote" } else { "using your edited" }, path.display());
+            errln!("rinscope live: {} {} — edit it, or move the sliders", if created { "wrote" } else { "using your edited" }, path.display());
             path
         }
     };
@@ -123,12 +122,12 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
         None => None,
     };
     for d in viewer_sinks.iter().chain(file_sinks.iter()).flat_map(|s| &s.description) {
-        eprintln!("rinscope live: {d}");
+        errln!("rinscope live: {d}");
     }
     let panel = !args.no_panel && std::io::stdout().is_terminal() && std::io::stdin().is_terminal();
     let stop = stop_flag();
     if !panel {
-        eprintln!("rinscope live: running; edit {} to change parameters, Ctrl-C to stop", path.display());
+        errln!("rinscope live: running; edit {} to change parameters, Ctrl-C to stop", path.display());
     }
     let options = live::LiveOptions { config_path: path, speed: args.speed, duration_s: args.duration_s, panel, log_to_stderr: true };
     let outputs = live::Outputs { viewer: viewer_sinks.as_ref().map(sink::OpenSinks::stream), file: file_sinks.as_ref().map(sink::OpenSinks::stream) };
@@ -164,7 +163,7 @@ pub(super) fn modulation(args: &ModulationArgs) -> Result<(), Failure> {
     let sinks = open_sinks(args.sinks.request(default_recording("rotation-modulation"))?, "rotation-modulation")?;
     let stop = stop_flag();
     let started = std::time::Instant::now();
-    eprintln!("rinscope: simulating {hours} h three times in parallel (no rotation, continuous azimuth, 16-position)...");
+    errln!("rinscope: simulating {hours} h three times in parallel (no rotation, continuous azimuth, 16-position)...");
     let traces = match modulation::simulate_variants(hours, &stop) {
         Ok(t) => t,
         Err(e) => {
@@ -208,7 +207,7 @@ pub(super) fn default_recording(name: &str) -> PathBuf {
 pub(super) fn open_sinks(request: SinkRequest, recording_id: &str) -> Result<sink::OpenSinks, Failure> {
     let sinks = sink::open(&request, APPLICATION_ID, recording_id)?;
     for d in &sinks.description {
-        eprintln!("rinscope: {d}");
+        errln!("rinscope: {d}");
     }
     Ok(sinks)
 }
@@ -216,7 +215,7 @@ pub(super) fn open_sinks(request: SinkRequest, recording_id: &str) -> Result<sin
 /// Writes `value` as pretty JSON to the file given with `flag`, atomically.
 pub(super) fn write_json(flag: &str, path: &std::path::Path, value: &impl serde::Serialize) -> Result<(), Failure> {
     let json = serde_json::to_string_pretty(value).map_err(|e| Failure::run(e.to_string()))?;
-    write_atomically(path, json.as_bytes()).map_err(|e| Failure::input(format!("{flag} {e}")))
+    write_atomically(path, json.as_bytes()).map_err(|e| Failure::output(flag, &e))
 }
 
 /// The line that tells where a saved recording is and how to open it; an error if the only
@@ -271,11 +270,7 @@ pub(super) fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
             if let Some(s) = sinks {
                 s.abandon();
             }
-            return Err(match e {
-                CalibError::Interrupted => Failure::interrupted("calibrate did not finish; nothing was estimated and no recording was made"),
-                CalibError::VehicleMoves(_) => Failure::input(format!("calibrate: {e}")),
-                e => Failure::run(format!("calibrate: {e}")),
-            });
+            return Err(Failure::calibration("calibrate", e, "calibrate did not finish; nothing was estimated and no recording was made"));
         }
     };
     let wall = started.elapsed().as_secs_f64();
@@ -337,7 +332,7 @@ pub(super) fn montecarlo(args: &MonteCarloArgs) -> Result<(), Failure> {
     let started = std::time::Instant::now();
     let result = monte_carlo_runs(&params, runs, shard, &tick, &stop);
     bar.finish_and_clear();
-    let done = result.map_err(|e| Failure::run(format!("montecarlo: {e}")))?;
+    let done = result.map_err(|e| Failure::calibration("montecarlo", e, "montecarlo did not finish"))?;
     let summary = montecarlo::summarize(&monte_carlo_setup(&params), runs, &done, started.elapsed().as_secs_f64());
     if shard != Shard::WHOLE {
         outln!("shard {}/{}: {} of the {runs} runs (i mod {} == {})", shard.index, shard.count, mine, shard.count, shard.index);
@@ -383,14 +378,19 @@ fn montecarlo_merge(files: &[PathBuf], source: &ScenarioSource, eta_measured_sig
     Ok(())
 }
 
-/// Reads a text file of at most 1 GB (a FIFO or a device is refused).
+/// Reads a text file of at most 1 GB (opened by the rule for every input: a FIFO or a device is
+/// refused at once).
 pub(super) fn read_small_file(path: &Path, what: &str) -> Result<String, Failure> {
-    let meta = std::fs::metadata(path).map_err(|e| Failure::input(format!("{what} {}: {e}", path.display())))?;
-    if !meta.is_file() || meta.len() > 1 << 30 {
-        return Err(Failure::input(format!("{what} {}: not a regular file of at most 1 GB", path.display())));
+    use std::io::Read as _;
+    let fail = |e: std::io::Error| Failure::input(format!("{what} {}: {e}", path.display()));
+    let file = crate::io::files::open_input(path).map_err(fail)?;
+    let len = file.metadata().map_err(fail)?.len();
+    if len > 1 << 30 {
+        return Err(Failure::input(format!("{what} {}: {len} bytes, more than the 1 GB such a file can be", path.display())));
     }
-    crate::io::files::note_input(path);
-    std::fs::read_to_string(path).map_err(|e| Failure::input(format!("{what} {}: {e}", path.display())))
+    let mut text = String::new();
+    file.take((1 << 30) + 1).read_to_string(&mut text).map_err(fail)?;
+    Ok(text)
 }
 
 /// `rinscope tpr`.
@@ -400,7 +400,7 @@ pub(super) fn tpr(args: &TprArgs) -> Result<(), Failure> {
     tpr::check(&params).map_err(|e| Failure::input(format!("tpr: {e}")))?;
     let sinks = open_sinks(args.sinks.request(default_recording(&params.meta.name))?, &format!("{}-seed{}", params.meta.name, params.meta.seed))?;
     let stop = stop_flag();
-    eprintln!("rinscope: navigating {:.1} h (forking at the second fix)...", params.duration_s / 3600.0);
+    errln!("rinscope: navigating {:.1} h (forking at the second fix)...", params.duration_s / 3600.0);
     let result = match tpr::compare_resets(&params, 60.0, &stop) {
         Ok(r) => r,
         Err(e) => {
@@ -423,7 +423,7 @@ pub(super) fn tpr(args: &TprArgs) -> Result<(), Failure> {
         return Err(Failure::interrupted("the recording holds what was simulated until then"));
     }
     if let Some(n) = args.seeds {
-        eprintln!("rinscope: {n} seeds from {} in parallel...", params.meta.seed);
+        errln!("rinscope: {n} seeds from {} in parallel...", params.meta.seed);
         let started = std::time::Instant::now();
         let rows = tpr::sweep(&params, n, &stop).map_err(|e| Failure::input(format!("tpr: {e}")))?;
         if stop.load(Ordering::SeqCst) {
@@ -482,7 +482,7 @@ pub(super) fn reproduce(markdown: Option<&Path>) -> Result<(), Failure> {
     let table = reproduce::run_all()?;
     out!("{}", table.text());
     if let Some(path) = markdown {
-        write_atomically(path, table.markdown().as_bytes()).map_err(|e| Failure::input(format!("--markdown {e}")))?;
+        write_atomically(path, table.markdown().as_bytes()).map_err(|e| Failure::output("--markdown", &e))?;
     }
     if table.all_agree() {
         Ok(())

@@ -14,7 +14,10 @@ use crate::scenario::presets;
 
 impl From<crate::app::playback::PlaybackError> for Failure {
     fn from(e: crate::app::playback::PlaybackError) -> Self {
-        Self::input(format!("replay: {e}"))
+        match e {
+            crate::app::playback::PlaybackError::Record(_) => Self::run(format!("replay: {e}")),
+            _ => Self::input(format!("replay: {e}")),
+        }
     }
 }
 
@@ -25,6 +28,7 @@ pub(super) fn export_log(args: &ExportLogArgs) -> Result<(), Failure> {
     let stop = stop_flag();
     let written = write_log_set(&params, &args.out, format, args.no_initial_attitude, &stop).map_err(|e| match e {
         crate::app::export_log::ExportError::Interrupted => Failure::interrupted(format!("export-log: {e}")),
+        crate::app::export_log::ExportError::Write(_) => Failure::run(format!("export-log: {e}")),
         other => Failure::input(format!("export-log: {other}")),
     })?;
     outln!(
@@ -200,7 +204,7 @@ pub(super) fn calibrate_log(args: &CalibrateArgs, dir: &Path) -> Result<(), Fail
     let started = std::time::Instant::now();
     let (cal, report, data, traces) = calibration::calibrate_log(&log, !args.no_recording, &stop).map_err(|e| match e {
         LogCalibrationError::Interrupted => Failure::interrupted("calibrate --log did not finish; nothing was estimated"),
-        LogCalibrationError::Calibration(c) => Failure::run(format!("calibrate --log: {c}")),
+        LogCalibrationError::Calibration(c) => Failure::calibration("calibrate --log", c, "calibrate --log did not finish; nothing was estimated"),
         other => Failure::input(format!("calibrate --log: {other}")),
     })?;
     out!("{}", report.text());

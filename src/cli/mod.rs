@@ -10,9 +10,18 @@
 //! rinscope scenarios | check-config FILE | reproduce | bench
 //! ```
 //!
-//! Exit codes: 0 success, 1 a failure while running (or a reproduction outside tolerance),
-//! 2 bad input (config, path, viewer), 128 + the signal when stopped by SIGINT (130), SIGTERM (143)
-//! or SIGHUP (129): what was simulated is saved, and the command says it was cut short.
+//! Exit codes, one policy for every command (docs/reliability.md):
+//!
+//! * 0 — success.
+//! * 1 — the run failed though its input was good: an output could not be written (disk full,
+//!   permission, a recording that did not verify), a viewer failed and nothing kept the data,
+//!   `reproduce` outside its tolerance.
+//! * 2 — bad input, refused with one message naming it: arguments, a configuration, a log set's
+//!   manifest or data (a value that is not a number, too few samples, data an estimator cannot
+//!   use), an input that is not a regular file, an output path that cannot be used, a viewer that
+//!   cannot be reached.
+//! * 128 + the signal when stopped by SIGINT (130), SIGTERM (143) or SIGHUP (129): what was
+//!   simulated is saved, and the command says it was cut short; 141 when stdout's reader went away.
 
 mod allan;
 mod commands;
@@ -438,19 +447,20 @@ struct TprArgs {
     seeds: Option<u64>,
 }
 
-/// A failure with the exit code it deserves.
+/// A failure with the exit code it deserves (the policy in the module docs): every command maps
+/// its errors through these constructors, never through a code of its own.
 struct Failure {
     code: u8,
     message: String,
 }
 
 impl Failure {
-    /// Bad input (exit 2).
+    /// Bad input (exit 2): arguments, configuration, a log set's files or data.
     fn input(message: impl Into<String>) -> Self {
         Self { code: 2, message: message.into() }
     }
 
-    /// A failure while running (exit 1).
+    /// The run failed though its input was good (exit 1): an output, a viewer, a disagreement.
     fn run(message: impl Into<String>) -> Self {
         Self { code: 1, message: message.into() }
     }
@@ -459,6 +469,27 @@ impl Failure {
     fn interrupted(message: impl Into<String>) -> Self {
         let by = crate::app::terminate::stop_reason().unwrap_or("a stop request");
         Self { code: crate::app::terminate::interrupted_exit_code(), message: format!("interrupted by {by}: {}", message.into()) }
+    }
+
+    /// An output file `flag` names that could not be written: exit 1 when writing failed (disk
+    /// full, permission), 2 when the path itself cannot be used (a directory, a symlinked partial,
+    /// an input of the run, another run writing it).
+    fn output(flag: &str, e: &crate::io::files::OutputError) -> Self {
+        let message = format!("{flag} {e}");
+        match e {
+            crate::io::files::OutputError::Io { .. } => Self::run(message),
+            _ => Self::input(message),
+        }
+    }
+
+    /// A calibration that did not end (`calibrate`, `calibrate --log`, `montecarlo`): cut short by a
+    /// signal, or refused because of its input — a table without axes, data the estimators cannot
+    /// use (singular normal equations), a log set's unreadable or bad data.
+    fn calibration(command: &str, e: crate::calib::CalibError, interrupted: &str) -> Self {
+        match e {
+            crate::calib::CalibError::Interrupted => Self::interrupted(interrupted),
+            e => Self::input(format!("{command}: {e}")),
+        }
     }
 }
 
@@ -471,7 +502,7 @@ impl From<ConfigError> for Failure {
 impl From<SinkError> for Failure {
     fn from(e: SinkError) -> Self {
         let code = match e {
-            SinkError::Rerun(_) | SinkError::Spawn(_) | SinkError::Write(_) => 1,
+            SinkError::Rerun(_) | SinkError::Spawn(_) | SinkError::Write(_) | SinkError::ExportWrite(_) => 1,
             _ => 2,
         };
         Self { code, message: e.to_string() }
@@ -511,7 +542,7 @@ pub fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(f) => {
-            eprintln!("rinscope: {}", f.message);
+            errln!("rinscope: {}", f.message);
             ExitCode::from(f.code)
         }
     }

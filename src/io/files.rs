@@ -1,4 +1,10 @@
-//! Every output file goes through here: written to `PATH.partial` and renamed onto `PATH` only
+//! Every file a run reads or writes goes through here.
+//!
+//! Inputs (a scenario, a log set's manifest, table description and data files, a calibration, a
+//! shard file, a recording) are opened by [`open_input`] only: without blocking, and refused at
+//! once unless they are regular files, so a FIFO, a device or a directory never hangs a command.
+//!
+//! Outputs are written to `PATH.partial` and renamed onto `PATH` only
 //! when complete, so a failed, interrupted or concurrent run never leaves a half-written file
 //! under the final name and never replaces a good one.
 //!
@@ -65,6 +71,45 @@ pub enum OutputError {
         /// The OS error.
         source: std::io::Error,
     },
+}
+
+/// Opens a file this run reads: the one rule for every input a user names.
+///
+/// The file is opened with `O_NONBLOCK` (a FIFO without a writer would otherwise block `open` for
+/// ever, beyond the reach of any signal's polite stop) and `O_NOCTTY`, then checked on the open
+/// handle, so a path swapped between a check and the open cannot slip through: anything but a
+/// regular file (a FIFO, a device such as `/dev/zero` that never ends, a directory, a socket) is
+/// refused with an error that says what it is. `O_NONBLOCK` has no effect on a regular file's
+/// reads (open(2)), so the handle reads as usual. The path is noted as an input ([`note_input`]):
+/// no output of the same run may replace it.
+///
+/// # Errors
+/// The OS error of the open (no such file, permission denied, ...), or
+/// [`std::io::ErrorKind::InvalidInput`] for what is not a regular file. The message does not
+/// name the path: the caller's error does.
+pub fn open_input(path: &Path) -> std::io::Result<File> {
+    use std::os::unix::fs::FileTypeExt as _;
+    let file = OpenOptions::new().read(true).custom_flags(libc::O_NONBLOCK | libc::O_NOCTTY | libc::O_CLOEXEC).open(path)?;
+    let kind = file.metadata()?.file_type();
+    if !kind.is_file() {
+        let what = if kind.is_fifo() {
+            "a FIFO (named pipe)"
+        } else if kind.is_dir() {
+            "a directory"
+        } else if kind.is_char_device() || kind.is_block_device() {
+            "a device"
+        } else if kind.is_socket() {
+            "a socket"
+        } else {
+            "not a file"
+        };
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!("not a regular file but {what}; give a file (an input is never read from a pipe, a device or a directory)"),
+        ));
+    }
+    note_input(path);
+    Ok(file)
 }
 
 /// The files this process reads (canonical paths), so that no output replaces one of them.
@@ -155,6 +200,47 @@ pub fn remove_unfinished() {
             std::fs::remove_file(&p).ok();
         }
     }
+}
+
+/// Makes the partial folder of the folder `path` (`PATH.partial/`, e.g. a log set being exported)
+/// for this run, locked (`flock` on the folder) for as long as the returned handle is open: rename
+/// it onto `PATH` while holding it. A partial folder left by a run that died (its lock is free) is
+/// emptied and taken over, so a crash never blocks the next run; one that another run is writing
+/// is refused at once ([`OutputError::Busy`]); a symlink or a file at that name is refused.
+///
+/// # Errors
+/// See [`OutputError`].
+pub fn create_partial_dir(path: &Path) -> Result<File, OutputError> {
+    let partial = partial_path(path);
+    let io = |action, source| OutputError::Io { path: partial.clone(), action, source };
+    let fresh = match std::fs::create_dir(&partial) {
+        Ok(()) => true,
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => false,
+        Err(e) => return Err(io("create", e)),
+    };
+    let dir = OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_DIRECTORY | libc::O_NOFOLLOW | libc::O_CLOEXEC)
+        .open(&partial)
+        .map_err(|e| match e.raw_os_error() {
+            Some(libc::ELOOP) => OutputError::NotAFile { partial: partial.clone(), problem: "is a symlink" },
+            Some(libc::ENOTDIR) => OutputError::NotAFile { partial: partial.clone(), problem: "is not a folder" },
+            _ => io("open", e),
+        })?;
+    match dir.try_lock() {
+        Ok(()) => {}
+        Err(std::fs::TryLockError::WouldBlock) => return Err(OutputError::Busy { path: path.to_path_buf(), partial }),
+        Err(std::fs::TryLockError::Error(e)) => return Err(io("lock", e)),
+    }
+    if !fresh {
+        // Left by a run that died: ours now, started afresh.
+        for entry in std::fs::read_dir(&partial).map_err(|e| io("empty", e))? {
+            let p = entry.map_err(|e| io("empty", e))?.path();
+            let removed = if p.is_dir() && !p.is_symlink() { std::fs::remove_dir_all(&p) } else { std::fs::remove_file(&p) };
+            removed.map_err(|e| io("empty", e))?;
+        }
+    }
+    Ok(dir)
 }
 
 /// An output being written: `PATH.partial`, locked; [`PartialFile::commit`] makes it `PATH`.
@@ -333,6 +419,51 @@ mod tests {
         assert!(matches!(check_output_path(Path::new("new/")), Err(OutputError::IsDirectory(_))));
         assert!(matches!(check_output_path(&d.join("missing/x.json")), Err(OutputError::NoDirectory { .. })));
         assert!(check_output_path(&d.join("x.json")).is_ok());
+    }
+
+    #[test]
+    fn a_partial_folder_is_locked_and_a_dead_runs_one_is_taken_over() {
+        let d = scratch("dir");
+        let out = d.join("logset");
+        let partial = partial_path(&out);
+        // A folder a killed export left, with a file in it: taken over, emptied.
+        std::fs::create_dir(&partial).expect("stale");
+        std::fs::write(partial.join("imu.csv"), "half").expect("stale file");
+        let held = create_partial_dir(&out).expect("a dead run's folder is taken over");
+        assert_eq!(std::fs::read_dir(&partial).expect("dir").count(), 0, "started afresh");
+        // While held, a second writer is refused.
+        let e = create_partial_dir(&out).expect_err("second writer");
+        assert!(matches!(e, OutputError::Busy { .. }), "{e}");
+        drop(held);
+        assert!(create_partial_dir(&out).is_ok(), "free again once the first lets go");
+        // A symlink at the partial's name is not followed.
+        let other = d.join("other");
+        std::fs::create_dir(&other).expect("victim dir");
+        std::fs::write(other.join("keep"), "precious").expect("victim");
+        std::os::unix::fs::symlink(&other, partial_path(&d.join("x"))).expect("symlink");
+        let e = create_partial_dir(&d.join("x")).expect_err("symlink");
+        assert!(matches!(e, OutputError::NotAFile { .. }), "{e}");
+        assert!(other.join("keep").exists());
+    }
+
+    #[test]
+    fn inputs_that_are_not_regular_files_are_refused_at_once() {
+        let d = scratch("inputs");
+        let fifo = d.join("imu.csv");
+        let status = std::process::Command::new("mkfifo").arg(&fifo).status().expect("mkfifo (coreutils) runs");
+        assert!(status.success(), "mkfifo {}", fifo.display());
+        // No writer: a blocking open would never return.
+        for (p, what) in [(fifo.as_path(), "FIFO"), (Path::new("/dev/zero"), "device"), (d.as_path(), "directory")] {
+            let e = open_input(p).expect_err("refused");
+            assert_eq!(e.kind(), std::io::ErrorKind::InvalidInput, "{}", p.display());
+            assert!(e.to_string().contains("not a regular file") && e.to_string().contains(what), "{e}");
+        }
+        let file = d.join("ok.csv");
+        std::fs::write(&file, "t_s\n0\n").expect("file");
+        let mut text = String::new();
+        std::io::Read::read_to_string(&mut open_input(&file).expect("a regular file opens"), &mut text).expect("reads");
+        assert_eq!(text, "t_s\n0\n");
+        assert_eq!(open_input(&d.join("missing")).expect_err("missing").kind(), std::io::ErrorKind::NotFound);
     }
 
     #[test]

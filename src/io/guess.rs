@@ -62,7 +62,7 @@ fn layout_error(path: &Path, why: String) -> LogError {
 }
 
 fn read_head(path: &Path) -> Result<String> {
-    let file = std::fs::File::open(path).map_err(|e| LogError::io(path, "cannot open", e))?;
+    let file = crate::io::files::open_input(path).map_err(|e| LogError::io(path, "cannot open", e))?;
     let mut buf = Vec::new();
     file.take(HEAD_BYTES).read_to_end(&mut buf).map_err(|e| LogError::io(path, "cannot read", e))?;
     // The last line may be cut by the byte limit: drop it unless the file ended.

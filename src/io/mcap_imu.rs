@@ -331,8 +331,7 @@ pub(crate) struct McapImuSource {
 
 impl McapImuSource {
     pub(crate) fn open(path: &Path, topic: Option<&str>) -> Result<Self> {
-        let mut file = File::open(path).map_err(|e| LogError::io(path, "cannot open", e))?;
-        crate::io::files::note_input(path);
+        let mut file = crate::io::files::open_input(path).map_err(|e| LogError::io(path, "cannot open", e))?;
         let channels = match summary_channels(path, &mut file) {
             Ok(Some(c)) => c,
             // No (usable) summary: a recording cut short, or written without one.

@@ -347,8 +347,7 @@ pub(crate) struct NpySource {
 
 impl NpySource {
     pub(crate) fn open(path: &Path) -> Result<Self> {
-        let mut file = File::open(path).map_err(|e| LogError::io(path, "cannot open", e))?;
-        crate::io::files::note_input(path);
+        let mut file = crate::io::files::open_input(path).map_err(|e| LogError::io(path, "cannot open", e))?;
         let len = file
             .metadata()
             .map_err(|e| LogError::io(path, "cannot read", e))?

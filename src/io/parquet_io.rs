@@ -134,8 +134,7 @@ pub(crate) struct ParquetSource {
 
 impl ParquetSource {
     pub(crate) fn open(path: &Path) -> Result<Self> {
-        let file = File::open(path).map_err(|e| LogError::io(path, "cannot open", e))?;
-        crate::io::files::note_input(path);
+        let file = crate::io::files::open_input(path).map_err(|e| LogError::io(path, "cannot open", e))?;
         let metadata = ArrowReaderMetadata::load(
             &file,
             ArrowReaderOptions::new().with_skip_arrow_metadata(true),

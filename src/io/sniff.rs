@@ -120,7 +120,7 @@ fn classify(head: &[u8]) -> (Option<Format>, String) {
 /// [`LogError::Io`] if the file cannot be read, [`LogError::NotTheFormat`] if the content does not
 /// match the extension (a CSV named `.npy`, a truncated Parquet without its `PAR1` footer, ...).
 pub fn detect_format(path: &Path) -> Result<Format> {
-    let mut file = std::fs::File::open(path).map_err(|e| LogError::io(path, "cannot open", e))?;
+    let mut file = crate::io::files::open_input(path).map_err(|e| LogError::io(path, "cannot open", e))?;
     let mut head = Vec::with_capacity(512);
     (&mut file)
         .take(512)

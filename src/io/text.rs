@@ -47,8 +47,7 @@ pub(crate) struct LineReader {
 
 impl LineReader {
     pub(crate) fn open(path: &Path) -> Result<Self> {
-        let file = File::open(path).map_err(|e| LogError::io(path, "cannot open", e))?;
-        crate::io::files::note_input(path);
+        let file = crate::io::files::open_input(path).map_err(|e| LogError::io(path, "cannot open", e))?;
         Ok(Self {
             path: path.to_path_buf(),
             reader: BufReader::with_capacity(1 << 16, file),

@@ -26,7 +26,7 @@ pub struct Event {
 
 /// The `events` entries of the recording at `path`, in time order.
 pub fn events(path: &Path) -> anyhow::Result<Vec<Event>> {
-    let file = std::fs::File::open(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let file = crate::io::files::open_input(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let decoder = DecoderApp::decode_eager(BufReader::new(file)).map_err(|e| anyhow::anyhow!("{}: not a readable .rrd: {e}", path.display()))?;
     let text_component = rerun::TextLog::descriptor_text().component;
     let level_component = rerun::TextLog::descriptor_level().component;
@@ -77,7 +77,7 @@ impl Contents {
 /// What the recording at `path` holds (see [`Contents`]).
 pub fn contents(path: &Path) -> anyhow::Result<Contents> {
     use rerun::external::re_sdk_types::blueprint::{archetypes::ViewBlueprint, components::ViewOrigin};
-    let file = std::fs::File::open(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let file = crate::io::files::open_input(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let decoder = DecoderApp::decode_eager(BufReader::new(file)).map_err(|e| anyhow::anyhow!("{}: not a readable .rrd: {e}", path.display()))?;
     let origin_component = ViewBlueprint::descriptor_space_origin().component;
     let mut out = Contents::default();

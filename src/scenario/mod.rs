@@ -224,23 +224,17 @@ impl Params {
 /// Largest configuration file read, bytes: a scenario is a few kB; anything this big is not one.
 const MAX_CONFIG_BYTES: u64 = 16 << 20;
 
-/// Reads a configuration file: a regular file of at most [`MAX_CONFIG_BYTES`] (a FIFO, a device
-/// or `/dev/zero` would block or never end).
+/// Reads a configuration file (a scenario, a log set's manifest or table description): a regular
+/// file ([`crate::io::files::open_input`], the rule for every input) of at most
+/// [`MAX_CONFIG_BYTES`].
 pub fn read_text(path: &Path) -> Result<String, ConfigError> {
     use std::io::Read as _;
-    use std::os::unix::fs::OpenOptionsExt as _;
     let err = |source: std::io::Error| ConfigError::Read { path: path.display().to_string(), source };
-    // Opened without blocking (a FIFO without a writer would wait for ever) and checked on the
-    // handle, so a path swapped for a FIFO between a check and the read cannot block either.
-    let file = std::fs::OpenOptions::new().read(true).custom_flags(libc::O_NONBLOCK).open(path).map_err(err)?;
+    let file = crate::io::files::open_input(path).map_err(err)?;
     let meta = file.metadata().map_err(err)?;
-    if !meta.is_file() {
-        return Err(err(std::io::Error::other("not a regular file (a directory, FIFO or device is not a configuration)")));
-    }
     if meta.len() > MAX_CONFIG_BYTES {
         return Err(err(std::io::Error::other(format!("{} bytes: larger than any configuration ({} MB at most)", meta.len(), MAX_CONFIG_BYTES >> 20))));
     }
-    crate::io::files::note_input(path);
     let mut text = String::new();
     file.take(MAX_CONFIG_BYTES + 1).read_to_string(&mut text).map_err(err)?;
     Ok(text)

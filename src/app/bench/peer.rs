@@ -180,7 +180,7 @@ fn check_python(python: &Path) -> anyhow::Result<()> {
         bail!("{} has no pyins: install it with `{} -m pip install python-ins==1.0.1` (assets/bench/pyins/requirements-lock.txt has the versions measured)", python.display(), python.display());
     }
     if version != "1.0.1" {
-        eprintln!("note: {} has python-ins {version}; the numbers in docs/benchmarks.md are for 1.0.1", python.display());
+        errln!("note: {} has python-ins {version}; the numbers in docs/benchmarks.md are for 1.0.1", python.display());
     }
     Ok(())
 }
@@ -213,7 +213,7 @@ fn compare_stream(opts: &PeerOptions, dir: &Path, kind: &str, stop: &std::sync::
     };
     for round in 0..opts.rounds {
         check(stop)?;
-        eprintln!("peer pyins: {kind} stream, round {} of {}", round + 1, opts.rounds);
+        errln!("peer pyins: {kind} stream, round {} of {}", round + 1, opts.rounds);
         let (r, state) = run_rinscope(&logs)?;
         let (k, kstate) = run_pyins(&opts.python, &args_pyins("kernel"))?;
         let (p, _) = run_pyins(&opts.python, &args_pyins("pipeline"))?;

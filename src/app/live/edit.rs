@@ -119,7 +119,7 @@ pub fn set_in_text(text: &str, key: &KeyPath, value: Value) -> Result<String, St
 /// Sets `key` to `value` in the file at `path`, atomically.
 pub fn set_in_file(path: &Path, key: &KeyPath, value: Value) -> Result<(), EditError> {
     let shown = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| EditError::Io { path: shown.clone(), source })?;
+    let text = super::read_text(path).map_err(|source| EditError::Io { path: shown.clone(), source })?;
     let new = set_in_text(&text, key, value).map_err(|message| {
         if message.contains("TOML parse error") || message.contains("expected") {
             EditError::Syntax { path: shown.clone(), message }

@@ -103,7 +103,7 @@ pub fn sim_loop(mut sim: LiveSim, reloads: &Receiver<WatchEvent>, out: &Sender<R
     let mut pending: Option<WatchEvent> = None;
     let say = |text: String, level: &'static str, t_s: f64| {
         if log_to_stderr {
-            eprintln!("rinscope live: {text}");
+            errln!("rinscope live: {text}");
         }
         lock(status).message = text.clone();
         out.send(RecorderMsg::Event { t_s, text, level }).is_ok()
@@ -313,9 +313,13 @@ pub fn new_status(params: &Params, speed: f64) -> SharedStatus {
     }))
 }
 
-/// Reads the config text that the watcher will compare saves against.
+/// Reads the config text that the watcher will compare saves against (opened by the rule for
+/// every input, [`crate::io::files::open_input`]).
 pub fn read_text(path: &Path) -> std::io::Result<String> {
-    std::fs::read_to_string(path)
+    use std::io::Read as _;
+    let mut text = String::new();
+    crate::io::files::open_input(path)?.read_to_string(&mut text)?;
+    Ok(text)
 }
 
 /// How a live session runs.

@@ -35,6 +35,9 @@ pub enum PlaybackError {
     /// The data do not fit together (clocks, lengths, the vehicle moving during alignment...).
     #[error("{0}")]
     Data(String),
+    /// The replay's recording failed (not the data's fault: exit 1, not 2).
+    #[error("rerun: {0}")]
+    Record(String),
 }
 
 fn data_err(message: impl Into<String>) -> PlaybackError {

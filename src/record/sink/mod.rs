@@ -68,9 +68,12 @@ pub enum SinkError {
     /// Spawning the viewer failed.
     #[error("--spawn: {0}")]
     Spawn(String),
-    /// The export tables could not be written.
+    /// The export folder cannot be used.
     #[error("--export: {0}")]
     Export(String),
+    /// The export tables could not be written to the end (disk full, ...).
+    #[error("--export: {0}")]
+    ExportWrite(String),
     /// Any other Rerun SDK error.
     #[error("rerun: {0}")]
     Rerun(String),
@@ -175,7 +178,7 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
         let host = if ip.is_unspecified() { "127.0.0.1".to_owned() } else { ip.to_string() };
         let url = format!("rerun+http://{host}:{port}/proxy");
         if !ip.is_loopback() {
-            eprintln!("rinscope: WARNING: --bind {ip}: anyone who can reach port {port} of this machine can watch this session (there is no authentication)");
+            errln!("rinscope: WARNING: --bind {ip}: anyone who can reach port {port} of this machine can watch this session (there is no authentication)");
         }
         description.push(format!(
             "serving on {addr}: `rerun --connect {url}`, or in a browser https://app.rerun.io/version/0.36.3/index.html?url={}",
@@ -199,7 +202,7 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
         let server = config.host_web_viewer().map_err(|e| SinkError::Serve { addr: web_addr, reason: e.to_string() })?;
         let page = format!("http://{host}:{web_port}/?url={}", format!("rerun+http://{host}:{grpc_port}/proxy").replace(':', "%3A").replace('/', "%2F").replace('+', "%2B"));
         if !ip.is_loopback() {
-            eprintln!("rinscope: WARNING: --bind {ip}: anyone who can reach ports {web_port} and {grpc_port} of this machine can watch this session (there is no authentication)");
+            errln!("rinscope: WARNING: --bind {ip}: anyone who can reach ports {web_port} and {grpc_port} of this machine can watch this session (there is no authentication)");
         }
         description.push(format!("viewer in the browser: open {page}"));
         web = Some(WebServer { _server: Box::new(server), page });
@@ -283,13 +286,13 @@ impl OpenSinks {
         };
         let exported = match export {
             None => Vec::new(),
-            Some(e) => e.lock().unwrap_or_else(std::sync::PoisonError::into_inner).finish().map_err(|e| SinkError::Export(e.to_string()))?,
+            Some(e) => e.lock().unwrap_or_else(std::sync::PoisonError::into_inner).finish().map_err(|e| SinkError::ExportWrite(e.to_string()))?,
         };
         let viewer_problems = viewer_problems.lock().unwrap_or_else(std::sync::PoisonError::into_inner).clone();
         // A browser may still be reading: the page and the stream (held by `rec`) serve until the
         // stop flag (Ctrl-C) is set.
         if let (Some(w), Some(stop)) = (web, stop) {
-            eprintln!("rinscope: the run is complete; its viewer stays at {} until Ctrl-C", w.page);
+            errln!("rinscope: the run is complete; its viewer stays at {} until Ctrl-C", w.page);
             while !stop.load(std::sync::atomic::Ordering::SeqCst) {
                 std::thread::sleep(Duration::from_millis(100));
             }

@@ -76,7 +76,7 @@ impl Detachable {
         }
         let rest = if self.file_kept { "the saved file goes on" } else { "nothing else keeps this run's data: use --save FILE" };
         let message = format!("{}: {why}; streaming to it stopped ({rest})", self.name);
-        eprintln!("rinscope: {message}");
+        errln!("rinscope: {message}");
         self.problems.lock().unwrap_or_else(std::sync::PoisonError::into_inner).push(message);
     }
 

@@ -289,7 +289,7 @@ fn validate_manifest_for(dir: &Path, raw: &RawManifest, origin: &str, raw_table:
     let encoders = match &raw.encoders {
         None => None,
         Some(e) => Some(EncoderFile {
-            path: dir.join(&e.file),
+            path: readable(&c, "encoders.file", &dir.join(&e.file))?,
             latch_delay_s: c.range("encoders.latch_delay_ms", e.latch_delay_ms, "ms", -1000.0, 1000.0, "")? * 1e-3,
             interpolate_gaps: match e.gap_policy.as_str() {
                 "interpolate" => true,
@@ -301,7 +301,7 @@ fn validate_manifest_for(dir: &Path, raw: &RawManifest, origin: &str, raw_table:
     let reference = match &raw.reference {
         None => Reference::None,
         Some(r) => match (&r.file, r.attitude_deg) {
-            (Some(f), None) => Reference::File(dir.join(f)),
+            (Some(f), None) => Reference::File(readable(&c, "reference.file", &dir.join(f))?),
             (None, Some(a)) => Reference::Static(attitude(&c, "reference.attitude_deg", a)?),
             _ => return Err(c.invalid("reference", "give either `file` or `attitude_deg`")),
         },
@@ -350,6 +350,15 @@ fn validate_manifest_for(dir: &Path, raw: &RawManifest, origin: &str, raw_table:
     })
 }
 
+/// `path` if it opens as an input ([`crate::io::files::open_input`]): a missing file, a FIFO, a
+/// device or a directory named by `key` is refused with the manifest, before anything runs.
+fn readable(c: &Checker<'_>, key: &str, path: &Path) -> Result<PathBuf, ConfigError> {
+    match crate::io::files::open_input(path) {
+        Ok(_) => Ok(path.to_path_buf()),
+        Err(e) => Err(c.invalid(key, format!("{}: {e}", path.display()))),
+    }
+}
+
 fn attitude(c: &Checker<'_>, key: &str, a: [f64; 3]) -> Result<Attitude, ConfigError> {
     Ok(Attitude {
         pitch_rad: c.range(&format!("{key}[0]"), a[0], "deg", -90.0, 90.0, "pitch")? * RAD_PER_DEG,
@@ -361,8 +370,9 @@ fn attitude(c: &Checker<'_>, key: &str, a: [f64; 3]) -> Result<Attitude, ConfigE
 fn imu_file(c: &Checker<'_>, dir: &Path, raw: &RawImuFile) -> Result<ImuFile, ConfigError> {
     let time = time_unit(c, "imu.time", raw.time.as_deref().unwrap_or("s"))?;
     let path = dir.join(&raw.file);
-    // No layout: the file's content tells it where that is unambiguous (an unreadable file is
-    // reported when read; an ambiguous one here, with the candidates).
+    readable(c, "imu.file", &path)?;
+    // No layout: the file's content tells it where that is unambiguous (an ambiguous one is
+    // refused here, with the candidates).
     let guessed = match raw.layout.as_str() {
         "" | "columns" if raw.columns.is_some() => "columns",
         "columns" => return Err(c.invalid("imu.layout", "\"columns\" needs the [imu.columns] table that describes them")),
@@ -533,7 +543,9 @@ mod tests {
         assert_eq!(layout("trj.txt", "psins-imu").ok(), Some(Layout::PsinsImu));
         assert_eq!(layout("trj.txt", "").ok(), Some(Layout::PsinsImu));
         assert_eq!(layout("imu.csv", "").ok(), Some(Layout::Rinscope));
-        assert_eq!(layout("missing.csv", "").ok(), Some(Layout::Rinscope));
+        // A file that is missing or not a regular file is refused with the manifest (issue 20).
+        let e = layout("missing.csv", "").expect_err("missing").to_string();
+        assert!(e.contains("imu.file") && e.contains("missing.csv"), "{e}");
         let e = layout("trj.txt", "psins-simu").expect_err("not a layout").to_string();
         assert!(e.contains("\"psins-imu\""), "{e}");
         // An absent key is the empty layout, and is not written back.
