@@ -163,7 +163,7 @@ fn a_declared_rate_the_stamps_contradict_is_refused_naming_both() {
     std::fs::write(dir.join("log.toml"), "[log]\nname = \"r\"\n[imu]\nfile = \"imu.csv\"\nrate_hz = 20.0\n[initial]\nposition = [34.0, 108.9, 380.0]\n").expect("manifest");
     let o = rinscope().arg("replay").arg(&dir).args(["--save"]).arg(dir.join("x.rrd")).output().expect("replay");
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(stderr(&o).contains("rate_hz = 20 Hz") && stderr(&o).contains("100.0000 Hz"), "{}", stderr(&o));
+    assert!(stderr(&o).contains("`imu.rate_hz`: 20 Hz is declared") && stderr(&o).contains("100.0000 Hz"), "{}", stderr(&o));
     assert!(!dir.join("x.rrd").exists());
     std::fs::remove_dir_all(&dir).ok();
 }

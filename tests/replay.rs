@@ -417,3 +417,158 @@ fn a_strapdown_replay_records_and_exports_the_ins_alone() {
     assert_eq!(names, expected[3..]);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Runs `command` (`replay`, `calibrate`, `allan`) on `log` expecting a refusal: exit 2 and one
+/// short message holding every `expected` fragment, nothing saved.
+fn refused_by(command: &str, log: &Path, expected: &[&str]) -> String {
+    let out = log.join("out.rrd");
+    let mut c = rinscope();
+    match command {
+        "calibrate" => c.args(["calibrate", "--no-recording", "--log"]).arg(log),
+        "allan" => c.args(["allan", "--no-recording"]).arg(log),
+        _ => c.arg("replay").arg(log).arg("--save").arg(&out),
+    };
+    let o = c.output().expect(command);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{command}: exit code; stderr: {err}");
+    let lines: Vec<&str> = err.lines().filter(|l| !l.starts_with("rinscope: saving to") && !l.starts_with("rinscope: reading")).collect();
+    // One message (a TOML error quotes its line under it), and a short one.
+    assert_eq!(lines.iter().filter(|l| l.starts_with("rinscope: ")).count(), 1, "{command}: one message: {err}");
+    let message = lines.join("\n");
+    assert!(message.len() < 1000, "{command}: a short message ({} bytes): {err}", message.len());
+    for e in expected {
+        assert!(err.contains(e), "{command}: stderr should mention `{e}`: {err}");
+    }
+    assert!(!out.exists() && !log.join("out.rrd.partial").exists(), "nothing written for refused input");
+    message
+}
+
+/// A copy of log set `base` whose file `name` is rewritten by rinscope's writer as `names`/`rows`.
+fn rewritten(base: &Path, dir: &Path, case: &str, name: &str, edit: &dyn Fn(&mut Vec<String>, &mut Vec<Vec<f64>>)) -> PathBuf {
+    let out = broken(base, dir, case, "log.toml", &|l| l);
+    // Read from the base: a file this process read is an input its writer refuses to replace.
+    let (source, path) = (base.join(name), out.join(name));
+    let probe = rinscope::io::ColumnReader::open(&source, &[], &rinscope::io::ReadOptions::default()).expect("probe");
+    let n = probe.all_columns().len();
+    let cols: Vec<rinscope::io::Col> = (0..n).map(rinscope::io::Col::Index).collect();
+    let mut reader = rinscope::io::ColumnReader::open(&source, &cols, &rinscope::io::ReadOptions::default()).expect("open");
+    let (mut names, mut rows): (Vec<String>, Vec<Vec<f64>>) = ((0..n).map(|i| format!("c{i}")).collect(), Vec::new());
+    let mut row = vec![0.0; n];
+    while reader.next_row(&mut row).expect("row") {
+        rows.push(row.clone());
+    }
+    drop(reader);
+    edit(&mut names, &mut rows);
+    std::fs::remove_file(&path).expect("remove");
+    let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+    let mut w = rinscope::io::TableWriter::create_keyed(&path, &refs).expect("writer");
+    for r in &rows {
+        w.write_row(r).expect("row");
+    }
+    w.finish().expect("finish");
+    out
+}
+
+#[test]
+fn trust_round_2_each_defect_is_refused_where_it_is() {
+    // Issue 20, items 3-9: what a hostile user's damaged log sets got through, each refused now by
+    // the reader that meets it, with one message naming the file, the row, the column and the value.
+    let dir = scratch("trust2");
+    let base = export(&dir, "jiang2017-calibration", "csv");
+    let set_cell = |line: usize, field: usize, value: &'static str| {
+        move |mut l: Vec<String>| {
+            let mut f: Vec<String> = l[line].split(',').map(String::from).collect();
+            f[field] = value.into();
+            l[line] = f.join(",");
+            l
+        }
+    };
+    // 6: one finite but absurd value turned the attitude into NaN (exit 0, NaN RMS, nulls).
+    let absurd = broken(&base, &dir, "absurd", "imu.csv", &set_cell(500, 2, "1e300"));
+    for command in ["replay", "calibrate", "allan"] {
+        refused_by(command, &absurd, &["imu.csv", "data row 500 (line 501)", "column dtheta_y_rad", "\"1e300\"", "gyro"]);
+    }
+    refused_by("replay", &broken(&base, &dir, "absurd-ref", "reference.csv", &set_cell(9000, 1, "-1e30")), &["reference.csv", "line 9001", "pitch_rad", "\"-1e30\""]);
+    // 3: the last line cut inside its last field, no line end.
+    let cut = broken(&base, &dir, "cut", "imu.csv", &|l| l);
+    let text = std::fs::read_to_string(cut.join("imu.csv")).expect("imu");
+    std::fs::write(cut.join("imu.csv"), &text[..text.len() - 4]).expect("cut");
+    refused_by("replay", &cut, &["imu.csv", "the last line has no line end", "truncated"]);
+    // 7: a first row that cannot be read is that row's error, not "no IMU samples".
+    let first = broken(&base, &dir, "first", "imu.csv", &|mut l| {
+        l[1] = "0.0,1e-7".into();
+        l
+    });
+    for command in ["replay", "calibrate", "allan"] {
+        let m = refused_by(command, &first, &["imu.csv", "data row 1 (line 2)", "2 fields"]);
+        assert!(!m.contains("no IMU samples"), "{m}");
+    }
+    // 8: damage after the IMU's last stamp in the encoder and reference files.
+    let tail = broken(&base, &dir, "tail-enc", "encoders.csv", &|mut l| {
+        l.push("1e3,0.1".into());
+        l
+    });
+    refused_by("replay", &tail, &["encoders.csv", "2 fields where the header has 3"]);
+    refused_by("calibrate", &tail, &["encoders.csv", "2 fields where the header has 3"]);
+    let garbage = broken(&base, &dir, "tail-ref", "log.toml", &|l| l);
+    let mut bytes = std::fs::read(garbage.join("reference.csv")).expect("reference");
+    bytes.extend([0x00, 0xff, 0x13, b'x', b'\n']);
+    std::fs::write(garbage.join("reference.csv"), bytes).expect("garbage");
+    refused_by("replay", &garbage, &["reference.csv", "data row 40003 (line 40004)", "1 fields where the header has 4"]);
+    // 9: the messages. NaN in an encoder file is not "an IMU log's"; a refused encoder gap has its row.
+    let m = refused_by("replay", &broken(&base, &dir, "nan-enc", "encoders.csv", &set_cell(300, 1, "NaN")), &["encoders.csv", "data row 300 (line 301)", "outer_rad", "NaN"]);
+    assert!(!m.contains("IMU log"), "{m}");
+    let gap = broken(&base, &dir, "enc-gap", "encoders.csv", &|mut l| {
+        l.drain(1000..1010);
+        l
+    });
+    refused_by("replay", &gap, &["encoders.csv", "data row 1000 (line 1001)", "a gap of 0.055000 s"]);
+    let edit_manifest = |case: &str, from: &str, to: &str| {
+        let log = broken(&base, &dir, case, "log.toml", &|l| l);
+        let text = std::fs::read_to_string(log.join("log.toml")).expect("manifest");
+        assert!(text.contains(from), "{from}");
+        std::fs::write(log.join("log.toml"), text.replacen(from, to, 1)).expect("manifest");
+        log
+    };
+    let m = refused_by("replay", &edit_manifest("kalibr", "layout = \"rinscope\"", "layout = \"kalibr\""), &["imu.csv", "rinscope columns", "use layout = \"rinscope\""]);
+    assert!(!m.contains("holds rates"), "{m}");
+    let m = refused_by("replay", &edit_manifest("frame", "frame = \"rfu\"", "frame = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]"), &["log.toml", "frame", "2 rows", "3×3 matrix"]);
+    assert!(!m.contains("untagged"), "{m}");
+    refused_by("replay", &edit_manifest("topic", "layout = \"rinscope\"", "layout = \"rinscope\"\ntopic = \"/imu\""), &["imu.topic", "ros2"]);
+    refused_by("replay", &edit_manifest("latch", "latch_delay_ms = 0.0", "latch_delay_ms = 1e300"), &["encoders.latch_delay_ms", "1e300 ms"]);
+    let nested = broken(&base, &dir, "nested", "log.toml", &|l| l);
+    let table = std::fs::read_to_string(nested.join("table.toml")).expect("table");
+    std::fs::write(nested.join("table.toml"), format!("{table}\nx = {}1{}\n", "[".repeat(100_000), "]".repeat(100_000))).expect("table");
+    refused_by("replay", &nested, &["table.toml"]);
+    // 5: a declared rate the stamps contradict, refused naming both — also by calibrate and allan,
+    // and 20 Hz (which made series_hz 25 Hz out of range) no longer blames series_hz.
+    for (case, rate) in [("rate20", "20.0"), ("rate210", "210.0")] {
+        let log = edit_manifest(case, "rate_hz = 200.0", &format!("rate_hz = {rate}"));
+        for command in ["replay", "calibrate", "allan"] {
+            let m = refused_by(command, &log, &["imu.rate_hz", "the time stamps of", "step by 0.005000 s = 200.0000 Hz"]);
+            assert!(!m.contains("series_hz"), "{m}");
+        }
+    }
+    // 4 and 5 on .npy: an array of the wrong width, an encoder or reference file of another width,
+    // the npy7 time unit the stamps contradict.
+    let npy = export(&dir, "jiang2017-calibration", "npy");
+    let wide = rewritten(&npy, &dir, "wide", "imu.npy", &|names, rows| {
+        names.push("c7".into());
+        rows.iter_mut().for_each(|r| r.push(0.0));
+    });
+    refused_by("replay", &wide, &["imu.npy", "(N, 8)", "7 columns"]);
+    refused_by("allan", &wide, &["imu.npy", "(N, 8)"]);
+    let as_encoders = broken(&npy, &dir, "npy-enc", "log.toml", &|l| l);
+    std::fs::copy(npy.join("imu.npy"), as_encoders.join("encoders.npy")).expect("copy");
+    refused_by("replay", &as_encoders, &["encoders.npy", "7 columns", "holds exactly 3"]);
+    let wide_ref = rewritten(&npy, &dir, "npy-ref", "reference.npy", &|names, rows| {
+        names.push("c4".into());
+        rows.iter_mut().for_each(|r| r.push(1.0));
+    });
+    refused_by("calibrate", &wide_ref, &["reference.npy", "5 columns", "holds exactly 4"]);
+    let ms = broken(&npy, &dir, "npy-ms", "log.toml", &|l| l.into_iter().map(|x| if x == "time = \"s\"" { "time = \"ms\"".to_owned() } else { x }).collect());
+    for command in ["replay", "calibrate", "allan"] {
+        refused_by(command, &ms, &["imu.rate_hz", "read in ms", "200000"]);
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -237,6 +237,7 @@ pub fn collect_from_log(log: &LogSet, known: &TableErrors, stop: &AtomicBool) ->
                 return Ok(());
             }
         }
+        pb.finish().map_err(|e| fail(e.into()))?;
         *found2.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = attitude;
         Ok(())
     };
@@ -284,6 +285,15 @@ pub enum LogCalibrationError {
 /// `calibrate --log`: seed 000's filter and the exact least squares on a log set, the compensation
 /// before/after on the same data (a log has no independent second run).
 pub fn calibrate_log(log: &LogSet, history: bool, stop: &AtomicBool) -> Result<(Calibration, Report, Data, ValidationTrace), LogCalibrationError> {
+    calibrate_log_files(log, history, stop).map_err(|e| match e {
+        // A pass over the log's files failed on their data (every pass reads them again when they
+        // do not fit in memory): the data's error, as `replay` gives it, not the estimators'.
+        LogCalibrationError::Calibration(CalibError::Data(message)) => LogCalibrationError::Playback(PlaybackError::Data(message)),
+        other => other,
+    })
+}
+
+fn calibrate_log_files(log: &LogSet, history: bool, stop: &AtomicBool) -> Result<(Calibration, Report, Data, ValidationTrace), LogCalibrationError> {
     let cfg = &log.table.calibration;
     let set = ParamSet::new(&log.table.chain, Nuisance::None);
     let known = set.without_estimated(&log.table.compensation);

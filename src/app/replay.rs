@@ -325,6 +325,9 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
             }
         }
     }
+    if !interrupted {
+        pb.finish()?;
+    }
     let reference = match &log.reference {
         Reference::None if log.table.strapdown => "none: the INS's own solution (give [reference] to compare it with one)".to_owned(),
         Reference::None => "none: the compensated demodulation (the \"nominal\" row is nominal − compensated)".to_owned(),

@@ -317,4 +317,43 @@ impl InsCore {
     pub fn sample_s(&self) -> f64 {
         self.h
     }
+
+    /// Whether every integrator's attitude and the navigation solution are finite numbers (what
+    /// a replay checks after each update: a result is finite or not given).
+    #[must_use]
+    pub fn is_finite(&self) -> bool {
+        let attitudes = self.history.iter().all(|h| h[1].1.quaternion().coords.iter().all(|x| x.is_finite()));
+        let nav = self.nav.as_ref().is_none_or(|n| {
+            let s = &n.state;
+            s.latitude_rad.is_finite() && s.longitude_rad.is_finite() && s.height_m.is_finite() && s.v_n.iter().all(|x| x.is_finite())
+        });
+        attitudes && nav
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_non_finite_sample_is_seen_at_the_next_update() {
+        // Issue 20: the replay's last line of defence (`is_finite` after each update) must see a
+        // NaN that got past the readers, in the attitude or in the navigation.
+        let cfg = InsParams::ideal(200.0, crate::ins::coning::Algorithm::TwoSampleP1);
+        let site = Site { latitude_rad: 0.6, longitude_rad: 1.9, height_m: 400.0 };
+        let mut core = InsCore::new(&cfg, site, Rot::identity(), &[]);
+        let (g, f) = (Vector3::new(1e-7, 0.0, 3e-7), Vector3::new(0.0, 0.0, 0.049));
+        let mut t = 0.0;
+        for _ in 0..10 {
+            t += 0.005;
+            core.push(t, g, f);
+        }
+        assert!(core.is_finite());
+        let mut updated = false;
+        for _ in 0..4 {
+            t += 0.005;
+            updated |= core.push(t, Vector3::new(f64::NAN, 0.0, 0.0), f).updated;
+        }
+        assert!(updated && !core.is_finite());
+    }
 }

@@ -122,7 +122,7 @@ pub enum LogError {
         value: String,
     },
     /// A NaN or infinite cell.
-    #[error("{}: {at}, column {column}: the value is {value} (NaN and infinity are not accepted in an IMU log)", .file.display())]
+    #[error("{}: {at}, column {column}: the value is {value} (a log's values must be finite numbers)", .file.display())]
     NonFinite {
         /// The file.
         file: PathBuf,
@@ -163,6 +163,15 @@ pub enum LogError {
         reference: &'static str,
         /// The short row is the file's last line and has no line end.
         truncated_last_line: bool,
+    },
+    /// The file's last data line has no line end: it was cut off (while being written?), perhaps
+    /// inside a number ("0.0316" → "0.0"), which no check of the value could see.
+    #[error("{}: {at}: the last line has no line end: the file looks truncated (cut off while being written?), perhaps inside its last number; if the line is complete, end the file with a line break", .file.display())]
+    TruncatedLine {
+        /// The file.
+        file: PathBuf,
+        /// Row and line.
+        at: Location,
     },
     /// A .npy with an element type we do not read.
     #[error("{}: the array's dtype is {dtype:?}; expected float64 ('<f8') or float32 ('<f4'), save with arr.astype(np.float64)", .file.display())]
@@ -237,7 +246,7 @@ pub enum LogError {
         t: String,
     },
     /// A gap larger than the allowed multiple of the nominal interval (policy Refuse).
-    #[error("{}: {at}: gap of {gap_s:.6} s ({multiple:.1} × the nominal {nominal_s:.6} s) between t = {t_before_s:.6} s and {t_after_s:.6} s (relative to the first sample); set gap_policy = \"split\" in the manifest's [imu] to carry the attitude across it", .file.display())]
+    #[error("{}: {at}: gap of {} s ({} × the nominal {} s) between t = {} s and {} s (relative to the first sample); set gap_policy = \"split\" in the manifest's [imu] to carry the attitude across it", .file.display(), fixed_number(*.gap_s, 6), fixed_number(*.multiple, 1), fixed_number(*.nominal_s, 6), fixed_number(*.t_before_s, 6), fixed_number(*.t_after_s, 6))]
     Gap {
         /// The file.
         file: PathBuf,
@@ -312,6 +321,7 @@ impl LogError {
             | Self::NonFinite { file, .. }
             | Self::BadValue { file, .. }
             | Self::FieldCount { file, .. }
+            | Self::TruncatedLine { file, .. }
             | Self::NpyDtype { file, .. }
             | Self::Shape { file, .. }
             | Self::ColumnType { file, .. }
@@ -341,6 +351,21 @@ impl LogError {
             detail: detail.into(),
         }
     }
+}
+
+/// A number as a message shows it: as Rust writes it for everyday sizes, in exponent form beyond
+/// them (`1e300`, never 301 digits).
+#[must_use]
+pub fn short_number(v: f64) -> String {
+    let a = v.abs();
+    if v == 0.0 || !v.is_finite() || (1e-4..1e9).contains(&a) { format!("{v}") } else { format!("{v:e}") }
+}
+
+/// A number with `decimals` fixed decimals where it is of an everyday size, else as
+/// [`short_number`] (`{:.6}` of 1e300 has 307 characters).
+#[must_use]
+pub fn fixed_number(v: f64, decimals: usize) -> String {
+    if v.is_finite() && v.abs() < 1e9 { format!("{v:.decimals$}") } else { short_number(v) }
 }
 
 /// Cuts a cell's text for an error message.

@@ -41,7 +41,8 @@ impl Frame {
             Self::Matrix(m) => {
                 let orthonormality_error = (m.transpose() * m - Matrix3::identity()).abs().max();
                 let determinant = m.determinant();
-                if orthonormality_error > 1e-6 || (determinant - 1.0).abs() > 1e-6 {
+                // Written so that a NaN anywhere fails too.
+                if !(m.iter().all(|x| x.is_finite()) && orthonormality_error <= 1e-6 && (determinant - 1.0).abs() <= 1e-6) {
                     return Err(FrameError::NotARotation {
                         orthonormality_error,
                         determinant,

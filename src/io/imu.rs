@@ -59,17 +59,18 @@
 //! first eight intervals) is an error ([`GapPolicy::Refuse`]) or an [`ImuEvent::Gap`]
 //! ([`GapPolicy::Split`]). NaN and infinite values are errors naming row and column.
 
+use crate::io::clock::{Clock, RawStamp};
+pub use crate::io::clock::{GPS_WEEK_S, StartTime, TimeUnit};
 use crate::io::error::{Location, LogError, Result};
 use crate::io::frames::Frame;
 use crate::io::layout::{plan_for, read_options};
 use crate::io::psins_imu::PsinsHeader;
 use crate::io::table::ColumnReader;
+use crate::io::validity::{Sensor, check_imu_value};
 use nalgebra::{Matrix3, Vector3};
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 
-/// Seconds in a GPS week.
-pub const GPS_WEEK_S: f64 = 604_800.0;
 const LOOKAHEAD: usize = 9;
 
 /// One IMU sample in SI units and the RFU frame.
@@ -90,49 +91,6 @@ pub enum SampleKind {
     Increments,
     /// Angular rate (rad/s) and specific force (m/s²).
     Rates,
-}
-
-/// The unit of a time column.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum TimeUnit {
-    /// Seconds.
-    Seconds,
-    /// Milliseconds.
-    Milliseconds,
-    /// Microseconds.
-    Microseconds,
-    /// Nanoseconds (integer stamps are kept exact).
-    Nanoseconds,
-    /// GPS seconds of week, with week rollover.
-    GpsSecondsOfWeek,
-}
-
-impl TimeUnit {
-    fn to_s(self) -> f64 {
-        match self {
-            Self::Seconds | Self::GpsSecondsOfWeek => 1.0,
-            Self::Milliseconds => 1e-3,
-            Self::Microseconds => 1e-6,
-            Self::Nanoseconds => 1e-9,
-        }
-    }
-    fn ns_per_unit(self) -> Option<i64> {
-        match self {
-            Self::Milliseconds => Some(1_000_000),
-            Self::Microseconds => Some(1_000),
-            Self::Nanoseconds => Some(1),
-            Self::Seconds | Self::GpsSecondsOfWeek => None,
-        }
-    }
-    fn symbol(self) -> &'static str {
-        match self {
-            Self::Seconds => "s",
-            Self::Milliseconds => "ms",
-            Self::Microseconds => "us",
-            Self::Nanoseconds => "ns",
-            Self::GpsSecondsOfWeek => "s of GPS week",
-        }
-    }
 }
 
 /// A file layout (see the module docs for each).
@@ -256,82 +214,12 @@ pub enum ImuEvent {
     },
 }
 
-/// The first time stamp of a stream, as written in the file.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum StartTime {
-    /// Seconds (or ms/us converted to s when not integers).
-    Seconds(f64),
-    /// Integer nanoseconds (exact).
-    Nanoseconds(i64),
-    /// GPS seconds of week.
-    GpsSecondsOfWeek(f64),
-}
-
-/// A time stamp as written (formatted only for an error message: the hot path stays free of
-/// allocation).
-#[derive(Debug, Clone, Copy)]
-struct RawStamp {
-    value: f64,
-    exact: Option<i64>,
-    unit: TimeUnit,
-}
-
-impl std::fmt::Display for RawStamp {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self.exact {
-            Some(int) => write!(f, "{int} {}", self.unit.symbol()),
-            None => write!(f, "{} {}", self.value, self.unit.symbol()),
-        }
-    }
-}
-
-/// Converts raw time stamps to seconds since the first, in order.
-struct Clock {
-    unit: TimeUnit,
-    first_ns: Option<i64>,
-    first: Option<f64>,
-    prev_sow: f64,
-    week_offset_s: f64,
-}
-
-impl Clock {
-    fn convert(&mut self, value: f64, exact: Option<i64>) -> (f64, RawStamp) {
-        if let (Some(per), Some(int)) = (self.unit.ns_per_unit(), exact)
-            && let Some(ns) = int.checked_mul(per)
-        {
-            let first = *self.first_ns.get_or_insert(ns);
-            self.first.get_or_insert(value);
-            let t = (i128::from(ns) - i128::from(first)) as f64 * 1e-9;
-            return (t, RawStamp { value, exact: Some(int), unit: self.unit });
-        }
-        let first = *self.first.get_or_insert(value);
-        let raw = RawStamp { value, exact: None, unit: self.unit };
-        if self.unit == TimeUnit::GpsSecondsOfWeek {
-            if self.prev_sow - value > GPS_WEEK_S / 2.0 {
-                self.week_offset_s += GPS_WEEK_S;
-            }
-            self.prev_sow = value;
-            return (value + self.week_offset_s - first, raw);
-        }
-        ((value - first) * self.unit.to_s(), raw)
-    }
-
-    fn start(&self) -> Option<StartTime> {
-        match (self.first_ns, self.first) {
-            (Some(ns), _) => Some(StartTime::Nanoseconds(ns)),
-            (None, Some(v)) if self.unit == TimeUnit::GpsSecondsOfWeek => {
-                Some(StartTime::GpsSecondsOfWeek(v))
-            }
-            (None, Some(v)) => Some(StartTime::Seconds(v * self.unit.to_s())),
-            (None, None) => None,
-        }
-    }
-}
-
 struct Pending {
     sample: ImuSample,
     at: Location,
     raw_t: RawStamp,
+    /// The six sensor cells as written (file units and axes), for the bounds' messages.
+    cells: [f64; 6],
 }
 
 /// A stream of IMU events from a file; see the module docs. Iterate it: `Result<ImuEvent>` items,
@@ -364,6 +252,11 @@ pub struct ImuReader {
     /// The data row of `block`'s first row (1-based).
     block_first_row: u64,
 }
+
+/// The largest relative difference accepted between a declared sampling rate and the rate the
+/// time stamps show (jittery clocks and PSINS's dither stay well inside 2 %; a wrong rate or time
+/// unit is off by factors).
+pub const RATE_TOLERANCE: f64 = 0.02;
 
 /// Rows read at once from formats that allow it.
 const BLOCK_ROWS: usize = 4096;
@@ -454,6 +347,13 @@ impl ImuReader {
                 }
             }
         }
+        // A reader reports its own first error: a file whose first row cannot be read is that
+        // error, not an empty log.
+        if this.lookahead.is_empty()
+            && let Some(e) = this.read_error.take()
+        {
+            return Err(e);
+        }
         let mut dts: Vec<f64> = this
             .lookahead
             .iter()
@@ -499,7 +399,8 @@ impl ImuReader {
             gyro = self.c * gyro;
             accel = self.c * accel;
         }
-        Ok(Some(Pending { sample: ImuSample { t_s, gyro, accel }, at, raw_t }))
+        let cells = [row[1], row[2], row[3], row[4], row[5], row[6]];
+        Ok(Some(Pending { sample: ImuSample { t_s, gyro, accel }, at, raw_t, cells }))
     }
 
     /// Increments or rates.
@@ -539,6 +440,26 @@ impl ImuReader {
         self.measured_dt_s
     }
 
+    /// Why `declared_hz` cannot be this file's rate: the median of its first intervals differs by
+    /// more than [`RATE_TOLERANCE`] (None: they agree, or too few samples to tell). Every increment
+    /// would be integrated, or every rate held, over the wrong interval without a word.
+    #[must_use]
+    pub fn rate_disagreement(&self, declared_hz: f64) -> Option<String> {
+        let measured = self.measured_dt_s?;
+        if (measured * declared_hz - 1.0).abs() <= RATE_TOLERANCE {
+            return None;
+        }
+        let unit = self.clock.unit.symbol();
+        Some(format!(
+            "{} Hz is declared, but the time stamps of {} ({}, read in {unit}) step by {} s = {} Hz (the median of the first intervals): correct the rate (rate_hz, --rate-hz) or the time column's unit",
+            crate::io::error::short_number(declared_hz),
+            self.path.display(),
+            self.time_column,
+            crate::io::error::fixed_number(measured, 6),
+            crate::io::error::fixed_number(1.0 / measured, 4)
+        ))
+    }
+
     /// The first time stamp as written in the file (known once a row has been read).
     #[must_use]
     pub fn start_time(&self) -> Option<StartTime> {
@@ -567,6 +488,15 @@ impl ImuReader {
             },
         };
         let t = p.sample.t_s;
+        crate::io::validity::check_span(&self.path, p.at, &self.time_column, p.raw_t.value, t)?;
+        // The interval the sample covers (the first: the nominal one), for the increments' bounds.
+        let interval = match self.prev {
+            Some((t_prev, _)) => t - t_prev,
+            None => self.nominal_dt_s.unwrap_or(1.0),
+        };
+        if interval > 0.0 {
+            self.check_values(&p, interval)?;
+        }
         if let Some((t_prev, raw_prev)) = self.prev.take() {
             let dt = t - t_prev;
             if dt < 0.0 {
@@ -615,6 +545,28 @@ impl ImuReader {
         }
         self.prev = Some((t, p.raw_t));
         Ok(Some(ImuEvent::Sample(p.sample)))
+    }
+}
+
+impl ImuReader {
+    /// The numeric-validity rule ([`crate::io::validity`]) on one sample's six values.
+    #[inline]
+    fn check_values(&self, p: &Pending, interval_s: f64) -> Result<()> {
+        let increments = (self.kind == SampleKind::Increments).then_some(interval_s);
+        for (k, cell) in p.cells.iter().enumerate() {
+            let si = cell * self.scale[k];
+            let (sensor, bound) = if k < 3 {
+                (Sensor::Gyro, crate::io::validity::MAX_RATE_RAD_PER_S)
+            } else {
+                (Sensor::Accel, crate::io::validity::MAX_SPECIFIC_FORCE_MPS2)
+            };
+            // The hot path: one comparison per value; the message only when it fails.
+            if !(si.abs() <= bound * increments.unwrap_or(1.0)) {
+                let column = self.reader.columns().get(k + 1).map_or("", String::as_str);
+                check_imu_value(&self.path, p.at, column, *cell, si, sensor, increments)?;
+            }
+        }
+        Ok(())
     }
 }
 

@@ -77,10 +77,63 @@ fn check_psins(path: &Path, layout: &Layout) -> Result<()> {
     }
 }
 
+/// A layout that reads its columns by position (psins, kf-gins, kalibr, npy7) must see exactly its
+/// seven columns in an .npy (no names there to tell an extra one), and no rinscope header in a
+/// text file (its names say the units, which a positional layout would ignore).
+fn check_positional(path: &Path, layout: &Layout, header: HeaderMode) -> Result<()> {
+    let format = detect_format(path)?;
+    if !matches!(format, Format::Npy | Format::Text) {
+        return Ok(());
+    }
+    let probe = ColumnReader::open(path, &[], &ReadOptions { header, ..ReadOptions::default() })?;
+    let names = probe.all_columns();
+    if format == Format::Npy {
+        if names.len() != 7 {
+            return Err(LogError::Shape {
+                file: path.to_path_buf(),
+                shape: format!("(N, {})", names.len()),
+                expected: format!(
+                    "the {} layout reads 7 columns by position ({}); an .npy has no column names, so an array of {} cannot be read: save exactly those 7",
+                    layout.name(),
+                    positional_columns(layout),
+                    names.len()
+                ),
+            });
+        }
+        return Ok(());
+    }
+    if rinscope_plan(path, names).is_ok() {
+        return Err(LogError::Layout {
+            file: path.to_path_buf(),
+            problem: format!(
+                "its header names rinscope columns ({}) with their units, but layout = \"{}\" reads {} by position and ignores those names: this is the rinscope layout; use layout = \"rinscope\" (or give no layout)",
+                names.join(", "),
+                layout.name(),
+                positional_columns(layout)
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// What a positional layout's seven columns are, for messages.
+fn positional_columns(layout: &Layout) -> &'static str {
+    match layout {
+        Layout::Psins | Layout::PsinsImu => "[wm vm t]: Δθ x y z (rad), Δv x y z (m/s), t (s)",
+        Layout::KfGins => "GPS seconds of week, Δθ x y z (rad), Δv x y z (m/s)",
+        Layout::Kalibr => "timestamp (ns), ω x y z (rad/s), α x y z (m/s²)",
+        _ => "t, Δθ x y z (rad), Δv x y z (m/s)",
+    }
+}
+
 pub(crate) fn plan_for(path: &Path, options: &ImuOptions) -> Result<Plan> {
     use HeaderMode::{Absent, Auto};
     use SampleKind::{Increments, Rates};
     check_psins(path, &options.layout)?;
+    if let Layout::Psins | Layout::KfGins | Layout::Kalibr | Layout::Npy7 { .. } = &options.layout {
+        // KF-GINS files have no header: its check reads the first line as one only to see names.
+        check_positional(path, &options.layout, Auto)?;
+    }
     Ok(match &options.layout {
         // imufile.m's [wm vm t], decoded by the PSINS source (`psins_imu`).
         Layout::Psins | Layout::PsinsImu => fixed(
@@ -113,6 +166,12 @@ pub(crate) fn plan_for(path: &Path, options: &ImuOptions) -> Result<Plan> {
                 return Err(LogError::Layout {
                     file: path.to_path_buf(),
                     problem: "the Ros2 layout reads MCAP files only".into(),
+                });
+            }
+            if options.layout == Layout::Rinscope && is_mcap {
+                return Err(LogError::Layout {
+                    file: path.to_path_buf(),
+                    problem: "this is an MCAP file (ROS 2 sensor_msgs/msg/Imu), which the rinscope layout (tables with units in their column names) does not read: use layout = \"ros2\" (or give no layout)".into(),
                 });
             }
             let mut plan = rinscope_plan(path, probe.all_columns())?;

@@ -79,6 +79,8 @@ struct Records {
     /// The current chunk's decompressed records, and the read position in them.
     chunk: Vec<u8>,
     chunk_pos: usize,
+    /// Bytes of the file given to the reader so far.
+    fed: u64,
 }
 
 impl Records {
@@ -91,6 +93,7 @@ impl Records {
             reader: LinearReader::new_with_options(options),
             chunk: Vec::new(),
             chunk_pos: 0,
+            fed: 0,
         }
     }
 
@@ -118,6 +121,17 @@ impl Records {
                 }
             }
             let Some(event) = self.reader.next_event() else {
+                // The closing magic was read (the reader is fed no more than it asks for, so
+                // nothing of the file is buffered): anything after it is not this recording's —
+                // a second file appended, or garbage.
+                let mut probe = [0u8; 1];
+                let more = self.file.read(&mut probe).map_err(|e| LogError::io(path, "cannot read", e))?;
+                if more > 0 {
+                    return Err(mcap_error(
+                        path,
+                        format!("bytes follow the recording's closing magic at byte {}: a second file appended, or garbage (an MCAP ends with its magic)", self.fed),
+                    ));
+                }
                 return Ok(false);
             };
             match event.map_err(|e| mcap_error(path, e))? {
@@ -128,6 +142,7 @@ impl Records {
                         .read(buf)
                         .map_err(|e| LogError::io(path, "cannot read", e))?;
                     self.reader.notify_read(n);
+                    self.fed += n as u64;
                 }
                 LinearReadEvent::Record {
                     opcode: op::CHUNK,

@@ -17,6 +17,7 @@
 
 pub mod files;
 mod cdr;
+mod clock;
 mod error;
 mod frames;
 mod guess;
@@ -31,13 +32,14 @@ mod sniff;
 mod table;
 mod text;
 pub mod units;
+pub mod validity;
 mod writer;
 
-pub use error::{FrameError, Location, LogError, Result};
+pub use error::{FrameError, Location, LogError, Result, fixed_number, short_number};
 pub use frames::{Frame, frame_matrix};
 pub use guess::guess_layout;
 pub use imu::{
-    BlockEnd, ColumnMap, GPS_WEEK_S, GapPolicy, ImuEvent, ImuOptions, ImuReader, ImuSample, Layout, SampleKind,
+    BlockEnd, ColumnMap, GPS_WEEK_S, GapPolicy, RATE_TOLERANCE, ImuEvent, ImuOptions, ImuReader, ImuSample, Layout, SampleKind,
     StartTime, StaticCheck, TimeUnit,
 };
 pub use mcap_imu::MCAP_IMU_COLUMNS;

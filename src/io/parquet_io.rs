@@ -117,6 +117,45 @@ fn check_chunk_ranges(path: &Path, metadata: &ArrowReaderMetadata, file_len: u64
     Ok(())
 }
 
+/// Checks that the column chunks, page indexes and bloom filters the footer refers to fill the
+/// file up to the footer: bytes that nothing refers to are not this table's — two files joined
+/// (`cat a.parquet b.parquet`: b's footer then reads a's bytes at b's offsets), or damage.
+fn check_unreferenced(path: &Path, metadata: &ArrowReaderMetadata, file: &File, file_len: u64) -> Result<()> {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut tail = [0u8; 8];
+    let mut f = file.try_clone().map_err(|e| LogError::io(path, "cannot read", e))?;
+    f.seek(SeekFrom::End(-8)).and_then(|_| f.read_exact(&mut tail)).map_err(|e| LogError::io(path, "cannot read", e))?;
+    let footer_len = u64::from(u32::from_le_bytes([tail[0], tail[1], tail[2], tail[3]]));
+    let Some(footer_start) = file_len.checked_sub(8 + footer_len) else {
+        return Err(LogError::corrupt(path, "Parquet footer longer than the file"));
+    };
+    let end = |offset: Option<i64>, len: Option<i64>| -> u64 {
+        match (offset, len) {
+            (Some(o), Some(l)) => u64::try_from(o).unwrap_or(0).saturating_add(u64::try_from(l).unwrap_or(0)),
+            _ => 0,
+        }
+    };
+    let mut data_end = 4; // the leading magic
+    for group in metadata.metadata().row_groups() {
+        for column in group.columns() {
+            let start = column.dictionary_page_offset().unwrap_or_else(|| column.data_page_offset());
+            data_end = data_end.max(end(Some(start), Some(column.compressed_size())));
+            data_end = data_end.max(end(column.column_index_offset(), column.column_index_length().map(i64::from)));
+            data_end = data_end.max(end(column.offset_index_offset(), column.offset_index_length().map(i64::from)));
+            data_end = data_end.max(end(column.bloom_filter_offset(), column.bloom_filter_length().map(i64::from)));
+        }
+    }
+    if data_end < footer_start {
+        return Err(LogError::corrupt(
+            path,
+            format!(
+                "bytes {data_end}..{footer_start} lie between the table's data and its footer and nothing refers to them: two Parquet files joined into one (the footer of the second reads the first's bytes), or a damaged file"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 pub(crate) struct ParquetSource {
     path: PathBuf,
     file: File,
@@ -140,13 +179,9 @@ impl ParquetSource {
             ArrowReaderOptions::new().with_skip_arrow_metadata(true),
         )
         .map_err(|e| LogError::corrupt(path, format!("not a readable Parquet file: {e}")))?;
-        check_chunk_ranges(
-            path,
-            &metadata,
-            file.metadata()
-                .map_err(|e| LogError::io(path, "cannot read", e))?
-                .len(),
-        )?;
+        let file_len = file.metadata().map_err(|e| LogError::io(path, "cannot read", e))?.len();
+        check_chunk_ranges(path, &metadata, file_len)?;
+        check_unreferenced(path, &metadata, &file, file_len)?;
         let names = metadata
             .schema()
             .fields()

@@ -385,6 +385,9 @@ impl Source for PsinsSource {
                 truncated_last_line: !line.terminated && found < self.width,
             });
         }
+        if !line.terminated {
+            return Err(LogError::TruncatedLine { file: self.path.clone(), at: self.location() });
+        }
         let mut values = [0.0; 7];
         for k in 0..6 {
             values[k] = self.count(&line.bytes, k)? * self.scales[k];

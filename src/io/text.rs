@@ -10,7 +10,8 @@
 //!   number. If it is all numbers, the last `#` comment line becomes the header when it has the same
 //!   number of fields (EuRoC/Kalibr write `#timestamp [ns],w_RS_S_x [rad s^-1],...`); else there is none.
 //! * Columns without a header are named `index 0`, `index 1`, ...
-//! * Every row must have as many fields as the header (or, without one, as the first row).
+//! * Every row must have as many fields as the header (or, without one, as the first row), and end
+//!   with a line end: a last line without one was cut off, perhaps inside a number.
 //! * Lines are read one at a time (at most 1 MiB each): memory does not grow with the file.
 
 use crate::io::error::{Location, LogError, Result, cell_text};
@@ -357,6 +358,9 @@ impl Source for TextSource {
                 truncated_last_line: !self.current.terminated
                     && self.spans.len() < self.field_count,
             });
+        }
+        if !self.current.terminated {
+            return Err(LogError::TruncatedLine { file: self.path.clone(), at: self.location() });
         }
         for (k, &col) in self.selected.iter().enumerate() {
             let span = self.spans.get(col).copied().unwrap_or((0, 0));

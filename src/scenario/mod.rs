@@ -45,7 +45,7 @@ pub enum ConfigError {
         message: String,
     },
     /// A number that is not finite (nan, inf).
-    #[error("{origin}: `{key}` = {value} {unit} is not a finite number")]
+    #[error("{origin}: `{key}` = {} {unit} is not a finite number", crate::io::short_number(*.value))]
     NotFinite {
         /// The file or scenario name.
         origin: String,
@@ -57,7 +57,7 @@ pub enum ConfigError {
         unit: &'static str,
     },
     /// A number outside its allowed range.
-    #[error("{origin}: `{key}` = {value} {unit} is out of range: {range}")]
+    #[error("{origin}: `{key}` = {} {unit} is out of range: {range}", crate::io::short_number(*.value))]
     OutOfRange {
         /// The file or scenario name.
         origin: String,
@@ -249,9 +249,26 @@ pub fn load_file(path: &Path) -> Result<Params, ConfigError> {
 pub fn parse(text: &str, origin: &str) -> Result<Params, ConfigError> {
     let raw: RawConfig = toml::from_str(text).map_err(|e| ConfigError::Parse {
         origin: origin.to_owned(),
-        message: e.to_string().trim_end().to_owned(),
+        message: parse_message(&e),
     })?;
     validate::validate(raw, origin)
+}
+
+/// The toml crate's message, which quotes the offending line: each quoted line cut to 160
+/// characters and the whole to 40 lines (a 200 kB line of nested brackets is not echoed back).
+pub(crate) fn parse_message(e: &toml::de::Error) -> String {
+    const LINE: usize = 160;
+    let text = e.to_string();
+    let mut out: Vec<String> = Vec::new();
+    for line in text.trim_end().lines().take(40) {
+        if line.chars().count() > LINE {
+            let cut: String = line.chars().take(LINE).collect();
+            out.push(format!("{cut}… ({} characters)", line.chars().count()));
+        } else {
+            out.push(line.to_owned());
+        }
+    }
+    out.join("\n")
 }
 
 /// Every leaf of a resolved config as `dotted.key -> value text` (arrays of tables indexed `[i]`),

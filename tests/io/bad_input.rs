@@ -314,17 +314,19 @@ fn npy_dtype_and_shape() {
         let e = ColumnReader::open(&path, &[], &ReadOptions::default()).unwrap_err();
         assert!(matches!(e, LogError::Shape { .. }), "{shape}: {e:?}");
     }
-    // Npy7 on an N×6 array: the missing column is named.
-    let path = dir.join("six.npy");
-    write_npy(&path, &[vec![0.0; 6]], "<f8");
+    // Npy7 on an N×6 or N×8 array (issue 20: an 8-column array was read as its first 7): an .npy
+    // has no names to tell which column is missing or extra, so the width itself is refused.
     let mut opts = ImuOptions::new(Layout::Npy7 {
         time: rinscope::io::TimeUnit::Seconds,
     });
     opts.frame = Some(Frame::Named("rfu".into()));
-    assert!(matches!(
-        ImuReader::open(&path, &opts).unwrap_err(),
-        LogError::MissingColumn { .. }
-    ));
+    for width in [6, 8] {
+        let path = dir.join(format!("w{width}.npy"));
+        write_npy(&path, &[vec![0.0; width], vec![0.005; width]], "<f8");
+        let e = ImuReader::open(&path, &opts).unwrap_err();
+        let msg = e.to_string();
+        assert!(matches!(e, LogError::Shape { .. }) && msg.contains(&format!("(N, {width})")) && msg.contains("7 columns"), "{msg}");
+    }
 }
 
 #[test]

@@ -14,4 +14,5 @@ mod psins;
 mod psins_writer;
 mod psins_bad;
 mod time_frames;
+mod validity;
 mod writers;

@@ -150,9 +150,14 @@ fn truncated_last_line() {
     let path = write_text(&dir, "cut.imu", &text[..fourth]);
     let e = error(&path, &["data row 500 (line 518)", "4 fields", "truncated"]);
     assert!(matches!(e, LogError::FieldCount { found: 4, truncated_last_line: true, .. }), "{e:?}");
-    // Cut inside the 6th number: every field is there, and the row reads (nothing to tell).
+    // Cut inside the 6th number: every field is there, but the line has no end (issue 20: a count
+    // cut short is still a whole number, so only the missing line end tells).
     let sixth = text.len() - 1;
     let path = write_text(&dir, "cut6.imu", &text[..sixth]);
+    let e = error(&path, &["data row 500 (line 518)", "no line end", "truncated"]);
+    assert!(matches!(e, LogError::TruncatedLine { .. }), "{e:?}");
+    // The same line with its end reads.
+    let path = write_text(&dir, "whole.imu", &format!("{text}\n"));
     assert_eq!(samples(ImuReader::open(&path, &ImuOptions::new(Layout::PsinsImu)).unwrap()).len(), 500);
 }
 

@@ -144,6 +144,10 @@ pub struct Playback {
     pub notes: Vec<String>,
     /// Whether the last reference lookup found the reference inside its file's span.
     reference_inside: Option<bool>,
+    /// The IMU file (for messages).
+    imu_path: std::path::PathBuf,
+    /// The IMU file was read to its end (not cut short by `--to`).
+    imu_read_to_end: bool,
 }
 
 enum ReferenceTrack {
@@ -228,12 +232,14 @@ impl Playback {
             alignment: None,
             notes: Vec::new(),
             reference_inside: None,
+            imu_path: f.path.clone(),
+            imu_read_to_end: false,
         };
         if let Some(from) = from_rel {
             let mut skipped = 0u64;
             loop {
                 let Some(s) = me.read()? else {
-                    return Err(data_err(format!("{}: log.from_s = {:.6} s is after the file's last sample", f.path.display(), from + file_start_s)));
+                    return Err(data_err(format!("{}: log.from_s = {} s is after the file's last sample", f.path.display(), crate::io::fixed_number(from + file_start_s, 6))));
                 };
                 if s.t_s >= from - 0.5 * nominal_s {
                     me.pending.push_back(s);
@@ -241,10 +247,10 @@ impl Playback {
                 }
                 skipped += 1;
             }
-            me.notes.push(format!("replayed from {:.6} s on the file's clock ({skipped} samples before it skipped)", from + file_start_s));
+            me.notes.push(format!("replayed from {} s on the file's clock ({skipped} samples before it skipped)", crate::io::fixed_number(from + file_start_s, 6)));
         }
         if until_s.is_finite() {
-            me.notes.push(format!("replayed up to {:.6} s on the file's clock", until_s + file_start_s));
+            me.notes.push(format!("replayed up to {} s on the file's clock", crate::io::fixed_number(until_s + file_start_s, 6)));
         }
         if matches!(log.reference, Reference::Static(_)) {
             check_units_at_rest(log, 5.0)?;
@@ -323,7 +329,34 @@ impl Playback {
     pub fn step(&mut self) -> Result<Option<SampleOut>, PlaybackError> {
         let Some(s) = self.read()? else { return Ok(None) };
         self.samples += 1;
-        Ok(Some(self.core.push(s.t_s - self.origin_s, s.dtheta, s.dv)))
+        let out = self.core.push(s.t_s - self.origin_s, s.dtheta, s.dv);
+        // Every sample is inside the readers' bounds (`io::validity`), so this is a last line of
+        // defence: a result is finite, or the replay stops here and says where.
+        if out.updated && !self.core.is_finite() {
+            return Err(data_err(format!(
+                "{}: the navigation solution stops being a finite number at {} s on the file's clock (IMU sample {}): the data drive the INS beyond what it can integrate",
+                self.imu_path.display(),
+                crate::io::fixed_number(self.file_time_s(out.t_s), 6),
+                self.samples
+            )));
+        }
+        Ok(Some(out))
+    }
+
+    /// After the last sample: reads what is left of the encoder and reference files (their
+    /// readings after the IMU's last instant), so that damage anywhere in them is reported — when
+    /// the IMU file was read to its end (a replay cut short by `--to` reads no file further).
+    pub fn finish(&mut self) -> Result<(), PlaybackError> {
+        if !self.imu_read_to_end {
+            return Ok(());
+        }
+        if let Some(t) = self.encoders.as_mut() {
+            t.read_to_end()?;
+        }
+        if let ReferenceTrack::File(t) = &mut self.reference {
+            t.read_to_end()?;
+        }
+        Ok(())
     }
 
     /// The raw encoder angles at instant `t_s` (the table's initial angles without an encoder file).
@@ -380,7 +413,10 @@ impl Playback {
         }
         loop {
             match self.imu.next_item()? {
-                None => return Ok(None),
+                None => {
+                    self.imu_read_to_end = true;
+                    return Ok(None);
+                }
                 // The end of the span replayed (--to): the rest of the file is not read.
                 Some(ImuItem::Sample { t_s, .. }) if t_s > self.until_s + 1e-9 => return Ok(None),
                 Some(ImuItem::Gap { from_s, to_s }) => self.gaps.push(Gap { from_s: from_s - self.origin_s, to_s: to_s - self.origin_s }),
@@ -444,20 +480,6 @@ impl ImuSamples {
     fn open_checked(log: &LogSet) -> Result<(Self, StartTime), PlaybackError> {
         let f = &log.imu;
         let imu = ImuReader::open(&f.path, &Self::options(log))?;
-        // A declared rate the stamps contradict would integrate every increment over the wrong
-        // interval (or hold every rate over it) without a word: refused, naming both.
-        if let Some(measured) = imu.measured_dt_s()
-            && ((measured * f.rate_hz) - 1.0).abs() > RATE_TOLERANCE
-        {
-            return Err(data_err(format!(
-                "{}: imu.rate_hz = {} Hz is declared, but the time stamps ({}) step by {:.6} s = {:.4} Hz (median of the first intervals): correct rate_hz (or --rate-hz) or the time column's unit",
-                f.path.display(),
-                f.rate_hz,
-                imu.columns().first().map_or("time", String::as_str),
-                measured,
-                1.0 / measured
-            )));
-        }
         if let Some(declared) = f.kind
             && imu.kind() != declared
         {
@@ -504,9 +526,9 @@ impl ImuSamples {
     }
 }
 
-/// The largest relative difference accepted between the declared rate and the stamps' (jittery
-/// clocks and PSINS's dither stay well inside 2 %; a wrong unit or rate is off by factors).
-pub const RATE_TOLERANCE: f64 = 0.02;
+/// The largest relative difference accepted between the declared rate and the stamps' (checked when
+/// the log set is loaded: `scenario::logset`).
+pub use crate::io::RATE_TOLERANCE;
 
 fn kind_name(k: SampleKind) -> &'static str {
     match k {

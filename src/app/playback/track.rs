@@ -5,7 +5,8 @@ use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 
 use super::{data_err, PlaybackError};
-use crate::io::{Col, ColumnReader, Format, ReadOptions, StartTime};
+use crate::io::validity::{check_angle, check_span};
+use crate::io::{fixed_number, Col, ColumnReader, Format, Location, ReadOptions, StartTime};
 use crate::math::units::wrap_pi;
 use crate::model::scheme::MAX_AXES;
 
@@ -35,7 +36,8 @@ pub(super) struct Track {
     time_ns: bool,
     /// Seconds to add to a stamp (the encoders' latch delay, negative: the reading is older).
     pub(super) shift_s: f64,
-    buf: VecDeque<(f64, [f64; MAX_AXES])>,
+    /// Readings around the instant asked for: stamp (s after the IMU's first), values, where in the file.
+    buf: VecDeque<(f64, [f64; MAX_AXES], Location)>,
     exhausted: bool,
     pub(super) interpolate_gaps: bool,
     /// Outside the file's span: nothing (a reference that starts late or ends early) instead of an error.
@@ -44,23 +46,25 @@ pub(super) struct Track {
     pub(super) span_seen: (Option<f64>, f64),
     nominal_s: f64,
     gap_factor: f64,
+    /// The last stamp read (s after the IMU's first).
+    last_t: Option<f64>,
 }
 
 const MATCH_S: f64 = 1e-9;
 
 impl Track {
     pub(super) fn at(&mut self, t: f64) -> Result<Option<[f64; MAX_AXES]>, PlaybackError> {
-        while !self.exhausted && self.buf.back().is_none_or(|(tb, _)| *tb < t - MATCH_S) {
+        while !self.exhausted && self.buf.back().is_none_or(|(tb, _, _)| *tb < t - MATCH_S) {
             self.read_one()?;
         }
         // Keep the two readings around t (and one before, for a rate).
         while self.buf.len() > 3 && self.buf[1].0 <= t - MATCH_S {
             self.buf.pop_front();
         }
-        let Some(&(t_first, v_first)) = self.buf.front() else {
+        let Some(&(t_first, v_first, _)) = self.buf.front() else {
             return Err(data_err(format!("{}: the {} file has no readings", self.path.display(), self.what)));
         };
-        if let Some(&(_, v)) = self.buf.iter().find(|(tk, _)| (tk - t).abs() <= MATCH_S) {
+        if let Some(&(_, v, _)) = self.buf.iter().find(|(tk, _, _)| (tk - t).abs() <= MATCH_S) {
             return Ok(Some(v));
         }
         if t < t_first {
@@ -72,34 +76,34 @@ impl Track {
                 return Ok(None);
             }
             return Err(data_err(format!(
-                "{}: the {} readings start at {:.6} s, the IMU data need them from {:.6} s: the clocks do not overlap",
+                "{}: the {} readings start at {} s, the IMU data need them from {} s: the clocks do not overlap",
                 self.path.display(),
                 self.what,
-                t_first,
-                t
+                fixed_number(t_first, 6),
+                fixed_number(t, 6)
             )));
         }
-        let j = self.buf.iter().position(|(tk, _)| *tk > t);
+        let j = self.buf.iter().position(|(tk, _, _)| *tk > t);
         let Some(j) = j else {
-            let (t_last, v_last) = self.buf[self.buf.len() - 1];
+            let (t_last, v_last, at) = self.buf[self.buf.len() - 1];
             if t - t_last <= 0.5 * self.nominal_s {
                 return Ok(Some(v_last));
             }
             if self.clip {
                 return Ok(None);
             }
-            return Err(data_err(format!("{}: the {} readings end at {:.6} s, the IMU data go on to {:.6} s", self.path.display(), self.what, t_last, t)));
+            return Err(data_err(format!("{}: the {} readings end at {} s ({at}), the IMU data go on to {} s", self.path.display(), self.what, fixed_number(t_last, 6), fixed_number(t, 6))));
         };
-        let (ta, va) = self.buf[j - 1];
-        let (tb, vb) = self.buf[j];
+        let (ta, va, _) = self.buf[j - 1];
+        let (tb, vb, at) = self.buf[j];
         if tb - ta > self.gap_factor * self.nominal_s && !self.interpolate_gaps {
             return Err(data_err(format!(
-                "{}: a gap of {:.6} s in the {} readings between {:.6} s and {:.6} s (gap_policy = \"refuse\"; \"interpolate\" bridges it)",
+                "{}: {at}: a gap of {} s in the {} readings between {} s and {} s (gap_policy = \"refuse\"; \"interpolate\" bridges it)",
                 self.path.display(),
-                tb - ta,
+                fixed_number(tb - ta, 6),
                 self.what,
-                ta,
-                tb
+                fixed_number(ta, 6),
+                fixed_number(tb, 6)
             )));
         }
         let f = (t - ta) / (tb - ta);
@@ -112,12 +116,25 @@ impl Track {
     }
 
     fn read_one(&mut self) -> Result<(), PlaybackError> {
+        let Some((t, v, at)) = self.next_reading()? else {
+            self.exhausted = true;
+            return Ok(());
+        };
+        self.buf.push_back((t, v, at));
+        self.span_seen.0.get_or_insert(t);
+        self.span_seen.1 = t;
+        Ok(())
+    }
+
+    /// The next reading, checked: a number in every cell, a stamp after the previous one on the
+    /// IMU's clock, angles inside [`crate::io::validity::MAX_ANGLE_RAD`].
+    fn next_reading(&mut self) -> Result<Option<(f64, [f64; MAX_AXES], Location)>, PlaybackError> {
         let n = self.to_si.len();
         let mut row = [0.0; 1 + MAX_AXES];
         if !self.reader.next_row(&mut row[..=n])? {
-            self.exhausted = true;
-            return Ok(());
+            return Ok(None);
         }
+        let at = self.reader.location();
         let t = match self.clock {
             Clock::Seconds(t0) => row[0] - t0,
             Clock::Gps(t0) => {
@@ -125,28 +142,40 @@ impl Track {
                 if d < -302_400.0 { d + 604_800.0 } else { d }
             }
             Clock::Nanoseconds(t0) => match (self.time_ns, self.reader.exact_integer(0)) {
-                (true, Some(ns)) => (ns - t0) as f64 * 1e-9,
+                (true, Some(ns)) => (i128::from(ns) - i128::from(t0)) as f64 * 1e-9,
                 _ => row[0] - t0 as f64 * 1e-9,
             },
         } + self.shift_s;
-        if let Some(&(t_prev, _)) = self.buf.back()
+        let columns = self.reader.columns();
+        let column = |k: usize| columns.get(k).map_or("", String::as_str);
+        check_span(&self.path, at, column(0), row[0], t)?;
+        if let Some(t_prev) = self.last_t
             && t <= t_prev
         {
             return Err(data_err(format!(
-                "{} ({}): time {:.9} s is not after the previous reading's {:.9} s; stamps must increase",
+                "{} ({at}): time {} s is not after the previous reading's {} s; stamps must increase",
                 self.path.display(),
-                self.reader.location(),
-                t,
-                t_prev
+                fixed_number(t, 9),
+                fixed_number(t_prev, 9)
             )));
         }
+        self.last_t = Some(t);
         let mut v = [0.0; MAX_AXES];
         for k in 0..n {
             v[k] = row[1 + k] * self.to_si[k];
+            check_angle(&self.path, at, column(1 + k), row[1 + k], v[k])?;
         }
-        self.buf.push_back((t, v));
-        self.span_seen.0.get_or_insert(t);
-        self.span_seen.1 = t;
+        Ok(Some((t, v, at)))
+    }
+
+    /// Reads what is left of the file, checking every reading as [`Self::at`] would and keeping
+    /// none of them: damage after the last instant the IMU asked for is reported too.
+    pub(super) fn read_to_end(&mut self) -> Result<(), PlaybackError> {
+        while !self.exhausted {
+            if self.next_reading()?.is_none() {
+                self.exhausted = true;
+            }
+        }
         Ok(())
     }
 }
@@ -159,8 +188,14 @@ pub(super) fn open_track(path: &Path, what: &'static str, names: &[String], wrap
     let format = probe.format();
     drop(probe);
     let (cols, to_si, time_ns, time_gps) = if format == Format::Npy {
-        if all.len() < 1 + names.len() {
-            return Err(data_err(format!("{}: {} columns; the {what} .npy needs t_s then {} (rad)", path.display(), all.len(), names.join(", "))));
+        if all.len() != 1 + names.len() {
+            return Err(data_err(format!(
+                "{}: {} columns; the {what} .npy holds exactly {}: t_s then {} (rad) — an .npy has no column names, so an array of another width cannot be read",
+                path.display(),
+                all.len(),
+                1 + names.len(),
+                names.join(", ")
+            )));
         }
         ((0..=names.len()).map(Col::from).collect::<Vec<_>>(), vec![1.0; names.len()], false, false)
     } else {
@@ -207,6 +242,7 @@ pub(super) fn open_track(path: &Path, what: &'static str, names: &[String], wrap
         span_seen: (None, 0.0),
         nominal_s,
         gap_factor: 3.0,
+        last_t: None,
     })
 }
 

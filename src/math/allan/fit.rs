@@ -322,7 +322,9 @@ fn fit_pass(curve: &AllanCurve, allowed: [bool; 5]) -> NoiseFit {
     let r = &b - &a * &theta;
     let active: Vec<usize> = (0..5).filter(|&k| theta[k] > 0.0).collect();
     let dof = np.saturating_sub(active.len()).max(1);
-    let chi2_per_dof = r.norm_squared() / dof as f64;
+    // A curve of zeros (a constant channel: a simulation's error-free sensor) is fitted exactly by
+    // no term; its weights are 1/0, so its χ² is said, not computed.
+    let chi2_per_dof = if ymax > 0.0 { r.norm_squared() / dof as f64 } else { 0.0 };
     let inflate = chi2_per_dof.max(1.0);
     let variance_of = |k: usize| -> f64 {
         let mut cols = active.clone();

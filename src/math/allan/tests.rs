@@ -211,6 +211,12 @@ fn constant_input_gives_a_zero_curve_and_no_terms() {
     assert!(r.adev_si.iter().all(|&a| a == 0.0));
     assert!(r.fit.significant_terms().is_empty());
     assert!(r.adev_upper_si.iter().all(|v| v.is_finite()));
+    // Issue 20: every number of the result is finite (the χ² was NaN, a null in the JSON).
+    assert!(r.fit_chi2_per_dof.is_finite(), "{}", r.fit_chi2_per_dof);
+    for t in crate::math::allan::TERMS {
+        let e = r.fit.get(t);
+        assert!(e.value.is_finite() && e.sigma.is_finite(), "{t:?}: {e:?}");
+    }
 }
 
 #[test]

@@ -160,13 +160,45 @@ pub(super) fn time_unit(c: &Checker<'_>, key: &str, name: &str) -> Result<TimeUn
 }
 
 /// A frame: a name or a matrix.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum RawFrame {
     /// "frd", "rfu", ...
     Named(String),
     /// Rows of C (v_rfu = C · v_file).
     Matrix([[f64; 3]; 3]),
+}
+
+/// Read by hand, so that a matrix of the wrong shape says what it is (serde's untagged enums say
+/// only "did not match any variant").
+impl<'de> Deserialize<'de> for RawFrame {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        const EXPECTED: &str = "a frame name (\"rfu\", \"frd\", \"flu\", ...) or a 3×3 matrix [[c11, c12, c13], [c21, c22, c23], [c31, c32, c33]] (rows of C, v_rfu = C · v_file)";
+        let value = toml::Value::deserialize(d)?;
+        let rows = match value {
+            toml::Value::String(name) => return Ok(Self::Named(name)),
+            toml::Value::Array(rows) => rows,
+            other => return Err(D::Error::custom(format!("frame: a {} is not {EXPECTED}", other.type_str()))),
+        };
+        if rows.len() != 3 {
+            return Err(D::Error::custom(format!("frame: a matrix of {} rows is not {EXPECTED}", rows.len())));
+        }
+        let mut m = [[0.0; 3]; 3];
+        for (r, row) in rows.iter().enumerate() {
+            let Some(cells) = row.as_array().filter(|c| c.len() == 3) else {
+                return Err(D::Error::custom(format!("frame: row {} is {}, not 3 numbers: {EXPECTED}", r + 1, row.as_array().map_or_else(|| format!("a {}", row.type_str()), |c| format!("{} values", c.len())))));
+            };
+            for (k, cell) in cells.iter().enumerate() {
+                m[r][k] = match cell {
+                    toml::Value::Float(x) => *x,
+                    toml::Value::Integer(i) => *i as f64,
+                    other => return Err(D::Error::custom(format!("frame: row {} column {} is a {}, not a number", r + 1, k + 1, other.type_str()))),
+                };
+            }
+        }
+        Ok(Self::Matrix(m))
+    }
 }
 
 /// `[encoders]`: time and one angle column per table axis, named `<axis>_deg`, `<axis>_rad` or

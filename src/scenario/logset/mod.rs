@@ -189,7 +189,7 @@ fn load_for(dir: &Path, edit: impl FnOnce(&mut RawManifest), navigates: bool) ->
     let manifest_path = dir.join(MANIFEST);
     let text = super::read_text(&manifest_path)?;
     let origin = manifest_path.display().to_string();
-    let mut raw: RawManifest = toml::from_str(&text).map_err(|e| ConfigError::Parse { origin: origin.clone(), message: e.to_string().trim_end().to_owned() })?;
+    let mut raw: RawManifest = toml::from_str(&text).map_err(|e| ConfigError::Parse { origin: origin.clone(), message: super::parse_message(&e) })?;
     edit(&mut raw);
     let table_path = dir.join(&raw.log.table);
     // A strapdown log needs no table description: the default name may be absent.
@@ -204,7 +204,7 @@ fn load_for(dir: &Path, edit: impl FnOnce(&mut RawManifest), navigates: bool) ->
 pub fn read_table(path: &Path) -> Result<(RawTable, String), ConfigError> {
     let text = super::read_text(path)?;
     let origin = path.display().to_string();
-    let raw: RawTable = toml::from_str(&text).map_err(|e| ConfigError::Parse { origin: origin.clone(), message: e.to_string().trim_end().to_owned() })?;
+    let raw: RawTable = toml::from_str(&text).map_err(|e| ConfigError::Parse { origin: origin.clone(), message: super::parse_message(&e) })?;
     Ok((raw, origin))
 }
 
@@ -427,14 +427,28 @@ fn imu_file(c: &Checker<'_>, dir: &Path, raw: &RawImuFile) -> Result<ImuFile, Co
         "split" => GapPolicy::Split,
         other => return Err(c.invalid("imu.gap_policy", format!("\"{other}\" is not a policy; use \"refuse\" or \"split\""))),
     };
+    if raw.topic.is_some() && layout != Layout::Ros2 {
+        return Err(c.invalid("imu.topic", format!("is read by the ros2 layout (MCAP) only, and this file's layout is {}: drop the key", layout.name())));
+    }
     let path = dir.join(&raw.file);
+    let mut options = crate::io::ImuOptions::new(layout.clone());
+    options.frame = frame.clone();
+    options.topic = raw.topic.clone();
     let rate_hz = match raw.rate_hz {
-        Some(r) => c.range("imu.rate_hz", r, "Hz", 1.0, 100_000.0, "")?,
+        Some(r) => {
+            let r = c.range("imu.rate_hz", r, "Hz", 1.0, 100_000.0, "")?;
+            // A declared rate the stamps contradict would integrate every increment (or hold every
+            // rate) over the wrong interval: refused here, before anything is derived from it. A
+            // file that cannot be opened says why when a command reads it.
+            if let Ok(reader) = crate::io::ImuReader::open(&path, &options)
+                && let Some(why) = reader.rate_disagreement(r)
+            {
+                return Err(c.invalid("imu.rate_hz", why));
+            }
+            r
+        }
         None => {
             // What the stamps say (the median of the first intervals).
-            let mut options = crate::io::ImuOptions::new(layout.clone());
-            options.frame = frame.clone();
-            options.topic = raw.topic.clone();
             let dt = crate::io::ImuReader::open(&path, &options).map_err(|e| c.invalid("imu.rate_hz", format!("absent, and the rate cannot be read from the stamps: {e}")))?.measured_dt_s();
             let Some(dt) = dt else {
                 return Err(c.invalid("imu.rate_hz", "absent, and the file has too few samples to measure it"));

@@ -1,0 +1,125 @@
+//! One numeric-validity rule for every value that enters the navigation: finite, and inside what a
+//! real instrument can give. A value beyond these bounds is a damaged file (a flipped byte, a cut
+//! field, a column of something else) or a unit the file does not state — never data: the readers
+//! refuse it naming the file, the row, the column and the value, before it can turn an attitude
+//! into NaN.
+//!
+//! The bounds are chosen so that no real instrument reaches them, with a wide margin:
+//!
+//! | quantity | bound | the widest real range |
+//! |---|---|---|
+//! | angular rate | 100 rev/s = 628.3 rad/s | MEMS gyros for spinning projectiles ±20 000 °/s (56 rev/s); navigation gyros ±500–1000 °/s |
+//! | specific force | 1000 g = 9806.65 m/s² | gun-hardened IMUs ±100 g (they survive 20 000 g of shock but do not measure it) |
+//! | an increment | the bound above × its interval | — |
+//! | an encoder or reference angle | 1e8 rad (16 million turns) | beyond it an f64 no longer resolves 0.01″ |
+//! | a time stamp, from the log's first | 1e9 s (32 years) | — |
+
+use crate::io::error::{Location, LogError, fixed_number, short_number};
+use std::path::Path;
+
+/// The fastest rotation any gyro measures: 100 revolutions per second, rad/s.
+pub const MAX_RATE_RAD_PER_S: f64 = 100.0 * std::f64::consts::TAU;
+
+/// The largest specific force any IMU's accelerometers measure: 1000 g, m/s².
+pub const MAX_SPECIFIC_FORCE_MPS2: f64 = 1000.0 * crate::io::units::STANDARD_GRAVITY_MPS2;
+
+/// The largest angle an encoder or reference file may hold, rad: beyond 1e8 rad an f64 resolves
+/// no better than 1.5e-8 rad (0.003″), and no table turns 16 million times in one log.
+pub const MAX_ANGLE_RAD: f64 = 1e8;
+
+/// The longest a log may last from its first stamp, s (32 years): a stamp beyond it is not on the
+/// same clock.
+pub const MAX_LOG_SPAN_S: f64 = 1e9;
+
+/// What an IMU column measures, for its bound.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Sensor {
+    /// A gyro (rate or angle increment).
+    Gyro,
+    /// An accelerometer (specific force or velocity increment).
+    Accel,
+}
+
+/// Checks one IMU value `si` (SI units, rate or increment; `interval_s`: the interval an increment
+/// covers, None for a rate) read as `cell` from `column` at `at`.
+pub(crate) fn check_imu_value(file: &Path, at: Location, column: &str, cell: f64, si: f64, sensor: Sensor, interval_s: Option<f64>) -> Result<(), LogError> {
+    let (rate_bound, unit, what) = match sensor {
+        Sensor::Gyro => (MAX_RATE_RAD_PER_S, "rad", "gyro"),
+        Sensor::Accel => (MAX_SPECIFIC_FORCE_MPS2, "m/s", "accelerometer"),
+    };
+    let bound = rate_bound * interval_s.unwrap_or(1.0);
+    if si.abs() <= bound {
+        return Ok(());
+    }
+    let limit = match sensor {
+        Sensor::Gyro => "100 rev/s = 628.3 rad/s",
+        Sensor::Accel => "1000 g = 9806.65 m/s²",
+    };
+    let (value, bound_text) = match interval_s {
+        Some(dt) => (format!("{} {unit} in {} s", short_number(si), fixed_number(dt, 6)), format!("{limit}: {} {unit} in {} s", fixed_number(bound, 4), fixed_number(dt, 6))),
+        None => (format!("{} {}", short_number(si), if sensor == Sensor::Gyro { "rad/s" } else { "m/s²" }), limit.to_owned()),
+    };
+    Err(LogError::BadValue {
+        file: file.to_path_buf(),
+        at,
+        column: column.to_owned(),
+        value: short_number(cell),
+        problem: format!("({value}) is beyond what any {what} measures (at most {bound_text}): a damaged file, or a unit other than the column's"),
+    })
+}
+
+/// Checks an encoder or reference angle `si` (rad) read as `cell` from `column` at `at`.
+///
+/// # Errors
+/// [`LogError::BadValue`] naming the value and the bound.
+pub fn check_angle(file: &Path, at: Location, column: &str, cell: f64, si: f64) -> Result<(), LogError> {
+    if si.abs() <= MAX_ANGLE_RAD {
+        return Ok(());
+    }
+    Err(LogError::BadValue {
+        file: file.to_path_buf(),
+        at,
+        column: column.to_owned(),
+        value: short_number(cell),
+        problem: format!("({} rad) is not an angle a table or a reference gives: beyond ±1e8 rad (16 million turns) an f64 no longer resolves 0.01″; a damaged file?", short_number(si)),
+    })
+}
+
+/// Checks a time stamp `t_s` (s after the log's first) read as `cell` from `column` at `at`.
+///
+/// # Errors
+/// [`LogError::BadValue`] naming the value and the bound.
+pub fn check_span(file: &Path, at: Location, column: &str, cell: f64, t_s: f64) -> Result<(), LogError> {
+    if t_s.abs() <= MAX_LOG_SPAN_S {
+        return Ok(());
+    }
+    Err(LogError::BadValue {
+        file: file.to_path_buf(),
+        at,
+        column: column.to_owned(),
+        value: short_number(cell),
+        problem: format!("is {} s from the IMU's first stamp: not a time on the same clock (a log spans at most 1e9 s); a damaged file?", short_number(t_s)),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bounds_refuse_the_absurd_and_say_it_short() {
+        let f = Path::new("imu.csv");
+        let at = Location { row: 12, line: Some(13) };
+        assert!(check_imu_value(f, at, "gyro_x_rad_per_s", 600.0, 600.0, Sensor::Gyro, None).is_ok());
+        assert!(check_imu_value(f, at, "dv_z_mps", 0.049, 0.049, Sensor::Accel, Some(0.005)).is_ok());
+        let e = check_imu_value(f, at, "dtheta_x_rad", 1e300, 1e300, Sensor::Gyro, Some(0.005)).expect_err("1e300 rad").to_string();
+        assert!(e.contains("data row 12 (line 13), column dtheta_x_rad: \"1e300\"") && e.contains("gyro") && e.len() < 300, "{e}");
+        let e = check_imu_value(f, at, "accel_x_g", 2000.0, 19_613.3, Sensor::Accel, None).expect_err("2000 g").to_string();
+        assert!(e.contains("1000 g") && e.contains("m/s²"), "{e}");
+        assert!(check_imu_value(f, at, "gyro_x_rad_per_s", 1.0, f64::NAN, Sensor::Gyro, None).is_err(), "NaN fails every bound");
+        assert!(check_angle(f, at, "outer_rad", 6.0e7, 6.0e7).is_ok());
+        let e = check_angle(f, at, "outer_deg", 1e300, 1e300f64.to_radians()).expect_err("1e300 deg").to_string();
+        assert!(e.contains("\"1e300\"") && e.len() < 300, "{e}");
+        assert!(check_span(f, at, "t_s", 1e300, 1e300).expect_err("1e300 s").to_string().len() < 300);
+    }
+}
