@@ -2,8 +2,9 @@
 //! them (issue 20, "Trust, round 2"): valid log sets of every format (csv, npy, parquet, MCAP, and a
 //! strapdown csv set that aligns on its data) written by `export-log`, damaged by a seeded generator
 //! — bytes flipped, the file cut, its last field cut, garbage appended, columns swapped, added or
-//! dropped, absurd values, rows deleted, repeated or swapped, the manifest and the table description
-//! edited — and run on the real binary. The promises checked on every run:
+//! dropped, absurd values, columns scaled as by a wrong unit, rows deleted, repeated or swapped (also
+//! with gaps carried across), the manifest and the table description edited — and run on the real
+//! binary. The promises checked on every run:
 //!
 //! * exit 0 only with finite results: the JSON has no null where the undamaged run has a number,
 //!   the printed tables no NaN or inf, and damage that cannot be valid data (a NaN, 1e300, a cut
@@ -20,7 +21,8 @@
 //! ```
 //!
 //! (`RINSCOPE_DAMAGE_SEED` picks another seed; `RINSCOPE_DAMAGE_KEEP=1` keeps the cases that break
-//! a promise; `RINSCOPE_DAMAGE_BIN=PATH` runs another build, e.g. a copy of the binary before a fix.) Both print the outcomes per damage class; docs/reliability.md has the table.
+//! a promise; `RINSCOPE_DAMAGE_BIN=PATH` runs another build, e.g. a copy of the binary before a
+//! fix.) Both print the outcomes per damage class; docs/reliability.md has the table.
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 

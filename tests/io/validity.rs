@@ -163,3 +163,31 @@ fn positional_layouts_refuse_files_they_cannot_read_by_position() {
     let e = read(&mcap, Layout::Rinscope).unwrap_err();
     message_of(&e, &mcap, &["MCAP", "layout = \"ros2\""]);
 }
+
+#[test]
+fn bytes_after_a_files_end_are_refused() {
+    // Issue 20, item 8: a second file appended after an MCAP's closing magic, or two Parquet files
+    // joined with `cat` (the second's footer then reads the first's bytes), read as if whole.
+    let dir = scratch("validity_after_end");
+    let messages: Vec<(u64, Vec<u8>)> = (0..50).map(|k| (1_000_000_000 + k * 10_000_000, cdr_imu(1, (k * 10_000_000) as u32, "imu", [0.01, 0.02, 0.03], [0.0, 0.0, 9.8]))).collect();
+    let mcap = dir.join("imu.mcap");
+    write_mcap(&mcap, &[McapTopic { topic: "/imu", schema: "sensor_msgs/msg/Imu", messages }], true);
+    assert_eq!(read(&mcap, Layout::Ros2).unwrap(), 50);
+    let whole = std::fs::read(&mcap).unwrap();
+    for (case, tail) in [("garbage", b"\x00\x01 not mcap".to_vec()), ("twice", whole.clone())] {
+        let path = dir.join(format!("{case}.mcap"));
+        std::fs::write(&path, [whole.clone(), tail].concat()).unwrap();
+        let e = read(&path, Layout::Ros2).unwrap_err();
+        message_of(&e, &path, &["bytes follow the recording's closing magic", &format!("at byte {}", whole.len())]);
+    }
+    let rows: Vec<Vec<f64>> = truth_increments(100).iter().map(|s| vec![s.t_s, s.gyro.x, s.gyro.y, s.gyro.z, s.accel.x, s.accel.y, s.accel.z]).collect();
+    let names = ["t_s", "dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad", "dv_x_mps", "dv_y_mps", "dv_z_mps"];
+    let parquet = dir.join("imu.parquet");
+    write_parquet(&parquet, &names, &rows, None, 40);
+    assert_eq!(read(&parquet, Layout::Rinscope).unwrap(), 100);
+    let joined = dir.join("joined.parquet");
+    let bytes = std::fs::read(&parquet).unwrap();
+    std::fs::write(&joined, [bytes.clone(), bytes].concat()).unwrap();
+    let e = read(&joined, Layout::Rinscope).unwrap_err();
+    message_of(&e, &joined, &["nothing refers to them", "two Parquet files joined"]);
+}
