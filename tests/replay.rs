@@ -443,8 +443,11 @@ fn refused_by(command: &str, log: &Path, expected: &[&str]) -> String {
     message
 }
 
+/// An edit of a table held as column names and rows.
+type TableEdit<'a> = &'a dyn Fn(&mut Vec<String>, &mut Vec<Vec<f64>>);
+
 /// A copy of log set `base` whose file `name` is rewritten by rinscope's writer as `names`/`rows`.
-fn rewritten(base: &Path, dir: &Path, case: &str, name: &str, edit: &dyn Fn(&mut Vec<String>, &mut Vec<Vec<f64>>)) -> PathBuf {
+fn rewritten(base: &Path, dir: &Path, case: &str, name: &str, edit: TableEdit<'_>) -> PathBuf {
     let out = broken(base, dir, case, "log.toml", &|l| l);
     // Read from the base: a file this process read is an input its writer refuses to replace.
     let (source, path) = (base.join(name), out.join(name));

@@ -561,7 +561,7 @@ impl ImuReader {
                 (Sensor::Accel, crate::io::validity::MAX_SPECIFIC_FORCE_MPS2)
             };
             // The hot path: one comparison per value; the message only when it fails.
-            if !(si.abs() <= bound * increments.unwrap_or(1.0)) {
+            if si.is_nan() || si.abs() > bound * increments.unwrap_or(1.0) {
                 let column = self.reader.columns().get(k + 1).map_or("", String::as_str);
                 check_imu_value(&self.path, p.at, column, *cell, si, sensor, increments)?;
             }
