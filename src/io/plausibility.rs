@@ -87,6 +87,9 @@ pub fn check_static(
     let kind = reader.kind();
     let columns = reader.columns().to_vec();
     let (mut sum_g, mut sum_a) = (Vector3::zeros(), Vector3::zeros());
+    // The size of the specific force sample by sample: a table turning the IMU turns its direction,
+    // not its size (the mean vector of a turning IMU is not gravity's size).
+    let mut sum_a_norm = 0.0;
     let mut times = Vec::new();
     for event in reader.by_ref() {
         let ImuEvent::Sample(s) = event? else {
@@ -97,6 +100,7 @@ pub fn check_static(
         }
         sum_g += s.gyro;
         sum_a += s.accel;
+        sum_a_norm += s.accel.norm();
         times.push(s.t_s);
         if times.len() >= 1_000_000 {
             break;
@@ -139,7 +143,7 @@ pub fn check_static(
     let gyro_cols = columns.get(1..4).map_or_else(String::new, |c| c.join(", "));
     let hz = 1.0 / dt;
     let tol = check.gravity_tolerance;
-    let a = mean_a.norm();
+    let a = if n > 0 { sum_a_norm / n as f64 } else { 0.0 };
     let per = |x: f64| {
         if kind == SampleKind::Rates {
             format!("{x:.4} m/s²")
