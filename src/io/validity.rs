@@ -59,13 +59,12 @@ pub(crate) fn check_imu_value(file: &Path, at: Location, column: &str, cell: f64
         Some(dt) => (format!("{} {unit} in {} s", short_number(si), fixed_number(dt, 6)), format!("{limit}: {} {unit} in {} s", fixed_number(bound, 4), fixed_number(dt, 6))),
         None => (format!("{} {}", short_number(si), if sensor == Sensor::Gyro { "rad/s" } else { "m/s²" }), limit.to_owned()),
     };
-    Err(LogError::BadValue {
-        file: file.to_path_buf(),
-        at,
-        column: column.to_owned(),
-        value: short_number(cell),
-        problem: format!("({value}) is beyond what any {what} measures (at most {bound_text}): a damaged file, or a unit other than the column's"),
-    })
+    Err(bad_value(file, at, column, cell, format!("({value}) is beyond what any {what} measures (at most {bound_text}): a damaged file, or a unit other than the column's")))
+}
+
+/// The one refusal of the rule: `cell` as read from `column` at `at` of `file`, in short form, and why.
+fn bad_value(file: &Path, at: Location, column: &str, cell: f64, problem: String) -> LogError {
+    LogError::BadValue { file: file.to_path_buf(), at, column: column.to_owned(), value: short_number(cell), problem }
 }
 
 /// Checks an encoder or reference angle `si` (rad) read as `cell` from `column` at `at`.
@@ -76,13 +75,7 @@ pub fn check_angle(file: &Path, at: Location, column: &str, cell: f64, si: f64) 
     if si.abs() <= MAX_ANGLE_RAD {
         return Ok(());
     }
-    Err(LogError::BadValue {
-        file: file.to_path_buf(),
-        at,
-        column: column.to_owned(),
-        value: short_number(cell),
-        problem: format!("({} rad) is not an angle a table or a reference gives: beyond ±1e8 rad (16 million turns) an f64 no longer resolves 0.01″; a damaged file?", short_number(si)),
-    })
+    Err(bad_value(file, at, column, cell, format!("({} rad) is not an angle a table or a reference gives: beyond ±1e8 rad (16 million turns) an f64 no longer resolves 0.01″; a damaged file?", short_number(si))))
 }
 
 /// Checks a time stamp `t_s` (s after the log's first) read as `cell` from `column` at `at`.
@@ -93,13 +86,7 @@ pub fn check_span(file: &Path, at: Location, column: &str, cell: f64, t_s: f64) 
     if t_s.abs() <= MAX_LOG_SPAN_S {
         return Ok(());
     }
-    Err(LogError::BadValue {
-        file: file.to_path_buf(),
-        at,
-        column: column.to_owned(),
-        value: short_number(cell),
-        problem: format!("is {} s from the IMU's first stamp: not a time on the same clock (a log spans at most 1e9 s); a damaged file?", short_number(t_s)),
-    })
+    Err(bad_value(file, at, column, cell, format!("is {} s from the IMU's first stamp: not a time on the same clock (a log spans at most 1e9 s); a damaged file?", short_number(t_s))))
 }
 
 #[cfg(test)]
