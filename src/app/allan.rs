@@ -8,9 +8,12 @@ use std::time::Instant;
 use nalgebra::Vector3;
 
 use super::playback::{ImuItem, ImuSamples, PlaybackError};
-use crate::ins::allan::{analyze_imu, ChannelError, ImuAllan, Truth};
+use crate::ins::allan::{analyze_channel, analyze_imu, ChannelError, ImuAllan, Sensor, Truth};
+use crate::io::series::{read_series, Sampling, SeriesColumn};
+use crate::io::units::Quantity;
 use crate::ins::InsParams;
-use crate::math::allan::{AllanOptions, Phase, TauSpacing, MIN_SAMPLES};
+use crate::math::allan::estimators::Estimator;
+use crate::math::allan::{averaging_factors, AllanOptions, Phase, TauSpacing, MIN_SAMPLES};
 use crate::math::units::RAD_PER_DEG;
 use crate::scenario::logset::LogSet;
 use crate::scenario::Params;
@@ -18,8 +21,10 @@ use crate::scenario::Params;
 /// How to analyse.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AllanRequest {
-    /// Cluster times: None octaves (m = 1, 2, 4, ...), Some(n) n per decade.
-    pub per_decade: Option<u32>,
+    /// Cluster times (`--taus`).
+    pub spacing: TauSpacing,
+    /// The curves asked for (`--estimator`; OADEV, with the IEEE fit, by default).
+    pub estimators: Vec<Estimator>,
     /// Sum this many samples into one first (1: none).
     pub decimate: usize,
     /// Half-width of the confidence intervals, normal sigmas.
@@ -31,7 +36,7 @@ pub struct AllanRequest {
 
 impl Default for AllanRequest {
     fn default() -> Self {
-        Self { per_decade: None, decimate: 1, ci_sigma: 1.0, errors_only: false }
+        Self { spacing: TauSpacing::Octave, estimators: vec![Estimator::Oadev], decimate: 1, ci_sigma: 1.0, errors_only: false }
     }
 }
 
@@ -133,12 +138,32 @@ pub fn options(req: &AllanRequest) -> Result<AllanOptions, AllanRunError> {
     if !(req.ci_sigma > 0.0 && req.ci_sigma <= 3.0) {
         return Err(AllanRunError::Config(format!("--ci-sigma {}: must be > 0 and <= 3 (normal sigmas)", req.ci_sigma)));
     }
-    let spacing = match req.per_decade {
-        None => TauSpacing::Octave,
-        Some(n) if (1..=100).contains(&n) => TauSpacing::PerDecade(n),
-        Some(n) => return Err(AllanRunError::Config(format!("--per-decade {n}: must be 1 ..= 100 cluster times per decade"))),
-    };
-    Ok(AllanOptions { spacing, ci_sigma: req.ci_sigma, ..AllanOptions::default() })
+    if let TauSpacing::PerDecade(n) = req.spacing {
+        if n == 0 {
+            return Err(AllanRunError::Config("--taus 0: give at least 1 cluster time per decade (or octave, decade, all)".into()));
+        }
+    }
+    if req.estimators.is_empty() {
+        return Err(AllanRunError::Config("--estimator: name at least one (adev, oadev, mdev, tdev, hdev, ohdev, totdev, or all)".into()));
+    }
+    Ok(AllanOptions { spacing: req.spacing.clone(), ci_sigma: req.ci_sigma, ..AllanOptions::default() })
+}
+
+/// Most series points × cluster times the analysis takes on (about a minute on one core).
+const MAX_WORK: f64 = 3e10;
+
+/// Refuses a τ set whose cost is out of reach (`--taus all` on millions of samples), naming the
+/// way out.
+fn check_work(n: usize, opts: &AllanOptions, req: &AllanRequest) -> Result<(), AllanRunError> {
+    let taus = averaging_factors(n / opts.min_clusters.max(2), &opts.spacing).map_err(|e| AllanRunError::Config(e.to_string()))?.len();
+    let work = n as f64 * taus as f64 * req.estimators.len().max(1) as f64;
+    if work > MAX_WORK {
+        return Err(AllanRunError::Config(format!(
+            "{taus} cluster times × {n} samples × {} estimator(s) = {work:.1e} operations, beyond the {MAX_WORK:.0e} this command takes on: give --taus octave, decade or N per decade, or --decimate",
+            req.estimators.len()
+        )));
+    }
+    Ok(())
 }
 
 /// The configured noise of an `[imu]` (None if it configures none: nothing to compare with).
@@ -287,6 +312,70 @@ fn finish(g: Gather, source: String, seed: Option<u64>, rate_hz: f64, truth: Opt
     }
     let started = Instant::now();
     let tau0_s = req.decimate as f64 / rate_hz;
-    let channels = analyze_imu(&g.phases, tau0_s, opts, truth, true)?;
+    check_work(n, opts, req)?;
+    let channels = analyze_imu(&g.phases, tau0_s, opts, &req.estimators, truth, true)?;
     Ok(ImuAllan { source, seed, rate_hz, decimate: req.decimate, samples: n, ci_sigma: req.ci_sigma, channels, notes, interrupted, gather_s, analysis_s: started.elapsed().as_secs_f64() })
+}
+
+/// `allan --series`: the columns of one table file, each its own channel (a gyro for angular
+/// units, an accelerometer for linear ones, a clock for time and fractional frequency), analysed
+/// as far as each estimator is defined (m up to N/2: no 16-sample minimum; the IEEE fit needs 16).
+///
+/// # Errors
+/// The file, a column, the sampling, a request out of range, a channel with too few samples.
+pub fn series(path: &std::path::Path, columns: &[SeriesColumn], sampling: &Sampling, req: &AllanRequest) -> Result<ImuAllan, AllanRunError> {
+    let mut opts = options(req)?;
+    opts.min_clusters = 2;
+    let started = Instant::now();
+    let data = read_series(path, columns, sampling).map_err(|e| AllanRunError::Config(e.to_string()))?;
+    let gather_s = started.elapsed().as_secs_f64();
+    let started = Instant::now();
+    let mut notes = Vec::new();
+    let mut channels = Vec::new();
+    for ((spec, name), increments) in data.columns.iter().zip(&data.names).zip(&data.increments) {
+        let sensor = match spec.increment_quantity() {
+            Quantity::Angle => Sensor::Gyro,
+            Quantity::Velocity => Sensor::Accel,
+            _ => Sensor::Clock,
+        };
+        let phase = decimated(increments, req.decimate);
+        check_work(phase.len(), &opts, req)?;
+        let channel = analyze_channel(sensor, name, &phase, data.tau0_s * req.decimate as f64, &opts, &req.estimators, None)?;
+        if sensor.is_inertial() && channel.report.is_none() {
+            notes.push(format!("{}: {} samples, fewer than the {MIN_SAMPLES} the IEEE fit needs: the curves only, as far as each estimator is defined", channel.name(), phase.len()));
+        }
+        if !sensor.is_inertial() {
+            notes.push(format!("{}: a clock (a {} in {}): the power-law noise type per τ is in the table; no IEEE 952 fit (an inertial-sensor standard)", channel.name(), spec.kind.name(), spec.unit_text()));
+        }
+        for k in &channel.curves {
+            let limit = k.estimator.max_m(phase.len() + 1).min(phase.len() / 2);
+            if phase.len() < 64 {
+                notes.push(format!("{}: {} samples: {} defined up to m = {limit} (τ = {} s)", channel.name(), phase.len(), k.estimator.name(), limit as f64 * data.tau0_s * req.decimate as f64));
+            }
+        }
+        channels.push(channel);
+    }
+    let source = format!("series {} ({})", path.display(), data.columns.iter().zip(&data.names).map(|(c, n)| format!("{n}: {} ({})", c.kind.name(), c.unit_text())).collect::<Vec<_>>().join("; "));
+    Ok(ImuAllan {
+        source,
+        seed: None,
+        rate_hz: 1.0 / data.tau0_s,
+        decimate: req.decimate,
+        samples: data.increments.first().map_or(0, Vec::len) / req.decimate,
+        ci_sigma: req.ci_sigma,
+        channels,
+        notes,
+        interrupted: false,
+        gather_s,
+        analysis_s: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// The phase of `increments` summed `by` at a time (a partial last block dropped).
+fn decimated(increments: &[f64], by: usize) -> Phase {
+    if by <= 1 {
+        return Phase::from_increments(increments);
+    }
+    let sums: Vec<f64> = increments.chunks_exact(by).map(|c| c.iter().sum()).collect();
+    Phase::from_increments(&sums)
 }

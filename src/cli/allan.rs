@@ -8,7 +8,43 @@ use super::{AllanArgs, Failure};
 use crate::app::allan::{self, AllanRequest, AllanRunError};
 use crate::app::terminate::stop_flag;
 use crate::record::export::Exporter;
+use crate::io::series::{Sampling, SeriesColumn};
+use crate::io::units::{unit_named, Quantity};
+use crate::io::Col;
+use crate::math::allan::estimators::Estimator;
+use crate::math::allan::TauSpacing;
 use crate::scenario::{self, logset};
+use std::path::PathBuf;
+
+/// `--taus`: octave, decade, all, or N per decade (1 ..= 1000).
+fn parse_taus(text: &str) -> Result<TauSpacing, Failure> {
+    match text.trim() {
+        "octave" => Ok(TauSpacing::Octave),
+        "decade" => Ok(TauSpacing::Decade),
+        "all" => Ok(TauSpacing::All),
+        t => match t.parse::<u32>() {
+            Ok(n) if (1..=1000).contains(&n) => Ok(TauSpacing::PerDecade(n)),
+            _ => Err(Failure::input(format!("allan: --taus {t:?}: give octave, decade, all, or a number of cluster times per decade (1 ..= 1000)"))),
+        },
+    }
+}
+
+/// `--estimator`: a comma-separated list of Stable32's names, or all.
+fn parse_estimators(text: &str) -> Result<Vec<Estimator>, Failure> {
+    if text.trim() == "all" {
+        return Ok(Estimator::ALL.to_vec());
+    }
+    let mut list = Vec::new();
+    for name in text.split(',').map(str::trim).filter(|n| !n.is_empty()) {
+        let e = Estimator::parse(&name.to_lowercase()).ok_or_else(|| {
+            Failure::input(format!("allan: --estimator {name:?} is not an estimator (adev, oadev, mdev, tdev, hdev, ohdev, totdev, or all)"))
+        })?;
+        if !list.contains(&e) {
+            list.push(e);
+        }
+    }
+    Ok(list)
+}
 
 /// The preset `rinscope allan` simulates when given neither a log set nor a scenario.
 const DEFAULT_SCENARIO: &str = "static-imu-10h";
@@ -29,19 +65,40 @@ pub(super) fn allan(args: &AllanArgs) -> Result<(), Failure> {
     if args.errors_only && args.dir.is_some() {
         return Err(Failure::input("allan: --errors-only needs the truth, which only a simulation has (give --scenario or --config)"));
     }
-    let request = AllanRequest { per_decade: args.per_decade, decimate: args.decimate, ci_sigma: args.ci_sigma, errors_only: args.errors_only };
+    let spacing = match (&args.taus, args.per_decade) {
+        (Some(t), _) => parse_taus(t)?,
+        (None, Some(n)) => parse_taus(&n.to_string()).map_err(|e| Failure::input(e.message.replace("--taus", "--per-decade")))?,
+        (None, None) => TauSpacing::Octave,
+    };
+    let request = AllanRequest { spacing, estimators: parse_estimators(&args.estimator)?, decimate: args.decimate, ci_sigma: args.ci_sigma, errors_only: args.errors_only };
     allan::options(&request)?;
     enum Source {
         Log(Box<logset::LogSet>),
         Scenario(Box<scenario::Params>),
+        Series(PathBuf, Vec<SeriesColumn>, Sampling),
     }
-    let (source, name, description) = match &args.dir {
-        Some(dir) => {
+    let (source, name, description) = match (&args.dir, &args.series) {
+        (_, Some(file)) => {
+            let columns = args.column.iter().map(|c| SeriesColumn::parse(c).map_err(|e| Failure::input(format!("allan: {e}")))).collect::<Result<Vec<_>, _>>()?;
+            let sampling = match (&args.time_column, args.rate_hz) {
+                (Some(t), _) => {
+                    let (col, unit) = t.rsplit_once(':').map_or((t.as_str(), "s"), |(c, u)| (c, u));
+                    let unit = unit_named(unit).filter(|u| u.quantity == Quantity::Time).ok_or_else(|| Failure::input(format!("allan: --time-column {t:?}: {unit:?} is not a unit of time (s, ms, us, ns)")))?;
+                    Sampling::TimeColumn(col.parse::<usize>().map_or_else(|_| Col::Name(col.to_owned()), Col::Index), unit)
+                }
+                (None, Some(hz)) => Sampling::RateHz(hz),
+                (None, None) => return Err(Failure::input("allan: --series needs the sampling: --rate-hz HZ or --time-column COLUMN[:UNIT]")),
+            };
+            let stem = file.file_stem().map_or_else(|| "series".to_owned(), |s| s.to_string_lossy().into_owned());
+            let description = format!("Series `{}`, columns {}.", file.display(), args.column.join(", "));
+            (Source::Series(file.clone(), columns, sampling), stem, description)
+        }
+        (Some(dir), None) => {
             let log = logset::load_imu(dir)?;
             let (name, description) = (log.name.clone(), log.description.clone());
             (Source::Log(Box::new(log)), name, description)
         }
-        None => {
+        (None, None) => {
             let mut params = args.source.load(DEFAULT_SCENARIO)?;
             if let Some(d) = args.duration_s {
                 if !(d.is_finite() && d > 0.0 && d <= scenario::MAX_DURATION_S) {
@@ -81,6 +138,10 @@ pub(super) fn allan(args: &AllanArgs) -> Result<(), Failure> {
         Source::Log(log) => {
             errln!("rinscope: reading {} ...", log.imu.path.display());
             allan::log_set(log, &request, &stop, &progress)
+        }
+        Source::Series(file, columns, sampling) => {
+            errln!("rinscope: reading {} ...", file.display());
+            allan::series(file, columns, sampling, &request)
         }
         Source::Scenario(p) => {
             errln!("rinscope: simulating {:.2} h of {} at {} Hz, then the Allan analysis of 6 channels ...", p.duration_s / 3600.0, p.meta.name, p.step_hz);

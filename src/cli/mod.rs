@@ -357,8 +357,34 @@ struct ReplayArgs {
 #[derive(Args)]
 struct AllanArgs {
     /// A log set's folder (with log.toml) to analyse instead of simulating a scenario.
-    #[arg(conflicts_with_all = ["scenario", "config", "duration_s"])]
+    #[arg(conflicts_with_all = ["scenario", "config", "duration_s", "series"])]
     dir: Option<PathBuf>,
+    /// Any series instead: a table file (CSV/text, .npy, Parquet) whose --column(s) to analyse,
+    /// sampled at --rate-hz or stamped by --time-column. No log set, no table.toml.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["scenario", "config", "duration_s", "errors_only"], requires = "column")]
+    series: Option<PathBuf>,
+    /// With --series: COLUMN:KIND[:UNIT], repeatable. COLUMN a header name or a 0-based position;
+    /// KIND rate (deg/s, deg/h, rad/s, m/s2, g, mg, ug), increment (rad, deg, arcsec, m/s, s),
+    /// phase (s, ns, ps; rad, deg; m/s) or frequency (fractional: 1, ppm, ppb, ppt).
+    /// E.g. gyro_z:rate:deg/s, 2:frequency, x:phase:ns.
+    #[arg(long, value_name = "COLUMN:KIND[:UNIT]", requires = "series")]
+    column: Vec<String>,
+    /// With --series: the sample rate, Hz (or --time-column).
+    #[arg(long, value_name = "HZ", requires = "series", conflicts_with = "time_column")]
+    rate_hz: Option<f64>,
+    /// With --series: the column of sample times, COLUMN[:UNIT] (unit s, ms, us, ns; default s);
+    /// the samples must be evenly spaced (to 1 %).
+    #[arg(long, value_name = "COLUMN[:UNIT]", requires = "series")]
+    time_column: Option<String>,
+    /// The estimators, comma-separated, as Stable32 and allantools name them: adev, oadev
+    /// (default), mdev, tdev, hdev, ohdev, totdev, or all. The IEEE coefficients are always read
+    /// from the overlapping Allan variance (IEEE 952 defines them on it).
+    #[arg(long, value_name = "LIST", default_value = "oadev")]
+    estimator: String,
+    /// Cluster times: octave (m = 1, 2, 4, ...; default), decade (1, 2, 4, 10, 20, 40, ...),
+    /// all (every m), or N per decade.
+    #[arg(long, value_name = "SET", conflicts_with = "per_decade")]
+    taus: Option<String>,
     // Default static-imu-10h.
     #[command(flatten)]
     source: ScenarioSource,
@@ -370,7 +396,7 @@ struct AllanArgs {
     /// Override the scenario's simulated duration, s.
     #[arg(long)]
     duration_s: Option<f64>,
-    /// Cluster times per decade (default: octaves, m = 1, 2, 4, ...).
+    /// Cluster times per decade (the same as --taus N).
     #[arg(long, value_name = "N")]
     per_decade: Option<u32>,
     /// Sum this many samples into one before the analysis (a long, fast log in less memory).

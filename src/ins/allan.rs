@@ -7,7 +7,8 @@ use serde_json::{json, Map, Value};
 
 use super::noise::IeeeTerms;
 use super::sensor::{AccelSpec, GyroSpec};
-use crate::math::allan::{analyze, gauss_markov_avar, AllanError, AllanOptions, AllanReport, Estimate, NoiseTerm, Phase, SlopeReading, TERMS};
+use crate::math::allan::estimators::{deviation_curve, DeviationCurve, Estimator};
+use crate::math::allan::{analyze, averaging_factors, gauss_markov_avar, AllanError, AllanOptions, AllanReport, Estimate, NoiseTerm, Phase, SlopeReading, MIN_SAMPLES, TERMS};
 use crate::math::units::{
     MPS2_PER_SQRT_S_PER_UG_PER_SQRT_H, MPS2_PER_UG, MPS3_PER_UG_PER_H, MPS_PER_SQRT_S_PER_UG_PER_SQRT_HZ, RAD_PER_ARCSEC, RAD_PER_S2_PER_DEG_PER_H2, RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H,
     RAD_PER_S_PER_DEG_PER_H, RAD_PER_S_PER_SQRT_S_PER_DEG_PER_H_PER_SQRT_H,
@@ -16,13 +17,16 @@ use crate::math::units::{
 /// The axis names, in channel order.
 pub const AXES: [&str; 3] = ["x", "y", "z"];
 
-/// Which triad a channel belongs to.
+/// What a channel measures.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Sensor {
     /// Gyros: increments in rad, rates in rad/s.
     Gyro,
     /// Accelerometers: increments in m/s, rates in m/s².
     Accel,
+    /// A clock or an oscillator (`allan --series` of a phase in s or a fractional frequency):
+    /// increments in s, "rates" dimensionless. No IEEE 952 fit; the noise type per τ instead.
+    Clock,
 }
 
 /// A conventional unit: its name in JSON keys and entity paths, as printed, and its SI value.
@@ -37,25 +41,49 @@ pub struct Unit {
 }
 
 impl Sensor {
-    /// Both, in channel order.
-    pub const ALL: [Sensor; 2] = [Sensor::Gyro, Sensor::Accel];
+    /// All, in channel order.
+    pub const ALL: [Sensor; 3] = [Sensor::Gyro, Sensor::Accel, Sensor::Clock];
 
-    /// "gyro" or "accel".
+    /// "gyro", "accel" or "clock".
     #[must_use]
     pub fn name(self) -> &'static str {
         match self {
             Self::Gyro => "gyro",
             Self::Accel => "accel",
+            Self::Clock => "clock",
         }
     }
 
-    /// The unit of the Allan deviation of its rate: °/h for gyros, µg for accelerometers.
+    /// The IEEE 952 / 1293 coefficients apply (inertial sensors).
+    #[must_use]
+    pub fn is_inertial(self) -> bool {
+        self != Self::Clock
+    }
+
+    /// The unit of the Allan deviation of its rate: °/h for gyros, µg for accelerometers, a
+    /// fractional frequency (dimensionless) for clocks.
     #[must_use]
     pub fn adev_unit(self) -> Unit {
         match self {
             Self::Gyro => Unit { key: "deg_per_h", text: "°/h", si: RAD_PER_S_PER_DEG_PER_H },
             Self::Accel => Unit { key: "ug", text: "µg", si: MPS2_PER_UG },
+            Self::Clock => Unit { key: "frac", text: "", si: 1.0 },
         }
+    }
+
+    /// The unit of a deviation of the phase (TDEV): arcsec, m/s, ns.
+    #[must_use]
+    pub fn phase_unit(self) -> Unit {
+        match self {
+            Self::Clock => Unit { key: "ns", text: "ns", si: 1e-9 },
+            _ => self.unit(NoiseTerm::Quantization),
+        }
+    }
+
+    /// The unit of `estimator`'s deviation.
+    #[must_use]
+    pub fn deviation_unit(self, estimator: Estimator) -> Unit {
+        if estimator.is_of_phase() { self.phase_unit() } else { self.adev_unit() }
     }
 
     /// The conventional unit of a coefficient (IEEE 952 for gyros, 1293 for accelerometers).
@@ -72,6 +100,12 @@ impl Sensor {
             (Self::Accel, NoiseTerm::BiasInstability) => ("ug", "µg", MPS2_PER_UG),
             (Self::Accel, NoiseTerm::RateRandomWalk) => ("ug_per_sqrt_h", "µg/√h", MPS2_PER_SQRT_S_PER_UG_PER_SQRT_H),
             (Self::Accel, NoiseTerm::RateRamp) => ("ug_per_h", "µg/h", MPS3_PER_UG_PER_H),
+            // A clock's coefficients of the same model, SI (σ_y² = 3Q²/τ² + N²/τ + ...).
+            (Self::Clock, NoiseTerm::Quantization) => ("s", "s", 1.0),
+            (Self::Clock, NoiseTerm::RandomWalk) => ("sqrt_s", "√s", 1.0),
+            (Self::Clock, NoiseTerm::BiasInstability) => ("frac", "", 1.0),
+            (Self::Clock, NoiseTerm::RateRandomWalk) => ("per_sqrt_s", "/√s", 1.0),
+            (Self::Clock, NoiseTerm::RateRamp) => ("per_s", "/s", 1.0),
         };
         Unit { key, text, si }
     }
@@ -88,6 +122,9 @@ impl Sensor {
             (Self::Accel, NoiseTerm::RateRandomWalk) => "acceleration random walk",
             (Self::Gyro, NoiseTerm::RateRamp) => "rate ramp",
             (Self::Accel, NoiseTerm::RateRamp) => "acceleration ramp",
+            (Self::Clock, NoiseTerm::RandomWalk) => "white FM",
+            (Self::Clock, NoiseTerm::RateRandomWalk) => "random-walk FM",
+            (Self::Clock, NoiseTerm::RateRamp) => "frequency drift",
         }
     }
 
@@ -141,12 +178,15 @@ impl Truth {
 /// One channel's analysis.
 #[derive(Debug, Clone)]
 pub struct Channel {
-    /// Gyro or accelerometer.
+    /// Gyro, accelerometer or clock.
     pub sensor: Sensor,
-    /// 0, 1, 2 for x, y, z.
-    pub axis: usize,
-    /// The curve, its confidence, the fit.
-    pub report: AllanReport,
+    /// The axis (x, y, z) or the series' column name.
+    pub label: String,
+    /// The overlapping Allan deviation, its confidence, the IEEE fit (inertial sensors with at
+    /// least [`MIN_SAMPLES`] samples; IEEE 952 defines the coefficients on this estimator).
+    pub report: Option<AllanReport>,
+    /// The curves of the other estimators asked for (and OADEV's, where there is no `report`).
+    pub curves: Vec<DeviationCurve>,
     /// What was configured, if known.
     pub truth: Option<Truth>,
 }
@@ -155,13 +195,13 @@ impl Channel {
     /// "gyro x".
     #[must_use]
     pub fn name(&self) -> String {
-        format!("{} {}", self.sensor.name(), AXES[self.axis])
+        format!("{} {}", self.sensor.name(), self.label)
     }
 
-    /// The fitted coefficient of `term` in its conventional unit.
+    /// The fitted coefficient of `term` in its conventional unit (zero, not found, without a fit).
     #[must_use]
     pub fn fitted(&self, term: NoiseTerm) -> Estimate {
-        self.report.fit.get(term).scaled(1.0 / self.sensor.unit(term).si)
+        self.report.as_ref().map_or(Estimate { value: 0.0, sigma: 0.0, significant: false }, |r| r.fit.get(term)).scaled(1.0 / self.sensor.unit(term).si)
     }
 
     /// The configured coefficient of `term` in its conventional unit (None without a truth).
@@ -182,20 +222,45 @@ pub struct ChannelError {
 }
 
 /// Analyses the six channels (`phases` in the order gyro x, y, z, accel x, y, z) sampled every
-/// `tau0_s`; `truth` holds the gyros' and the accelerometers' configured noise. `parallel`: one
-/// channel per core (rayon), else one after the other (the benchmark's single-core number).
+/// `tau0_s`; `truth` holds the gyros' and the accelerometers' configured noise; `estimators` the
+/// curves asked for beside the IEEE fit's OADEV. `parallel`: one channel per core (rayon), else
+/// one after the other (the benchmark's single-core number).
 ///
 /// # Errors
 /// The first channel that cannot be analysed, named.
-pub fn analyze_imu(phases: &[Phase], tau0_s: f64, opts: &AllanOptions, truth: Option<[Truth; 2]>, parallel: bool) -> Result<Vec<Channel>, ChannelError> {
+pub fn analyze_imu(phases: &[Phase], tau0_s: f64, opts: &AllanOptions, estimators: &[Estimator], truth: Option<[Truth; 2]>, parallel: bool) -> Result<Vec<Channel>, ChannelError> {
     use rayon::prelude::*;
-    let one = |i: usize| -> Result<Channel, ChannelError> {
-        let (sensor, axis) = (Sensor::ALL[i / 3], i % 3);
-        let report = analyze(&phases[i], tau0_s, opts).map_err(|error| ChannelError { channel: format!("{} {}", sensor.name(), AXES[axis]), error })?;
-        Ok(Channel { sensor, axis, report, truth: truth.map(|t| t[i / 3]) })
-    };
+    let one = |i: usize| analyze_channel(Sensor::ALL[i / 3], AXES[i % 3], &phases[i], tau0_s, opts, estimators, truth.map(|t| t[i / 3]));
     let n = phases.len().min(6);
     if parallel { (0..n).into_par_iter().map(one).collect() } else { (0..n).map(one).collect() }
+}
+
+/// Analyses one channel: for an inertial sensor with at least [`MIN_SAMPLES`] samples, the
+/// OADEV and its IEEE fit ([`analyze`]) at the cluster sizes of `opts`; and the curves of
+/// `estimators` (OADEV's too where there is no fit) at the same spacing, each as far as it is
+/// defined and `opts.min_clusters` allows.
+///
+/// # Errors
+/// A non-finite sample, too few samples for any estimator, a bad option; named by channel.
+pub fn analyze_channel(sensor: Sensor, label: &str, phase: &Phase, tau0_s: f64, opts: &AllanOptions, estimators: &[Estimator], truth: Option<Truth>) -> Result<Channel, ChannelError> {
+    let fail = |error| ChannelError { channel: format!("{} {label}", sensor.name()), error };
+    if let Some((index, value)) = phase.first_bad() {
+        return Err(fail(AllanError::NonFinite { index, value }));
+    }
+    let report = if sensor.is_inertial() && phase.len() >= MIN_SAMPLES.max(2 * opts.min_clusters) { Some(analyze(phase, tau0_s, opts).map_err(fail)?) } else { None };
+    let x = phase.points();
+    // Every curve at the spacing of the fit, up to N / min_clusters (each as far as it is defined).
+    let m_max = phase.len() / opts.min_clusters.max(2);
+    let ms = averaging_factors(m_max, &opts.spacing).map_err(fail)?;
+    let curves: Vec<DeviationCurve> = estimators
+        .iter()
+        .filter(|e| report.is_none() || **e != Estimator::Oadev)
+        .map(|e| deviation_curve(*e, x, tau0_s, &ms, opts.ci_sigma))
+        .collect();
+    if report.is_none() && curves.iter().all(|c| c.m.is_empty()) {
+        return Err(fail(AllanError::TooFewSamples { got: phase.len(), min: 2 }));
+    }
+    Ok(Channel { sensor, label: label.to_owned(), report, curves, truth })
 }
 
 /// The analysis of an IMU log.
@@ -255,8 +320,14 @@ impl ImuAllan {
     /// The shortest and the longest cluster time analysed, s.
     #[must_use]
     pub fn tau_range_s(&self) -> (f64, f64) {
-        let taus = self.channels.first().map(|c| c.report.taus_s.as_slice()).unwrap_or_default();
-        (taus.first().copied().unwrap_or(0.0), taus.last().copied().unwrap_or(0.0))
+        let taus = self.channels.iter().flat_map(|c| c.report.iter().map(|r| r.taus_s.as_slice()).chain(c.curves.iter().map(|k| k.taus_s.as_slice())));
+        taus.fold((f64::INFINITY, 0.0), |(lo, hi), t| (lo.min(t.first().copied().unwrap_or(lo)), hi.max(t.last().copied().unwrap_or(hi))))
+    }
+
+    /// Number of cluster times of the longest curve.
+    #[must_use]
+    pub fn tau_count(&self) -> usize {
+        self.channels.iter().flat_map(|c| c.report.iter().map(|r| r.taus_s.len()).chain(c.curves.iter().map(|k| k.taus_s.len()))).max().unwrap_or(0)
     }
 
     /// The one-line heading.
@@ -272,7 +343,7 @@ impl ImuAllan {
             self.rate_hz,
             if self.decimate > 1 { format!(" summed by {}", self.decimate) } else { String::new() },
             self.samples as f64 * tau0 / 3600.0,
-            self.channels.first().map_or(0, |c| c.report.taus_s.len()),
+            self.tau_count(),
             sig(lo, 3),
             sig(hi, 4),
             self.ci_sigma
@@ -289,18 +360,18 @@ impl ImuAllan {
         s.push_str(&self.heading());
         s.push('\n');
         for sensor in Sensor::ALL {
-            let chans: Vec<&Channel> = self.channels.iter().filter(|c| c.sensor == sensor).collect();
+            let chans: Vec<(&Channel, &AllanReport)> = self.channels.iter().filter(|c| c.sensor == sensor).filter_map(|c| c.report.as_ref().map(|r| (c, r))).collect();
             if chans.is_empty() {
                 continue;
             }
-            let truth = chans[0].truth;
+            let truth = chans[0].0.truth;
             let labels: Vec<String> = TERMS.iter().map(|t| format!("{} {} ({})", t.letter(), sensor.term_name(*t), sensor.unit(*t).text)).collect();
             let w = labels.iter().map(|l| l.chars().count()).max().unwrap_or(0) + 2;
-            let cells: Vec<Vec<String>> = TERMS.iter().map(|t| chans.iter().map(|c| cell(c.fitted(*t), c.configured(*t))).collect()).collect();
+            let cells: Vec<Vec<String>> = TERMS.iter().map(|t| chans.iter().map(|(c, _)| cell(c.fitted(*t), c.configured(*t))).collect()).collect();
             let cw = cells.iter().flatten().map(|c| c.chars().count()).max().unwrap_or(0).max(4) + 2;
             s += &format!("\n{:<w$}", format!("{} (fit ±1σ, error)", sensor.name()));
-            for c in &chans {
-                s += &format!("{:<cw$}", AXES[c.axis]);
+            for (c, _) in &chans {
+                s += &format!("{:<cw$}", c.label);
             }
             if truth.is_some() {
                 s += "configured";
@@ -311,21 +382,21 @@ impl ImuAllan {
                 for c in &cells[k] {
                     s += &format!("{c:<cw$}");
                 }
-                if let Some(v) = chans[0].configured(*term) {
+                if let Some(v) = chans[0].0.configured(*term) {
                     s += &sig(v, 4);
                 }
                 s = s.trim_end().to_owned();
                 s.push('\n');
             }
             s += &format!("{:<w$}", "χ²/dof of the fit");
-            for c in &chans {
-                s += &format!("{:<cw$}", sig(c.report.fit_chi2_per_dof, 3));
+            for (_, r) in &chans {
+                s += &format!("{:<cw$}", sig(r.fit_chi2_per_dof, 3));
             }
             s = s.trim_end().to_owned();
             s.push('\n');
-            for c in &chans {
-                for w in &c.report.fit_contradictions {
-                    s += &format!("WARNING {} {}: {}\n", sensor.name(), AXES[c.axis], w.text());
+            for (c, r) in &chans {
+                for w in &r.fit_contradictions {
+                    s += &format!("WARNING {}: {}\n", c.name(), w.text());
                 }
             }
             if let Some(t) = truth.filter(Truth::has_markov) {
@@ -337,7 +408,16 @@ impl ImuAllan {
                 );
             }
         }
-        s.push_str("\n± the fit's 1σ (weighted NNLS of the IEEE 952/1293 model, inflated by √(χ²/dof)); (…) its error against the configured value;\n— not found, with its 1σ detection limit. Slope-line readings, the curves, their bounds and EDF are in --json.\n");
+        if self.channels.iter().any(|c| c.report.is_some()) {
+            s.push_str("\n± the fit's 1σ (weighted NNLS of the IEEE 952/1293 model on the overlapping Allan variance, inflated by √(χ²/dof));\n(…) its error against the configured value; — not found, with its 1σ detection limit. Slope-line readings, the curves,\ntheir bounds and EDF are in --json and --export.\n");
+        }
+        for c in self.channels.iter().filter(|c| !c.curves.is_empty()) {
+            // Three estimators per table: a terminal's width.
+            for group in c.curves.chunks(3) {
+                s += &curve_table(c, group, self.ci_sigma);
+            }
+            s += "noise: the power law the EDF assumed (WPM/FPM white/flicker phase, WFM/FFM/RWFM white/flicker/random-walk rate), by the lag-1\nautocorrelation; * carried from a shorter τ (under 30 points). EDF per τ in --json and --export.\n";
+        }
         for n in &self.notes {
             s += &format!("note: {n}\n");
         }
@@ -347,10 +427,11 @@ impl ImuAllan {
     /// One sensor's coefficients as a markdown table, a row per axis (the recording's documents).
     #[must_use]
     pub fn markdown(&self, sensor: Sensor) -> String {
-        let chans: Vec<&Channel> = self.channels.iter().filter(|c| c.sensor == sensor).collect();
+        let chans: Vec<&Channel> = self.channels.iter().filter(|c| c.sensor == sensor && c.report.is_some()).collect();
         let title = match sensor {
             Sensor::Gyro => "Gyros",
             Sensor::Accel => "Accelerometers",
+            Sensor::Clock => "Clocks",
         };
         let mut s = format!("**{title}**: fit ±1σ (error vs configured); — not found (1σ detection limit)\n\n| |");
         for term in TERMS {
@@ -360,7 +441,7 @@ impl ImuAllan {
         s += &"---|".repeat(TERMS.len());
         s.push('\n');
         for c in &chans {
-            s += &format!("| **{}** |", AXES[c.axis]);
+            s += &format!("| **{}** |", c.label);
             for term in TERMS {
                 s += &format!(" {} |", cell(c.fitted(term), c.configured(term)));
             }
@@ -393,9 +474,12 @@ impl ImuAllan {
         out.insert("interrupted".into(), json!(self.interrupted));
         out.insert("notes".into(), json!(self.notes));
         out.insert("estimator".into(), json!("overlapping Allan deviation of the rate; EDF by NIST SP 1065 Table 5 for the fitted noise mixture; chi-square interval (Wilson-Hilferty); coefficients by weighted NNLS of the IEEE 952/1293 model sigma^2 = 3Q^2/tau^2 + N^2/tau + (2 ln2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2"));
+        out.insert("curves_method".into(), json!("each estimator by its NIST SP 1065 definition; noise type per tau by the lag-1 autocorrelation (Riley & Greenhall 2004); EDF by Greenhall & Riley (PTTI 2003), TOTDEV by SP 1065 Table 7; chi-square interval (Wilson-Hilferty)"));
         for sensor in Sensor::ALL {
             let list: Vec<Value> = self.channels.iter().filter(|c| c.sensor == sensor).map(channel_json).collect();
-            out.insert(sensor.name().into(), Value::Array(list));
+            if sensor.is_inertial() || !list.is_empty() {
+                out.insert(sensor.name().into(), Value::Array(list));
+            }
         }
         Value::Object(out)
     }
@@ -405,13 +489,91 @@ fn reading_json(r: Option<SlopeReading>, si: f64) -> Value {
     r.map_or(Value::Null, |r| json!({"value": r.value_si / si, "sigma": r.sigma_si / si, "tau_s": r.tau_s, "local_slope": r.local_slope, "nominal_slope": r.nominal_slope, "matched": r.matched}))
 }
 
+/// One estimator's curve as JSON, the deviation's unit in the keys.
+fn curve_json(sensor: Sensor, k: &DeviationCurve) -> Value {
+    let u = sensor.deviation_unit(k.estimator);
+    let scale = |v: &[f64]| -> Vec<f64> { v.iter().map(|x| x / u.si).collect() };
+    json!({
+        "estimator": k.estimator.name(),
+        "tau_s": k.taus_s,
+        "m": k.m,
+        format!("dev_{}", u.key): scale(&k.dev),
+        format!("lower_{}", u.key): scale(&k.lower),
+        format!("upper_{}", u.key): scale(&k.upper),
+        "edf": k.edf,
+        "alpha": k.alpha,
+        "alpha_identified": k.alpha_identified,
+        "terms": k.n_terms,
+    })
+}
+
+/// The short name of a noise type in the curve tables (`*`: carried from a shorter τ).
+fn alpha_code(alpha: crate::math::allan::edf::Alpha, identified: bool) -> String {
+    let code = match alpha {
+        2 => "WPM",
+        1 => "FPM",
+        0 => "WFM",
+        -1 => "FFM",
+        -2 => "RWFM",
+        -3 => "FWFM",
+        _ => "RRFM",
+    };
+    if identified { code.to_owned() } else { format!("{code}*") }
+}
+
+/// A channel's curves as a terminal table: a row per τ, per estimator the deviation, its bounds
+/// and the noise type the EDF assumed.
+fn curve_table(c: &Channel, curves: &[DeviationCurve], ci_sigma: f64) -> String {
+    let mut taus: Vec<(usize, f64)> = curves.iter().flat_map(|k| k.m.iter().copied().zip(k.taus_s.iter().copied())).collect();
+    taus.sort_by_key(|(m, _)| *m);
+    taus.dedup_by_key(|(m, _)| *m);
+    let heads: Vec<String> = curves.iter().map(|k| {
+        let u = c.sensor.deviation_unit(k.estimator);
+        format!("{}{} [±{ci_sigma}σ] noise", k.estimator.name().to_uppercase(), if u.text.is_empty() { String::new() } else { format!(" ({})", u.text) })
+    }).collect();
+    let rows: Vec<Vec<String>> = taus
+        .iter()
+        .map(|(m, _)| {
+            curves
+                .iter()
+                .map(|k| {
+                    let u = c.sensor.deviation_unit(k.estimator).si;
+                    k.m.iter().position(|x| x == m).map_or_else(String::new, |j| {
+                        format!("{} [{}, {}] {}", sig(k.dev[j] / u, 4), sig(k.lower[j] / u, 3), sig(k.upper[j] / u, 3), alpha_code(k.alpha[j], k.alpha_identified[j]))
+                    })
+                })
+                .collect()
+        })
+        .collect();
+    let widths: Vec<usize> = (0..heads.len()).map(|i| rows.iter().map(|r| r[i].chars().count()).chain([heads[i].chars().count()]).max().unwrap_or(0) + 2).collect();
+    let mut s = format!("\n{} — τ (s)", c.name());
+    let tw = taus.iter().map(|(_, t)| sig(*t, 4).len()).max().unwrap_or(0).max(s.chars().count() - 1) + 2;
+    s = format!("{:<tw$}", s);
+    for (h, w) in heads.iter().zip(&widths) {
+        s += &format!("{h:<w$}");
+    }
+    s = s.trim_end().to_owned() + "\n";
+    for ((_, t), row) in taus.iter().zip(&rows) {
+        s += &format!("{:<tw$}", sig(*t, 4));
+        for (cell, w) in row.iter().zip(&widths) {
+            s += &format!("{cell:<w$}");
+        }
+        s = s.trim_end().to_owned() + "\n";
+    }
+    s
+}
+
 fn channel_json(c: &Channel) -> Value {
     let s = c.sensor;
     let u = s.adev_unit();
-    let r = &c.report;
-    let scale = |v: &[f64]| -> Vec<f64> { v.iter().map(|x| x / u.si).collect() };
     let mut m = Map::new();
-    m.insert("axis".into(), json!(AXES[c.axis]));
+    m.insert("axis".into(), json!(c.label));
+    m.insert("curves".into(), Value::Array(c.curves.iter().map(|k| curve_json(s, k)).collect()));
+    let Some(r) = &c.report else {
+        m.insert("fitted".into(), Value::Null);
+        return Value::Object(m);
+    };
+    let scale = |v: &[f64]| -> Vec<f64> { v.iter().map(|x| x / u.si).collect() };
     m.insert("tau_s".into(), json!(r.taus_s));
     m.insert(format!("adev_{}", u.key), json!(scale(&r.adev_si)));
     m.insert(format!("adev_lower_{}", u.key), json!(scale(&r.adev_lower_si)));

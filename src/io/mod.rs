@@ -28,6 +28,7 @@ mod npy;
 mod parquet_io;
 mod plausibility;
 mod psins_imu;
+pub mod series;
 mod sniff;
 mod table;
 mod text;

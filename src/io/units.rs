@@ -9,9 +9,9 @@
 //! | `rad_per_s`, `deg_per_s`, `deg_per_h` | angular rate (rad/s) | 1, π/180, π/648000 |
 //! | `mps`, `m_per_s` | velocity (m/s) | 1 |
 //! | `mps2`, `m_per_s2`, `g`, `mg`, `ug` | acceleration (m/s²) | 1, 1, g₀, 1e-3 g₀, 1e-6 g₀ (g₀ = 9.80665, standard gravity) |
-//! | `s`, `ms`, `us`, `ns` | time (s) | 1, 1e-3, 1e-6, 1e-9 |
+//! | `s`, `ms`, `us`, `ns`, `ps` | time (s) | 1, 1e-3, 1e-6, 1e-9, 1e-12 |
 //! | `m` | length (m) | 1 |
-//! | `ppm`, `1`, `count` | dimensionless | 1e-6, 1, 1 |
+//! | `ppm`, `ppb`, `ppt`, `1`, `count` | dimensionless | 1e-6, 1e-9, 1e-12, 1, 1 |
 
 use std::f64::consts::PI;
 
@@ -168,6 +168,11 @@ const UNITS: &[Unit] = &[
         to_si: 1e-9,
     },
     Unit {
+        suffix: "ps",
+        quantity: Quantity::Time,
+        to_si: 1e-12,
+    },
+    Unit {
         suffix: "m",
         quantity: Quantity::Length,
         to_si: 1.0,
@@ -176,6 +181,16 @@ const UNITS: &[Unit] = &[
         suffix: "ppm",
         quantity: Quantity::Dimensionless,
         to_si: 1e-6,
+    },
+    Unit {
+        suffix: "ppb",
+        quantity: Quantity::Dimensionless,
+        to_si: 1e-9,
+    },
+    Unit {
+        suffix: "ppt",
+        quantity: Quantity::Dimensionless,
+        to_si: 1e-12,
     },
     Unit {
         suffix: "1",
@@ -209,6 +224,27 @@ pub fn split_unit(name: &str) -> Option<(&str, Unit)> {
         }
     }
     best
+}
+
+/// A unit written on its own, as a user types it on a command line: the suffixes above, or the
+/// same with `/` for `_per_`, `µ` for `u`, `^2` or `²` for `2` and `m/s2` for `mps2`
+/// (`deg/h`, `m/s^2`, `µg`, `ns`).
+#[must_use]
+pub fn unit_named(text: &str) -> Option<Unit> {
+    let t = text.trim().replace('µ', "u").replace("^2", "2").replace('²', "2").replace('/', "_per_");
+    let t = match t.as_str() {
+        "m_per_s2" | "m_per_s_per_s" => "mps2".to_owned(),
+        "m_per_s" => "mps".to_owned(),
+        "" => "1".to_owned(),
+        _ => t,
+    };
+    UNITS.iter().find(|u| u.suffix == t).copied()
+}
+
+/// Every unit of `quantity` as a user writes it (`deg/h`), for error messages.
+#[must_use]
+pub fn units_for(quantity: Quantity) -> String {
+    UNITS.iter().filter(|u| u.quantity == quantity).map(|u| u.suffix.replace("_per_", "/")).collect::<Vec<_>>().join(", ")
 }
 
 /// The list of accepted suffixes for a quantity, for error messages.

@@ -23,6 +23,7 @@
 
 use serde::{Deserialize, Serialize};
 
+pub mod edf;
 pub mod estimators;
 mod fit;
 #[cfg(test)]
@@ -65,8 +66,12 @@ pub enum AllanError {
 /// Which cluster sizes m (τ = m·τ0) to evaluate.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum TauSpacing {
+    /// m = 1, 2, 3, ... (every averaging factor; Stable32's and allantools' "all").
+    All,
     /// m = 1, 2, 4, 8, ...
     Octave,
+    /// m = 1, 2, 4, 10, 20, 40, 100, ... (allantools' "decade", Stable32's spacing).
+    Decade,
     /// m = round(10^(i/n)), i = 0, 1, ..., duplicates removed.
     PerDecade(u32),
     /// Exactly these m (sorted, deduplicated, those above the limit dropped).
@@ -151,6 +156,19 @@ impl Phase {
         self.len() == 0
     }
 
+    /// The phase: N + 1 cumulative sums (θ_0 = 0) of the increments taken relative to the first
+    /// one (a linear trend removed, which every estimator here cancels).
+    #[must_use]
+    pub fn points(&self) -> &[f64] {
+        &self.theta
+    }
+
+    /// The first non-finite increment, if any (its index and value).
+    #[must_use]
+    pub fn first_bad(&self) -> Option<(usize, f64)> {
+        self.bad
+    }
+
     /// The first increment, which every other one is taken relative to.
     #[must_use]
     pub fn reference(&self) -> f64 {
@@ -183,9 +201,18 @@ pub fn cluster_sizes(n_samples: usize, spacing: &TauSpacing, min_clusters: usize
     if min_clusters < 2 {
         return Err(AllanError::BadOption("min_clusters must be >= 2"));
     }
-    let m_max = n_samples / min_clusters;
+    averaging_factors(n_samples / min_clusters, spacing)
+}
+
+/// The averaging factors 1 ≤ m ≤ `m_max` of `spacing`, sorted, without duplicates.
+///
+/// # Errors
+/// [`AllanError::BadOption`] for `PerDecade(0)`.
+pub fn averaging_factors(m_max: usize, spacing: &TauSpacing) -> Result<Vec<usize>, AllanError> {
     let mut ms: Vec<usize> = match spacing {
+        TauSpacing::All => (1..=m_max).collect(),
         TauSpacing::Octave => std::iter::successors(Some(1usize), |&m| m.checked_mul(2)).take_while(|&m| m <= m_max).collect(),
+        TauSpacing::Decade => std::iter::successors(Some(1usize), |&d| d.checked_mul(10)).take_while(|&d| d <= m_max).flat_map(|d| [d, 2 * d, 4 * d]).filter(|&m| m <= m_max).collect(),
         TauSpacing::PerDecade(0) => return Err(AllanError::BadOption("points per decade must be >= 1")),
         TauSpacing::PerDecade(n) => {
             (0u32..).map(|i| 10f64.powf(f64::from(i) / f64::from(*n)).round()).take_while(|&m| m <= m_max as f64).map(|m| m as usize).collect()

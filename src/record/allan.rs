@@ -12,7 +12,8 @@ use super::export::Exporter;
 use super::layout::{self, LegendCorner, Node};
 use super::palette::rgb;
 use super::{Stream, APPLICATION_ID};
-use crate::ins::allan::{Channel, ImuAllan, Sensor, AXES};
+use crate::ins::allan::{Channel, ImuAllan, Sensor};
+use crate::math::allan::estimators::Estimator;
 use crate::io::LogError;
 use crate::math::allan::TERMS;
 
@@ -28,9 +29,15 @@ const TERM_COLORS: [[u8; 3]; 5] = [[200, 110, 240], [80, 140, 250], [60, 200, 90
 /// Points per decade of the drawn lines (fit, slope lines, truth).
 const LINE_POINTS_PER_DECADE: f64 = 20.0;
 
+/// The channel's entity: `allan/gyro_x`, `allan/clock_<column>` (the column name reduced to
+/// letters, digits and `_`).
 fn path(c: &Channel) -> String {
-    format!("allan/{}_{}", c.sensor.name(), AXES[c.axis])
+    let label: String = c.label.chars().map(|ch| if ch.is_ascii_alphanumeric() || ch == '_' { ch } else { '_' }).collect();
+    format!("allan/{}_{label}", c.sensor.name())
 }
+
+/// Colours of the other estimators' curves, in `Estimator::ALL` order.
+const ESTIMATOR_COLORS: [[u8; 3]; 7] = [[250, 160, 60], [235, 235, 235], [90, 200, 250], [250, 120, 200], [150, 230, 120], [200, 160, 250], [250, 210, 90]];
 
 /// One curve on the log10 τ timeline.
 fn send(stream: &Stream, entity: &str, log10_tau: &[f64], log10_value: &[f64], drawn: &mut Vec<(f64, f64)>) -> RecordingStreamResult<()> {
@@ -54,8 +61,12 @@ fn grid(lo: f64, hi: f64) -> Vec<f64> {
 fn log_channel(stream: &Stream, c: &Channel, ci_sigma: f64) -> RecordingStreamResult<PlotRange> {
     let base = path(c);
     let u = c.sensor.adev_unit();
-    let r = &c.report;
     let lg = |v: f64| (v / u.si).log10();
+    let Some(r) = &c.report else {
+        let mut drawn = Vec::new();
+        log_curves(stream, c, &base, |e| !e.is_of_phase(), &mut drawn)?;
+        return Ok(range_of(&drawn));
+    };
     let keep: Vec<usize> = (0..r.taus_s.len()).filter(|&j| r.adev_si[j] > 0.0).collect();
     if keep.is_empty() {
         return Ok(PlotRange { x: (-3.0, 3.0), y: (-1.0, 1.0), legend: LegendCorner::RightBottom });
@@ -117,7 +128,44 @@ fn log_channel(stream: &Stream, c: &Channel, ci_sigma: f64) -> RecordingStreamRe
         }
         send(stream, &e, &dense, &yt, &mut drawn)?;
     }
+    log_curves(stream, c, &base, |e| !e.is_of_phase(), &mut drawn)?;
+    let x_hi = drawn.iter().map(|p| p.0).fold(x_hi, f64::max);
     Ok(plot_range(&drawn, (x_lo, x_hi)))
+}
+
+/// The ranges of a plot that shows `drawn` (at least a decade of τ).
+fn range_of(drawn: &[(f64, f64)]) -> PlotRange {
+    if drawn.is_empty() {
+        return PlotRange { x: (-3.0, 3.0), y: (-1.0, 1.0), legend: LegendCorner::RightBottom };
+    }
+    let (lo, hi) = drawn.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.0), hi.max(p.0)));
+    plot_range(drawn, (lo, hi.max(lo + 1.0)))
+}
+
+/// Logs the curves of `c.curves` that `keep` selects under `base`, each with its bounds, in its
+/// estimator's colour.
+fn log_curves(stream: &Stream, c: &Channel, base: &str, keep: impl Fn(Estimator) -> bool, drawn: &mut Vec<(f64, f64)>) -> RecordingStreamResult<()> {
+    for k in c.curves.iter().filter(|k| keep(k.estimator)) {
+        let u = c.sensor.deviation_unit(k.estimator);
+        let js: Vec<usize> = (0..k.dev.len()).filter(|&j| k.dev[j] > 0.0).collect();
+        if js.is_empty() {
+            continue;
+        }
+        let color = ESTIMATOR_COLORS[Estimator::ALL.iter().position(|e| *e == k.estimator).unwrap_or(0)];
+        let name = k.estimator.name();
+        let dir = format!("{base}/log10_{name}{}", if u.key == "frac" { String::new() } else { format!("_{}", u.key) });
+        let x: Vec<f64> = js.iter().map(|&j| k.taus_s[j].log10()).collect();
+        let e = format!("{dir}/measured");
+        stream.rec().log_static(e.as_str(), &rerun::SeriesLines::new().with_colors([rgb(color)]).with_widths([2.0]).with_names([name.to_uppercase()]))?;
+        stream.rec().log_static(e.as_str(), &rerun::SeriesPoints::new().with_colors([rgb(color)]).with_marker_sizes([2.5]).with_names([name.to_uppercase()]))?;
+        send(stream, &e, &x, &js.iter().map(|&j| (k.dev[j] / u.si).log10()).collect::<Vec<_>>(), drawn)?;
+        for (side, bound) in [("ci_upper", &k.upper), ("ci_lower", &k.lower)] {
+            let e = format!("{dir}/{side}");
+            line_style(stream, &e, color.map(|v| v / 2 + 40), 1.0, &format!("{} bound", name.to_uppercase()))?;
+            send(stream, &e, &x, &js.iter().map(|&j| (bound[j].max(f64::MIN_POSITIVE) / u.si).log10()).collect::<Vec<_>>(), drawn)?;
+        }
+    }
+    Ok(())
 }
 
 /// The view's ranges and the legend's corner: the first corner (bottom right, bottom left, top
@@ -147,6 +195,14 @@ fn plot_range(drawn: &[(f64, f64)], x: (f64, f64)) -> PlotRange {
     PlotRange { x: wide, y: (y.0 - 0.8 * sy, y_r.1), legend: LegendCorner::RightBottom }
 }
 
+/// A log-log plot of `entity` showing `range`.
+fn plot_view(title: String, entity: String, range: &PlotRange) -> Node {
+    Node::view("TimeSeries", title, entity)
+        .with_property("TimeAxis", &layout::time_axis_range(range.x.0, range.x.1))
+        .with_property("ScalarAxis", &layout::scalar_range(range.y.0, range.y.1))
+        .with_property("PlotLegend", &layout::legend_at(range.legend))
+}
+
 /// What a plot shows, log10 units, and where its legend goes.
 struct PlotRange {
     x: (f64, f64),
@@ -164,8 +220,10 @@ fn about(r: &ImuAllan, description: &str) -> String {
     let mut notes: String = r.notes.iter().map(|n| format!("\n*Note:* {n}\n")).collect();
     // A fit is a claim: where the data contradict a term or every IEEE combination, said here too.
     for c in &r.channels {
-        for w in &c.report.fit_contradictions {
-            notes += &format!("\n**WARNING** {} {}: {} (χ²/dof {:.3})\n", c.sensor.name(), crate::ins::allan::AXES[c.axis], w.text(), c.report.fit_chi2_per_dof);
+        if let Some(rep) = &c.report {
+            for w in &rep.fit_contradictions {
+                notes += &format!("\n**WARNING** {}: {} (χ²/dof {:.3})\n", c.name(), w.text(), rep.fit_chi2_per_dof);
+            }
         }
     }
     format!(
@@ -176,7 +234,10 @@ fn about(r: &ImuAllan, description: &str) -> String {
          | term | gyro / accelerometer | slope |\n|---|---|---|\n{terms}\n\
          White: the measured overlapping ADEV; grey: its ±{}σ confidence bounds (χ² with the equivalent degrees of freedom of \
          NIST SP 1065); coloured: the slope line of each term the fit found, labelled with its coefficient and drawn where \
-         it makes at least a tenth of the fitted variance; cyan dots: the exact ADEV of the configured noise (when it is known). The flat floor of B is at 0.664·B.\n\n{}\n",
+         it makes at least a tenth of the fitted variance, and only for the terms the fit found (a term the data contradict is not drawn); \
+         cyan dots: the exact ADEV of the configured noise (when it is known). The flat floor of B is at 0.664·B. Other \
+         estimators asked for with `--estimator` (MDEV, HDEV, TOTDEV, ...) are drawn in their own colours with their bounds \
+         (EDF by Greenhall & Riley for the noise type identified at each τ); TDEV, a deviation of the phase, has its own plot.\n\n{}\n",
         r.heading(),
         r.ci_sigma,
         description.trim()
@@ -188,34 +249,42 @@ pub fn log(stream: &Stream, r: &ImuAllan, description: &str) -> RecordingStreamR
     let rec = stream.rec();
     rec.send_recording_name(format!("rinscope allan: {}", r.source))?;
     rec.log_static("docs/allan", &rerun::TextDocument::from_markdown(about(r, description)))?;
-    for sensor in Sensor::ALL {
+    for sensor in Sensor::ALL.into_iter().filter(|s| r.channels.iter().any(|c| c.sensor == *s && c.report.is_some())) {
         rec.log_static(format!("docs/coefficients_{}", sensor.name()), &rerun::TextDocument::from_markdown(r.markdown(sensor)))?;
     }
-    let mut ranges = Vec::new();
+    // One plot per channel of the rate deviations; TDEV (of the phase, another unit) beside it.
+    let mut views: Vec<(Sensor, Node)> = Vec::new();
     for c in &r.channels {
-        ranges.push(log_channel(stream, c, r.ci_sigma)?);
-    }
-    let view = |(c, range): (&Channel, &PlotRange)| {
+        let range = log_channel(stream, c, r.ci_sigma)?;
         let u = c.sensor.adev_unit();
-        Node::view("TimeSeries", format!("{} {}: log10 ADEV [log10 {}] vs log10 τ [log10 s]", c.sensor.name(), AXES[c.axis], u.text), path(c))
-            .with_property("TimeAxis", &layout::time_axis_range(range.x.0, range.x.1))
-            .with_property("ScalarAxis", &layout::scalar_range(range.y.0, range.y.1))
-            .with_property("PlotLegend", &layout::legend_at(range.legend))
-    };
-    let row = |sensor: Sensor| Node::container(ContainerKind::Horizontal, r.channels.iter().zip(&ranges).filter(|(c, _)| c.sensor == sensor).map(view).collect(), &[]);
-    let docs = Node::container(
-        ContainerKind::Horizontal,
-        vec![
-            Node::view("TextDocument", "gyro coefficients", "docs/coefficients_gyro"),
-            Node::container(
-                ContainerKind::Tabs,
-                vec![Node::view("TextDocument", "accelerometer coefficients", "docs/coefficients_accel"), Node::view("TextDocument", "how to read the plots", "docs/allan")],
-                &[],
-            ),
-        ],
-        &[],
-    );
-    let root = Node::container(ContainerKind::Vertical, vec![row(Sensor::Gyro), row(Sensor::Accel), docs], &[1.0, 1.0, 0.62]);
+        let unit = if u.text.is_empty() { "log10 fractional frequency".to_owned() } else { format!("log10 {}", u.text) };
+        let what = if c.report.is_some() { "ADEV" } else { "deviation" };
+        views.push((c.sensor, plot_view(format!("{}: log10 {what} [{unit}] vs log10 τ [log10 s]", c.name()), path(c), &range)));
+        if c.curves.iter().any(|k| k.estimator.is_of_phase()) {
+            let base = format!("{}_tdev", path(c));
+            let mut drawn = Vec::new();
+            log_curves(stream, c, &base, Estimator::is_of_phase, &mut drawn)?;
+            let pu = c.sensor.phase_unit();
+            views.push((c.sensor, plot_view(format!("{}: log10 TDEV [log10 {}] vs log10 τ [log10 s]", c.name(), pu.text), base, &range_of(&drawn))));
+        }
+    }
+    let mut rows: Vec<Node> = Vec::new();
+    for sensor in Sensor::ALL {
+        let these: Vec<Node> = views.iter().filter(|(s, _)| *s == sensor).map(|(_, v)| v.clone()).collect();
+        if !these.is_empty() {
+            rows.push(Node::container(ContainerKind::Horizontal, these, &[]));
+        }
+    }
+    let mut tabs: Vec<Node> = Sensor::ALL
+        .iter()
+        .filter(|s| r.channels.iter().any(|c| c.sensor == **s && c.report.is_some()))
+        .map(|s| Node::view("TextDocument", format!("{} coefficients", s.name()), format!("docs/coefficients_{}", s.name())))
+        .collect();
+    tabs.push(Node::view("TextDocument", "how to read the plots", "docs/allan"));
+    let mut shares: Vec<f32> = vec![1.0; rows.len()];
+    rows.push(Node::container(ContainerKind::Tabs, tabs, &[]));
+    shares.push(0.62);
+    let root = Node::container(ContainerKind::Vertical, rows, &shares);
     layout::send(rec, APPLICATION_ID, &root, &layout::Playback { timeline: LOG10_TAU_TIMELINE, speed: 1.0, follow: true })
 }
 
@@ -231,8 +300,16 @@ pub fn log(stream: &Stream, r: &ImuAllan, description: &str) -> RecordingStreamR
 /// A table that cannot be written.
 pub fn export(exporter: &mut Exporter, r: &ImuAllan) -> Result<(), LogError> {
     for c in &r.channels {
+        for k in &c.curves {
+            let u = c.sensor.deviation_unit(k.estimator);
+            let columns: Vec<String> = ["tau_s".to_owned(), "m".to_owned(), format!("dev_{}", u.key), format!("lower_{}", u.key), format!("upper_{}", u.key), "edf".to_owned(), "alpha".to_owned(), "alpha_identified".to_owned(), "terms_count".to_owned()].into();
+            let rows: Vec<Vec<f64>> = (0..k.m.len())
+                .map(|j| vec![k.taus_s[j], k.m[j] as f64, k.dev[j] / u.si, k.lower[j] / u.si, k.upper[j] / u.si, k.edf[j], f64::from(k.alpha[j]), f64::from(u8::from(k.alpha_identified[j])), k.n_terms[j] as f64])
+                .collect();
+            exporter.write_table(&format!("{}_{}", path(c), k.estimator.name()), &columns, &rows)?;
+        }
         let u = c.sensor.adev_unit();
-        let rep = &c.report;
+        let Some(rep) = &c.report else { continue };
         let mut columns: Vec<String> = ["tau_s", "adev", "adev_lower", "adev_upper", "fit_adev"].iter().enumerate().map(|(i, n)| if i == 0 { (*n).to_owned() } else { format!("{n}_{}", u.key) }).collect();
         columns.extend(["edf".to_owned(), "second_differences_count".to_owned()]);
         if c.truth.is_some() {
@@ -251,7 +328,8 @@ pub fn export(exporter: &mut Exporter, r: &ImuAllan) -> Result<(), LogError> {
         exporter.write_table(&path(c), &columns, &rows)?;
     }
     for sensor in Sensor::ALL {
-        let chans: Vec<&Channel> = r.channels.iter().filter(|c| c.sensor == sensor).collect();
+        let chans: Vec<(usize, &Channel, &crate::math::allan::AllanReport)> =
+            r.channels.iter().filter(|c| c.sensor == sensor).enumerate().filter_map(|(i, c)| c.report.as_ref().map(|rep| (i, c, rep))).collect();
         if chans.is_empty() {
             continue;
         }
@@ -263,13 +341,13 @@ pub fn export(exporter: &mut Exporter, r: &ImuAllan) -> Result<(), LogError> {
         columns.push("fit_chi2_per_dof".to_owned());
         let rows: Vec<Vec<f64>> = chans
             .iter()
-            .map(|c| {
-                let mut row = vec![c.axis as f64];
+            .map(|(i, c, rep)| {
+                let mut row = vec![*i as f64];
                 for term in TERMS {
                     let e = c.fitted(term);
                     row.extend([e.value, e.sigma, f64::from(u8::from(e.significant))]);
                 }
-                row.push(c.report.fit_chi2_per_dof);
+                row.push(rep.fit_chi2_per_dof);
                 row
             })
             .collect();

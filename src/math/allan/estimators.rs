@@ -8,6 +8,8 @@
 //! the estimator is not defined at that m for that length (too few terms): a short series is
 //! analysed as far as it goes, not refused.
 
+use super::edf::{identify_noise, Alpha};
+
 /// Which estimator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Estimator {
@@ -121,6 +123,100 @@ impl Estimator {
             }
         }
     }
+}
+
+/// One estimator's curve over a set of averaging factors, with its confidence intervals.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct DeviationCurve {
+    /// Which estimator.
+    pub estimator: Estimator,
+    /// Averaging factors m where the estimator is defined.
+    pub m: Vec<usize>,
+    /// τ = m·τ0, s.
+    pub taus_s: Vec<f64>,
+    /// The deviation: of the rate (SI rate unit) for every estimator but TDEV, which is of the
+    /// phase (SI phase unit: s, rad, m/s).
+    pub dev: Vec<f64>,
+    /// Lower confidence bound at −`ci_sigma` (the unit of `dev`).
+    pub lower: Vec<f64>,
+    /// Upper confidence bound at +`ci_sigma`.
+    pub upper: Vec<f64>,
+    /// Equivalent degrees of freedom ([`Estimator::edf`]).
+    pub edf: Vec<f64>,
+    /// The noise type α the EDF assumed.
+    pub alpha: Vec<Alpha>,
+    /// α identified at this τ (else carried from the last τ where it was, or white FM if none).
+    pub alpha_identified: Vec<bool>,
+    /// Terms averaged.
+    pub n_terms: Vec<usize>,
+}
+
+impl Estimator {
+    /// The largest m where the estimator is defined for `n` phase points (at least one term).
+    #[must_use]
+    pub fn max_m(self, n: usize) -> usize {
+        match self {
+            Self::Adev | Self::Oadev => n.saturating_sub(1) / 2,
+            Self::Hdev | Self::Ohdev => n.saturating_sub(1) / 3,
+            Self::Mdev | Self::Tdev => n / 3,
+            Self::Totdev => n.saturating_sub(2),
+        }
+    }
+
+    /// What the deviation is of ("the rate"; TDEV: "the phase").
+    #[must_use]
+    pub fn is_of_phase(self) -> bool {
+        self == Self::Tdev
+    }
+
+    /// The name a reader knows it by.
+    #[must_use]
+    pub fn title(self) -> &'static str {
+        match self {
+            Self::Adev => "Allan deviation (non-overlapping)",
+            Self::Oadev => "Allan deviation (overlapping)",
+            Self::Mdev => "modified Allan deviation",
+            Self::Tdev => "time deviation",
+            Self::Hdev => "Hadamard deviation (non-overlapping)",
+            Self::Ohdev => "Hadamard deviation (overlapping)",
+            Self::Totdev => "total deviation",
+        }
+    }
+}
+
+/// The curve of `estimator` on the phase `x` (N points τ0 apart) at the averaging factors `ms`
+/// (those where it is not defined skipped), with ±`ci_sigma` χ² intervals from its EDF for the
+/// noise identified at each τ ([`identify_noise`]). OADEV takes the fused O(N) pass of the IMU
+/// analysis; the others their definitions.
+#[must_use]
+pub fn deviation_curve(estimator: Estimator, x: &[f64], tau0_s: f64, ms: &[usize], ci_sigma: f64) -> DeviationCurve {
+    let ms: Vec<usize> = ms.iter().copied().filter(|&m| m >= 1 && m <= estimator.max_m(x.len())).collect();
+    let variances: Vec<Option<(f64, usize)>> = if estimator == Estimator::Oadev {
+        super::second_difference_sums(x, &ms).into_iter().zip(&ms).map(|((s, terms), &m)| Some((s / (2.0 * (m as f64 * tau0_s).powi(2) * terms as f64), terms))).collect()
+    } else {
+        ms.iter().map(|&m| estimator.variance(x, tau0_s, m)).collect()
+    };
+    let mut c = DeviationCurve { estimator, m: vec![], taus_s: vec![], dev: vec![], lower: vec![], upper: vec![], edf: vec![], alpha: vec![], alpha_identified: vec![], n_terms: vec![] };
+    let mut last_alpha = None;
+    for (&m, v) in ms.iter().zip(variances) {
+        let Some((var, terms)) = v else { continue };
+        let found = identify_noise(x, m, estimator);
+        let alpha = found.or(last_alpha).unwrap_or(0);
+        last_alpha = Some(alpha);
+        let edf = estimator.edf(alpha, m, x.len()).unwrap_or(1.0);
+        let dev = var.max(0.0).sqrt();
+        let (lo, hi) = super::adev_confidence(dev, edf, ci_sigma);
+        c.m.push(m);
+        c.taus_s.push(m as f64 * tau0_s);
+        c.dev.push(dev);
+        c.lower.push(lo);
+        c.upper.push(hi);
+        c.edf.push(edf);
+        c.alpha.push(alpha);
+        c.alpha_identified.push(found.is_some());
+        c.n_terms.push(terms);
+    }
+    c
 }
 
 /// Phase from a rate series y (fractional frequency, rad/s, m/s², ...) every τ0: x_0 = 0,

@@ -1,0 +1,267 @@
+//! A series for `rinscope allan --series`: named or numbered columns of one table file (CSV or
+//! whitespace text, `.npy`, Parquet — whatever [`ColumnReader`] reads), each with its kind and unit,
+//! sampled at a declared rate or stamped by a time column. Returned as increments in SI, the form
+//! every Allan-type estimator starts from (docs/allan.md, "Any series").
+//!
+//! | kind | what a value is | units | increment |
+//! |---|---|---|---|
+//! | `rate` | a rate over the sample interval | angular rate, acceleration | value·τ0 |
+//! | `increment` | what accumulated over the interval | angle, velocity, time | value |
+//! | `phase` | the accumulated quantity itself (a clock's time error, an angle) | angle, velocity, time | x_{k+1} − x_k |
+//! | `frequency` | a fractional frequency y | `1`, `ppm`, `ppb`, `ppt` | y·τ0 (s) |
+
+use std::path::Path;
+
+use crate::io::error::LogError;
+use crate::io::table::{Col, ColumnReader, ReadOptions};
+use crate::io::units::{unit_named, units_for, Quantity, Unit};
+
+/// What the values of a column are.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SeriesKind {
+    /// A rate (°/s, m/s², ...).
+    Rate,
+    /// An increment per sample (rad, m/s, ...).
+    Increment,
+    /// The accumulated quantity (a time error in s, an angle).
+    Phase,
+    /// A fractional frequency (dimensionless).
+    Frequency,
+}
+
+impl SeriesKind {
+    const ALL: [(Self, &'static str); 4] = [(Self::Rate, "rate"), (Self::Increment, "increment"), (Self::Phase, "phase"), (Self::Frequency, "frequency")];
+
+    /// The name on the command line.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        Self::ALL.iter().find(|(k, _)| *k == self).map_or("", |(_, n)| n)
+    }
+
+    /// The quantities a unit of this kind may measure.
+    fn quantities(self) -> &'static [Quantity] {
+        match self {
+            Self::Rate => &[Quantity::AngularRate, Quantity::Acceleration],
+            Self::Increment | Self::Phase => &[Quantity::Angle, Quantity::Velocity, Quantity::Time],
+            Self::Frequency => &[Quantity::Dimensionless],
+        }
+    }
+
+    /// The unit a value of this kind has when none is written.
+    fn default_unit(self) -> Option<&'static str> {
+        match self {
+            Self::Frequency => Some("1"),
+            Self::Phase => Some("s"),
+            _ => None,
+        }
+    }
+}
+
+/// One column to analyse: `COLUMN:KIND[:UNIT]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeriesColumn {
+    /// The column: a header name, or a 0-based position.
+    pub col: Col,
+    /// What its values are.
+    pub kind: SeriesKind,
+    /// Their unit.
+    pub unit: Unit,
+}
+
+impl SeriesColumn {
+    /// Parses `COLUMN:KIND[:UNIT]` (`gyro_z:rate:deg/s`, `2:frequency`, `x:phase:ns`); a column
+    /// that is a whole number is a 0-based position. The unit is checked against the kind.
+    ///
+    /// # Errors
+    /// A malformed spec, an unknown kind or unit, a unit of the wrong quantity — each named.
+    pub fn parse(spec: &str) -> std::result::Result<Self, String> {
+        let parts: Vec<&str> = spec.rsplitn(3, ':').collect();
+        let kinds = || SeriesKind::ALL.iter().map(|(_, n)| *n).collect::<Vec<_>>().join(", ");
+        let kind_of = |k: &str| SeriesKind::ALL.iter().find(|(_, n)| *n == k.trim()).map(|(k, _)| *k);
+        // rsplitn from the right: [unit, kind, column] or [kind, column] (a unit-less kind).
+        let (column, kind, unit) = match parts.as_slice() {
+            [u, k, c] if kind_of(k).is_some() => (*c, kind_of(k), Some(*u)),
+            [k, c] => (*c, kind_of(k), None),
+            [u, k, c] => {
+                // `a:b:c` whose middle is not a kind: the column name may hold a colon.
+                match kind_of(u) {
+                    Some(kind) => (&spec[..spec.len() - u.len() - 1], Some(kind), None),
+                    None => return Err(format!("--column {spec:?}: {k:?} (after column {c:?}) is not a kind ({}); expected COLUMN:KIND[:UNIT], e.g. gyro_z:rate:deg/s", kinds())),
+                }
+            }
+            _ => return Err(format!("--column {spec:?}: expected COLUMN:KIND[:UNIT], e.g. gyro_z:rate:deg/s, 2:frequency, x:phase:ns")),
+        };
+        let Some(kind) = kind else {
+            return Err(format!("--column {spec:?}: the kind must be one of {}", kinds()));
+        };
+        if column.trim().is_empty() {
+            return Err(format!("--column {spec:?}: no column named before the kind"));
+        }
+        let unit_text = unit.or(kind.default_unit()).ok_or_else(|| {
+            let q: Vec<String> = kind.quantities().iter().map(|q| units_for(*q)).collect();
+            format!("--column {spec:?}: a {} needs a unit ({})", kind.name(), q.join("; "))
+        })?;
+        let unit = unit_named(unit_text).ok_or_else(|| format!("--column {spec:?}: unknown unit {unit_text:?}"))?;
+        if !kind.quantities().contains(&unit.quantity) {
+            let q: Vec<String> = kind.quantities().iter().map(|q| units_for(*q)).collect();
+            return Err(format!("--column {spec:?}: {unit_text:?} is not a unit of a {} (use {})", kind.name(), q.join("; ")));
+        }
+        let col = column.trim().parse::<usize>().map_or_else(|_| Col::Name(column.trim().to_owned()), Col::Index);
+        Ok(Self { col, kind, unit })
+    }
+
+    /// The unit as a reader writes it (`deg/s`; `fractional` for a frequency in `1`).
+    #[must_use]
+    pub fn unit_text(&self) -> String {
+        match self.unit.suffix {
+            "1" => "fractional".to_owned(),
+            u => u.replace("_per_", "/"),
+        }
+    }
+
+    /// The SI quantity its increments are of: angle, velocity or time.
+    #[must_use]
+    pub fn increment_quantity(&self) -> Quantity {
+        match self.unit.quantity {
+            Quantity::AngularRate | Quantity::Angle => Quantity::Angle,
+            Quantity::Acceleration | Quantity::Velocity => Quantity::Velocity,
+            _ => Quantity::Time,
+        }
+    }
+}
+
+/// How the samples are spaced.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Sampling {
+    /// Evenly, at this rate (Hz).
+    RateHz(f64),
+    /// As a time column says (its unit), which must be even to 1 %.
+    TimeColumn(Col, Unit),
+}
+
+/// The columns read.
+#[derive(Debug, Clone)]
+pub struct Series {
+    /// Each column's header name (or `index N`).
+    pub names: Vec<String>,
+    /// The specs, in the same order.
+    pub columns: Vec<SeriesColumn>,
+    /// Each column's increments, SI (rad, m/s or s), one per sample interval.
+    pub increments: Vec<Vec<f64>>,
+    /// The sample interval, s.
+    pub tau0_s: f64,
+    /// Rows read.
+    pub rows: usize,
+}
+
+/// Why a series cannot be read.
+#[derive(Debug, thiserror::Error)]
+pub enum SeriesError {
+    /// The file or a cell.
+    #[error(transparent)]
+    Log(#[from] LogError),
+    /// The series as a whole (too short, a rate out of range, a time column that does not advance).
+    #[error("{0}")]
+    Series(String),
+}
+
+/// Largest relative spread of the time column's steps accepted as even sampling.
+const EVEN_TOLERANCE: f64 = 0.01;
+
+/// Reads `columns` of `path` sampled as `sampling` says, as increments in SI.
+///
+/// # Errors
+/// The file or a column cannot be read (the error names the column, row and value), a time column
+/// that does not advance evenly (the row), fewer than two rows, a rate out of range.
+pub fn read_series(path: &Path, columns: &[SeriesColumn], sampling: &Sampling) -> Result<Series, SeriesError> {
+    let bad = |what: String| SeriesError::Series(format!("{}: {what}", path.display()));
+    let mut cols: Vec<Col> = columns.iter().map(|c| c.col.clone()).collect();
+    if let Sampling::TimeColumn(t, _) = sampling {
+        cols.push(t.clone());
+    }
+    let mut reader = ColumnReader::open(path, &cols, &ReadOptions::default())?;
+    let names: Vec<String> = reader.columns()[..columns.len()].to_vec();
+    let mut values: Vec<Vec<f64>> = vec![Vec::new(); columns.len()];
+    let mut row = vec![0.0; cols.len()];
+    let (mut t_first, mut t_prev, mut steps) = (None::<f64>, 0.0, Vec::new());
+    while reader.next_row(&mut row)? {
+        for (v, x) in values.iter_mut().zip(&row) {
+            v.push(*x);
+        }
+        if let Sampling::TimeColumn(_, unit) = sampling {
+            let t = row[columns.len()] * unit.to_si;
+            if t_first.is_some() {
+                steps.push((t - t_prev, reader.location()));
+            }
+            t_first.get_or_insert(t);
+            t_prev = t;
+        }
+    }
+    let rows = values.first().map_or(0, Vec::len);
+    if rows < 2 {
+        return Err(bad(format!("{rows} row(s): a series needs at least two samples")));
+    }
+    let tau0_s = match sampling {
+        Sampling::RateHz(hz) => {
+            if !(hz.is_finite() && *hz > 0.0 && *hz <= 1e9) {
+                return Err(bad(format!("--rate-hz {hz}: must be > 0 and at most 1e9 Hz")));
+            }
+            1.0 / hz
+        }
+        Sampling::TimeColumn(..) => {
+            let mut sorted: Vec<f64> = steps.iter().map(|(d, _)| *d).collect();
+            sorted.sort_by(f64::total_cmp);
+            let median = sorted[sorted.len() / 2];
+            if !(median > 0.0) {
+                return Err(bad(format!("the time column does not advance (median step {median} s)")));
+            }
+            if let Some((d, at)) = steps.iter().find(|(d, _)| (d / median - 1.0).abs() > EVEN_TOLERANCE) {
+                let time_col = &reader.columns()[columns.len()];
+                return Err(SeriesError::Log(LogError::BadValue {
+                    file: path.to_owned(),
+                    at: *at,
+                    column: time_col.clone(),
+                    value: format!("step {d} s"),
+                    problem: format!(
+                        "where the series steps {median} s: the Allan-type estimators need evenly spaced samples (a gap, or a jitter over {} %); cut the file at the gap or resample it",
+                        EVEN_TOLERANCE * 100.0
+                    ),
+                }));
+            }
+            (t_prev - t_first.unwrap_or(0.0)) / (rows - 1) as f64
+        }
+    };
+    let increments = columns
+        .iter()
+        .zip(values)
+        .map(|(c, v)| {
+            let f = c.unit.to_si;
+            match c.kind {
+                SeriesKind::Rate | SeriesKind::Frequency => v.iter().map(|x| x * f * tau0_s).collect(),
+                SeriesKind::Increment => v.iter().map(|x| x * f).collect(),
+                SeriesKind::Phase => v.windows(2).map(|w| (w[1] - w[0]) * f).collect(),
+            }
+        })
+        .collect();
+    Ok(Series { names, columns: columns.to_vec(), increments, tau0_s, rows })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_column_spec_names_its_column_kind_and_unit() {
+        let c = SeriesColumn::parse("gyro_z:rate:deg/s").expect("valid");
+        assert_eq!((c.col, c.kind, c.unit.suffix), (Col::Name("gyro_z".into()), SeriesKind::Rate, "deg_per_s"));
+        let c = SeriesColumn::parse("2:frequency").expect("valid");
+        assert_eq!((c.col, c.kind, c.unit.suffix), (Col::Index(2), SeriesKind::Frequency, "1"));
+        let c = SeriesColumn::parse("x:phase:ns").expect("valid");
+        assert_eq!((c.kind, c.unit.to_si), (SeriesKind::Phase, 1e-9));
+        assert_eq!(SeriesColumn::parse("a:accel:rate:m/s^2").expect("a colon in the name").col, Col::Name("a:accel".into()));
+        for (spec, says) in [("gx:rate", "needs a unit"), ("gx:speed:deg/s", "kind"), ("gx:rate:furlong", "unknown unit"), ("gx:rate:ns", "not a unit of a rate"), ("gx", "expected COLUMN:KIND")] {
+            let e = SeriesColumn::parse(spec).expect_err(spec);
+            assert!(e.contains(says) && e.contains(spec), "{spec}: {e}");
+        }
+    }
+}
