@@ -345,7 +345,7 @@ pub fn series(path: &std::path::Path, columns: &[SeriesColumn], sampling: &Sampl
             notes.push(format!("{}: {} samples, fewer than the {MIN_SAMPLES} the IEEE fit needs: the curves only, as far as each estimator is defined", channel.name(), phase.len()));
         }
         if !sensor.is_inertial() {
-            notes.push(format!("{}: a clock (a {} in {}): the power-law noise type per τ is in the table; no IEEE 952 fit (an inertial-sensor standard)", channel.name(), spec.kind.name(), spec.unit_text()));
+            notes.push(format!("{}: a clock ({} {}): the power-law noise type per τ is in the table; no IEEE 952 fit (an inertial-sensor standard)", channel.name(), spec.unit_text(), spec.kind.name()));
         }
         for k in &channel.curves {
             let limit = k.estimator.max_m(phase.len() + 1).min(phase.len() / 2);
