@@ -506,6 +506,23 @@ pub(super) fn bench(steps: u64, json: Option<&std::path::Path>, only: &[String])
     Ok(())
 }
 
+/// `bench --peer allantools`.
+pub(super) fn bench_allantools(python: &std::path::Path, rounds: usize, samples: u64, json: Option<&std::path::Path>) -> Result<(), Failure> {
+    use crate::app::bench::allantools;
+    check_output_dir("--json", json)?;
+    let stop = stop_flag();
+    let reports = match allantools::compare(python, samples, rounds, &stop) {
+        Ok(r) => r,
+        Err(_) if stop.load(std::sync::atomic::Ordering::SeqCst) => return Err(Failure::interrupted("the comparison did not finish; nothing written")),
+        Err(e) => return Err(Failure::run(format!("{e:#}"))),
+    };
+    out!("{}", allantools::text(&reports, samples));
+    if let Some(path) = json {
+        write_json("--json", path, &reports)?;
+    }
+    Ok(())
+}
+
 /// `bench --peer pyins`.
 pub(super) fn bench_peer(python: PathBuf, rounds: usize, samples: u64, json: Option<&std::path::Path>) -> Result<(), Failure> {
     use crate::app::bench::peer;

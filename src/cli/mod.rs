@@ -95,9 +95,10 @@ enum Command {
         /// Steps of each pure-simulation repetition.
         #[arg(long, default_value_t = 2_000_000)]
         steps: u64,
-        /// Instead: measure `rinscope replay` against a peer INS on the same streams, whole processes
-        /// alternated (`pyins`: python-ins 1.0.1; docs/benchmarks.md).
-        #[arg(long, value_parser = ["pyins"])]
+        /// Instead: measure against a peer, whole processes alternated on the same input (`pyins`:
+        /// `rinscope replay` vs python-ins 1.0.1; `allantools`: `rinscope allan --series` vs
+        /// allantools 2024.6, per estimator; docs/benchmarks.md).
+        #[arg(long, value_parser = ["pyins", "allantools"])]
         peer: Option<String>,
         /// --peer: the Python interpreter that has the peer installed.
         #[arg(long, default_value = "python3")]
@@ -105,7 +106,7 @@ enum Command {
         /// --peer: alternated rounds per stream.
         #[arg(long, default_value_t = 5)]
         rounds: usize,
-        /// --peer: samples per stream (2 kHz).
+        /// --peer: samples per stream (pyins: at 2 kHz; allantools: the series' length).
         #[arg(long, default_value_t = 2_000_000)]
         samples: u64,
         /// Also write every figure as JSON (with --peer: every round's numbers), to compare a change
@@ -563,6 +564,7 @@ pub fn main() -> ExitCode {
         Command::CheckConfig { file } => commands::check_config(&file),
         Command::Reproduce { markdown } => commands::reproduce(markdown.as_deref()),
         Command::Bench { steps, peer: None, json, only, .. } => commands::bench(steps, json.as_deref(), &only),
+        Command::Bench { peer: Some(peer), python, rounds, samples, json, .. } if peer == "allantools" => commands::bench_allantools(&python, rounds, samples, json.as_deref()),
         Command::Bench { peer: Some(_), python, rounds, samples, json, .. } => commands::bench_peer(python, rounds, samples, json.as_deref()),
     };
     match result {

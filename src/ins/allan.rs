@@ -472,6 +472,8 @@ impl ImuAllan {
         out.insert("samples".into(), json!(self.samples));
         out.insert("confidence_sigma".into(), json!(self.ci_sigma));
         out.insert("interrupted".into(), json!(self.interrupted));
+        out.insert("gather_s".into(), json!(self.gather_s));
+        out.insert("analysis_s".into(), json!(self.analysis_s));
         out.insert("notes".into(), json!(self.notes));
         out.insert("estimator".into(), json!("overlapping Allan deviation of the rate; EDF by NIST SP 1065 Table 5 for the fitted noise mixture; chi-square interval (Wilson-Hilferty); coefficients by weighted NNLS of the IEEE 952/1293 model sigma^2 = 3Q^2/tau^2 + N^2/tau + (2 ln2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2"));
         out.insert("curves_method".into(), json!("each estimator by its NIST SP 1065 definition; noise type per tau by the lag-1 autocorrelation (Riley & Greenhall 2004); EDF by Greenhall & Riley (PTTI 2003), TOTDEV by SP 1065 Table 7; chi-square interval (Wilson-Hilferty)"));

@@ -1,6 +1,7 @@
 //! `rinscope bench`: simulation speed without recording, and a full recorded run's speed and size;
 //! `bench --peer pyins` (peer.rs) against another INS.
 
+pub mod allantools;
 mod logs;
 pub mod peer;
 
