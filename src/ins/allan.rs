@@ -437,22 +437,28 @@ impl ImuAllan {
         for term in TERMS {
             s += &format!(" {} ({}) |", term.letter(), sensor.unit(term).text);
         }
-        s += "\n|---|";
-        s += &"---|".repeat(TERMS.len());
+        s += " χ²/dof |\n|---|";
+        s += &"---|".repeat(TERMS.len() + 1);
         s.push('\n');
         for c in &chans {
             s += &format!("| **{}** |", c.label);
             for term in TERMS {
                 s += &format!(" {} |", cell(c.fitted(term), c.configured(term)));
             }
-            s.push('\n');
+            s += &format!(" {} |\n", c.report.as_ref().map_or_else(String::new, |r| sig(r.fit_chi2_per_dof, 3)));
         }
         if let Some(c) = chans.first().filter(|c| c.truth.is_some()) {
             s += "| configured |";
             for term in TERMS {
                 s += &format!(" {} |", c.configured(term).map_or_else(String::new, |v| sig(v, 4)));
             }
-            s.push('\n');
+            s += " |\n";
+        }
+        // A fit is a claim: where the data contradict it, said beside the coefficients.
+        for c in &chans {
+            for w in c.report.iter().flat_map(|r| &r.fit_contradictions) {
+                s += &format!("\n**WARNING** {}: {}\n", c.name(), w.text());
+            }
         }
         if let Some(t) = chans.first().and_then(|c| c.truth).filter(Truth::has_markov) {
             s += &format!("\nAlso configured: a Gauss-Markov bias, σ {} {}, T {} s.\n", sig(t.markov_sigma_si / sensor.adev_unit().si, 3), sensor.adev_unit().text, t.correlation_s);

@@ -156,7 +156,7 @@ fn log_curves(stream: &Stream, c: &Channel, base: &str, keep: impl Fn(Estimator)
         let dir = format!("{base}/log10_{name}{}", if u.key == "frac" { String::new() } else { format!("_{}", u.key) });
         let x: Vec<f64> = js.iter().map(|&j| k.taus_s[j].log10()).collect();
         let e = format!("{dir}/measured");
-        stream.rec().log_static(e.as_str(), &rerun::SeriesLines::new().with_colors([rgb(color)]).with_widths([2.0]).with_names([name.to_uppercase()]))?;
+        stream.rec().log_static(e.as_str(), &rerun::SeriesLines::new().with_colors([rgb(color)]).with_widths([1.5]).with_names([name.to_uppercase()]))?;
         stream.rec().log_static(e.as_str(), &rerun::SeriesPoints::new().with_colors([rgb(color)]).with_marker_sizes([2.5]).with_names([name.to_uppercase()]))?;
         send(stream, &e, &x, &js.iter().map(|&j| (k.dev[j] / u.si).log10()).collect::<Vec<_>>(), drawn)?;
         for (side, bound) in [("ci_upper", &k.upper), ("ci_lower", &k.lower)] {
