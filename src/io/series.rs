@@ -12,7 +12,7 @@
 
 use std::path::Path;
 
-use crate::io::error::LogError;
+use crate::io::error::{Location, LogError};
 use crate::io::table::{Col, ColumnReader, ReadOptions};
 use crate::io::units::{unit_named, units_for, Quantity, Unit};
 
@@ -182,19 +182,27 @@ pub fn read_series(path: &Path, columns: &[SeriesColumn], sampling: &Sampling) -
     let mut reader = ColumnReader::open(path, &cols, &ReadOptions::default())?;
     let names: Vec<String> = reader.columns()[..columns.len()].to_vec();
     let mut values: Vec<Vec<f64>> = vec![Vec::new(); columns.len()];
-    let mut row = vec![0.0; cols.len()];
+    let width = cols.len();
+    let mut batch = Vec::with_capacity(width * 65_536);
     let (mut t_first, mut t_prev, mut steps) = (None::<f64>, 0.0, Vec::new());
-    while reader.next_row(&mut row)? {
-        for (v, x) in values.iter_mut().zip(&row) {
-            v.push(*x);
+    loop {
+        batch.clear();
+        if reader.next_batch(&mut batch, 65_536)? == 0 {
+            break;
         }
-        if let Sampling::TimeColumn(_, unit) = sampling {
-            let t = row[columns.len()] * unit.to_si;
-            if t_first.is_some() {
-                steps.push((t - t_prev, reader.location()));
+        for row in batch.chunks_exact(width) {
+            for (v, x) in values.iter_mut().zip(row) {
+                v.push(*x);
             }
-            t_first.get_or_insert(t);
-            t_prev = t;
+            if let Sampling::TimeColumn(_, unit) = sampling {
+                let t = row[columns.len()] * unit.to_si;
+                if t_first.is_some() {
+                    // The row of the sample after the step, 1-based.
+                    steps.push((t - t_prev, Location { row: values[0].len() as u64, line: None }));
+                }
+                t_first.get_or_insert(t);
+                t_prev = t;
+            }
         }
     }
     let rows = values.first().map_or(0, Vec::len);

@@ -244,6 +244,27 @@ fn sum_sq_second_diff(a: &[f64], b: &[f64], c: &[f64]) -> f64 {
     ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7])) + rest
 }
 
+/// Σ (d_k − 3c_k + 3b_k − a_k)² over equal-length slices (third differences), 8 lanes as above.
+fn sum_sq_third_diff(a: &[f64], b: &[f64], c: &[f64], d: &[f64]) -> f64 {
+    let (a8, ar) = a.as_chunks::<8>();
+    let (b8, br) = b.as_chunks::<8>();
+    let (c8, cr) = c.as_chunks::<8>();
+    let (d8, dr) = d.as_chunks::<8>();
+    let mut acc = [0.0f64; 8];
+    for (((w, x), y), z) in a8.iter().zip(b8).zip(c8).zip(d8) {
+        for l in 0..8 {
+            let v = z[l] - 3.0 * y[l] + 3.0 * x[l] - w[l];
+            acc[l] += v * v;
+        }
+    }
+    let mut rest = 0.0;
+    for (((&w, &x), &y), &z) in ar.iter().zip(br).zip(cr).zip(dr) {
+        let v = z - 3.0 * y + 3.0 * x - w;
+        rest += v * v;
+    }
+    ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7])) + rest
+}
+
 /// For each m of `ms`: Σ_k (θ_{k+2m} − 2θ_{k+m} + θ_k)², k = 0..N+1−2m, and the number of terms.
 /// Summed per block of 16 384 terms (partial sums keep the rounding small). Cluster sizes up to
 /// 2048 share one pass over θ (each block of θ stays in cache for all of them); larger ones get

@@ -79,8 +79,9 @@ impl Estimator {
                 Some((mean / (2.0 * tau * tau), count))
             }
             Self::Ohdev => {
-                let (mean, count) = mean_of(&mut (0..n.checked_sub(3 * m)?).map(third))?;
-                Some((mean / (6.0 * tau * tau), count))
+                let count = n.checked_sub(3 * m).filter(|c| *c > 0)?;
+                let sum = super::sum_sq_third_diff(&x[..count], &x[m..m + count], &x[2 * m..2 * m + count], &x[3 * m..3 * m + count]);
+                Some((sum / count as f64 / (6.0 * tau * tau), count))
             }
             Self::Hdev => {
                 let (mean, count) = mean_of(&mut (0..n.checked_sub(3 * m)?).step_by(m).map(third))?;
@@ -117,8 +118,18 @@ impl Estimator {
                         x[k as usize]
                     }
                 };
+                // i = 1..=N−2 (0-based): where m ≤ i ≤ N−1−m no reflection is reached and the
+                // terms are OADEV's second differences (one fused pass); the ends go through `at`.
                 let mi = m as isize;
-                let sum: f64 = (1..n as isize - 1).map(|i| (at(i - mi) - 2.0 * at(i) + at(i + mi)).powi(2)).sum();
+                let last = n as isize - 1;
+                let (lo, hi) = (mi.max(1), (last - mi).min(last - 1));
+                let term = |i: isize| (at(i - mi) - 2.0 * at(i) + at(i + mi)).powi(2);
+                let sum: f64 = if lo <= hi {
+                    let (a, b) = ((lo - mi) as usize, (hi - mi) as usize + 1);
+                    super::sum_sq_second_diff(&x[a..b], &x[a + m..b + m], &x[a + 2 * m..b + 2 * m]) + (1..lo).map(term).sum::<f64>() + (hi + 1..last).map(term).sum::<f64>()
+                } else {
+                    (1..last).map(term).sum()
+                };
                 Some((sum / (2.0 * tau * tau * (n - 2) as f64), n - 2))
             }
         }
