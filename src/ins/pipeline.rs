@@ -140,6 +140,14 @@ impl InsRun {
         self.core.algorithms()
     }
 
+    /// A live session's reload: the table (its errors, compensation, motion) is `model` from the
+    /// next sample on; the sensors and the computer go on as they were.
+    pub fn replace_model(&mut self, model: Model) {
+        self.truth.replace_model(model);
+        self.last_error.iter_mut().for_each(|e| *e = None);
+        self.chains = ChainMemo::new(self.demod.len());
+    }
+
     /// The model (truth).
     #[must_use]
     pub fn model(&self) -> &Model {

@@ -113,6 +113,12 @@ impl TruthImu {
         me
     }
 
+    /// The table or vehicle changed (a live session's reload): the motion goes on from the end of
+    /// the last increment under `model`.
+    pub fn replace_model(&mut self, model: Model) {
+        *self = Self::new(model, self.earth, self.t_last_s);
+    }
+
     /// Starts the piece of motion that begins at `t_s`: its end, and its closed form if it has one.
     fn start_piece(&mut self, t_s: f64) {
         self.next_break = self.breakpoint_after(t_s);

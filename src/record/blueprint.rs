@@ -151,7 +151,11 @@ impl Recorder {
                 Node::container(ContainerKind::Vertical, column, &[])
             }
         };
-        let root = Node::container(ContainerKind::Horizontal, vec![left, right], &[1.1, 1.0]);
+        let mut root = Node::container(ContainerKind::Horizontal, vec![left, right], &[1.1, 1.0]);
+        if self.live {
+            // Every plot framed on its data so far (the viewer would keep ±1 from before them).
+            root.frame_plots_without_range(&|origin| self.live_range(origin));
+        }
         // Play a whole run in about a minute; a live session follows the newest data.
         let speed = if self.live { 1.0 } else { (p.duration_s / 60.0).max(1.0).round() };
         layout::send(&self.rec, APPLICATION_ID, &root, &layout::Playback { timeline: TIMELINE, speed, follow: self.live || p.recording.open_at_end })

@@ -47,6 +47,25 @@ impl Node {
         Self::View { class, name: name.into(), origin: origin.into(), properties: Vec::new() }
     }
 
+    /// Gives every time-series view under this node that has no value range the range `range`
+    /// returns for its space origin (None: left to the viewer).
+    pub fn frame_plots_without_range(&mut self, range: &dyn Fn(&str) -> Option<(f64, f64)>) {
+        match self {
+            Self::Container { children, .. } => {
+                for c in children {
+                    c.frame_plots_without_range(range);
+                }
+            }
+            Self::View { class, origin, properties, .. } => {
+                if *class == "TimeSeries" && !properties.iter().any(|(n, _)| *n == "ScalarAxis") {
+                    if let Some((lo, hi)) = range(origin) {
+                        properties.push(("ScalarAxis", scalar_range(lo, hi).as_serialized_batches()));
+                    }
+                }
+            }
+        }
+    }
+
     /// Adds a view property (e.g. `EyeControls3D`, `TimeAxis`).
     #[must_use]
     pub fn with_property(mut self, name: &'static str, archetype: &dyn AsComponents) -> Self {

@@ -19,6 +19,7 @@ use crossbeam_channel::{Receiver, Sender};
 use crate::math::timeline::decimation;
 use crate::record::{Recorder, Stream};
 use crate::scenario::{Params, RawConfig};
+use crate::ins::pipeline::InsView;
 use crate::sim::StepOutput;
 pub use session::{describe_changes, LiveSim};
 use watch::WatchEvent;
@@ -63,9 +64,9 @@ pub fn snapshot(status: &SharedStatus) -> Status {
 /// What the simulation sends to the recorder.
 pub enum RecorderMsg {
     /// Rows for the time series.
-    Series(Vec<StepOutput>),
+    Series(Vec<(StepOutput, Option<InsView>)>),
     /// Scene frames.
-    Scene(Vec<StepOutput>),
+    Scene(Vec<(StepOutput, Option<InsView>)>),
     /// New parameters from simulated time `t_s`.
     Reconfigure {
         /// When.
@@ -168,10 +169,10 @@ pub fn sim_loop(mut sim: LiveSim, reloads: &Receiver<WatchEvent>, out: &Sender<R
             let i = sim.steps();
             let o = sim.step();
             if i.is_multiple_of(series_every) {
-                series.push(o);
+                series.push((o, sim.ins_view(false)));
             }
             if i.is_multiple_of(scene_every) {
-                scene.push(o);
+                scene.push((o, sim.ins_view(true)));
             }
             n += 1;
         }
@@ -231,8 +232,8 @@ pub fn recorder_loop(mut viewer: Option<Recorder>, mut file: Option<Recorder>, m
         if let Some(msg) = msg {
             for recorder in viewer.iter_mut().chain(file.iter_mut()) {
                 match &msg {
-                    RecorderMsg::Series(rows) => rows.iter().try_for_each(|r| recorder.push_series(r))?,
-                    RecorderMsg::Scene(rows) => rows.iter().try_for_each(|r| recorder.push_scene(r))?,
+                    RecorderMsg::Series(rows) => rows.iter().try_for_each(|(r, ins)| recorder.push_row(r, ins.as_ref()))?,
+                    RecorderMsg::Scene(rows) => rows.iter().try_for_each(|(r, ins)| recorder.push_scene_row(r, ins.as_ref()))?,
                     RecorderMsg::Reconfigure { t_s, params } => recorder.reconfigure(*t_s, params)?,
                     RecorderMsg::Event { t_s, text, level } => recorder.event(*t_s, text, level)?,
                 }

@@ -1,6 +1,7 @@
 //! The simulation of a live session: the turntable step whose parameters can be replaced between
 //! two steps, and the words that say what a reload changed.
 
+use crate::ins::pipeline::{InsRun, InsView};
 use crate::model::scheme::AxisValues;
 use crate::scenario::{self, Params, RawConfig};
 use crate::sim::{step, DemodState, ErrorStats, Model, StepOutput};
@@ -18,6 +19,10 @@ pub struct LiveSim {
     /// RMS and peak since the parameters last changed (what the panel shows).
     pub since_change: ErrorStats,
     last_gimbal_rad: AxisValues,
+    /// The INS in the loop (a scenario with `[imu]`): one IMU sample per step, as `run` does.
+    ins: Option<InsRun>,
+    /// The instant of the INS's latest attitude update.
+    ins_update_s: Option<f64>,
 }
 
 impl LiveSim {
@@ -26,7 +31,8 @@ impl LiveSim {
     pub fn new(params: Params) -> Self {
         let model = params.table_model();
         let last_gimbal_rad = model.scheme.state(0.0).0;
-        Self { params, model, state: DemodState::default(), step_index: 0, stats: ErrorStats::default(), since_change: ErrorStats::default(), last_gimbal_rad }
+        let ins = params.ins_run();
+        Self { params, model, state: DemodState::default(), step_index: 0, stats: ErrorStats::default(), since_change: ErrorStats::default(), last_gimbal_rad, ins, ins_update_s: None }
     }
 
     /// Simulated time of the next step, s.
@@ -44,12 +50,25 @@ impl LiveSim {
     /// One step.
     pub fn step(&mut self) -> StepOutput {
         let t = self.t_s();
+        if let Some(ins) = self.ins.as_mut() {
+            let s = ins.step();
+            if s.updated {
+                self.ins_update_s = Some(s.t_s);
+            }
+        }
         let out = step(&self.model, &mut self.state, t);
         self.stats.add(&out);
         self.since_change.add(&out);
         self.last_gimbal_rad = out.gimbal_rad;
         self.step_index += 1;
         out
+    }
+
+    /// The INS's errors at its latest attitude update (with the true IMU attitude for the scene),
+    /// None without an IMU in the loop or before its first update.
+    pub fn ins_view(&mut self, with_truth: bool) -> Option<InsView> {
+        let (ins, t) = (self.ins.as_mut()?, self.ins_update_s?);
+        Some(if with_truth { ins.view(t) } else { ins.errors_view(t) })
     }
 
     /// Replaces the parameters between two steps. Returns what changed, in words (empty: nothing did);
@@ -67,6 +86,11 @@ impl LiveSim {
         if changes.is_empty() {
             return Ok(changes);
         }
+        let (a, b) = (scenario::flatten(&old.written), scenario::flatten(&new.written));
+        let instrument = |k: &String| k.starts_with("imu.") || k.starts_with("navigation.");
+        if let Some(key) = a.keys().chain(b.keys()).filter(|k| instrument(k)).find(|k| a.get(*k) != b.get(*k)) {
+            return Err(format!("{key} cannot change in a running session (the INS has been integrating with the old one); restart `rinscope live`"));
+        }
         let mut model = new.table_model();
         let initial_changed = old.resolved.turntable.axis.iter().zip(&new.resolved.turntable.axis).any(|(a, b)| a.initial_angle_deg != b.initial_angle_deg);
         if old.resolved.scheme == new.resolved.scheme && !initial_changed {
@@ -77,6 +101,9 @@ impl LiveSim {
             // A new motion starts from where the gimbals were at the last step, at that step's time.
             model.scheme = new.table.scheme.with_initial(&self.last_gimbal_rad);
             model.scheme_t0_s = self.step_index.saturating_sub(1) as f64 / self.params.step_hz;
+        }
+        if let Some(ins) = self.ins.as_mut() {
+            ins.replace_model(model.clone());
         }
         self.model = model;
         self.params = new;
