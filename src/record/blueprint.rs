@@ -122,7 +122,13 @@ impl Recorder {
                     let (lo, hi) = logs.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)));
                     let view = plot("coning drift: log10 |heading error in ″|, thick measured, thin analytic rate × t".to_owned(), super::ins_view::CONING_LOG_PATH)
                         .with_property("PlotLegend", &layout::no_legend());
-                    tabs.push(if lo.is_finite() { view.with_property("ScalarAxis", &layout::scalar_range((lo - 1.0).floor(), hi.ceil())) } else { view });
+                    // Once measured lines exist, their whole extent (their steep start too: no
+                    // fixed range hides a series); before, the analytic lines'.
+                    let range = self.live_range(super::ins_view::CONING_LOG_PATH).or_else(|| lo.is_finite().then(|| ((lo - 1.0).floor(), hi.ceil())));
+                    tabs.push(match range {
+                        Some((a, b)) => view.with_property("ScalarAxis", &layout::scalar_range(a, b)),
+                        None => view,
+                    });
                 }
                 if self.has_series("ins/position_error_m") {
                     // Keyed in the titles: a legend would cover the curves.

@@ -225,7 +225,7 @@ pub struct Recorder {
     ranges: Option<PlotRanges>,
     /// The command's own panels, kept for when the layout is sent again.
     custom: Option<CustomLayout>,
-    /// Live mode: how the plots are framed as their data grow.
+    /// Each series' extent, and in live mode how the plots are framed as their data grow.
     live_frames: Option<LiveFrames>,
 }
 
@@ -251,7 +251,7 @@ const REFRAME_MIN_INTERVAL: std::time::Duration = std::time::Duration::from_mill
 /// The value range a plot of `what` shows for data in `[lo, hi]`: error plots symmetric about
 /// zero (±1.25 h, h on the 1-2-3-10 grid of [`crate::math::units::nice_half_range`], as the saved
 /// recordings are framed); others `[lo, hi]` widened to whole steps of a 1-2-5 × 10^k grid with
-/// about four steps over the data.
+/// about eight steps over the data.
 pub(crate) fn frame(what: rows::Quantity, lo: f64, hi: f64) -> (f64, f64) {
     use crate::math::units::{nice_at_least, nice_half_range};
     use rows::Quantity as Q;
@@ -260,7 +260,7 @@ pub(crate) fn frame(what: rows::Quantity, lo: f64, hi: f64) -> (f64, f64) {
         return (-1.25 * h, 1.25 * h);
     }
     let span = (hi - lo).max(1e-9 * lo.abs().max(hi.abs())).max(1e-12);
-    let step = nice_at_least(span / 4.0);
+    let step = nice_at_least(span / 8.0);
     let (a, b) = ((lo / step).floor() * step, (hi / step).ceil() * step);
     if b > a { (a, b) } else { (a - step, b + step) }
 }
@@ -346,7 +346,7 @@ impl Recorder {
             error_unit: unit,
             ranges: None,
             custom: custom.clone(),
-            live_frames: live.then(|| LiveFrames { extents: Default::default(), drawn: Default::default(), params: Box::new(params.clone()), sent: std::time::Instant::now() }),
+            live_frames: Some(LiveFrames { extents: Default::default(), drawn: Default::default(), params: Box::new(params.clone()), sent: std::time::Instant::now() }),
         };
         me.log_once(params)?;
         me.log_ins_once()?;
@@ -392,6 +392,8 @@ impl Recorder {
     /// Frames the error plots on the run's peaks (symmetric, labelled ticks) and sends the layout
     /// again: noise of 1e-5″ on a compensated line does not fill a plot and look like a drift.
     pub fn frame_plots(&mut self, params: &Params, ranges: PlotRanges) -> RecordingStreamResult<()> {
+        // Every row out first: the plots framed on their data take the whole extent.
+        self.flush_series()?;
         self.ranges = Some(ranges);
         self.mark_moves(params, &ranges)?;
         self.send_blueprint(params, self.custom.clone())
@@ -575,7 +577,7 @@ impl Recorder {
 
     /// Live mode: sends the layout again when a series has left the range it was framed at.
     fn reframe_live(&mut self) -> RecordingStreamResult<()> {
-        let Some(f) = &self.live_frames else { return Ok(()) };
+        let Some(f) = self.live_frames.as_ref().filter(|_| self.live) else { return Ok(()) };
         let outside = self.series.iter().any(|s| match (f.extents.get(&s.path), f.drawn.get(&s.path)) {
             (Some(&(lo, hi)), Some(&(a, b))) => lo.is_finite() && (lo < a || hi > b),
             (Some(&(lo, _)), None) => lo.is_finite(),
@@ -593,8 +595,8 @@ impl Recorder {
         Ok(())
     }
 
-    /// Live mode: the value range of the plot whose space origin is `origin` (every series at or
-    /// under it), None before it has data.
+    /// The value range of the plot whose space origin is `origin` on its data so far (every
+    /// series at or under it, [`frame`]), None before it has data.
     pub(crate) fn live_range(&self, origin: &str) -> Option<(f64, f64)> {
         let f = self.live_frames.as_ref()?;
         let under = |p: &str| p == origin || p.strip_prefix(origin).is_some_and(|r| r.starts_with('/'));

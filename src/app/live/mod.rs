@@ -67,6 +67,8 @@ pub enum RecorderMsg {
     Series(Vec<(StepOutput, Option<InsView>)>),
     /// Scene frames.
     Scene(Vec<(StepOutput, Option<InsView>)>),
+    /// The IMU samples of the signal window (the first seconds' gyro plots).
+    Signal(Vec<crate::ins::core::SampleOut>),
     /// New parameters from simulated time `t_s`.
     Reconfigure {
         /// When.
@@ -176,6 +178,10 @@ pub fn sim_loop(mut sim: LiveSim, reloads: &Receiver<WatchEvent>, out: &Sender<R
             }
             n += 1;
         }
+        let signal = sim.take_signal();
+        if !signal.is_empty() && out.send(RecorderMsg::Signal(signal)).is_err() {
+            return sim;
+        }
         if !series.is_empty() && out.send(RecorderMsg::Series(series)).is_err() {
             return sim;
         }
@@ -234,6 +240,7 @@ pub fn recorder_loop(mut viewer: Option<Recorder>, mut file: Option<Recorder>, m
                 match &msg {
                     RecorderMsg::Series(rows) => rows.iter().try_for_each(|(r, ins)| recorder.push_row(r, ins.as_ref()))?,
                     RecorderMsg::Scene(rows) => rows.iter().try_for_each(|(r, ins)| recorder.push_scene_row(r, ins.as_ref()))?,
+                    RecorderMsg::Signal(samples) => samples.iter().try_for_each(|s| recorder.push_signal(s))?,
                     RecorderMsg::Reconfigure { t_s, params } => recorder.reconfigure(*t_s, params)?,
                     RecorderMsg::Event { t_s, text, level } => recorder.event(*t_s, text, level)?,
                 }

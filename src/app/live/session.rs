@@ -23,6 +23,9 @@ pub struct LiveSim {
     ins: Option<InsRun>,
     /// The instant of the INS's latest attitude update.
     ins_update_s: Option<f64>,
+    /// The IMU samples of the signal window (the first seconds' raw and filtered gyro plots) not
+    /// yet handed to the recorder.
+    signal: Vec<crate::ins::core::SampleOut>,
 }
 
 impl LiveSim {
@@ -32,7 +35,7 @@ impl LiveSim {
         let model = params.table_model();
         let last_gimbal_rad = model.scheme.state(0.0).0;
         let ins = params.ins_run();
-        Self { params, model, state: DemodState::default(), step_index: 0, stats: ErrorStats::default(), since_change: ErrorStats::default(), last_gimbal_rad, ins, ins_update_s: None }
+        Self { params, model, state: DemodState::default(), step_index: 0, stats: ErrorStats::default(), since_change: ErrorStats::default(), last_gimbal_rad, ins, ins_update_s: None, signal: Vec::new() }
     }
 
     /// Simulated time of the next step, s.
@@ -55,6 +58,9 @@ impl LiveSim {
             if s.updated {
                 self.ins_update_s = Some(s.t_s);
             }
+            if s.t_s <= ins.config().signal_window_s {
+                self.signal.push(s);
+            }
         }
         let out = step(&self.model, &mut self.state, t);
         self.stats.add(&out);
@@ -62,6 +68,11 @@ impl LiveSim {
         self.last_gimbal_rad = out.gimbal_rad;
         self.step_index += 1;
         out
+    }
+
+    /// The signal window's samples since the last call.
+    pub fn take_signal(&mut self) -> Vec<crate::ins::core::SampleOut> {
+        std::mem::take(&mut self.signal)
     }
 
     /// The INS's errors at its latest attitude update (with the true IMU attitude for the scene),
