@@ -66,16 +66,17 @@ pub(super) fn run(args: &RunArgs) -> Result<(), Failure> {
 /// `rinscope live`.
 pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
     use std::io::IsTerminal;
-    if args.sinks.export.is_some() {
-        return Err(Failure::input("--export is for runs that end (run, replay, calibrate, tpr, modulation); save the live session with --save and export a run of its file"));
-    }
+    // --export: the session's series as tables, written when it ends (with the saved file's
+    // stream if there is one, else with the viewer's).
+    let export = args.sinks.export_request()?;
     let path = match (&args.config, &args.scenario) {
         (Some(p), _) => p.clone(),
         (None, name) => {
             let name = name.as_deref().unwrap_or(presets::DEFAULT_SCENARIO);
             presets::load(name)?; // a clear error for an unknown name
             let (path, created) = live::ensure_preset_copy(name).map_err(|e| Failure::input(format!("{e:#}")))?;
-            errln!("rinscope live: {} {} — edit it, or move the sliders", if created { "wrote" } else { "using your edited" }, path.display());
+            let sliders = if args.no_panel { "" } else { ", or move the sliders" };
+            errln!("rinscope live: {} {} — edit it{sliders}", if created { "wrote" } else { "using your edited" }, path.display());
             path
         }
     };
@@ -102,6 +103,7 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
         bind: args.sinks.bind,
         serve_web: args.sinks.serve_web,
         stop_on_failure: Some(stop_flag()),
+        export: if args.sinks.save.is_none() { export.clone() } else { None },
         ..Default::default()
     };
     let recording_id = format!("{}-seed{}-live", params.meta.name, params.meta.seed);
@@ -118,7 +120,7 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
         None
     };
     let file_sinks = match &args.sinks.save {
-        Some(p) => Some(sink::open(&SinkRequest { save: Some(p.clone()), stop_on_failure: Some(stop_flag()), ..Default::default() }, APPLICATION_ID, &recording_id)?),
+        Some(p) => Some(sink::open(&SinkRequest { save: Some(p.clone()), stop_on_failure: Some(stop_flag()), export, ..Default::default() }, APPLICATION_ID, &recording_id)?),
         None => None,
     };
     for d in viewer_sinks.iter().chain(file_sinks.iter()).flat_map(|s| &s.description) {
@@ -133,11 +135,18 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
     let outputs = live::Outputs { viewer: viewer_sinks.as_ref().map(sink::OpenSinks::stream), file: file_sinks.as_ref().map(sink::OpenSinks::stream) };
     let result = live::run_session(&options, params, outputs, &stop);
     // Whatever happened, complete the saved file: it holds everything simulated so far.
+    let mut exported = Vec::new();
     if let Some(v) = viewer_sinks {
-        v.finish().ok();
+        if let Ok(done) = v.finish() {
+            exported.extend(done.exported);
+        }
     }
     let saved = match file_sinks {
-        Some(f) => f.finish()?.recording,
+        Some(f) => {
+            let done = f.finish()?;
+            exported.extend(done.exported);
+            done.recording
+        }
         None => None,
     };
     let summary = result?;
@@ -151,6 +160,7 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
     if let Some((p, bytes)) = saved {
         outln!("recording: {} ({:.2} MB) — open with `rerun {}`, list its events with `rinscope events {}`", p.display(), bytes as f64 / 1e6, p.display(), p.display());
     }
+    print_tables(&exported);
     Ok(())
 }
 

@@ -355,7 +355,13 @@ impl Recorder {
         }
         me.log_error_geometry(params, me.geometry_at(0.0))?;
         me.send_blueprint(params, custom)?;
-        me.event(0.0, &format!("run started: {} ({} s at {} Hz, seed {})", params.meta.name, params.duration_s, params.step_hz, params.meta.seed), "INFO")?;
+        let started = if live {
+            // A live session has no length of its own: it runs until it is stopped.
+            format!("live session started: {} at {} Hz, seed {} (it runs until stopped)", params.meta.name, params.step_hz, params.meta.seed)
+        } else {
+            format!("run started: {} ({} s at {} Hz, seed {})", params.meta.name, params.duration_s, params.step_hz, params.meta.seed)
+        };
+        me.event(0.0, &started, "INFO")?;
         Ok(me)
     }
 
