@@ -101,7 +101,11 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
         connect: args.sinks.connect.clone(),
         serve: args.sinks.serve,
         bind: args.sinks.bind,
-        serve_web: args.sinks.serve_web,
+        // The class page takes --serve-web's port; the viewer it embeds the next one.
+        serve_web: match args.sinks.serve_web {
+            Some(p) => Some(p.checked_add(1).filter(|p| p.checked_add(1).is_some()).ok_or_else(|| Failure::input(format!("--serve-web {p}: the class page needs this port and the next two")))?),
+            None => None,
+        },
         stop_on_failure: Some(stop_flag()),
         export: if args.sinks.save.is_none() { export.clone() } else { None },
         ..Default::default()
@@ -131,9 +135,27 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
     if !panel {
         errln!("rinscope live: running; edit {} to change parameters, Ctrl-C to stop", path.display());
     }
-    let options = live::LiveOptions { config_path: path, speed: args.speed, duration_s: args.duration_s, panel, log_to_stderr: true };
+    let status = live::new_status(&params, args.speed.unwrap_or(params.live_speed));
+    // `--serve-web`: the class page, the viewer beside the sliders, on the port asked for.
+    let class_page = match (args.sinks.serve_web, viewer_sinks.as_ref().and_then(sink::OpenSinks::web_page)) {
+        (Some(port), Some(viewer_url)) => {
+            let ip = args.sinks.bind.unwrap_or(std::net::IpAddr::V4(std::net::Ipv4Addr::LOCALHOST));
+            let token = if ip.is_loopback() { None } else { Some(live::web::random_token().map_err(|e| Failure::run(format!("no random token for the class page: {e}")))?) };
+            let host = if ip.is_unspecified() { "127.0.0.1".to_owned() } else { ip.to_string() };
+            let cfg = live::web::PageConfig { addr: std::net::SocketAddr::new(ip, port), host, viewer_url: viewer_url.to_owned(), config_path: path.clone(), token: token.clone() };
+            let page = live::web::start(cfg, status.clone(), format!("{} — {}", params.meta.name, params.meta.title)).map_err(|e| Failure::input(format!("--serve-web: {e:#}")))?;
+            errln!("rinscope live: the class page (viewer and sliders): {}", page.url);
+            if token.is_some() {
+                errln!("rinscope live: shared beyond this machine: anyone who reaches the page can watch; changing a parameter needs the token in that URL (give it only to whom may)");
+            }
+            Some(page)
+        }
+        _ => None,
+    };
+    let options = live::LiveOptions { config_path: path, speed: args.speed, duration_s: args.duration_s, panel, log_to_stderr: true, page_url: class_page.as_ref().map(|p| p.url.clone()) };
     let outputs = live::Outputs { viewer: viewer_sinks.as_ref().map(sink::OpenSinks::stream), file: file_sinks.as_ref().map(sink::OpenSinks::stream) };
-    let result = live::run_session(&options, params, outputs, &stop);
+    let result = live::run_session_with_status(&options, params, outputs, &stop, &status);
+    drop(class_page);
     // Whatever happened, complete the saved file: it holds everything simulated so far.
     let mut exported = Vec::new();
     if let Some(v) = viewer_sinks {

@@ -136,12 +136,15 @@ struct SinkArgs {
     /// Serve the stream over gRPC on this port (default 9876) for native or web viewers.
     #[arg(long, num_args = 0..=1, default_missing_value = "9876")]
     serve: Option<u16>,
-    /// Serve the viewer itself for a browser on this HTTP port (default 9090), with the stream: open
-    /// the printed URL, nothing to install. After a run the page stays until Ctrl-C.
+    /// Serve the viewer itself for a browser on this HTTP port (default 9090), with the stream on
+    /// the next port: open the printed URL, nothing to install. After a run the page stays until
+    /// Ctrl-C. `live`: a class page on this port, the viewer beside the parameters' sliders (the
+    /// viewer on the next port, the stream on the one after); it ends with the session.
     #[arg(long, num_args = 0..=1, default_missing_value = "9090", value_name = "PORT")]
     serve_web: Option<u16>,
     /// --serve / --serve-web: the address to listen on (default 127.0.0.1, this machine only;
-    /// 0.0.0.0 shares the session with the whole network, without authentication).
+    /// 0.0.0.0 shares the session with the whole network: anyone can watch; live's class page
+    /// then needs the random token of its printed URL to change a parameter).
     #[arg(long, value_name = "ADDR")]
     bind: Option<std::net::IpAddr>,
     /// Also write the numbers as tables into this folder: every recorded time series (one file per

@@ -29,6 +29,8 @@ mod layout;
 pub mod modulation;
 mod palette;
 pub mod read;
+mod frames;
+use frames::LiveFrames;
 mod rows;
 mod scene;
 pub mod sink;
@@ -229,41 +231,6 @@ pub struct Recorder {
     live_frames: Option<LiveFrames>,
 }
 
-/// Live mode: every plot framed on its data so far, re-framed when they leave the frame. The
-/// viewer fits a plot's value axis once, when the plot first appears — before a live session has
-/// data — and keeps ±1 after; so a live layout carries each plot's range itself, on the 1-2-5
-/// grid the saved recordings use ([`frame`]), and is sent again when a series leaves it (at most
-/// once every [`REFRAME_MIN_INTERVAL`]).
-struct LiveFrames {
-    /// Each series' value extent so far (entity path → min, max), finite values only.
-    extents: std::collections::BTreeMap<String, (f64, f64)>,
-    /// The range each series' extent gave when the layout was last sent.
-    drawn: std::collections::BTreeMap<String, (f64, f64)>,
-    /// The parameters the layout is built from.
-    params: Box<Params>,
-    /// When the layout was last sent.
-    sent: std::time::Instant,
-}
-
-/// Least wall time between two live re-framings.
-const REFRAME_MIN_INTERVAL: std::time::Duration = std::time::Duration::from_millis(500);
-
-/// The value range a plot of `what` shows for data in `[lo, hi]`: error plots symmetric about
-/// zero (±1.25 h, h on the 1-2-3-10 grid of [`crate::math::units::nice_half_range`], as the saved
-/// recordings are framed); others `[lo, hi]` widened to whole steps of a 1-2-5 × 10^k grid with
-/// about eight steps over the data.
-pub(crate) fn frame(what: rows::Quantity, lo: f64, hi: f64) -> (f64, f64) {
-    use crate::math::units::{nice_at_least, nice_half_range};
-    use rows::Quantity as Q;
-    if matches!(what, Q::TableError(_) | Q::InsError(_) | Q::ClosedForm | Q::PositionError | Q::VelocityError | Q::Swing(_)) {
-        let h = nice_half_range(lo.abs().max(hi.abs()));
-        return (-1.25 * h, 1.25 * h);
-    }
-    let span = (hi - lo).max(1e-9 * lo.abs().max(hi.abs())).max(1e-12);
-    let step = nice_at_least(span / 8.0);
-    let (a, b) = ((lo / step).floor() * step, (hi / step).ceil() * step);
-    if b > a { (a, b) } else { (a - step, b + step) }
-}
 
 /// The error plots' symmetric ranges, from a run's peaks (see [`crate::math::units::nice_half_range`]).
 #[derive(Debug, Clone, Copy)]
@@ -581,41 +548,6 @@ impl Recorder {
         self.reframe_live()
     }
 
-    /// Live mode: sends the layout again when a series has left the range it was framed at.
-    fn reframe_live(&mut self) -> RecordingStreamResult<()> {
-        let Some(f) = self.live_frames.as_ref().filter(|_| self.live) else { return Ok(()) };
-        let outside = self.series.iter().any(|s| match (f.extents.get(&s.path), f.drawn.get(&s.path)) {
-            (Some(&(lo, hi)), Some(&(a, b))) => lo.is_finite() && (lo < a || hi > b),
-            (Some(&(lo, _)), None) => lo.is_finite(),
-            _ => false,
-        });
-        if !outside || f.sent.elapsed() < REFRAME_MIN_INTERVAL {
-            return Ok(());
-        }
-        let params = f.params.clone();
-        self.send_blueprint(&params, self.custom.clone())?;
-        if let Some(f) = self.live_frames.as_mut() {
-            f.drawn = self.series.iter().filter_map(|s| f.extents.get(&s.path).filter(|e| e.0.is_finite()).map(|&(lo, hi)| (s.path.clone(), frame(s.what, lo, hi)))).collect();
-            f.sent = std::time::Instant::now();
-        }
-        Ok(())
-    }
-
-    /// The value range of the plot whose space origin is `origin` on its data so far (every
-    /// series at or under it, [`frame`]), None before it has data.
-    pub(crate) fn live_range(&self, origin: &str) -> Option<(f64, f64)> {
-        let f = self.live_frames.as_ref()?;
-        let under = |p: &str| p == origin || p.strip_prefix(origin).is_some_and(|r| r.starts_with('/'));
-        let mut what = None;
-        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        for s in self.series.iter().filter(|s| under(&s.path)) {
-            if let Some(&(a, b)) = f.extents.get(&s.path).filter(|e| e.0.is_finite()) {
-                (lo, hi) = (lo.min(a), hi.max(b));
-                what.get_or_insert(s.what);
-            }
-        }
-        what.map(|w| frame(w, lo, hi))
-    }
 
     /// Sends the buffered scene frames.
     pub fn flush_scene(&mut self) -> RecordingStreamResult<()> {

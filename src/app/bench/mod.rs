@@ -358,7 +358,7 @@ fn live_latency(dir: &std::path::Path, figs: &mut Figures, interrupt: &AtomicBoo
     let params = crate::scenario::load_file(&path)?;
     let status = live::new_status(&params, 1.0);
     let stop = std::sync::Arc::new(AtomicBool::new(false));
-    let opts = live::LiveOptions { config_path: path.clone(), speed: Some(1.0), duration_s: None, panel: false, log_to_stderr: false };
+    let opts = live::LiveOptions { config_path: path.clone(), speed: Some(1.0), duration_s: None, panel: false, log_to_stderr: false, page_url: None };
     let rec_path = dir.join("live.rrd");
     let sinks = sink::open(&SinkRequest { save: Some(rec_path), ..Default::default() }, "rinscope-bench", "live")?;
     let session = {

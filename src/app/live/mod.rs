@@ -8,6 +8,7 @@ pub mod edit;
 pub mod panel;
 mod session;
 pub mod watch;
+pub mod web;
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -343,6 +344,8 @@ pub struct LiveOptions {
     pub panel: bool,
     /// Without a panel: print reloads and errors to stderr.
     pub log_to_stderr: bool,
+    /// The class page's URL (`--serve-web`), shown in the panel all the time.
+    pub page_url: Option<String>,
 }
 
 /// Restores the terminal when dropped (normal exit, error or panic unwinding).
@@ -370,7 +373,10 @@ pub fn run_session_with_status(opts: &LiveOptions, params: Params, outputs: Outp
     let file = outputs.file.map(|rec| Recorder::new_live(rec, &params)).transpose()?;
     // Bounded: a recorder that falls behind slows the simulation instead of growing memory.
     let (out_tx, out_rx) = crossbeam_channel::bounded::<RecorderMsg>(64);
-    let title = format!("rinscope live — {} — {}", params.meta.name, params.meta.title);
+    let title = match &opts.page_url {
+        Some(url) => format!("rinscope live — {} — class page: {url}", params.meta.name),
+        None => format!("rinscope live — {} — {}", params.meta.name, params.meta.title),
+    };
     let resolved = params.resolved.clone();
 
     let recorder_thread = std::thread::Builder::new().name("recorder".into()).spawn(move || recorder_loop(viewer, file, &out_rx))?;

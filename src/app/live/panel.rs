@@ -50,6 +50,16 @@ pub enum Control {
     },
 }
 
+impl Control {
+    /// What the user reads.
+    #[must_use]
+    pub fn label(&self) -> &str {
+        match self {
+            Self::Slider { label, .. } | Self::Toggle { label, .. } => label,
+        }
+    }
+}
+
 /// What a key press asks for.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Action {
@@ -218,6 +228,35 @@ impl Panel {
             KeyCode::Char('r') => self.reset_selected(),
             KeyCode::Char(' ') | KeyCode::Enter => self.toggle_selected(),
             _ => Action::None,
+        }
+    }
+
+    /// Sets control `index` to `value` (a number for a slider, 0 or 1 for a toggle), as a slider
+    /// move would: within the control's range, on its step grid. What the class page sends.
+    ///
+    /// # Errors
+    /// No such control, a value that is not a finite number, or outside the range (named with the
+    /// control, its unit and its range).
+    pub fn set_control(&mut self, index: usize, value: f64) -> Result<Action, String> {
+        let Some(control) = self.controls.get(index) else {
+            return Err(format!("no control {index} (there are {})", self.controls.len()));
+        };
+        if !value.is_finite() {
+            return Err(format!("{}: {value} is not a finite number", control.label()));
+        }
+        match control {
+            Control::Slider { label, unit, min, max, .. } if !(*min..=*max).contains(&value) => Err(format!("{label}: {value}{unit} is outside {}{unit} ..= {}{unit}", trim(*min), trim(*max))),
+            Control::Slider { .. } => {
+                self.selected = index;
+                Ok(self.set_selected(|_, _, _| value))
+            }
+            Control::Toggle { label, value: on, .. } => match value {
+                v if v == 0.0 || v == 1.0 => {
+                    self.selected = index;
+                    Ok(if (v == 1.0) == *on { Action::None } else { self.toggle_selected() })
+                }
+                _ => Err(format!("{label}: {value} is neither 0 (off) nor 1 (on)")),
+            },
         }
     }
 

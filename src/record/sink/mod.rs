@@ -119,6 +119,14 @@ pub struct OpenSinks {
 }
 
 /// The web viewer's HTTP server and the page that shows the stream.
+impl OpenSinks {
+    /// The browser viewer's URL (with its stream), when `serve_web` was asked for.
+    #[must_use]
+    pub fn web_page(&self) -> Option<&str> {
+        self.web.as_ref().map(|w| w.page.as_str())
+    }
+}
+
 struct WebServer {
     /// Rerun's `WebViewerServer`: serves while it lives.
     _server: Box<dyn std::any::Any + Send>,
@@ -191,8 +199,9 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
         let ip = req.bind.unwrap_or(IpAddr::V4(Ipv4Addr::LOCALHOST));
         let web_addr = SocketAddr::new(ip, web_port);
         std::net::TcpListener::bind(web_addr).map_err(|e| SinkError::Serve { addr: web_addr, reason: e.to_string() })?;
-        // The stream on a free port beside it; the page connects to it.
-        let grpc_port = std::net::TcpListener::bind((ip, 0)).and_then(|l| l.local_addr()).map_err(|e| SinkError::Serve { addr: web_addr, reason: e.to_string() })?.port();
+        // The stream on the next port (known in advance: a firewall can be opened for both); the
+        // page connects to it.
+        let grpc_port = web_port.checked_add(1).ok_or(SinkError::Serve { addr: web_addr, reason: "the stream needs the next port too".into() })?;
         let options = rerun::ServerOptions { memory_limit: rerun::MemoryLimit::from_bytes(1 << 30), ..Default::default() };
         let sink = rerun::grpc_server::GrpcServerSink::new(&ip.to_string(), grpc_port, options).map_err(|e| SinkError::Serve { addr: SocketAddr::new(ip, grpc_port), reason: e.to_string() })?;
         sinks.push(Box::new(sink));
@@ -291,7 +300,7 @@ impl OpenSinks {
         let viewer_problems = viewer_problems.lock().unwrap_or_else(std::sync::PoisonError::into_inner).clone();
         // A browser may still be reading: the page and the stream (held by `rec`) serve until the
         // stop flag (Ctrl-C) is set.
-        if let (Some(w), Some(stop)) = (web, stop) {
+        if let (Some(w), Some(stop)) = (web, stop.filter(|s| !s.load(std::sync::atomic::Ordering::SeqCst))) {
             errln!("rinscope: the run is complete; its viewer stays at {} until Ctrl-C", w.page);
             while !stop.load(std::sync::atomic::Ordering::SeqCst) {
                 std::thread::sleep(Duration::from_millis(100));
