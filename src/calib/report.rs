@@ -475,7 +475,7 @@ impl Report {
             }
         };
         table("Angles (phase errors in arcsec of phase)", &self.angles);
-        table("Seed 000's state X (eq. 29)", &self.paper_state);
+        table("Jiang et al. 2017's state X (eq. 29)", &self.paper_state);
         table("State vector (table and reference nuisance)", &self.state);
         if let Some(c) = &self.compensation {
             s.push_str("**Compensation**, on an independent run (other noise seed): attitude error RMS / peak, arcsec\n\n| | pitch | roll | heading |\n|---|---:|---:|---:|\n");

@@ -23,7 +23,7 @@ pub fn log(stream: &Stream, params: &Params, r: &TprResult, table: &str) -> Reco
             .with_component::<rerun::components::Text>("seed", [params.meta.seed.to_string()]),
     )?;
     let doc = format!(
-        "# {}\n\n*{}*\n\n{}\n\n```\n{}```\n\nSeed 003 (Fig. 9): radial error after the resets below {} m with TPR, above {} m \
+        "# {}\n\n*{}*\n\n{}\n\n```\n{}```\n\nZheng et al. 2016 (Fig. 9): radial error after the resets below {} m with TPR, above {} m \
          conventionally. docs/tpr.md derives the estimator in rinscope's signs.\n",
         params.meta.name,
         params.meta.title,
