@@ -130,6 +130,26 @@ pub fn set_in_file(path: &Path, key: &KeyPath, value: Value) -> Result<(), EditE
     Ok(rewrite_input(path, new.as_bytes())?)
 }
 
+/// Sets every key of `writes` in the file at `path`, atomically and at once (one reload for a
+/// control that writes several keys, or "calibrate now").
+///
+/// # Errors
+/// As [`set_in_file`]; nothing is written unless every key could be set.
+pub fn set_many_in_file(path: &Path, writes: &[(KeyPath, Value)]) -> Result<(), EditError> {
+    let shown = path.display().to_string();
+    let mut text = super::read_text(path).map_err(|source| EditError::Io { path: shown.clone(), source })?;
+    for (key, value) in writes {
+        text = set_in_text(&text, key, value.clone()).map_err(|message| {
+            if message.contains("TOML parse error") || message.contains("expected") {
+                EditError::Syntax { path: shown.clone(), message }
+            } else {
+                EditError::Missing { path: shown.clone(), key: key.to_string() }
+            }
+        })?;
+    }
+    Ok(rewrite_input(path, text.as_bytes())?)
+}
+
 /// A value a control writes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Scalar {

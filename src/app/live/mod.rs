@@ -434,10 +434,9 @@ fn panel_loop(path: &Path, resolved: &RawConfig, title: String, status: &SharedS
                     }
                     panel::Action::Set(writes) => {
                         last_write = Instant::now();
-                        for (k, v) in writes {
-                            if let Err(e) = edit::set_in_file(path, &k, v.to_value()) {
-                                lock(status).message = format!("slider not written: {e}");
-                            }
+                        let writes: Vec<_> = writes.into_iter().map(|(k, v)| (k, v.to_value())).collect();
+                        if let Err(e) = edit::set_many_in_file(path, &writes) {
+                            lock(status).message = format!("slider not written: {e}");
                         }
                     }
                     panel::Action::None => {}

@@ -82,10 +82,15 @@ pub struct Panel {
     pub show_help: bool,
     /// First line.
     pub title: String,
+    /// The table's axis names, in `[[turntable.axis]]` order (the compensation's keys name them).
+    axis_names: Vec<String>,
 }
 
 /// The one-line key help.
-pub const HELP: &str = "↑↓ select  ←→ adjust  Shift+←→/PgUp/PgDn ×10  Home/End min/max  0 zero  r reset  Space toggle  ? help (Esc closes)  q quit";
+pub const HELP: &str = "↑↓ select  ←→ adjust  Shift+←→/PgUp/PgDn ×10  Home/End min/max  0 zero  r reset  Space toggle  c calibrate now  ? help (Esc closes)  q quit";
+
+/// The per-axis table errors `[compensation.axis.NAME]` can hold.
+const COMPENSATED_AXIS_FIELDS: [&str; 6] = ["swing_half_angle_arcsec", "swing_phase_deg", "non_orthogonality_arcsec", "encoder_offset_arcsec", "encoder_scale_ppm", "encoder_delay_ms"];
 
 fn slider(label: String, key: &str, unit: &'static str, (min, max): (f64, f64), step: f64) -> Control {
     Control::Slider { label, keys: vec![KeyPath::parse(key)], unit, min, max, step, log: false, value: 0.0, initial: 0.0 }
@@ -148,7 +153,8 @@ impl Panel {
         controls.push(log("speed (× real time)", "live.speed", (0.1, 1000.0)));
         controls.push(log("3D exaggeration", "recording.exaggeration", (1.0, 10_000.0)));
         controls.push(Control::Toggle { label: "compensation".into(), key: KeyPath::parse("compensation.enabled"), value: true, initial: true });
-        let mut panel = Self { controls, selected: 0, show_help: false, title };
+        let axis_names = raw.turntable.axis.iter().map(|a| a.name.clone()).collect();
+        let mut panel = Self { controls, selected: 0, show_help: false, title, axis_names };
         panel.sync(raw);
         for c in &mut panel.controls {
             match c {
@@ -227,6 +233,7 @@ impl Panel {
             KeyCode::Char('0') => self.set_selected(|v, min, max| if (min..=max).contains(&0.0) { 0.0 } else { v }),
             KeyCode::Char('r') => self.reset_selected(),
             KeyCode::Char(' ') | KeyCode::Enter => self.toggle_selected(),
+            KeyCode::Char('c') => self.calibrate_now(),
             _ => Action::None,
         }
     }
@@ -258,6 +265,43 @@ impl Panel {
                 _ => Err(format!("{label}: {value} is neither 0 (off) nor 1 (on)")),
             },
         }
+    }
+
+    /// "Calibrate now": the compensation frozen at the table's current errors — every table error
+    /// the sliders show written into `[compensation]` (per axis into `[compensation.axis.NAME]`),
+    /// and the compensation switched on. Until then the compensation follows the truth (a key left
+    /// out of `[compensation]` takes the true value), so the compensated curve is zero; after it,
+    /// a slider moved shows what a table that changed since its calibration does.
+    #[must_use]
+    pub fn calibrate_now(&mut self) -> Action {
+        let mut writes = Vec::new();
+        for c in &self.controls {
+            let Control::Slider { keys, value, .. } = c else { continue };
+            for key in keys {
+                let k = key.to_string();
+                let target = if let Some(rest) = k.strip_prefix("turntable.axis[") {
+                    let (index, field) = rest.split_once("].").unwrap_or_default();
+                    match (index.parse::<usize>().ok().and_then(|i| self.axis_names.get(i)), COMPENSATED_AXIS_FIELDS.contains(&field)) {
+                        (Some(name), true) => Some(format!("compensation.axis.{name}.{field}")),
+                        _ => None,
+                    }
+                } else {
+                    k.strip_prefix("turntable.").map(|field| format!("compensation.{field}"))
+                };
+                if let Some(t) = target {
+                    writes.push((KeyPath::parse(&t), Scalar::Float(*value)));
+                }
+            }
+        }
+        for c in &mut self.controls {
+            if let Control::Toggle { key, value, .. } = c
+                && key.to_string() == "compensation.enabled"
+            {
+                *value = true;
+                writes.push((key.clone(), Scalar::Bool(true)));
+            }
+        }
+        Action::Set(writes)
     }
 
     fn nudge(&mut self, direction: f64, coarse: bool) -> Action {
@@ -308,7 +352,7 @@ impl Panel {
     /// Draws the panel.
     pub fn render(&self, frame: &mut Frame<'_>, status: &Status, config_path: &str) {
         let [top, list, bottom] =
-            Layout::vertical([Constraint::Length(2), Constraint::Min(3), Constraint::Length(if self.show_help { 13 } else { 9 })]).areas(frame.area());
+            Layout::vertical([Constraint::Length(2), Constraint::Min(3), Constraint::Length(if self.show_help { 15 } else { 9 })]).areas(frame.area());
         let head = vec![
             Line::from(Span::styled(self.title.clone(), Style::default().add_modifier(Modifier::BOLD))),
             Line::from(format!("sim t = {:.1} s   speed ×{}   config {config_path}", status.sim_t_s, trim(status.speed))),
@@ -354,6 +398,8 @@ impl Panel {
             foot.push(Line::from("Every slider writes its key into the config file (comments and layout kept);"));
             foot.push(Line::from("the file watcher reloads it exactly as when you save from an editor. Editing the"));
             foot.push(Line::from("file by hand moves the sliders. Bad values are reported and the old ones kept."));
+            foot.push(Line::from("c (calibrate now) freezes [compensation] at the table's current errors: move a slider after it"));
+            foot.push(Line::from("to see what a table that changed since its calibration does to the compensated curve."));
             foot.push(Line::from("q or Ctrl-C ends the session (a --save recording is completed); Esc closes this help."));
         }
         frame.render_widget(Paragraph::new(foot).wrap(Wrap { trim: true }), bottom);

@@ -173,3 +173,39 @@ fn the_slider_path_writes_the_file_and_the_watcher_applies_it() {
     assert!(st.generation >= 1);
     s.finish();
 }
+
+#[test]
+fn calibrate_now_freezes_the_compensation_and_a_later_change_shows_in_the_compensated_curve() {
+    use super::panel::{Action, Panel};
+    use crate::math::units::ARCSEC_PER_RAD;
+    // The worst compensated RMS over the three axes, arcsec, in the 20 s after `after` replaces `before`.
+    let compensated_after = |before: &str, after: &str| -> f64 {
+        let mut sim = LiveSim::new(scenario::parse(before, "before").expect("parses"));
+        for _ in 0..200 {
+            sim.step();
+        }
+        assert!(!sim.apply(scenario::parse(after, "after").expect("parses")).expect("applied").is_empty());
+        for _ in 0..4000 {
+            sim.step();
+        }
+        (0..3).map(|a| sim.since_change.stats[1][a].rms()).fold(0.0, f64::max) * ARCSEC_PER_RAD
+    };
+    let wider = |t: &str| t.replacen("swing_half_angle_arcsec = 300.0", "swing_half_angle_arcsec = 600.0", 1);
+    // Before "calibrate now" the compensation follows the truth: the compensated curve stays at zero.
+    let follows = compensated_after(PRESET, &wider(PRESET));
+    assert!(follows < 0.01, "compensation following the truth leaves {follows}″");
+    // "Calibrate now": the panel's writes, applied to the file's text as the panel applies them.
+    let mut panel = Panel::new(&params().resolved, "t".into());
+    let Action::Set(writes) = panel.calibrate_now() else { panic!("calibrate now writes") };
+    assert!(writes.iter().any(|(k, _)| k.to_string() == "compensation.axis.inner.swing_half_angle_arcsec"), "{writes:?}");
+    let mut calibrated = PRESET.to_owned();
+    for (k, v) in &writes {
+        calibrated = edit::set_in_text(&calibrated, k, v.to_value()).expect("written");
+    }
+    let frozen = scenario::parse(&calibrated, "calibrated").expect("a valid scenario");
+    assert_eq!(frozen.resolved.compensation.axis.get("inner").and_then(|a| a.swing_half_angle_arcsec), Some(300.0));
+    // The inner cone then doubles: the frozen compensation no longer matches, and the compensated
+    // curve shows it (the inner swing's 300″ of extra cone moves the attitude by tens of arcsec).
+    let shown = compensated_after(&calibrated, &wider(&calibrated));
+    assert!(shown > 10.0, "after calibrate now, a wider cone leaves only {shown}″ in the compensated curve");
+}

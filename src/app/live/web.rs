@@ -9,6 +9,8 @@
 //! - `POST /set` with `{"control": N, "value": X}`: control N of the panel's list — never a file,
 //!   a path or a config key — to a value inside its range. Bodies over [`MAX_BODY`] bytes, more
 //!   than [`MAX_REQUESTS_PER_S`] requests a second, and anything else are refused.
+//! - `POST /calibrate` (no body): "calibrate now", the compensation frozen at the table's current
+//!   errors ([`Panel::calibrate_now`]).
 //! - With `--bind` beyond loopback, `POST` needs the session's random token (in the printed URL;
 //!   the page sends it as `X-Rinscope-Token`).
 
@@ -137,11 +139,8 @@ fn answer(req: &mut tiny_http::Request, cfg: &PageConfig, panel: &mut Panel, st:
         (tiny_http::Method::Get, "/") => (200, PAGE.replace("{{VIEWER_URL}}", &cfg.viewer_url).replace("{{TITLE}}", &html_escape(&panel.title)), "text/html; charset=utf-8"),
         (tiny_http::Method::Get, "/controls") => (200, controls_json(panel, st, &cfg.config_path).to_string(), "application/json"),
         (tiny_http::Method::Post, "/set") => {
-            if let Some(token) = &cfg.token {
-                let given = req.headers().iter().find(|h| h.field.equiv("X-Rinscope-Token")).map(|h| h.value.as_str().to_owned());
-                if given.as_deref() != Some(token.as_str()) {
-                    return err(403, "this session is shared beyond this machine: changing a parameter needs the token of the URL the terminal printed".into());
-                }
+            if let Some(e) = token_refusal(req, cfg) {
+                return e;
             }
             if req.body_length().is_some_and(|n| n > MAX_BODY) {
                 return err(413, format!("a request body is at most {MAX_BODY} bytes"));
@@ -155,8 +154,30 @@ fn answer(req: &mut tiny_http::Request, cfg: &PageConfig, panel: &mut Panel, st:
                 Err(e) => err(400, e),
             }
         }
-        _ => err(404, format!("no {} {path} here: the page is /, its controls /controls, a change POST /set", req.method())),
+        (tiny_http::Method::Post, "/calibrate") => {
+            if let Some(e) = token_refusal(req, cfg) {
+                return e;
+            }
+            if req.body_length().is_some_and(|n| n > 0) {
+                return err(400, "\"calibrate now\" takes no body".into());
+            }
+            match write(panel.calibrate_now(), &cfg.config_path) {
+                Ok(()) => (200, json!({"ok": true}).to_string(), "application/json"),
+                Err(e) => err(400, e),
+            }
+        }
+        _ => err(404, format!("no {} {path} here: the page is /, its controls /controls, a change POST /set, \"calibrate now\" POST /calibrate", req.method())),
     }
+}
+
+/// The answer refusing a change without the session's token (None: it may go on).
+fn token_refusal(req: &tiny_http::Request, cfg: &PageConfig) -> Option<(u16, String, &'static str)> {
+    let token = cfg.token.as_ref()?;
+    let given = req.headers().iter().find(|h| h.field.equiv("X-Rinscope-Token")).map(|h| h.value.as_str().to_owned());
+    (given.as_deref() != Some(token.as_str())).then(|| {
+        let message = "this session is shared beyond this machine: changing a parameter needs the token of the URL the terminal printed";
+        (403, json!({ "error": message }).to_string(), "application/json")
+    })
 }
 
 /// Applies `{"control": N, "value": X}` through the panel and writes the file.
@@ -172,12 +193,15 @@ fn set(panel: &mut Panel, body: &[u8], config_path: &Path) -> Result<(), String>
         Some(x) => x.as_f64().ok_or("\"value\" must be a number (or true/false for a switch)")?,
         None => return Err("\"value\" is missing".into()),
     };
-    match panel.set_control(usize::try_from(index).unwrap_or(usize::MAX), value)? {
+    write(panel.set_control(usize::try_from(index).unwrap_or(usize::MAX), value)?, config_path)
+}
+
+/// Writes a panel's action into the file, all its keys at once.
+fn write(action: Action, config_path: &Path) -> Result<(), String> {
+    match action {
         Action::Set(writes) => {
-            for (k, v) in writes {
-                edit::set_in_file(config_path, &k, v.to_value()).map_err(|e| format!("not written: {e}"))?;
-            }
-            Ok(())
+            let writes: Vec<_> = writes.into_iter().map(|(k, v)| (k, v.to_value())).collect();
+            edit::set_many_in_file(config_path, &writes).map_err(|e| format!("not written: {e}"))
         }
         Action::None | Action::Quit => Ok(()),
     }
@@ -275,6 +299,12 @@ mod tests {
         assert_eq!(params.resolved.turntable.axis[1].swing_half_angle_arcsec, 450.0);
         // The user's comments and layout kept (the same editor the terminal panel uses).
         assert_eq!(text.lines().count(), PRESET.lines().count());
+        // "Calibrate now": the compensation frozen at the current errors (the inner swing now 450″).
+        let (code, body) = request(&p.url, "POST", "/calibrate", &[], b"");
+        assert_eq!(code, 200, "{body}");
+        let params = scenario::parse(&std::fs::read_to_string(&path).expect("config"), "calibrated").expect("valid");
+        assert_eq!(params.resolved.compensation.axis.get("inner").and_then(|a| a.swing_half_angle_arcsec), Some(450.0));
+        assert_eq!(params.resolved.compensation.enabled, Some(true));
     }
 
     #[test]
@@ -286,6 +316,8 @@ mod tests {
         let ok_token = [("X-Rinscope-Token", "s3cret")];
         let cases: Vec<(&str, &str, Vec<(&str, &str)>, Vec<u8>, u16, &str)> = vec![
             ("no token", "/set", vec![], json(&format!("{{\"control\": {inner}, \"value\": 450}}")), 403, "token"),
+            ("calibrate now without the token", "/calibrate", vec![], vec![], 403, "token"),
+            ("calibrate now with a body", "/calibrate", ok_token.to_vec(), json("{\"axis\": \"inner\"}"), 400, "no body"),
             ("a wrong token", "/set", vec![("X-Rinscope-Token", "guess")], json(&format!("{{\"control\": {inner}, \"value\": 450}}")), 403, "token"),
             ("a config key", "/set", ok_token.to_vec(), json("{\"key\": \"turntable.axis[1].swing_half_angle_arcsec\", \"value\": 450}"), 400, "unknown field"),
             ("a key beside the control", "/set", ok_token.to_vec(), json(&format!("{{\"control\": {inner}, \"value\": 450, \"path\": \"/etc/passwd\"}}")), 400, "unknown field"),
