@@ -142,7 +142,9 @@ impl Recorder {
             format!("{}/sensor_axes/labels", self.paths.imu),
             &rerun::Points3D::new([[0.55, 0.0, 0.0], [0.0, 0.55, 0.0], [0.0, 0.0, 0.55]])
                 .with_labels(["x_s", "y_s", "z_s"])
-                .with_colors(colors::SENSOR.map(rgb))
+                // Pale tints of the arrows' colours: a label the colour of its arrow vanishes where it
+                // crosses it (x_s red on red, z_s blue on dark blue).
+                .with_colors(colors::SENSOR.map(|c| rgb(c.map(|v| v / 3 + 170))))
                 .with_radii([0.002]),
         )?;
         Ok(())
