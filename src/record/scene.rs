@@ -225,12 +225,9 @@ impl Recorder {
             return Ok(());
         }
 
-        let x = p.recording.exaggeration;
-        let f = self.factors;
-        let own = super::own_factors(&f, x);
-        let own = if own.is_empty() { String::new() } else { format!(" ({}: too small at ×{x})", own.join(", ")) };
-        // Low enough to stay in the default camera's view over a single-axis table too.
-        self.label(at, "world/legend", &[([0.0, 0.0, 1.2], format!("error angles drawn ×{x}{own}").as_str())])?;
+        // The drawing factors are in the 3D view's title ("errors ×100, swing ×500"): a label in the
+        // scene saying so sat where the wedges' labels go (installation over it in the wobble preset).
+        let (x, f) = (p.recording.exaggeration, self.factors);
         // The base, mount and IMU links do not depend on the gimbal angles.
         let draw = self.chain.link_rotations(&self.drawing, &[0.0; crate::model::scheme::MAX_AXES]);
         let t = |q: &UnitQuaternion<f64>| rerun::Transform3D::from_rotation(to_rerun_quaternion(q));
