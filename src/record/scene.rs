@@ -255,7 +255,11 @@ impl Recorder {
                 let (mesh, rims) = cone(g.axis, g.e1, g.e2, alpha, half);
                 self.put(at, cone_path.as_str(), &rerun::Mesh3D::new(mesh.0).with_triangle_indices(mesh.1).with_albedo_factor(albedo(color, 60)))?;
                 self.put(at, format!("{cone_path}/rims"), &rerun::LineStrips3D::new(rims).with_colors([rgba(color, 200)]).with_radii([0.004]))?;
-                let tip = -g.axis * half - g.e1 * (half * alpha.tan());
+                // The label at the cone's lower end for an upright axis, at its far (+axis) end for a
+                // level one: at the lower end of both, the inner and outer labels of a dual-axis table
+                // meet under the table's centre.
+                let end = if g.axis.z.abs() < 0.5 { g.axis } else { -g.axis };
+                let tip = end * half - g.e1 * (half * alpha.tan());
                 let text = format!(
                     "{} swing α = {}, φ = {:.1}°{}",
                     g.name,
@@ -300,7 +304,11 @@ impl Recorder {
                 .with_radii([0.004]),
         )?;
         let text = format!("{what} {} (drawn ×{x})", fmt_angle(true_arcsec / ARCSEC_PER_RAD));
-        self.label(at, &format!("{path}/label"), &[(p3(tilted * length * 1.08), text.as_str())])
+        // Beyond the wedge's tip, on its open side: on the tip the label hid the wedge it names (a
+        // narrow wedge, η, needs more room than a wide one).
+        let side = (tilted - ideal).try_normalize(1e-12).unwrap_or_else(Vector3::zeros);
+        let beyond = if tilted.angle(&ideal) < 0.1 { 1.3 } else { 1.08 };
+        self.label(at, &format!("{path}/label"), &[(p3(tilted * length * beyond + side * length * 0.35), text.as_str())])
     }
 }
 
