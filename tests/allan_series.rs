@@ -6,7 +6,8 @@
 //! print allows. The files are written here in the formats' documented layouts (CSV, NumPy .npy
 //! by hand, Parquet by the parquet crate's own writer), not by rinscope.
 
-#[allow(dead_code)]
+// The io tests' own writers (hand-written .npy, the parquet crate's ArrowWriter); test helpers unwrap.
+#[allow(dead_code, clippy::unwrap_used)]
 #[path = "io/common.rs"]
 mod common;
 

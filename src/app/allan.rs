@@ -138,10 +138,8 @@ pub fn options(req: &AllanRequest) -> Result<AllanOptions, AllanRunError> {
     if !(req.ci_sigma > 0.0 && req.ci_sigma <= 3.0) {
         return Err(AllanRunError::Config(format!("--ci-sigma {}: must be > 0 and <= 3 (normal sigmas)", req.ci_sigma)));
     }
-    if let TauSpacing::PerDecade(n) = req.spacing {
-        if n == 0 {
-            return Err(AllanRunError::Config("--taus 0: give at least 1 cluster time per decade (or octave, decade, all)".into()));
-        }
+    if req.spacing == TauSpacing::PerDecade(0) {
+        return Err(AllanRunError::Config("--taus 0: give at least 1 cluster time per decade (or octave, decade, all)".into()));
     }
     if req.estimators.is_empty() {
         return Err(AllanRunError::Config("--estimator: name at least one (adev, oadev, mdev, tdev, hdev, ohdev, totdev, or all)".into()));

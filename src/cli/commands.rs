@@ -158,10 +158,8 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
     drop(class_page);
     // Whatever happened, complete the saved file: it holds everything simulated so far.
     let mut exported = Vec::new();
-    if let Some(v) = viewer_sinks {
-        if let Ok(done) = v.finish() {
-            exported.extend(done.exported);
-        }
+    if let Some(Ok(done)) = viewer_sinks.map(sink::OpenSinks::finish) {
+        exported.extend(done.exported);
     }
     let saved = match file_sinks {
         Some(f) => {

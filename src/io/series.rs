@@ -220,7 +220,7 @@ pub fn read_series(path: &Path, columns: &[SeriesColumn], sampling: &Sampling) -
             let mut sorted: Vec<f64> = steps.iter().map(|(d, _)| *d).collect();
             sorted.sort_by(f64::total_cmp);
             let median = sorted[sorted.len() / 2];
-            if !(median > 0.0) {
+            if median.is_nan() || median <= 0.0 {
                 return Err(bad(format!("the time column does not advance (median step {median} s)")));
             }
             if let Some((d, at)) = steps.iter().find(|(d, _)| (d / median - 1.0).abs() > EVEN_TOLERANCE) {

@@ -57,10 +57,11 @@ impl Node {
                 }
             }
             Self::View { class, origin, properties, .. } => {
-                if *class == "TimeSeries" && !properties.iter().any(|(n, _)| *n == "ScalarAxis") {
-                    if let Some((lo, hi)) = range(origin) {
-                        properties.push(("ScalarAxis", scalar_range(lo, hi).as_serialized_batches()));
-                    }
+                if *class == "TimeSeries"
+                    && !properties.iter().any(|(n, _)| *n == "ScalarAxis")
+                    && let Some((lo, hi)) = range(origin)
+                {
+                    properties.push(("ScalarAxis", scalar_range(lo, hi).as_serialized_batches()));
                 }
             }
         }

@@ -24,15 +24,21 @@ pub struct Event {
     pub text: String,
 }
 
-/// The `events` entries of the recording at `path`, in time order.
-pub fn events(path: &Path) -> anyhow::Result<Vec<Event>> {
+/// The messages of the recording at `path`, decoded (an unreadable file named in the error).
+fn decode(path: &Path) -> anyhow::Result<impl Iterator<Item = anyhow::Result<LogMsg>> + '_> {
     let file = crate::io::files::open_input(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let decoder = DecoderApp::decode_eager(BufReader::new(file)).map_err(|e| anyhow::anyhow!("{}: not a readable .rrd: {e}", path.display()))?;
+    Ok(decoder.map(move |m| m.map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))))
+}
+
+/// The `events` entries of the recording at `path`, in time order.
+pub fn events(path: &Path) -> anyhow::Result<Vec<Event>> {
+    let decoder = decode(path)?;
     let text_component = rerun::TextLog::descriptor_text().component;
     let level_component = rerun::TextLog::descriptor_level().component;
     let mut out = Vec::new();
     for msg in decoder {
-        let msg = msg.map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        let msg = msg?;
         let LogMsg::ArrowMsg(store_id, arrow_msg) = msg else { continue };
         if store_id.kind() != StoreKind::Recording {
             continue;
@@ -77,12 +83,11 @@ impl Contents {
 /// What the recording at `path` holds (see [`Contents`]).
 pub fn contents(path: &Path) -> anyhow::Result<Contents> {
     use rerun::external::re_sdk_types::blueprint::{archetypes::ViewBlueprint, components::ViewOrigin};
-    let file = crate::io::files::open_input(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    let decoder = DecoderApp::decode_eager(BufReader::new(file)).map_err(|e| anyhow::anyhow!("{}: not a readable .rrd: {e}", path.display()))?;
+    let decoder = decode(path)?;
     let origin_component = ViewBlueprint::descriptor_space_origin().component;
     let mut out = Contents::default();
     for msg in decoder {
-        let msg = msg.map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        let msg = msg?;
         let LogMsg::ArrowMsg(store_id, arrow_msg) = msg else { continue };
         let chunk = Chunk::from_arrow_msg(&arrow_msg)?;
         let entity = chunk.entity_path().to_string().trim_start_matches('/').to_owned();
@@ -125,8 +130,7 @@ pub fn plot_frames(path: &Path) -> anyhow::Result<Vec<PlotFrame>> {
     use rerun::external::re_sdk_types::blueprint::archetypes::{ScalarAxis, ViewBlueprint};
     use rerun::external::re_sdk_types::blueprint::components::{ViewClass, ViewOrigin};
     use std::collections::BTreeMap;
-    let file = crate::io::files::open_input(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    let decoder = DecoderApp::decode_eager(BufReader::new(file)).map_err(|e| anyhow::anyhow!("{}: not a readable .rrd: {e}", path.display()))?;
+    let decoder = decode(path)?;
     let scalar = rerun::Scalars::descriptor_scalars().component;
     let (origin_c, class_c, name_c) = (ViewBlueprint::descriptor_space_origin().component, ViewBlueprint::descriptor_class_identifier().component, ViewBlueprint::descriptor_display_name().component);
     let range_c = ScalarAxis::descriptor_range().component;
@@ -136,7 +140,7 @@ pub fn plot_frames(path: &Path) -> anyhow::Result<Vec<PlotFrame>> {
     type Views = BTreeMap<String, (String, String, String, Option<[f64; 2]>)>;
     let mut layouts: Vec<(String, Views)> = Vec::new();
     for msg in decoder {
-        let msg = msg.map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        let msg = msg?;
         let LogMsg::ArrowMsg(store_id, arrow_msg) = msg else { continue };
         let chunk = Chunk::from_arrow_msg(&arrow_msg)?;
         let entity = chunk.entity_path().to_string().trim_start_matches('/').to_owned();

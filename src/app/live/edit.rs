@@ -117,17 +117,11 @@ pub fn set_in_text(text: &str, key: &KeyPath, value: Value) -> Result<String, St
 }
 
 /// Sets `key` to `value` in the file at `path`, atomically.
+///
+/// # Errors
+/// The file cannot be read or written, is not valid TOML right now, or has no place for `key`.
 pub fn set_in_file(path: &Path, key: &KeyPath, value: Value) -> Result<(), EditError> {
-    let shown = path.display().to_string();
-    let text = super::read_text(path).map_err(|source| EditError::Io { path: shown.clone(), source })?;
-    let new = set_in_text(&text, key, value).map_err(|message| {
-        if message.contains("TOML parse error") || message.contains("expected") {
-            EditError::Syntax { path: shown.clone(), message }
-        } else {
-            EditError::Missing { path: shown.clone(), key: key.to_string() }
-        }
-    })?;
-    Ok(rewrite_input(path, new.as_bytes())?)
+    set_many_in_file(path, &[(key.clone(), value)])
 }
 
 /// Sets every key of `writes` in the file at `path`, atomically and at once (one reload for a

@@ -315,7 +315,8 @@ mod tests {
         let inner = control(&p.url, "inner swing half-angle");
         let json = |body: &str| body.as_bytes().to_vec();
         let ok_token = [("X-Rinscope-Token", "s3cret")];
-        let cases: Vec<(&str, &str, Vec<(&str, &str)>, Vec<u8>, u16, &str)> = vec![
+        type Case<'a> = (&'a str, &'a str, Vec<(&'a str, &'a str)>, Vec<u8>, u16, &'a str);
+        let cases: Vec<Case<'_>> = vec![
             ("no token", "/set", vec![], json(&format!("{{\"control\": {inner}, \"value\": 450}}")), 403, "token"),
             ("calibrate now without the token", "/calibrate", vec![], vec![], 403, "token"),
             ("calibrate now with a body", "/calibrate", ok_token.to_vec(), json("{\"axis\": \"inner\"}"), 400, "no body"),
