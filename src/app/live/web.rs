@@ -136,8 +136,9 @@ fn answer(req: &mut tiny_http::Request, cfg: &PageConfig, panel: &mut Panel, st:
     let err = |code: u16, message: String| (code, json!({ "error": message }).to_string(), "application/json");
     let path = req.url().split('?').next().unwrap_or("").to_owned();
     match (req.method(), path.as_str()) {
-        // The viewer in its dark theme (the page's script explains why and works around Rerun's first start).
-        (tiny_http::Method::Get, "/") => (200, PAGE.replace("{{VIEWER_URL}}", &format!("{}&theme=dark", cfg.viewer_url)).replace("{{TITLE}}", &html_escape(&panel.title)), "text/html; charset=utf-8"),
+        // The viewer's URL asks for its dark theme (record::sink; the page's script works around
+        // Rerun's first start).
+        (tiny_http::Method::Get, "/") => (200, PAGE.replace("{{VIEWER_URL}}", &cfg.viewer_url).replace("{{TITLE}}", &html_escape(&panel.title)), "text/html; charset=utf-8"),
         (tiny_http::Method::Get, "/controls") => (200, controls_json(panel, st, &cfg.config_path).to_string(), "application/json"),
         (tiny_http::Method::Post, "/set") => {
             if let Some(e) = token_refusal(req, cfg) {

@@ -209,11 +209,13 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
         let grpc_url = format!("rerun+http://{host}:{grpc_port}/proxy");
         let config = rerun::web_viewer::WebViewerConfig { bind_ip: ip.to_string(), web_port: web_port.into(), connect_to: vec![grpc_url], open_browser: false, ..Default::default() };
         let server = config.host_web_viewer().map_err(|e| SinkError::Serve { addr: web_addr, reason: e.to_string() })?;
-        let page = format!("http://{host}:{web_port}/?url={}", format!("rerun+http://{host}:{grpc_port}/proxy").replace(':', "%3A").replace('/', "%2F").replace('+', "%2B"));
+        // The viewer's dark theme whatever the browser's: the recording's 3D labels and colours are made
+        // for it (on the light one white and yellow labels all but vanish).
+        let page = format!("http://{host}:{web_port}/?url={}&theme=dark", format!("rerun+http://{host}:{grpc_port}/proxy").replace(':', "%3A").replace('/', "%2F").replace('+', "%2B"));
         if !ip.is_loopback() {
             errln!("rinscope: WARNING: --bind {ip}: anyone who can reach ports {web_port} and {grpc_port} of this machine can watch this session (there is no authentication)");
         }
-        description.push(format!("viewer in the browser: open {page}"));
+        description.push(format!("viewer in the browser: open {page} (in its dark theme; Rerun 0.36 ignores that on a browser's very first start: reload once if it opens light)"));
         web = Some(WebServer { _server: Box::new(server), page });
     }
 
