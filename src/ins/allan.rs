@@ -7,6 +7,7 @@ use serde_json::{json, Map, Value};
 
 use super::noise::IeeeTerms;
 use super::sensor::{AccelSpec, GyroSpec};
+use crate::math::allan::edf::alpha_code;
 use crate::math::allan::estimators::{deviation_curve, DeviationCurve, Estimator};
 use crate::math::allan::{analyze, averaging_factors, gauss_markov_avar, AllanError, AllanOptions, AllanReport, Estimate, NoiseTerm, Phase, SlopeReading, MIN_SAMPLES, TERMS};
 use crate::math::units::{
@@ -515,20 +516,6 @@ fn curve_json(sensor: Sensor, k: &DeviationCurve) -> Value {
     })
 }
 
-/// The short name of a noise type in the curve tables (`*`: carried from a shorter τ).
-fn alpha_code(alpha: crate::math::allan::edf::Alpha, identified: bool) -> String {
-    let code = match alpha {
-        2 => "WPM",
-        1 => "FPM",
-        0 => "WFM",
-        -1 => "FFM",
-        -2 => "RWFM",
-        -3 => "FWFM",
-        _ => "RRFM",
-    };
-    if identified { code.to_owned() } else { format!("{code}*") }
-}
-
 /// A channel's curves as a terminal table: a row per τ, per estimator the deviation, its bounds
 /// and the noise type the EDF assumed.
 fn curve_table(c: &Channel, curves: &[DeviationCurve], ci_sigma: f64) -> String {
@@ -547,7 +534,7 @@ fn curve_table(c: &Channel, curves: &[DeviationCurve], ci_sigma: f64) -> String 
                 .map(|k| {
                     let u = c.sensor.deviation_unit(k.estimator).si;
                     k.m.iter().position(|x| x == m).map_or_else(String::new, |j| {
-                        format!("{} [{}, {}] {}", sig(k.dev[j] / u, 4), sig(k.lower[j] / u, 3), sig(k.upper[j] / u, 3), alpha_code(k.alpha[j], k.alpha_identified[j]))
+                        format!("{} [{}, {}] {}{}", sig(k.dev[j] / u, 4), sig(k.lower[j] / u, 3), sig(k.upper[j] / u, 3), alpha_code(k.alpha[j]), if k.alpha_identified[j] { "" } else { "*" })
                     })
                 })
                 .collect()

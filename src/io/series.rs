@@ -197,8 +197,7 @@ pub fn read_series(path: &Path, columns: &[SeriesColumn], sampling: &Sampling) -
             if let Sampling::TimeColumn(_, unit) = sampling {
                 let t = row[columns.len()] * unit.to_si;
                 if t_first.is_some() {
-                    // The row of the sample after the step, 1-based.
-                    steps.push((t - t_prev, Location { row: values[0].len() as u64, line: None }));
+                    steps.push(t - t_prev);
                 }
                 t_first.get_or_insert(t);
                 t_prev = t;
@@ -217,17 +216,19 @@ pub fn read_series(path: &Path, columns: &[SeriesColumn], sampling: &Sampling) -
             1.0 / hz
         }
         Sampling::TimeColumn(..) => {
-            let mut sorted: Vec<f64> = steps.iter().map(|(d, _)| *d).collect();
+            let mut sorted = steps.clone();
             sorted.sort_by(f64::total_cmp);
             let median = sorted[sorted.len() / 2];
             if median.is_nan() || median <= 0.0 {
                 return Err(bad(format!("the time column does not advance (median step {median} s)")));
             }
-            if let Some((d, at)) = steps.iter().find(|(d, _)| (d / median - 1.0).abs() > EVEN_TOLERANCE) {
+            if let Some((k, d)) = steps.iter().enumerate().find(|(_, d)| (*d / median - 1.0).abs() > EVEN_TOLERANCE) {
+                // Step k ends at data row k + 2 (1-based).
+                let at = Location { row: k as u64 + 2, line: None };
                 let time_col = &reader.columns()[columns.len()];
                 return Err(SeriesError::Log(LogError::BadValue {
                     file: path.to_owned(),
-                    at: *at,
+                    at,
                     column: time_col.clone(),
                     value: format!("step {d} s"),
                     problem: format!(

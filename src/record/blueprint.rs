@@ -124,7 +124,7 @@ impl Recorder {
                         .with_property("PlotLegend", &layout::no_legend());
                     // Once measured lines exist, their whole extent (their steep start too: no
                     // fixed range hides a series); before, the analytic lines'.
-                    let range = self.live_range(super::ins_view::CONING_LOG_PATH).or_else(|| lo.is_finite().then(|| ((lo - 1.0).floor(), hi.ceil())));
+                    let range = self.data_range(super::ins_view::CONING_LOG_PATH).or_else(|| lo.is_finite().then(|| ((lo - 1.0).floor(), hi.ceil())));
                     tabs.push(match range {
                         Some((a, b)) => view.with_property("ScalarAxis", &layout::scalar_range(a, b)),
                         None => view,
@@ -160,7 +160,7 @@ impl Recorder {
         let mut root = Node::container(ContainerKind::Horizontal, vec![left, right], &[1.1, 1.0]);
         if self.live {
             // Every plot framed on its data so far (the viewer would keep ±1 from before them).
-            root.frame_plots_without_range(&|origin| self.live_range(origin));
+            root.frame_plots_without_range(&|origin| self.data_range(origin));
         }
         // Play a whole run in about a minute; a live session follows the newest data.
         let speed = if self.live { 1.0 } else { (p.duration_s / 60.0).max(1.0).round() };

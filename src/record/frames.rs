@@ -1,30 +1,47 @@
 //! How the plots are framed on their data: each series' extent as it grows, the range a plot of
 //! it shows ([`frame`]), and in live mode the layout sent again when a series leaves its frame.
 
+use std::collections::BTreeMap;
+use std::time::{Duration, Instant};
+
 use rerun::RecordingStreamResult;
 
 use super::rows;
 use super::Recorder;
 use crate::scenario::Params;
 
-/// Live mode: every plot framed on its data so far, re-framed when they leave the frame. The
-/// viewer fits a plot's value axis once, when the plot first appears — before a live session has
-/// data — and keeps ±1 after; so a live layout carries each plot's range itself, on the 1-2-5
-/// grid the saved recordings use ([`frame`]), and is sent again when a series leaves it (at most
-/// once every [`REFRAME_MIN_INTERVAL`]).
-pub(super) struct LiveFrames {
+/// Every plot framed on its data: each series' extent as it grows. The viewer fits a plot's value
+/// axis once, when the plot first appears — before a live session has data — and keeps ±1 after;
+/// so a live layout carries each plot's range itself, on the 1-2-5 grid the saved recordings use
+/// ([`frame`]), and is sent again when a series leaves it (at most once every
+/// [`REFRAME_MIN_INTERVAL`]). A run's layout, sent once its data are in, takes the same ranges.
+pub(super) struct Frames {
     /// Each series' value extent so far (entity path → min, max), finite values only.
-    pub(super) extents: std::collections::BTreeMap<String, (f64, f64)>,
-    /// The range each series' extent gave when the layout was last sent.
-    pub(super) drawn: std::collections::BTreeMap<String, (f64, f64)>,
-    /// The parameters the layout is built from.
-    pub(super) params: Box<Params>,
-    /// When the layout was last sent.
-    pub(super) sent: std::time::Instant,
+    extents: BTreeMap<String, (f64, f64)>,
+    /// The range each series' extent gave when the layout was last sent (live mode).
+    drawn: BTreeMap<String, (f64, f64)>,
+    /// Live mode: the parameters the layout is rebuilt from, and when it was last sent.
+    live: Option<(Box<Params>, Instant)>,
+}
+
+impl Frames {
+    /// Framing for a recorder; `live_params` in live mode (the layout is then sent again as the
+    /// data grow).
+    pub(super) fn new(live_params: Option<&Params>) -> Self {
+        Self { extents: BTreeMap::new(), drawn: BTreeMap::new(), live: live_params.map(|p| (Box::new(p.clone()), Instant::now())) }
+    }
+
+    /// Takes `values` (any width, row-major) of the series at `path` into its extent.
+    pub(super) fn observe(&mut self, path: &str, values: &[f64]) {
+        let e = self.extents.entry(path.to_owned()).or_insert((f64::INFINITY, f64::NEG_INFINITY));
+        for v in values.iter().filter(|v| v.is_finite()) {
+            *e = (e.0.min(*v), e.1.max(*v));
+        }
+    }
 }
 
 /// Least wall time between two live re-framings.
-const REFRAME_MIN_INTERVAL: std::time::Duration = std::time::Duration::from_millis(500);
+const REFRAME_MIN_INTERVAL: Duration = Duration::from_millis(500);
 
 /// The value range a plot of `what` shows for data in `[lo, hi]`: error plots symmetric about
 /// zero (±1.25 h, h on the 1-2-3-10 grid of [`crate::math::units::nice_half_range`], as the saved
@@ -46,28 +63,29 @@ pub(crate) fn frame(what: rows::Quantity, lo: f64, hi: f64) -> (f64, f64) {
 impl Recorder {
     /// Live mode: sends the layout again when a series has left the range it was framed at.
     pub(super) fn reframe_live(&mut self) -> RecordingStreamResult<()> {
-        let Some(f) = self.live_frames.as_ref().filter(|_| self.live) else { return Ok(()) };
+        let f = &self.frames;
+        let Some((params, sent)) = &f.live else { return Ok(()) };
         let outside = self.series.iter().any(|s| match (f.extents.get(&s.path), f.drawn.get(&s.path)) {
             (Some(&(lo, hi)), Some(&(a, b))) => lo.is_finite() && (lo < a || hi > b),
             (Some(&(lo, _)), None) => lo.is_finite(),
             _ => false,
         });
-        if !outside || f.sent.elapsed() < REFRAME_MIN_INTERVAL {
+        if !outside || sent.elapsed() < REFRAME_MIN_INTERVAL {
             return Ok(());
         }
-        let params = f.params.clone();
-        self.send_blueprint(&params, self.custom.clone())?;
-        if let Some(f) = self.live_frames.as_mut() {
-            f.drawn = self.series.iter().filter_map(|s| f.extents.get(&s.path).filter(|e| e.0.is_finite()).map(|&(lo, hi)| (s.path.clone(), frame(s.what, lo, hi)))).collect();
-            f.sent = std::time::Instant::now();
+        self.send_blueprint(params, self.custom.clone())?;
+        let drawn = self.series.iter().filter_map(|s| f.extents.get(&s.path).filter(|e| e.0.is_finite()).map(|&(lo, hi)| (s.path.clone(), frame(s.what, lo, hi)))).collect();
+        self.frames.drawn = drawn;
+        if let Some((_, sent)) = &mut self.frames.live {
+            *sent = Instant::now();
         }
         Ok(())
     }
 
     /// The value range of the plot whose space origin is `origin` on its data so far (every
     /// series at or under it, [`frame`]), None before it has data.
-    pub(crate) fn live_range(&self, origin: &str) -> Option<(f64, f64)> {
-        let f = self.live_frames.as_ref()?;
+    pub(crate) fn data_range(&self, origin: &str) -> Option<(f64, f64)> {
+        let f = &self.frames;
         let under = |p: &str| p == origin || p.strip_prefix(origin).is_some_and(|r| r.starts_with('/'));
         let mut what = None;
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);

@@ -30,7 +30,7 @@ pub mod modulation;
 mod palette;
 pub mod read;
 mod frames;
-use frames::LiveFrames;
+use frames::Frames;
 mod rows;
 mod scene;
 pub mod sink;
@@ -228,7 +228,7 @@ pub struct Recorder {
     /// The command's own panels, kept for when the layout is sent again.
     custom: Option<CustomLayout>,
     /// Each series' extent, and in live mode how the plots are framed as their data grow.
-    live_frames: Option<LiveFrames>,
+    frames: Frames,
 }
 
 
@@ -313,7 +313,7 @@ impl Recorder {
             error_unit: unit,
             ranges: None,
             custom: custom.clone(),
-            live_frames: Some(LiveFrames { extents: Default::default(), drawn: Default::default(), params: Box::new(params.clone()), sent: std::time::Instant::now() }),
+            frames: Frames::new(live.then_some(params)),
         };
         me.log_once(params)?;
         me.log_ins_once()?;
@@ -537,12 +537,7 @@ impl Recorder {
         for s in &mut self.series {
             let values = std::mem::take(&mut s.values);
             debug_assert_eq!(values.len(), s.width() * times.len());
-            if let Some(f) = self.live_frames.as_mut() {
-                let e = f.extents.entry(s.path.clone()).or_insert((f64::INFINITY, f64::NEG_INFINITY));
-                for v in values.iter().filter(|v| v.is_finite()) {
-                    *e = (e.0.min(*v), e.1.max(*v));
-                }
-            }
+            self.frames.observe(&s.path, &values);
             self.stream.send_series(&s.path, &s.names, &times, values, s.width())?;
         }
         self.reframe_live()

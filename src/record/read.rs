@@ -8,7 +8,7 @@ use std::io::BufReader;
 use std::path::Path;
 
 use rerun::external::re_log_encoding::DecoderApp;
-use rerun::external::re_log_types::{LogMsg, StoreKind};
+use rerun::external::re_log_types::{LogMsg, StoreId, StoreKind};
 use rerun::log::Chunk;
 
 use super::TIMELINE;
@@ -24,27 +24,29 @@ pub struct Event {
     pub text: String,
 }
 
-/// The messages of the recording at `path`, decoded (an unreadable file named in the error).
-fn decode(path: &Path) -> anyhow::Result<impl Iterator<Item = anyhow::Result<LogMsg>> + '_> {
+/// The data chunks of the recording at `path`, each with its store's kind and its entity path
+/// (without the leading `/`); an unreadable file named in the error.
+fn chunks(path: &Path) -> anyhow::Result<impl Iterator<Item = anyhow::Result<(StoreId, String, Chunk)>> + '_> {
     let file = crate::io::files::open_input(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let decoder = DecoderApp::decode_eager(BufReader::new(file)).map_err(|e| anyhow::anyhow!("{}: not a readable .rrd: {e}", path.display()))?;
-    Ok(decoder.map(move |m| m.map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))))
+    Ok(decoder.filter_map(move |m| match m {
+        Err(e) => Some(Err(anyhow::anyhow!("{}: {e}", path.display()))),
+        Ok(LogMsg::ArrowMsg(store_id, arrow_msg)) => Some(Chunk::from_arrow_msg(&arrow_msg).map_err(anyhow::Error::from).map(|chunk| {
+            let entity = chunk.entity_path().to_string().trim_start_matches('/').to_owned();
+            (store_id, entity, chunk)
+        })),
+        Ok(_) => None,
+    }))
 }
 
 /// The `events` entries of the recording at `path`, in time order.
 pub fn events(path: &Path) -> anyhow::Result<Vec<Event>> {
-    let decoder = decode(path)?;
     let text_component = rerun::TextLog::descriptor_text().component;
     let level_component = rerun::TextLog::descriptor_level().component;
     let mut out = Vec::new();
-    for msg in decoder {
-        let msg = msg?;
-        let LogMsg::ArrowMsg(store_id, arrow_msg) = msg else { continue };
-        if store_id.kind() != StoreKind::Recording {
-            continue;
-        }
-        let chunk = Chunk::from_arrow_msg(&arrow_msg)?;
-        if chunk.entity_path().to_string() != "/events" {
+    for item in chunks(path)? {
+        let (store_id, entity, chunk) = item?;
+        if store_id.kind() != StoreKind::Recording || entity != "events" {
             continue;
         }
         let times: Vec<Option<f64>> = chunk
@@ -83,14 +85,10 @@ impl Contents {
 /// What the recording at `path` holds (see [`Contents`]).
 pub fn contents(path: &Path) -> anyhow::Result<Contents> {
     use rerun::external::re_sdk_types::blueprint::{archetypes::ViewBlueprint, components::ViewOrigin};
-    let decoder = decode(path)?;
     let origin_component = ViewBlueprint::descriptor_space_origin().component;
     let mut out = Contents::default();
-    for msg in decoder {
-        let msg = msg?;
-        let LogMsg::ArrowMsg(store_id, arrow_msg) = msg else { continue };
-        let chunk = Chunk::from_arrow_msg(&arrow_msg)?;
-        let entity = chunk.entity_path().to_string().trim_start_matches('/').to_owned();
+    for item in chunks(path)? {
+        let (store_id, entity, chunk) = item?;
         match store_id.kind() {
             StoreKind::Recording => {
                 out.entities.insert(entity);
@@ -130,7 +128,6 @@ pub fn plot_frames(path: &Path) -> anyhow::Result<Vec<PlotFrame>> {
     use rerun::external::re_sdk_types::blueprint::archetypes::{ScalarAxis, ViewBlueprint};
     use rerun::external::re_sdk_types::blueprint::components::{ViewClass, ViewOrigin};
     use std::collections::BTreeMap;
-    let decoder = decode(path)?;
     let scalar = rerun::Scalars::descriptor_scalars().component;
     let (origin_c, class_c, name_c) = (ViewBlueprint::descriptor_space_origin().component, ViewBlueprint::descriptor_class_identifier().component, ViewBlueprint::descriptor_display_name().component);
     let range_c = ScalarAxis::descriptor_range().component;
@@ -139,11 +136,8 @@ pub fn plot_frames(path: &Path) -> anyhow::Result<Vec<PlotFrame>> {
     // Per blueprint store, in order: view entity → (class, title, origin, range).
     type Views = BTreeMap<String, (String, String, String, Option<[f64; 2]>)>;
     let mut layouts: Vec<(String, Views)> = Vec::new();
-    for msg in decoder {
-        let msg = msg?;
-        let LogMsg::ArrowMsg(store_id, arrow_msg) = msg else { continue };
-        let chunk = Chunk::from_arrow_msg(&arrow_msg)?;
-        let entity = chunk.entity_path().to_string().trim_start_matches('/').to_owned();
+    for item in chunks(path)? {
+        let (store_id, entity, chunk) = item?;
         match store_id.kind() {
             StoreKind::Recording => {
                 for values in chunk.iter_component::<rerun::components::Scalar>(scalar) {

@@ -23,18 +23,19 @@ const J_MAX: f64 = 100.0;
 /// rate (frequency), −1 flicker rate, −2 random-walk rate (−3, −4 only for the Hadamard family).
 pub type Alpha = i32;
 
-/// The noise type's name as clock people say it ("white FM"); for inertial sensors white FM is
-/// the angle/velocity random walk, flicker FM the bias instability, RW FM the rate random walk.
+/// The noise type's short name as clock people write it: WPM, FPM, WFM, FFM, RWFM (white and flicker
+/// phase; white, flicker and random-walk frequency), FWFM, RRFM. For inertial sensors WFM is the
+/// angle/velocity random walk, FFM the bias instability, RWFM the rate random walk.
 #[must_use]
-pub fn alpha_name(alpha: Alpha) -> &'static str {
+pub fn alpha_code(alpha: Alpha) -> &'static str {
     match alpha {
-        2 => "white PM",
-        1 => "flicker PM",
-        0 => "white FM",
-        -1 => "flicker FM",
-        -2 => "random-walk FM",
-        -3 => "flicker-walk FM",
-        _ => "random-run FM",
+        2 => "WPM",
+        1 => "FPM",
+        0 => "WFM",
+        -1 => "FFM",
+        -2 => "RWFM",
+        -3 => "FWFM",
+        _ => "RRFM",
     }
 }
 
