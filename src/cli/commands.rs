@@ -92,6 +92,9 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
         return Err(Failure::input(format!("--duration-s {d} s: must be > 0 and at most {} s (30 days)", scenario::MAX_DURATION_S)));
     }
     let viewer_given = args.sinks.viewer_asked();
+    if args.sinks.figures.is_some() && args.sinks.save.is_none() {
+        return Err(Failure::input("live --figures DIR draws the session's plots from its saved file when it ends: add --save FILE"));
+    }
     if args.no_viewer && args.sinks.save.is_none() {
         return Err(Failure::input("--no-viewer needs --save FILE (otherwise nothing would be kept)"));
     }
@@ -124,7 +127,7 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
         None
     };
     let file_sinks = match &args.sinks.save {
-        Some(p) => Some(sink::open(&SinkRequest { save: Some(p.clone()), stop_on_failure: Some(stop_flag()), export, ..Default::default() }, APPLICATION_ID, &recording_id)?),
+        Some(p) => Some(sink::open(&SinkRequest { save: Some(p.clone()), stop_on_failure: Some(stop_flag()), export, figures: args.sinks.figures.clone(), ..Default::default() }, APPLICATION_ID, &recording_id)?),
         None => None,
     };
     for d in viewer_sinks.iter().chain(file_sinks.iter()).flat_map(|s| &s.description) {
@@ -266,9 +269,16 @@ pub(super) fn kept(saved: &sink::Saved) -> Result<(), Failure> {
     Ok(())
 }
 
-/// The line that tells where the export tables are.
+/// The lines that tell where the export tables and the figures are.
 pub(super) fn print_exported(saved: &sink::Saved) {
     print_tables(&saved.exported);
+    if let Some(f) = &saved.figures {
+        let dir = f.files.first().and_then(|p| p.parent()).map_or_else(|| ".".into(), |d| d.display().to_string());
+        outln!("figures: {} plots drawn to {dir} (SVG and PNG)", f.plots);
+        if let Some(w) = &f.warning {
+            errln!("rinscope: --figures: {w}");
+        }
+    }
 }
 
 /// The line that tells where the tables `written` are.

@@ -155,6 +155,11 @@ struct SinkArgs {
     /// Table format of --export: parquet or csv.
     #[arg(long, default_value = "parquet", value_name = "FORMAT")]
     export_format: String,
+    /// Also draw every plot of the recording into this folder, as SVG and PNG for reports (the
+    /// same titles, names and colours; real logarithmic axes where the viewer plots log10 values).
+    /// Drawn from the saved file: with a viewer and no --save, the default file is saved too.
+    #[arg(long, value_name = "DIR")]
+    figures: Option<PathBuf>,
 }
 
 impl SinkArgs {
@@ -173,7 +178,7 @@ impl SinkArgs {
 
     /// The request, with `default_save` when no viewer was asked for.
     fn request(&self, default_save: PathBuf) -> Result<SinkRequest, Failure> {
-        let save = self.save.clone().or_else(|| (!self.viewer_asked()).then_some(default_save));
+        let save = self.save.clone().or_else(|| (!self.viewer_asked() || self.figures.is_some()).then_some(default_save));
         let export = self.export_request()?;
         if self.bind.is_some() && self.serve.is_none() && self.serve_web.is_none() {
             return Err(Failure::input("--bind ADDR goes with --serve or --serve-web"));
@@ -186,6 +191,7 @@ impl SinkArgs {
             bind: self.bind,
             serve_web: self.serve_web,
             export,
+            figures: self.figures.clone(),
             stop_on_failure: Some(crate::app::terminate::stop_flag()),
         })
     }
@@ -532,7 +538,7 @@ impl From<ConfigError> for Failure {
 impl From<SinkError> for Failure {
     fn from(e: SinkError) -> Self {
         let code = match e {
-            SinkError::Rerun(_) | SinkError::Spawn(_) | SinkError::Write(_) | SinkError::ExportWrite(_) => 1,
+            SinkError::Rerun(_) | SinkError::Spawn(_) | SinkError::Write(_) | SinkError::ExportWrite(_) | SinkError::FiguresWrite(_) => 1,
             _ => 2,
         };
         Self { code, message: e.to_string() }

@@ -24,6 +24,7 @@ mod body_view;
 mod cone;
 pub mod calibration;
 pub mod export;
+pub mod figures;
 mod ins_view;
 mod layout;
 pub mod modulation;

@@ -125,30 +125,131 @@ pub struct PlotFrame {
 /// Every time-series view of the last layout the recording at `path` carries, with the range of
 /// the data under it: a test checks that each plot's data lie inside its visible range.
 pub fn plot_frames(path: &Path) -> anyhow::Result<Vec<PlotFrame>> {
-    use rerun::external::re_sdk_types::blueprint::archetypes::{ScalarAxis, ViewBlueprint};
+    Ok(plots(path)?
+        .into_iter()
+        .map(|p| {
+            let mut f = PlotFrame { title: p.title, origin: p.origin, range: p.range, finite: 0, min: f64::INFINITY, max: f64::NEG_INFINITY, non_finite: 0 };
+            for v in p.series.iter().flat_map(|s| s.y.iter()) {
+                if v.is_finite() {
+                    (f.finite, f.min, f.max) = (f.finite + 1, f.min.min(*v), f.max.max(*v));
+                } else {
+                    f.non_finite += 1;
+                }
+            }
+            f
+        })
+        .collect())
+}
+
+/// A time-series view of a recording's last layout with its data: what `--figures` draws.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plot {
+    /// The view's title.
+    pub title: String,
+    /// Its space origin (without the leading `/`).
+    pub origin: String,
+    /// Its value range, if the layout sets one.
+    pub range: Option<[f64; 2]>,
+    /// Its time range (s on its timeline), if the layout sets one.
+    pub time_range: Option<[f64; 2]>,
+    /// Every series at or under the origin, in entity order.
+    pub series: Vec<PlotSeries>,
+}
+
+/// One line (or set of markers) of a plot.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlotSeries {
+    /// The entity it comes from (without the leading `/`).
+    pub entity: String,
+    /// Its name (the legend's), empty if the recording gives none.
+    pub name: String,
+    /// Its colour, RGBA.
+    pub color: [u8; 4],
+    /// Its line width, points (UI points, as the viewer draws it).
+    pub width: f32,
+    /// Drawn as a line.
+    pub line: bool,
+    /// Drawn as markers; `Some("down")` for ▼ event markers.
+    pub markers: Option<String>,
+    /// The timeline its times are on.
+    pub timeline: String,
+    /// Times, s of the timeline.
+    pub t: Vec<f64>,
+    /// Values (NaN where a row has none).
+    pub y: Vec<f64>,
+}
+
+/// How an entity's series are drawn (its static `SeriesLines` / `SeriesPoints`).
+#[derive(Default, Clone)]
+struct Style {
+    names: Vec<String>,
+    colors: Vec<[u8; 4]>,
+    widths: Vec<f32>,
+    line: bool,
+    points: bool,
+    marker: Option<String>,
+}
+
+/// Every time-series view of the last layout the recording at `path` carries, with its data.
+pub fn plots(path: &Path) -> anyhow::Result<Vec<Plot>> {
+    use rerun::external::re_sdk_types::blueprint::archetypes::{ScalarAxis, TimeAxis, ViewBlueprint};
     use rerun::external::re_sdk_types::blueprint::components::{ViewClass, ViewOrigin};
+    use rerun::external::re_sdk_types::datatypes::TimeRangeBoundary;
     use std::collections::BTreeMap;
     let scalar = rerun::Scalars::descriptor_scalars().component;
+    let (l_names, l_colors, l_widths) = (rerun::SeriesLines::descriptor_names().component, rerun::SeriesLines::descriptor_colors().component, rerun::SeriesLines::descriptor_widths().component);
+    let (p_names, p_colors, p_markers) = (rerun::SeriesPoints::descriptor_names().component, rerun::SeriesPoints::descriptor_colors().component, rerun::SeriesPoints::descriptor_markers().component);
     let (origin_c, class_c, name_c) = (ViewBlueprint::descriptor_space_origin().component, ViewBlueprint::descriptor_class_identifier().component, ViewBlueprint::descriptor_display_name().component);
-    let range_c = ScalarAxis::descriptor_range().component;
-    // Per entity: finite count, min, max, non-finite count.
-    let mut data: BTreeMap<String, (usize, f64, f64, usize)> = BTreeMap::new();
-    // Per blueprint store, in order: view entity → (class, title, origin, range).
-    type Views = BTreeMap<String, (String, String, String, Option<[f64; 2]>)>;
-    let mut layouts: Vec<(String, Views)> = Vec::new();
+    let (range_c, time_c) = (ScalarAxis::descriptor_range().component, TimeAxis::descriptor_view_range().component);
+    // Per entity: its style, and its rows (timeline, t, values).
+    let mut styles: BTreeMap<String, Style> = BTreeMap::new();
+    let mut rows: BTreeMap<String, Vec<(String, f64, Vec<f64>)>> = BTreeMap::new();
+    /// Per view entity: class, title, origin, value range, time range.
+    #[derive(Default)]
+    struct View {
+        class: String,
+        title: String,
+        origin: String,
+        range: Option<[f64; 2]>,
+        time_range: Option<[f64; 2]>,
+    }
+    let mut layouts: Vec<(String, BTreeMap<String, View>)> = Vec::new();
+    let secs = |t: i64| t as f64 / 1e9;
     for item in chunks(path)? {
         let (store_id, entity, chunk) = item?;
         match store_id.kind() {
             StoreKind::Recording => {
-                for values in chunk.iter_component::<rerun::components::Scalar>(scalar) {
-                    let d = data.entry(entity.clone()).or_insert((0, f64::INFINITY, f64::NEG_INFINITY, 0));
-                    for v in values.iter().map(|s| s.0.0) {
-                        if v.is_finite() {
-                            *d = (d.0 + 1, d.1.min(v), d.2.max(v), d.3);
-                        } else {
-                            d.3 += 1;
-                        }
+                let texts = |c| chunk.iter_component::<rerun::components::Name>(c).flat_map(|v| v.iter().map(|n| n.as_str().to_owned()).collect::<Vec<_>>()).collect::<Vec<_>>();
+                let colors = |c| chunk.iter_component::<rerun::components::Color>(c).flat_map(|v| v.iter().map(|c| c.to_array()).collect::<Vec<_>>()).collect::<Vec<_>>();
+                let (ln, lc, pn, pc) = (texts(l_names), colors(l_colors), texts(p_names), colors(p_colors));
+                let widths: Vec<f32> = chunk.iter_component::<rerun::components::StrokeWidth>(l_widths).flat_map(|v| v.iter().map(|w| w.0.0).collect::<Vec<_>>()).collect();
+                let markers: Vec<String> = chunk.iter_component::<rerun::components::MarkerShape>(p_markers).flat_map(|v| v.iter().map(|m| format!("{m:?}").to_lowercase()).collect::<Vec<_>>()).collect();
+                let has_lines = !ln.is_empty() || !lc.is_empty() || !widths.is_empty();
+                let has_points = !pn.is_empty() || !pc.is_empty() || !markers.is_empty();
+                if has_lines || has_points {
+                    let s = styles.entry(entity.clone()).or_default();
+                    if has_lines {
+                        s.line = true;
+                        s.names = if ln.is_empty() { s.names.clone() } else { ln };
+                        s.colors = if lc.is_empty() { s.colors.clone() } else { lc };
+                        s.widths = widths;
                     }
+                    if has_points {
+                        s.points = true;
+                        if s.names.is_empty() {
+                            s.names = pn;
+                        }
+                        if s.colors.is_empty() {
+                            s.colors = pc;
+                        }
+                        s.marker = markers.into_iter().next().or(s.marker.take());
+                    }
+                }
+                let Some(timeline) = [super::TIMELINE, super::allan::LOG10_TAU_TIMELINE].into_iter().find(|t| chunk.timelines().contains_key(&(*t).into())) else { continue };
+                let times: Vec<f64> = chunk.iter_component_indices(timeline.into(), scalar).map(|(t, _)| secs(t.as_i64())).collect();
+                let e = rows.entry(entity).or_default();
+                for (t, values) in times.into_iter().zip(chunk.iter_component::<rerun::components::Scalar>(scalar)) {
+                    e.push((timeline.to_owned(), t, values.iter().map(|s| s.0.0).collect()));
                 }
             }
             StoreKind::Blueprint => {
@@ -158,41 +259,68 @@ pub fn plot_frames(path: &Path) -> anyhow::Result<Vec<PlotFrame>> {
                     layouts.push((key, BTreeMap::new()));
                 }
                 let Some((_, views)) = layouts.last_mut() else { continue };
-                let (view, property) = match entity.strip_suffix("/ScalarAxis") {
-                    Some(v) => (v.to_owned(), true),
-                    None => (entity.clone(), false),
+                let (view, property) = match entity.rsplit_once('/') {
+                    Some((v, p @ ("ScalarAxis" | "TimeAxis"))) => (v.to_owned(), Some(p)),
+                    _ => (entity.clone(), None),
                 };
-                let e = views.entry(view).or_insert_with(|| (String::new(), String::new(), String::new(), None));
-                if property {
-                    for r in chunk.iter_component::<rerun::components::Range1D>(range_c) {
-                        if let Some(r) = r.first() {
-                            e.3 = Some(r.0.0);
+                let e = views.entry(view).or_default();
+                match property {
+                    Some("ScalarAxis") => {
+                        if let Some(r) = chunk.iter_component::<rerun::components::Range1D>(range_c).filter_map(|r| r.first().copied()).last() {
+                            e.range = Some(r.0.0);
                         }
                     }
-                } else {
-                    for c in chunk.iter_component::<ViewClass>(class_c) {
-                        e.0 = c.first().map(|c| c.0.0.as_str().to_owned()).unwrap_or_default();
+                    Some(_) => {
+                        use rerun::external::re_sdk_types::blueprint::components::TimeRange;
+                        if let Some(r) = chunk.iter_component::<TimeRange>(time_c).filter_map(|r| r.first().cloned()).last()
+                            && let (TimeRangeBoundary::Absolute(a), TimeRangeBoundary::Absolute(b)) = (r.0.start, r.0.end)
+                        {
+                            e.time_range = Some([secs(a.0), secs(b.0)]);
+                        }
                     }
-                    for n in chunk.iter_component::<rerun::components::Name>(name_c) {
-                        e.1 = n.first().map(|n| n.as_str().to_owned()).unwrap_or_default();
-                    }
-                    for o in chunk.iter_component::<ViewOrigin>(origin_c) {
-                        e.2 = o.first().map(|o| o.0.0.as_str().trim_start_matches('/').to_owned()).unwrap_or_default();
+                    None => {
+                        for c in chunk.iter_component::<ViewClass>(class_c) {
+                            e.class = c.first().map(|c| c.0.0.as_str().to_owned()).unwrap_or_default();
+                        }
+                        for n in chunk.iter_component::<rerun::components::Name>(name_c) {
+                            e.title = n.first().map(|n| n.as_str().to_owned()).unwrap_or_default();
+                        }
+                        for o in chunk.iter_component::<ViewOrigin>(origin_c) {
+                            e.origin = o.first().map(|o| o.0.0.as_str().trim_start_matches('/').to_owned()).unwrap_or_default();
+                        }
                     }
                 }
             }
         }
     }
+    for r in rows.values_mut() {
+        r.sort_by(|a, b| a.1.total_cmp(&b.1));
+    }
     let Some((_, views)) = layouts.pop() else { return Ok(Vec::new()) };
+    let under = |e: &str, origin: &str| e == origin || e.strip_prefix(origin).is_some_and(|r| r.starts_with('/'));
     Ok(views
         .into_values()
-        .filter(|(class, ..)| class == "TimeSeries")
-        .map(|(_, title, origin, range)| {
-            let mut f = PlotFrame { title, origin: origin.clone(), range, finite: 0, min: f64::INFINITY, max: f64::NEG_INFINITY, non_finite: 0 };
-            for (_, d) in data.iter().filter(|(e, _)| **e == origin || e.strip_prefix(origin.as_str()).is_some_and(|r| r.starts_with('/'))) {
-                (f.finite, f.min, f.max, f.non_finite) = (f.finite + d.0, f.min.min(d.1), f.max.max(d.2), f.non_finite + d.3);
+        .filter(|v| v.class == "TimeSeries")
+        .map(|v| {
+            let mut series = Vec::new();
+            for (entity, r) in rows.iter().filter(|(e, _)| under(e, &v.origin)) {
+                let style = styles.get(entity).cloned().unwrap_or_default();
+                let width = r.iter().map(|(_, _, vals)| vals.len()).max().unwrap_or(0);
+                for k in 0..width {
+                    series.push(PlotSeries {
+                        entity: entity.clone(),
+                        name: style.names.get(k).cloned().unwrap_or_default(),
+                        color: style.colors.get(k).copied().unwrap_or([200, 200, 200, 255]),
+                        width: style.widths.get(k).copied().unwrap_or(1.5),
+                        line: style.line || !style.points,
+                        markers: style.points.then(|| style.marker.clone().unwrap_or_else(|| "circle".into())),
+                        timeline: r.first().map(|x| x.0.clone()).unwrap_or_default(),
+                        t: r.iter().map(|x| x.1).collect(),
+                        y: r.iter().map(|x| x.2.get(k).copied().unwrap_or(f64::NAN)).collect(),
+                    });
+                }
             }
-            f
+            Plot { title: v.title, origin: v.origin, range: v.range, time_range: v.time_range, series }
         })
         .collect())
 }

@@ -74,6 +74,12 @@ pub enum SinkError {
     /// The export tables could not be written to the end (disk full, ...).
     #[error("--export: {0}")]
     ExportWrite(String),
+    /// The figures folder cannot be created.
+    #[error("--figures: {0}")]
+    Figures(String),
+    /// The figures could not be drawn or written (the recording is kept).
+    #[error("--figures: {0} (the recording itself was saved)")]
+    FiguresWrite(String),
     /// Any other Rerun SDK error.
     #[error("rerun: {0}")]
     Rerun(String),
@@ -98,6 +104,8 @@ pub struct SinkRequest {
     pub stop_on_failure: Option<Arc<AtomicBool>>,
     /// Also write every time series as tables into this folder.
     pub export: Option<(PathBuf, ExportFormat)>,
+    /// Draw every plot of the saved recording into this folder when the run ends (needs `save`).
+    pub figures: Option<PathBuf>,
 }
 
 /// An open recording and the file it will become.
@@ -116,6 +124,8 @@ pub struct OpenSinks {
     web: Option<WebServer>,
     /// The process's stop flag (ends the web viewer's wait after the run).
     stop: Option<Arc<AtomicBool>>,
+    /// `--figures DIR`.
+    figures: Option<PathBuf>,
 }
 
 /// The web viewer's HTTP server and the page that shows the stream.
@@ -154,6 +164,13 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
     let mut description = Vec::new();
     let problems: viewer::Problems = Arc::default();
     let file_kept = req.save.is_some();
+    if let Some(dir) = &req.figures {
+        if req.save.is_none() {
+            return Err(SinkError::Figures("the figures are drawn from the saved recording: add --save FILE".into()));
+        }
+        std::fs::create_dir_all(dir).map_err(|e| SinkError::Figures(format!("{}: cannot create the folder: {e}", dir.display())))?;
+        description.push(format!("figures (SVG and PNG) of every plot to {} when the run ends", dir.display()));
+    }
     let guarded = |inner: Box<dyn LogSink>, name: String| -> Box<dyn LogSink> { Box::new(viewer::Detachable::new(inner, name, Arc::clone(&problems), file_kept)) };
 
     if let Some(url) = &req.connect {
@@ -243,7 +260,7 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
         .recording_id(recording_id.to_owned())
         .set_sinks(sinks)
         .map_err(|e| SinkError::Rerun(e.to_string()))?;
-    Ok(OpenSinks { rec, export, file, viewer_problems: problems, description, web, stop: req.stop_on_failure.clone() })
+    Ok(OpenSinks { rec, export, file, viewer_problems: problems, description, web, stop: req.stop_on_failure.clone(), figures: req.figures.clone() })
 }
 
 /// Checks that the `.rrd` at `path` is complete: its header, its stream footer and the footer's
@@ -265,6 +282,8 @@ pub struct Saved {
     pub exported: Vec<PathBuf>,
     /// What went wrong with viewers (already reported when it happened).
     pub viewer_problems: Vec<String>,
+    /// `--figures`: what was drawn.
+    pub figures: Option<crate::record::figures::Written>,
 }
 
 impl OpenSinks {
@@ -287,7 +306,7 @@ impl OpenSinks {
     /// The file could not be completed ([`SinkError::Write`]; nothing replaced) or an export
     /// table failed.
     pub fn finish(self) -> Result<Saved, SinkError> {
-        let Self { rec, file, export, viewer_problems, web, stop, .. } = self;
+        let Self { rec, file, export, viewer_problems, web, stop, figures, .. } = self;
         // Viewers that stall are detached by their own timeouts; the file's writer is waited for
         // by `RrdFile::finish`, so a flush timeout here loses nothing.
         rec.flush_with_timeout(Duration::from_secs(10)).ok();
@@ -300,6 +319,10 @@ impl OpenSinks {
             Some(e) => e.lock().unwrap_or_else(std::sync::PoisonError::into_inner).finish().map_err(|e| SinkError::ExportWrite(e.to_string()))?,
         };
         let viewer_problems = viewer_problems.lock().unwrap_or_else(std::sync::PoisonError::into_inner).clone();
+        let figures = match (&figures, &recording) {
+            (Some(dir), Some((path, _))) => Some(crate::record::figures::write(path, dir).map_err(|e| SinkError::FiguresWrite(format!("{e:#}")))?),
+            _ => None,
+        };
         // A browser may still be reading: the page and the stream (held by `rec`) serve until the
         // stop flag (Ctrl-C) is set.
         if let (Some(w), Some(stop)) = (web, stop.filter(|s| !s.load(std::sync::atomic::Ordering::SeqCst))) {
@@ -310,7 +333,7 @@ impl OpenSinks {
             drop(w);
         }
         drop(rec);
-        Ok(Saved { recording, exported, viewer_problems })
+        Ok(Saved { recording, exported, viewer_problems, figures })
     }
 
     /// Closes every sink and deletes the partial file (the run failed).
