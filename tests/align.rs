@@ -22,7 +22,7 @@ fn scenario(seed: u64, rocking: bool, indexing: bool) -> String {
         ""
     };
     let scheme = if indexing {
-        // Seed 004's four positions, 10 °/s, with 20 s dwells: six positions within a 300 s window.
+        // The rotary-table paper's four positions, 10 °/s, with 20 s dwells: six positions within a 300 s window.
         "[scheme]\nkind = \"indexed\"\ninitial_dwell_s = 20.0\nrepeat = true\n\
          [[scheme.step]]\naxis = \"azimuth\"\nangle_deg = 90.0\nrate_deg_per_s = 10.0\ndwell_s = 20.0\n\
          [[scheme.step]]\naxis = \"azimuth\"\nangle_deg = 90.0\nrate_deg_per_s = 10.0\ndwell_s = 20.0\n\

@@ -133,7 +133,7 @@ fn a_run_writes_a_complete_recording_and_a_consistent_summary() {
     let summary: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).expect("summary")).expect("json");
     assert_eq!(summary["steps"], 40 * 200 + 1);
     let e = &summary["attitude_error_arcsec"];
-    // Seed 000 Table 2 errors are arcminutes: the uncompensated heading error peaks at several arcmin,
+    // Jiang et al. 2017 Table 2 errors are arcminutes: the uncompensated heading error peaks at several arcmin,
     // bounded by the sum of the error angles (10' + 5' + 20" = 920").
     let heading = e["uncompensated"]["heading"]["peak_arcsec"].as_f64().expect("number");
     assert!(heading > 300.0 && heading < 920.0, "heading peak {heading}");

@@ -268,7 +268,7 @@ fn null_paths(v: &serde_json::Value, path: &str, out: &mut BTreeSet<String>) {
     }
 }
 
-/// The scenario of the table log sets: seed 000's static calibration test, 20 s instead of 200.
+/// The scenario of the table log sets: Jiang et al. 2017's static calibration test, 20 s instead of 200.
 fn short_calibration_scenario(dir: &Path) -> PathBuf {
     let preset = read_text(&Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenarios/jiang2017-calibration.toml"));
     let text: Vec<String> = preset.lines().map(|l| if l.starts_with("duration_s =") { "duration_s = 20.0".to_owned() } else { l.to_owned() }).collect();

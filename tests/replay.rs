@@ -38,7 +38,7 @@ fn export(dir: &Path, scenario: &str, format: &str) -> PathBuf {
 
 #[test]
 fn export_then_replay_reproduces_the_in_loop_run_and_the_calibration() {
-    // jiang2017-calibration: an INS with seed 000 Table 1's sensor noise, 12″ encoder noise, both
+    // jiang2017-calibration: an INS with Jiang et al. 2017 Table 1's sensor noise, 12″ encoder noise, both
     // gimbals turning. The replay runs the same navigation computer on the logged samples, so the
     // INS errors must equal the in-loop run's (issue: within 1e-9 of their size), here compared
     // sample by sample through --export, and in the summaries.
@@ -314,7 +314,7 @@ fn every_column_varies(dir: &Path) -> Vec<String> {
 }
 
 /// A strapdown log set written by the test: 60 s of a vehicle turning (heading 10° → 100° at 3°/s
-/// from 5 s) and rolling (3°, 0.2 Hz), seed 000's Table 1 IMU, exported by `export-log` and then
+/// from 5 s) and rolling (3°, 0.2 Hz), Jiang et al. 2017's Table 1 IMU, exported by `export-log` and then
 /// stripped of its table (no table.toml, no encoders) with its start position added, as a log of
 /// a plain strapdown IMU is written.
 fn strapdown_log(dir: &Path) -> PathBuf {
@@ -386,7 +386,7 @@ fn a_strapdown_replay_records_and_exports_the_ins_alone() {
     assert_eq!(names, expected);
     let (header, rows) = csv_table(&tables.join("ins__attitude_error_arcsec__heading.csv"));
     assert_eq!(header, ["t_s", "t_file_s", "two_sample_p1_heading_error_arcsec"]);
-    // Started from the exact attitude, seed 000's gyros keep the heading within arcseconds in 60 s.
+    // Started from the exact attitude, Jiang et al. 2017's gyros keep the heading within arcseconds in 60 s.
     let peak = rows.iter().map(|r| r[2].abs()).fold(0.0, f64::max);
     assert!(peak < 60.0, "heading error {peak}″");
     // Times: t_file_s is the IMU file's clock, t_s + the summary's t0_file_clock_s.

@@ -1,5 +1,5 @@
 #!/bin/bash
-# Submits seed 000's Monte Carlo to Slurm as SHARDS array tasks (montecarlo.slurm) and one merge
+# Submits Jiang et al. 2017's Monte Carlo to Slurm as SHARDS array tasks (montecarlo.slurm) and one merge
 # (montecarlo-merge.slurm) that runs once every shard succeeded and is cancelled if one fails.
 #
 #   RUNS=5000 assets/cluster/submit-montecarlo.sh SHARDS [sbatch options for both jobs...]

@@ -1,4 +1,4 @@
-//! `rinscope calibrate` and `montecarlo`: simulate seed 000's static test (vehicle at rest, gimbals
+//! `rinscope calibrate` and `montecarlo`: simulate Jiang et al. 2017's static test (vehicle at rest, gimbals
 //! turning, INS and encoder noise in the loop), hand its data to the estimators of `calib`, validate
 //! the compensation on an independent run.
 
@@ -171,7 +171,7 @@ pub fn monte_carlo_setup(params: &Params) -> Setup<'_> {
     }
 }
 
-/// Seed 000's Monte Carlo on `params`' table, the runs of `shard` out of `runs`: each run a
+/// Jiang et al. 2017's Monte Carlo on `params`' table, the runs of `shard` out of `runs`: each run a
 /// calibration of a drawn table on its simulated static test, in parallel (`progress` ticks once
 /// per run, `stop` ends early). Returns the runs' errors; `montecarlo::summarize` makes the table.
 pub fn monte_carlo_runs(params: &Params, runs: usize, shard: Shard, progress: &(dyn Fn() + Sync), stop: &AtomicBool) -> Result<Vec<RunErrors>, CalibError> {
@@ -282,7 +282,7 @@ pub enum LogCalibrationError {
     Interrupted,
 }
 
-/// `calibrate --log`: seed 000's filter and the exact least squares on a log set, the compensation
+/// `calibrate --log`: Jiang et al. 2017's filter and the exact least squares on a log set, the compensation
 /// before/after on the same data (a log has no independent second run).
 pub fn calibrate_log(log: &LogSet, history: bool, stop: &AtomicBool) -> Result<(Calibration, Report, Data, ValidationTrace), LogCalibrationError> {
     calibrate_log_files(log, history, stop).map_err(|e| match e {

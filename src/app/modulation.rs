@@ -65,7 +65,7 @@ mod tests {
 
     #[test]
     fn rotation_averages_constant_biases_out() {
-        // The principle (seed 003 §1, Levinson & Majure 1987): with constant biases, turning the IMU
+        // The principle (Zheng et al. 2016 §1, Levinson & Majure 1987): with constant biases, turning the IMU
         // modulates their effect. Over 6 h: the 16-position sequence keeps the position error two
         // orders of magnitude below the static INS; azimuth rotation alone leaves the vertical gyro's
         // bias, so its heading error stays of the static order.

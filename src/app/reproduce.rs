@@ -204,12 +204,12 @@ pub fn run_all() -> anyhow::Result<Table> {
     let mut rows = Vec::new();
     let rad_per_arcmin = crate::math::units::RAD_PER_ARCMIN;
 
-    // Seed 004 §5, installation error 5′/5′: the paper's "reach 0.1 degrees", printed to one
+    // The rotary-table paper §5, installation error 5′/5′: the paper's "reach 0.1 degrees", printed to one
     // significant digit ([0.05, 0.15]).
     let p = presets::load("rotary-table-2016-installation")?;
     let stats = run_stats(&p.table_model(), &p.timeline());
     rows.push(Row::new(
-        "seed 004 §5, Fig. 5",
+        "the rotary-table paper §5, Fig. 5",
         "rotary-table-2016-installation",
         "peak error, largest of pitch, roll, heading, deg".into(),
         "reaches 0.1°".into(),
@@ -217,9 +217,9 @@ pub fn run_all() -> anyhow::Result<Table> {
         (0.05, 0.15),
         "the paper's 0.1, printed to one significant digit".into(),
     ));
-    rows.push(closed_form_row("seed 004 §5, Tables 1-3", "rotary-table-2016-installation", &p, &stats));
+    rows.push(closed_form_row("the rotary-table paper §5, Tables 1-3", "rotary-table-2016-installation", &p, &stats));
 
-    // Seed 004 §5, wobble θ = 0.01 rad at azimuth 30°: in the 180° dwell of a level vehicle the board
+    // The rotary-table paper §5, wobble θ = 0.01 rad at azimuth 30°: in the 180° dwell of a level vehicle the board
     // is tilted by 2θ toward azimuth 30°, so the largest Euler error is 2θ·cos 30° (first order; the
     // neglected terms are θ² relative).
     let p = presets::load("rotary-table-2016-wobble")?;
@@ -237,7 +237,7 @@ pub fn run_all() -> anyhow::Result<Table> {
     let analytic = 2.0 * theta * (30.0_f64).to_radians().cos() * DEG_PER_RAD;
     rows.push(
         Row::new(
-            "seed 004 §4.2, Figs. 6-7",
+            "the rotary-table paper §4.2, Figs. 6-7",
             "rotary-table-2016-wobble",
             "180° dwell, vehicle level: largest Euler error, deg".into(),
             "almost 1°".into(),
@@ -247,9 +247,9 @@ pub fn run_all() -> anyhow::Result<Table> {
         )
         .note(format!("the run's peak, {:.3}°, comes in a 9-s move with the vehicle tilted; the paper's \"almost 1°\" is the dwell value", stats.peak_over_axes(0) * DEG_PER_RAD)),
     );
-    rows.push(closed_form_row("seed 004 §5, Tables 4-6", "rotary-table-2016-wobble", &p, &stats));
+    rows.push(closed_form_row("the rotary-table paper §5, Tables 4-6", "rotary-table-2016-wobble", &p, &stats));
 
-    // Seed 004 §5, encoder (angular) error 1′: a heading error of 1′ while level, shared with roll
+    // The rotary-table paper §5, encoder (angular) error 1′: a heading error of 1′ while level, shared with roll
     // and pitch when tilted; its peak over the run is 1′ to second order (1′² relative).
     let p = presets::load("rotary-table-2016-angular")?;
     let stats = run_stats(&p.table_model(), &p.timeline());
@@ -257,7 +257,7 @@ pub fn run_all() -> anyhow::Result<Table> {
     let th = rad_per_arcmin;
     rows.push(
         Row::new(
-            "seed 004 §5, Fig. 8",
+            "the rotary-table paper §5, Fig. 8",
             "rotary-table-2016-angular",
             "peak error, largest of pitch, roll, heading, deg".into(),
             "< 0.02°".into(),
@@ -267,9 +267,9 @@ pub fn run_all() -> anyhow::Result<Table> {
         )
         .note("consistent: the paper gives only the bound \"less than 0.02 degrees\""),
     );
-    rows.push(closed_form_row("seed 004 §5, Tables 7-9", "rotary-table-2016-angular", &p, &stats));
+    rows.push(closed_form_row("the rotary-table paper §5, Tables 7-9", "rotary-table-2016-angular", &p, &stats));
 
-    // Seed 000: the closed form of eq. 28 (re-derived) against the exact model at Table 2's values;
+    // Jiang et al. 2017: the closed form of eq. 28 (re-derived) against the exact model at Table 2's values;
     // absolute residual of order α², α the largest error angle.
     let p = presets::load("jiang2017-dual-axis")?;
     let stats = run_stats(&p.table_model(), &p.timeline());
@@ -277,7 +277,7 @@ pub fn run_all() -> anyhow::Result<Table> {
     let alpha = largest_error_angle(&p);
     let a2 = alpha * alpha * ARCSEC_PER_RAD;
     rows.push(Row::new(
-        "seed 000 eq. 28, Table 2",
+        "Jiang et al. 2017 eq. 28, Table 2",
         "jiang2017-dual-axis",
         "closed form − exact, peak, arcsec".into(),
         "small-angle model".into(),
@@ -286,7 +286,7 @@ pub fn run_all() -> anyhow::Result<Table> {
         format!("second order: c·α², α = {:.1}′ the largest error angle (α² = {a2:.3}″), c ∈ [1/20, 2]", alpha / rad_per_arcmin),
     ));
 
-    // Seed 001 §3 eq. 16/19 and Figure 10: 7°, 0.5 Hz azimuth wobble, 6.25 ms lag. Theorem: the
+    // Li et al. 2014 §3 eq. 16/19 and Figure 10: 7°, 0.5 Hz azimuth wobble, 6.25 ms lag. Theorem: the
     // error is A·ω·τ·cos; neglected: (ωτ)²/2 = 2e-4 and the 100-Hz sampling of the peak,
     // (π f/fs)²/2 = 1.2e-4 relative.
     let base = presets::load("li2014-phase-lag")?;
@@ -296,7 +296,7 @@ pub fn run_all() -> anyhow::Result<Table> {
     let neglected = (omega * tau).powi(2) / 2.0 + (std::f64::consts::PI * 0.5 / 100.0).powi(2) / 2.0;
     rows.push(
         Row::new(
-            "seed 001 eq. 19, Fig. 10",
+            "Li et al. 2014 eq. 19, Fig. 10",
             "li2014-phase-lag",
             "heading error amplitude, Δt = 0, deg".into(),
             "0.1374 (0.1368 measured)".into(),
@@ -306,7 +306,7 @@ pub fn run_all() -> anyhow::Result<Table> {
         )
         .note("the paper's 0.1368 is its measured value (noise and its wobbler); its theorem gives 0.1374"),
     );
-    // Seed 001 Table 3: the synchronisation sweep. Theorem: 1σ = A·ω·τ_res/√2, τ_res = 6.25 ms − Δt.
+    // Li et al. 2014 Table 3: the synchronisation sweep. Theorem: 1σ = A·ω·τ_res/√2, τ_res = 6.25 ms − Δt.
     for (dt_ms, paper_lag, paper_sigma) in [(0.0, "6.22", 0.097), (3.0, "3.21", 0.053), (5.0, "1.20", 0.021), (6.1, "0.27", 0.011), (6.25, "×", 0.003)] {
         let mut p = base.clone();
         if let Some(ins) = p.ins.as_mut() {
@@ -325,7 +325,7 @@ pub fn run_all() -> anyhow::Result<Table> {
             ((0.0, second), format!("theorem: 0; what the theorem neglects, A·(ωτ)²/2 = {second:.1e}°"))
         };
         let mut row = Row::new(
-            "seed 001 Table 3",
+            "Li et al. 2014 Table 3",
             "li2014-phase-lag",
             format!("Δt = {dt_ms} ms: 1σ heading error, deg (residual lag {:.2} ms; paper {})", tau_res * 1e3, if paper_lag == "×" { "gives no lag".to_owned() } else { format!("{paper_lag} ms") }),
             format!("{paper_sigma}"),
@@ -343,7 +343,7 @@ pub fn run_all() -> anyhow::Result<Table> {
         }
         rows.push(row);
     }
-    // Seed 001 Table 1: the single-sample (the paper's "quaternion") algorithm's coning drift.
+    // Li et al. 2014 Table 1: the single-sample (the paper's "quaternion") algorithm's coning drift.
     let p = presets::load("li2014-coning")?;
     let stats = ins_stats(&p, 0.0);
     let single = crate::ins::coning::Algorithm::SingleSample;
@@ -352,7 +352,7 @@ pub fn run_all() -> anyhow::Result<Table> {
     let implied = (0.1381 / drift).clamp(-1.0, 1.0).asin().to_degrees();
     rows.push(
         Row::new(
-            "seed 001 Table 1",
+            "Li et al. 2014 Table 1",
             "li2014-coning",
             "single-sample (the paper's quaternion) algorithm: pitch drift in 10 min, deg".into(),
             "0.1381".into(),
@@ -363,14 +363,14 @@ pub fn run_all() -> anyhow::Result<Table> {
         .note(format!("the paper's 0.1381° is D·sin φ for φ = {implied:.1}°"))
         .not_reproduced("the paper does not give the phase between its yaw and roll wobbles"),
     );
-    // Seed 001 §4.2 / Table 6: the DAMS reaches 20″ (1σ) under three-axis wobbling.
+    // Li et al. 2014 §4.2 / Table 6: the DAMS reaches 20″ (1σ) under three-axis wobbling.
     for name in ["li2014-wobble-1", "li2014-wobble-2"] {
         let p = presets::load(name)?;
         let stats = ins_stats(&p, 0.0);
         let worst = stats[0].iter().map(sigma).fold(0.0, f64::max) * ARCSEC_PER_RAD;
         rows.push(
             Row::new(
-                "seed 001 §4.2, Table 6",
+                "Li et al. 2014 §4.2, Table 6",
                 name,
                 "largest 1σ attitude error over the 3 axes, arcsec".into(),
                 "≤ 20 (7.3-20.7)".into(),
@@ -385,7 +385,7 @@ pub fn run_all() -> anyhow::Result<Table> {
     Ok(Table { rows })
 }
 
-/// Seed 000 §6: what compensation with the calibrated parameters leaves, and the Monte Carlo.
+/// Jiang et al. 2017 §6: what compensation with the calibrated parameters leaves, and the Monte Carlo.
 fn calibration_rows(rows: &mut Vec<Row>) -> anyhow::Result<()> {
     let stop = std::sync::atomic::AtomicBool::new(false);
     let p = presets::load("jiang2017-calibration")?;
@@ -406,7 +406,7 @@ fn calibration_rows(rows: &mut Vec<Row>) -> anyhow::Result<()> {
             let hi = (1.0 + (3.0 * sig / floor.max(1e-300)).powi(2)).sqrt();
             rows.push(
                 Row::new(
-                    "seed 000 §6.2.2",
+                    "Jiang et al. 2017 §6.2.2",
                     "jiang2017-calibration",
                     format!("{name}: RMS error after LSQ compensation / with the true values (independent run)"),
                     format!("{:.2}× ({before}″ → {after}″)", before / after),
@@ -436,7 +436,7 @@ fn calibration_rows(rows: &mut Vec<Row>) -> anyhow::Result<()> {
             let rel = 3.0 / (2.0 * n).sqrt();
             rows.push(
                 Row::new(
-                    "seed 000 §6.2",
+                    "Jiang et al. 2017 §6.2",
                     "jiang2017-calibration (no INS)",
                     format!("{name}: RMS error with the true values (encoder noise only), arcsec"),
                     "—".into(),
@@ -447,13 +447,13 @@ fn calibration_rows(rows: &mut Vec<Row>) -> anyhow::Result<()> {
             );
         }
     }
-    // Seed 000 Table 3: mean calibration errors over many runs; rinscope's mean |error| of each
+    // Jiang et al. 2017 Table 3: mean calibration errors over many runs; rinscope's mean |error| of each
     // identifiable quantity, against the spread the filter reports for it: E|x| = σ·√(2/π).
     let mc = crate::app::calibrate::monte_carlo(&p, 200, &|| {}, &stop)?;
     let worst = mc.rows.iter().filter(|r| r.identifiable && !r.label.contains("of phase")).map(|r| r.nls.mean_abs).fold(0.0, f64::max);
     rows.push(
         Row::new(
-            "seed 000 §6.1, Table 3",
+            "Jiang et al. 2017 §6.1, Table 3",
             "jiang2017-calibration",
             "Monte Carlo (200 runs): largest mean |error| of the identifiable parameters, arcsec".into(),
             "0.65-1.14".into(),

@@ -487,7 +487,7 @@ mod tests {
     use crate::scenario::presets;
 
     /// A run's statistics against statistics at every attitude update, computed here independently
-    /// by the pipeline's own loop, on seed 001's 2 Hz three-axis wobble at 2 kHz with its Table 4
+    /// by the pipeline's own loop, on Li et al. 2014's 2 Hz three-axis wobble at 2 kHz with its Table 4
     /// IMU: the INS's errors (sampled at every update) are the same numbers; the table's errors,
     /// sampled at `Bandwidth::statistics_hz` (every 4th step here), read every peak to the 1e-4 that
     /// rate promises.

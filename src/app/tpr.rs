@@ -36,7 +36,7 @@ pub fn check(params: &Params) -> Result<(), TprError> {
         return Err(TprError::Config(format!("{}: needs an [imu] and a [navigation] section (see assets/scenarios/zheng2016-tpr.toml)", params.meta.name)));
     }
     if params.position_fix_s.len() < 2 {
-        return Err(TprError::Config(format!("{}: [position_fix] at_h needs two fixes (seed 003: at_h = [17.0, 21.0])", params.meta.name)));
+        return Err(TprError::Config(format!("{}: [position_fix] at_h needs two fixes (Zheng et al. 2016: at_h = [17.0, 21.0])", params.meta.name)));
     }
     Ok(())
 }
@@ -225,7 +225,7 @@ mod tests {
 
     #[test]
     fn without_stochastic_errors_tpr_removes_the_azimuth_error() {
-        // Seed 003 §4.3 without sensor noise (initial heading error 1′ only), at 25 Hz to keep the
+        // Zheng et al. 2016 §4.3 without sensor noise (initial heading error 1′ only), at 25 Hz to keep the
         // test short. The paper's estimator assumes zero level errors (its assumption a); velocity
         // damping leaves ~1″ of tilt, so its estimate is within 15 % of the true heading error, not
         // exact. With the level errors read from the velocity the same equations leave no residual

@@ -1,4 +1,4 @@
-//! The estimators on one static test's data: the static Kalman filter (seed 000 eq. 29-33) in
+//! The estimators on one static test's data: the static Kalman filter (Jiang et al. 2017 eq. 29-33) in
 //! information form and the chord Gauss–Newton least squares on the exact chain.
 
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
@@ -270,7 +270,7 @@ pub struct Calibration {
     pub set: ParamSet,
     /// Prior mean and 1σ.
     pub prior: (Vec<f64>, Vec<f64>),
-    /// The static Kalman filter (seed 000 eq. 29-33, first-order measurement model).
+    /// The static Kalman filter (Jiang et al. 2017 eq. 29-33, first-order measurement model).
     pub kf: Estimate,
     /// Nonlinear least squares on the exact chain.
     pub nls: Estimate,

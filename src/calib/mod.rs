@@ -1,8 +1,8 @@
-//! Static calibration of the turntable's swing cones and non-orthogonality (seed 000 §5-6), by the
+//! Static calibration of the turntable's swing cones and non-orthogonality (Jiang et al. 2017 §5-6), by the
 //! paper's static Kalman filter and by nonlinear least squares on the exact chain
 //! (docs/calibration.md).
 //!
-//! The vehicle is at rest and its attitude is known (seed 000 §5: "the roll and pitch angles are
+//! The vehicle is at rest and its attitude is known (Jiang et al. 2017 §5: "the roll and pitch angles are
 //! zero ... the head angle is a fixed value"); the gimbals turn; the INS reports the IMU attitude. The
 //! body attitude demodulated with the table model that leaves out the parameters being estimated
 //! differs from the known attitude by a small rotation `z` (nav frame, the paper's

@@ -1,4 +1,4 @@
-//! The Monte Carlo of seed 000 §6.1 (Tables 2-3): many calibrations, each with its own true
+//! The Monte Carlo of Jiang et al. 2017 §6.1 (Tables 2-3): many calibrations, each with its own true
 //! parameters drawn from `[calibration.montecarlo]` and its own noise, run in parallel; the error
 //! statistics of each estimator per quantity, the paper's beside.
 
@@ -14,7 +14,7 @@ use super::{CalibConfig, CalibError, Data, History, Param, ParamSet, calibrate};
 use crate::model::gimbal::{Chain, TableErrors};
 use crate::math::units::{ARCSEC_PER_RAD, wrap_pi};
 
-/// Seed 000 Table 3 (500 runs): (quantity, error mean ″, standard deviation ″).
+/// Jiang et al. 2017 Table 3 (500 runs): (quantity, error mean ″, standard deviation ″).
 pub const PAPER_TABLE3: [(&str, f64, f64); 5] = [("α1", 0.98, 0.0238), ("φ1", 1.14, 0.6103), ("α2", 0.78, 0.0078), ("φ2", 0.65, 0.0317), ("η", 1.05, 0.0091)];
 
 /// One quantity's error statistics, arcsec.
@@ -51,7 +51,7 @@ pub struct QuantityRow {
     /// The mean of the least squares' reported 1σ over the runs, ″ (to set beside `nls.std`).
     #[serde(default)]
     pub nls_reported_sigma: Option<f64>,
-    /// Seed 000 Table 3's (mean, std), when it has the quantity.
+    /// Jiang et al. 2017 Table 3's (mean, std), when it has the quantity.
     pub paper: Option<(f64, f64)>,
     /// Determined by the data (false: the prior / an independent measurement decides).
     pub identifiable: bool,
@@ -397,7 +397,7 @@ impl Summary {
             "Monte Carlo: {} of {} runs of {} in {:.1} s on {} threads\n{}\nerrors in arcsec (mean ± std of the signed error, mean |error|; the least squares' reported 1σ, mean over the runs, beside its std)\n",
             self.runs, self.runs_requested, self.scenario, self.wall_s, self.threads, self.setup
         );
-        s.push_str(&format!("  {:<24} {:>30} {:>30} {:>12} {:>22}\n", "", "static KF", "exact least squares", "reported 1σ", "seed 000 Table 3"));
+        s.push_str(&format!("  {:<24} {:>30} {:>30} {:>12} {:>22}\n", "", "static KF", "exact least squares", "reported 1σ", "Jiang et al. 2017 Table 3"));
         for r in &self.rows {
             let f = |st: &ErrorSpread| format!("{:>+9.4} ±{:>8.4} |{:>8.4}|", st.mean, st.std, st.mean_abs);
             let paper = r.paper.map_or(String::new(), |(m, sd)| format!("{m:>9.2} ±{sd:>8.4}"));

@@ -1,4 +1,4 @@
-//! What a calibration means: the physical angles with 1σ, the paper's state (seed 000 eq. 29, 34),
+//! What a calibration means: the physical angles with 1σ, the paper's state (Jiang et al. 2017 eq. 29, 34),
 //! the observability analysis, the compensation before/after, as text and JSON.
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
@@ -82,7 +82,7 @@ pub struct Compensation {
     pub with_truth: ErrorSummary,
 }
 
-/// Seed 000 §6.2.2, laboratory: peak attitude error before → after compensation, arcsec
+/// Jiang et al. 2017 §6.2.2, laboratory: peak attitude error before → after compensation, arcsec
 /// (pitch 1.6′ → 25.2″, roll 1.86′ → 30.24″, heading 2.5′ → 49.32″).
 pub const PAPER_LAB: [(f64, f64); 3] = [(96.0, 25.2), (111.6, 30.24), (150.0, 49.32)];
 
@@ -116,7 +116,7 @@ pub struct Report {
     pub state: Vec<Row>,
     /// The physical angles: α (arcsec), φ (deg), η (arcsec).
     pub angles: Vec<Row>,
-    /// Seed 000's state X (eq. 29), when the table has two axes, arcsec.
+    /// Jiang et al. 2017's state X (eq. 29), when the table has two axes, arcsec.
     pub paper_state: Vec<Row>,
     /// Directions the data do not determine.
     pub unobservable: Vec<Unobservable>,
@@ -328,7 +328,7 @@ pub fn build(scenario: &str, chain: &Chain, truth: &TableErrors, cal: &Calibrati
         }
     }
 
-    // Seed 000's state (eq. 29) for the dual-axis table: axis 1 = inner (index 1), axis 2 = outer (0).
+    // Jiang et al. 2017's state (eq. 29) for the dual-axis table: axis 1 = inner (index 1), axis 2 = outer (0).
     let mut paper_state = Vec::new();
     if n_axes == 2
         && let (Some(a1), Some(a2), Some(b1), Some(b2), Some(e)) =
@@ -356,7 +356,7 @@ pub fn build(scenario: &str, chain: &Chain, truth: &TableErrors, cal: &Calibrati
         let x1 = &paper_state[0].nls;
         if x1.value.abs() < 3.0 * x1.sigma {
             warnings.push(format!(
-                    "seed 000 eq. 34 recovers η as atan(x4/x1), and x1 = α1 cos φ1 = {:.3}″ ± {:.3}″ is within 3σ of zero (cos φ1 ≈ 0): that route gives no η here. rinscope estimates η (and its one observable combination) directly, not through x4/x1.",
+                    "Jiang et al. 2017 eq. 34 recovers η as atan(x4/x1), and x1 = α1 cos φ1 = {:.3}″ ± {:.3}″ is within 3σ of zero (cos φ1 ≈ 0): that route gives no η here. rinscope estimates η (and its one observable combination) directly, not through x4/x1.",
                     x1.value, x1.sigma
                 ));
         }
@@ -486,7 +486,7 @@ impl Report {
             let factors: Vec<String> = (0..3).map(|i| format!("{:.1}×", c.before.peak_rad[i] / c.after_nls.peak_rad[i].max(1e-300))).collect();
             s.push_str(&format!("| peak reduction (LSQ) | {} |\n", factors.join(" | ")));
             let paper: Vec<String> = PAPER_LAB.iter().map(|(b, a)| format!("{:.1}×", b / a)).collect();
-            s.push_str(&format!("| seed 000 laboratory | {} |\n\n", paper.join(" | ")));
+            s.push_str(&format!("| Jiang et al. 2017 laboratory | {} |\n\n", paper.join(" | ")));
         }
         s
     }
@@ -502,7 +502,7 @@ impl Report {
             s.push_str(&fmt_row(r));
         }
         if !self.paper_state.is_empty() {
-            s.push_str("\nseed 000's state X (eq. 29):\n");
+            s.push_str("\nJiang et al. 2017's state X (eq. 29):\n");
             s.push_str(&header);
             for r in &self.paper_state {
                 s.push_str(&fmt_row(r));
@@ -538,7 +538,7 @@ impl Report {
                 s.push_str(&format!(" {:>15.1}×", c.before.peak_rad[i] / c.after_nls.peak_rad[i].max(1e-300)));
             }
             s.push('\n');
-            s.push_str(&format!("  {:<22}", "seed 000 laboratory"));
+            s.push_str(&format!("  {:<22}", "Jiang et al. 2017 laboratory"));
             for (b, a) in PAPER_LAB {
                 s.push_str(&format!(" {:>15.1}×", b / a));
             }

@@ -10,7 +10,7 @@ use crate::app::calibrate::{calibrate_scenario, collect, monte_carlo};
 use crate::scenario::{presets, Params};
 use crate::math::units::{ARCSEC_PER_RAD, RAD_PER_ARCSEC, RAD_PER_DEG};
 
-/// The calibration preset (seed 000 Table 2 truth) with the IMU and encoder noise removed.
+/// The calibration preset (Jiang et al. 2017 Table 2 truth) with the IMU and encoder noise removed.
 fn noise_free() -> Params {
     let mut p = presets::load("jiang2017-calibration").expect("preset");
     p.ins = None;
@@ -47,7 +47,7 @@ fn first_order_columns_are_the_closed_form_model() {
 
 #[test]
 fn the_filter_is_eq_33_in_information_form() {
-    // Seed 000 eq. 33 literally (x̂_k = x̂_{k−1} + P_k H R⁻¹ (z − H x̂_{k−1}),
+    // Jiang et al. 2017 eq. 33 literally (x̂_k = x̂_{k−1} + P_k H R⁻¹ (z − H x̂_{k−1}),
     // P_k = (P_{k−1}⁻¹ + Hᵀ R⁻¹ H)⁻¹), run sample by sample on the first 2000 measurements, against
     // the information form the calibration uses: the same estimate to rounding.
     let mut p = presets::load("jiang2017-calibration").expect("preset");
@@ -88,7 +88,7 @@ fn the_filter_is_eq_33_in_information_form() {
 
 #[test]
 fn noise_free_data_give_the_true_parameters() {
-    // No IMU error, no encoder noise, seed 000 Table 2 values. What the data determine — α1, φ1,
+    // No IMU error, no encoder noise, Jiang et al. 2017 Table 2 values. What the data determine — α1, φ1,
     // α2 cos φ2 and η_eff = η − α2 sin φ2 — the exact least squares recovers to 0.01″ (phase: 0.01″
     // of phase angle); the first-order filter is off by its neglected second-order terms.
     let p = noise_free();
@@ -162,7 +162,7 @@ fn outer_swing_and_eta_are_one_rotation_and_the_report_says_so() {
 
 #[test]
 fn phase_and_eq_34_warnings_trigger_where_they_should() {
-    // φ1 = 90°: x1 = α1 cos φ1 = 0, so seed 000 eq. 34's η = atan(x4/x1) is undefined → warning.
+    // φ1 = 90°: x1 = α1 cos φ1 = 0, so Jiang et al. 2017 eq. 34's η = atan(x4/x1) is undefined → warning.
     // α1 = 0.02″ under 12″ encoder noise: the inner phase is undefined → warning.
     let mut p = presets::load("jiang2017-calibration").expect("preset");
     p.ins = None;
@@ -189,7 +189,7 @@ fn phase_and_eq_34_warnings_trigger_where_they_should() {
 
 #[test]
 fn compensation_with_the_estimates_beats_the_papers_factors() {
-    // Seed 000's laboratory: peaks 1.6′ → 25.2″ (pitch), 1.86′ → 30.24″ (roll), 2.5′ → 49.32″
+    // Jiang et al. 2017's laboratory: peaks 1.6′ → 25.2″ (pitch), 1.86′ → 30.24″ (roll), 2.5′ → 49.32″
     // (heading). Under the paper's noise (Table 1 INS, 12″ encoders) rinscope's compensation with
     // its own estimates, on an independent run, must reduce each peak at least as much.
     let p = presets::load("jiang2017-calibration").expect("preset");

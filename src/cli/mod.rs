@@ -52,14 +52,14 @@ enum Command {
     /// Rotation modulation: static INS with constant biases, no rotation vs continuous vs 16-position,
     /// simulated together and recorded side by side.
     Modulation(ModulationArgs),
-    /// Static calibration of the swing cones and non-orthogonality (seed 000 §5): static Kalman
+    /// Static calibration of the swing cones and non-orthogonality (Jiang et al. 2017 §5): static Kalman
     /// filter and exact least squares, compensation before/after, a recording with ghost cones
     /// (default scenario: jiang2017-calibration).
     Calibrate(CalibrateArgs),
-    /// Seed 000's Monte Carlo (Tables 2-3): many calibrations with drawn parameters, in parallel
+    /// Jiang et al. 2017's Monte Carlo (Tables 2-3): many calibrations with drawn parameters, in parallel
     /// (default scenario: jiang2017-calibration).
     Montecarlo(MonteCarloArgs),
-    /// Seed 003's Twice Position-fix Reset against the conventional reset, from one IMU stream
+    /// Zheng et al. 2016's Twice Position-fix Reset against the conventional reset, from one IMU stream
     /// (default scenario: zheng2016-tpr; needs [imu], [navigation] and two [position_fix] times).
     Tpr(TprArgs),
     /// Write a scenario as a log set (docs/logs.md): the IMU's measured increments, the encoder

@@ -1,4 +1,4 @@
-//! Coning-compensated attitude algorithms of the family of seed 001 eq. (1): the rotation vector
+//! Coning-compensated attitude algorithms of the family of Li et al. 2014 eq. (1): the rotation vector
 //! over one update of N gyro samples, using P samples of the previous update,
 //!
 //! ```text
@@ -16,7 +16,7 @@ pub enum Algorithm {
     SingleSample,
     /// Two samples, K = 2/3.
     TwoSample,
-    /// Two samples and one previous sample (seed 001's choice).
+    /// Two samples and one previous sample (Li et al. 2014's choice).
     TwoSampleP1,
     /// Two samples and two previous samples.
     TwoSampleP2,
@@ -125,8 +125,8 @@ mod tests {
     #[test]
     fn coefficients_match_the_exact_fractions() {
         // Exact rational solutions of the order conditions (docs/coning.md; computed with Python's
-        // fractions): two-sample 2/3 (Miller 1983); N=2,P=1: 11/15, -1/30 (seed 001 eq. 7 up to the
-        // garbled sign/index); N=2,P=2: 323/420, -13/210, 1/140 (seed 001 Table 1 magnitudes);
+        // fractions): two-sample 2/3 (Miller 1983); N=2,P=1: 11/15, -1/30 (Li et al. 2014 eq. 7 up to the
+        // garbled sign/index); N=2,P=2: 323/420, -13/210, 1/140 (Li et al. 2014 Table 1 magnitudes);
         // three-sample 9/20, 27/20.
         let close = |a: &[f64], b: &[f64]| a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-12);
         assert!(coefficients(1, 0).is_empty());

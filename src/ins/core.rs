@@ -3,8 +3,8 @@
 //! the replay of a log feed it the same way.
 //!
 //! Timing (docs/ins.md): after the FIR, sample k represents the truth at k·h − d (d = group delay);
-//! the navigation computer's zero-order hold is a further h/2 (seed 001 §3.1); outputs are compared
-//! with the truth `output_compensation` earlier (seed 001 §3.2's Δt).
+//! the navigation computer's zero-order hold is a further h/2 (Li et al. 2014 §3.1); outputs are compared
+//! with the truth `output_compensation` earlier (Li et al. 2014 §3.2's Δt).
 
 use nalgebra::Vector3;
 

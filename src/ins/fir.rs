@@ -1,11 +1,11 @@
-//! The anti-dither FIR filter of seed 001 §2.2, applied to each axis's increments, and its frequency
+//! The anti-dither FIR filter of Li et al. 2014 §2.2, applied to each axis's increments, and its frequency
 //! response. It is a low-pass filter (25 taps at 2 kHz, −4.4 dB at 100 Hz), not a notch filter: its
 //! zeros on the unit circle sit at 343.5, 369.0 Hz and above 450 Hz, not at the three ring-laser-gyro
 //! dither tones; at the tones (335.4, 375.5, 425.7 Hz) its stopband attenuates −91, −116, −106 dB.
 
 use nalgebra::Vector3;
 
-/// Seed 001 §2.2, verbatim: 25 symmetric taps designed for 2 kHz data against the dither at 335.4,
+/// Li et al. 2014 §2.2, verbatim: 25 symmetric taps designed for 2 kHz data against the dither at 335.4,
 /// 375.5 and 425.7 Hz, 100 Hz bandwidth (the paper calls them notches; see the module docs).
 pub const SEED001_TAPS: [f64; 25] = [
     -3.6162e-4, -5.5582e-5, -4.6181e-4, 1.3181e-3, 4.3263e-3, 1.1456e-2, 2.3008e-2, 3.9629e-2, 6.0210e-2, 8.2250e-2, 1.0213e-1, 1.1603e-1, 1.2103e-1,
@@ -82,7 +82,7 @@ mod tests {
 
     #[test]
     fn seed001_filter_suppresses_the_dither_tones() {
-        // Seed 001 §2.2: the three dither frequencies at 2 kHz fall in the stopband (the printed taps
+        // Li et al. 2014 §2.2: the three dither frequencies at 2 kHz fall in the stopband (the printed taps
         // were rounded to 5 digits); the attenuation there is deep (< -45 dB), not infinite. The passband keeps
         // low frequencies (0.5 Hz wobble: gain 1 to 1e-6).
         let f = Fir::new(&SEED001_TAPS);
@@ -92,14 +92,14 @@ mod tests {
         }
         assert!((f.amplitude(0.5, 2000.0) - 1.0).abs() < 2e-5);
         assert!((20.0 * f.amplitude(100.0, 2000.0).log10() + 4.36).abs() < 0.05);
-        // "extra attenuation at least 50 dB in the band 320-420 Hz" (seed 001 §2.2, about the new filter).
+        // "extra attenuation at least 50 dB in the band 320-420 Hz" (Li et al. 2014 §2.2, about the new filter).
         let worst = (320..=420).map(|f_hz| 20.0 * f.amplitude(f64::from(f_hz), 2000.0).log10()).fold(f64::MIN, f64::max);
         assert!(worst < -70.0, "worst in band {worst:.1} dB");
     }
 
     #[test]
     fn group_delay_is_twelve_samples_six_ms_at_2khz() {
-        // Seed 001 §3.1(c): "Its group delay is 12. The time delay is 6 ms if the sampling frequency is 2 kHz."
+        // Li et al. 2014 §3.1(c): "Its group delay is 12. The time delay is 6 ms if the sampling frequency is 2 kHz."
         let mut f = Fir::new(&SEED001_TAPS);
         assert_eq!(f.group_delay_samples(), 12.0);
         // An impulse comes out centred 12 samples later (symmetric taps).

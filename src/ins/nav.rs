@@ -1,6 +1,6 @@
 //! Strapdown navigation in the local-level frame (East-North-Up): velocity with rotation and
 //! sculling compensation, Coriolis and transport rate, normal gravity, latitude/longitude/height;
-//! the vertical channel held or free; optional horizontal velocity damping (seed 003 §4.1).
+//! the vertical channel held or free; optional horizontal velocity damping (Zheng et al. 2016 §4.1).
 
 use nalgebra::Vector3;
 

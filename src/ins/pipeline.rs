@@ -352,7 +352,7 @@ mod tests {
 
     #[test]
     fn phase_lag_theorem_holds_for_the_fir_and_the_zero_order_hold() {
-        // Seed 001 eq. 16/19: a 7°, 0.5 Hz single-axis wobble seen through a 6.25 ms lag (FIR 12
+        // Li et al. 2014 eq. 16/19: a 7°, 0.5 Hz single-axis wobble seen through a 6.25 ms lag (FIR 12
         // samples at 2 kHz + ZOH 0.25 ms) has an error amplitude A·ω·t_d = 0.1374°. The theorem is
         // first order: the neglected (ωτ)²/2 = 2e-4 and the 2 kHz sampling of the peak; within 1e-3.
         let p = params(

@@ -1,10 +1,10 @@
 //! Layer 2: position resets of a navigating INS at rest — the Twice Position-fix Reset estimator of
-//! seed 003 (§4, eq. 15-25) in rinscope's signs, its level-corrected extension, and the result of
+//! Zheng et al. 2016 (§4, eq. 15-25) in rinscope's signs, its level-corrected extension, and the result of
 //! comparing them with the conventional reset (docs/tpr.md).
 //!
 //! Psi-angle ψ: the error of the computed body orientation relative to the Earth; without sensor
 //! errors it is fixed in inertial space, so in the local frame it turns about the Earth's axis
-//! (seed 003 eq. 15). In the s-frame (x East, y along the Earth's axis, z completing; eq. 16) its x
+//! (Zheng et al. 2016 eq. 15). In the s-frame (x East, y along the Earth's axis, z completing; eq. 16) its x
 //! and z components rotate at Ω (eq. 18-20); with velocity damping the level attitude errors vanish,
 //! so ψ's level components are the position error angles, and the azimuth error is
 //! φ_U = ψ_z^s / cos L (eq. 21-22). rinscope's rotation vectors take the truth to the computed value,
@@ -26,13 +26,13 @@ use serde::Serialize;
 
 use crate::model::earth::EARTH_RATE;
 
-/// Seed 003 §4.3: radial position error after the resets, TPR below 100 m, conventional above 310 m.
+/// Zheng et al. 2016 §4.3: radial position error after the resets, TPR below 100 m, conventional above 310 m.
 pub const PAPER_RADIAL_M: (f64, f64) = (100.0, 310.0);
 
 /// The strategies compared after the second fix.
 pub const BRANCHES: usize = 3;
 /// Their names.
-pub const BRANCH_NAMES: [&str; BRANCHES] = ["conventional reset", "TPR (seed 003 eq. 25)", "TPR + level errors from velocity"];
+pub const BRANCH_NAMES: [&str; BRANCHES] = ["conventional reset", "TPR (Zheng et al. 2016 eq. 25)", "TPR + level errors from velocity"];
 
 /// One sample of every branch.
 #[derive(Debug, Clone, Copy, Default, Serialize)]
@@ -130,7 +130,7 @@ impl TprResult {
             "heading error at the second fix {:+.2}″; estimated by TPR {:+.2}″, by TPR + level {:+.2}″\n",
             self.heading_at_second_fix_arcsec, self.tpr_heading_estimate_arcsec, self.level_heading_estimate_arcsec
         ));
-        s.push_str(&format!("  {:<42} {:>13} {:>10} {:>12} {:>18}\n", "", "conventional", "TPR", "TPR + level", "seed 003 (Fig. 9)"));
+        s.push_str(&format!("  {:<42} {:>13} {:>10} {:>12} {:>18}\n", "", "conventional", "TPR", "TPR + level", "Zheng et al. 2016 (Fig. 9)"));
         let row = |label: &str, v: [f64; BRANCHES], digits: usize, paper: &str| format!("  {label:<42} {:>13.digits$} {:>10.digits$} {:>12.digits$} {paper:>18}\n", v[0], v[1], v[2]);
         s.push_str(&row("peak radial error after the 2nd fix (m)", peak_r, 1, "> 310 / < 100"));
         s.push_str(&row("radial error at the end (m)", last.radial_m, 1, ""));
@@ -141,7 +141,7 @@ impl TprResult {
         s
     }
 
-    /// One line: rinscope's result against seed 003's "< 100 m", and the floor no reset removes.
+    /// One line: rinscope's result against Zheng et al. 2016's "< 100 m", and the floor no reset removes.
     ///
     /// The angle random walk σ moves the azimuth by σ√T after the last fix whatever the reset, and
     /// a resting INS's position error grows as R·Ω·cos L per radian of azimuth error (6.2 m/h per
@@ -167,7 +167,7 @@ impl TprResult {
     }
 }
 
-/// Seed 003 eq. 25 and 22 in rinscope's signs: the azimuth error φ_U at the second fix (rad, a
+/// Zheng et al. 2016 eq. 25 and 22 in rinscope's signs: the azimuth error φ_U at the second fix (rad, a
 /// rotation about Up; the heading error is −φ_U) from the latitude errors measured just before each
 /// fix (rad), `psi_x1` being ψ_x^s just after the first reset (0 for a reset that keeps the attitude
 /// relative to local level), Δt between the fixes, latitude L.
@@ -186,7 +186,7 @@ pub fn azimuth_error_at_second_fix(psi_x1: f64, dlat2_rad: f64, dt_s: f64, latit
 /// `k` (1/s), from the horizontal velocity equation v̇ = g (φ_N, −φ_E) − k v − 2Ω sin L (−v_N, v_E):
 /// a computed attitude turned by φ sees g·(φ_N, −φ_E) of horizontal specific force, the last term
 /// is the Coriolis acceleration ω_ie × v. With damping, the tilt that holds the velocity error the
-/// growing position error needs is what assumption (a) of seed 003 neglects. Without damping the
+/// growing position error needs is what assumption (a) of Zheng et al. 2016 neglects. Without damping the
 /// velocity carries Schuler oscillations a slow rate cannot describe, and this is no estimate.
 #[must_use]
 pub fn level_errors_from_velocity(v: [f64; 2], v_dot: [f64; 2], k: f64, latitude_rad: f64, g: f64) -> [f64; 2] {
@@ -194,7 +194,7 @@ pub fn level_errors_from_velocity(v: [f64; 2], v_dot: [f64; 2], k: f64, latitude
     [-(v_dot[1] + k * v[1] + f * v[0]) / g, (v_dot[0] + k * v[0] - f * v[1]) / g]
 }
 
-/// The psi-angle equations of seed 003 (eq. 19-22) without its assumption (a): with ψ = φ + δθ
+/// The psi-angle equations of Zheng et al. 2016 (eq. 19-22) without its assumption (a): with ψ = φ + δθ
 /// (rinscope signs), ψ(t1+) = φ(t1) after a level-keeping reset, whose level part `phi1` (E, N) is
 /// known; at the second fix the level errors `phi2` and the latitude error `dlat2_rad` are known.
 /// Returns φ_U(t2), rad (heading error = −φ_U). With `phi1 = phi2 = 0` it is

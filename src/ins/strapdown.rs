@@ -1,7 +1,7 @@
 //! Strapdown attitude update: gyro increments → coning-compensated rotation vector → quaternion,
 //! with the navigation-frame rotation over each update.
 //!
-//! `n_from_s(m) = exp(−ζ) · n_from_s(m−1) · exp(ΔΦ)`, ζ = ω_in^n·h (seed 001 eq. 1 for ΔΦ).
+//! `n_from_s(m) = exp(−ζ) · n_from_s(m−1) · exp(ΔΦ)`, ζ = ω_in^n·h (Li et al. 2014 eq. 1 for ΔΦ).
 
 use nalgebra::{UnitQuaternion, Vector3};
 

@@ -322,7 +322,7 @@ mod tests {
 
     /// The drift about the cone axis (body z) of `alg` fed this truth's increments of pure coning
     /// (half-angle `alpha`, `freq_hz`) at `rate_hz` on a static, error-free table, over 20 s;
-    /// and the analytic drift (seed 001, docs/coning.md), both rad/s.
+    /// and the analytic drift (Li et al. 2014, docs/coning.md), both rad/s.
     fn coning_drift(alg: Algorithm, alpha: f64, freq_hz: f64, rate_hz: f64) -> (f64, f64) {
         use crate::math::attitude::Attitude;
         use crate::model::earth::Site;

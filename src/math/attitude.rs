@@ -1,7 +1,7 @@
-//! Vehicle attitude as pitch, roll and heading (seed 000 eq. 18-19), and the first-order map from a
+//! Vehicle attitude as pitch, roll and heading (Jiang et al. 2017 eq. 18-19), and the first-order map from a
 //! small attitude-error rotation vector to Euler-angle errors.
 //!
-//! Convention (seed 000 eq. 18, seed 004 section 4.1): n = East-North-Up, b = right-forward-up,
+//! Convention (Jiang et al. 2017 eq. 18, the rotary-table paper section 4.1): n = East-North-Up, b = right-forward-up,
 //! `n_from_b = Rz(-heading) * Rx(pitch) * Ry(roll)` with active right-handed rotations, so heading is
 //! measured clockwise from North (the forward axis has East component sin(heading)), pitch is the
 //! nose-up angle and roll turns the right wing down.
@@ -29,11 +29,11 @@ impl Attitude {
         let q = axis_angle(&Vector3::z(), -self.heading_rad)
             * axis_angle(&Vector3::x(), self.pitch_rad)
             * axis_angle(&Vector3::y(), self.roll_rad);
-        // FRAME: seed 000 eq. 18 builds C_b^n from the three Euler angles in this order.
+        // FRAME: Jiang et al. 2017 eq. 18 builds C_b^n from the three Euler angles in this order.
         Rot::from_quaternion(q)
     }
 
-    /// Extracts the Euler angles from C_b^n (seed 000 eq. 19 with the slip T31/T32 read as T31/T33).
+    /// Extracts the Euler angles from C_b^n (Jiang et al. 2017 eq. 19 with the slip T31/T32 read as T31/T33).
     #[must_use]
     pub fn from_n_from_b(n_from_b: &Rot<N, B>) -> Self {
         // Only five DCM elements are needed; computed straight from the quaternion (hot path).
@@ -143,7 +143,7 @@ mod tests {
 
     #[test]
     fn heading_is_clockwise_from_north() {
-        // Heading 90 deg: the forward axis (body y) points East (seed 000 eq. 18: T12 = sin(psi)cos(theta)).
+        // Heading 90 deg: the forward axis (body y) points East (Jiang et al. 2017 eq. 18: T12 = sin(psi)cos(theta)).
         let fwd = att(0.0, 0.0, 90.0).n_from_b().apply(V3::new(Vector3::y()));
         assert!((fwd.v - Vector3::x()).norm() < 1e-15);
         // Pitch 90 deg: forward points up.

@@ -200,7 +200,7 @@ mod angle_unit_tests {
         assert_eq!(nice_half_range(280.0), 300.0);
         assert_eq!(nice_half_range(0.1075), 0.2);
         assert_eq!(nice_half_range(1.0695), 2.0);
-        // Seed 004's "about 1 degree" reads in degrees; seed 000's 10′ errors in arcminutes, as the
+        // The rotary-table paper's "about 1 degree" reads in degrees; Jiang et al. 2017's 10′ errors in arcminutes, as the
         // paper gives them; encoder-noise arcseconds stay arcseconds.
         assert_eq!(AngleUnit::for_peak(1.0695 * RAD_PER_DEG), AngleUnit::Deg);
         assert_eq!(AngleUnit::for_peak(603.8 * RAD_PER_ARCSEC), AngleUnit::Arcmin);

@@ -6,12 +6,12 @@
 //! b_from_s = B · Π_k [ T_k · R(a_k, λ_k) · W_k ] · M
 //! ```
 //!
-//! - `B`   installation error: rotation of the table base on the body (seed 004 section 3.1);
-//! - `T_k` non-orthogonality: axis k tilted by η_k toward axis k-1, about (a_k × a_{k-1}) (seed 000 Fig. 4c);
+//! - `B`   installation error: rotation of the table base on the body (the rotary-table paper section 3.1);
+//! - `T_k` non-orthogonality: axis k tilted by η_k toward axis k-1, about (a_k × a_{k-1}) (Jiang et al. 2017 Fig. 4c);
 //! - `R(a_k, λ_k)` the shaft rotation by the true gimbal angle about the nominal axis a_k;
 //! - `W_k` swing cone: a rotor-fixed tilt of half-angle α_k and phase φ_k, i.e. in the parent frame the
-//!   rotation vector α_k (cos(λ_k+φ_k) e1 + sin(λ_k+φ_k) e2), turning with the shaft (seed 000 eq. 4-7,
-//!   seed 004 section 3.2);
+//!   rotation vector α_k (cos(λ_k+φ_k) e1 + sin(λ_k+φ_k) e2), turning with the shaft (Jiang et al. 2017 eq. 4-7,
+//!   the rotary-table paper section 3.2);
 //! - `M`   IMU mounting error on the last gimbal.
 //!
 //! All error rotations are exact (exponential map); the small-angle forms live only in
@@ -43,7 +43,7 @@ impl AxisGeometry {
     /// An axis along `axis` (a unit coordinate vector) with its cyclic reference directions.
     #[must_use]
     pub fn new(name: String, axis: Vector3<f64>, initial_angle_rad: f64) -> Self {
-        // Cyclic successor: for z the swing components are along (x, y) as in seed 000 eq. 4-5.
+        // Cyclic successor: for z the swing components are along (x, y) as in Jiang et al. 2017 eq. 4-5.
         let e1 = Vector3::new(axis.z, axis.x, axis.y);
         let e2 = axis.cross(&e1);
         Self { name, axis, e1, e2, initial_angle_rad }
@@ -65,7 +65,7 @@ pub struct AxisErrors {
     pub encoder_scale: f64,
     /// Encoder latch time behind the IMU sample, s.
     pub encoder_delay_s: f64,
-    /// Encoder white noise, 1σ per reading, rad (seed 000 Table 1: "Turntable (1σ) 12″").
+    /// Encoder white noise, 1σ per reading, rad (Jiang et al. 2017 Table 1: "Turntable (1σ) 12″").
     pub encoder_noise_rad: f64,
 }
 
@@ -464,7 +464,7 @@ mod tests {
     }
 
     fn seed000_errors() -> TableErrors {
-        // Seed 000 Table 2 (alpha2 read as 10', see seeds/README.md).
+        // Jiang et al. 2017 Table 2 (alpha2 read as 10', see seeds/README.md).
         let mut e = TableErrors::zero(2);
         e.axes[0].swing_half_angle_rad = 10.0 * RAD_PER_ARCMIN;
         e.axes[0].swing_phase_rad = RAD_PER_DEG;
@@ -481,7 +481,7 @@ mod tests {
             assert!((g.e1.cross(&g.e2) - a).norm() < 1e-15);
             assert!(g.e1.dot(&a).abs() < 1e-15);
         }
-        // z-axis swing components are along x then y (seed 000 eq. 4-5).
+        // z-axis swing components are along x then y (Jiang et al. 2017 eq. 4-5).
         let g = AxisGeometry::new("inner".into(), Vector3::z(), 0.0);
         assert_eq!(g.e1, Vector3::x());
         assert_eq!(g.e2, Vector3::y());

@@ -1,5 +1,5 @@
 //! Vehicle motion of b relative to n: a static attitude, scripted ramps of single Euler angles
-//! (seed 004 section 5), sinusoidal wobble per angle, and pure coning (the classical analytic test of
+//! (the rotary-table paper section 5), sinusoidal wobble per angle, and pure coning (the classical analytic test of
 //! attitude algorithms). Pure functions of time, with their angular rates.
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
@@ -324,7 +324,7 @@ mod tests {
     use super::*;
     use crate::math::units::RAD_PER_DEG;
 
-    /// Seed 004 section 5: roll to 30 deg at 6 deg/s at 500 s, pitch to 30 deg at 1100 s,
+    /// The rotary-table paper section 5: roll to 30 deg at 6 deg/s at 500 s, pitch to 30 deg at 1100 s,
     /// pitch back at 1700 s, roll back at 2300 s.
     fn seed004_profile() -> VehicleMotion {
         let ramp = |angle, start_s, target_deg: f64| Ramp { angle, start_s, target_rad: target_deg * RAD_PER_DEG, rate_rad_per_s: 6.0 * RAD_PER_DEG };

@@ -321,7 +321,7 @@ mod tests {
     use super::*;
     use crate::math::units::RAD_PER_DEG;
 
-    /// Seed 004 section 5: 0/90/180/270 deg, 10 deg/s, 290 s dwell, back to 0 (docs/schemes.md).
+    /// The rotary-table paper section 5: 0/90/180/270 deg, 10 deg/s, 290 s dwell, back to 0 (docs/schemes.md).
     fn four_position() -> Scheme {
         let step = |deg: f64| IndexedStep { axis: 0, angle_rad: deg * RAD_PER_DEG, rate_rad_per_s: 10.0 * RAD_PER_DEG, dwell_s: 290.0, accel_rad_per_s2: 0.0 };
         Scheme::indexed(vec![0.0], 290.0, vec![step(90.0), step(90.0), step(90.0), step(-270.0)], true)

@@ -259,13 +259,13 @@ pub fn log(stream: &Stream, r: &ImuAllan, description: &str) -> RecordingStreamR
         let u = c.sensor.adev_unit();
         let unit = if u.text.is_empty() { "log10 fractional frequency".to_owned() } else { format!("log10 {}", u.text) };
         let what = if c.report.is_some() { "ADEV" } else { "deviation" };
-        views.push((c.sensor, plot_view(format!("{}: log10 {what} [{unit}] vs log10 τ [log10 s]", c.name()), path(c), &range)));
+        views.push((c.sensor, plot_view(format!("{}: log10 {what} [{unit}] vs log10 τ — the axis's \"+1s\" is τ = 10 s", c.name()), path(c), &range)));
         if c.curves.iter().any(|k| k.estimator.is_of_phase()) {
             let base = format!("{}_tdev", path(c));
             let mut drawn = Vec::new();
             log_curves(stream, c, &base, Estimator::is_of_phase, &mut drawn)?;
             let pu = c.sensor.phase_unit();
-            views.push((c.sensor, plot_view(format!("{}: log10 TDEV [log10 {}] vs log10 τ [log10 s]", c.name(), pu.text), base, &range_of(&drawn))));
+            views.push((c.sensor, plot_view(format!("{}: log10 TDEV [log10 {}] vs log10 τ — the axis's \"+1s\" is τ = 10 s", c.name(), pu.text), base, &range_of(&drawn))));
         }
     }
     let mut rows: Vec<Node> = Vec::new();

@@ -62,14 +62,14 @@ impl Recorder {
         // Labels beyond the tips (an arrow's own label sits at its middle, inside the case).
         let at = tips.map(|[x, y, z]| [x * 1.12, y * 1.1, z * 1.15]);
         let names = ["x right", "y forward", "z up"];
-        rec.log_static(format!("{INS_BODY}/axes/labels"), &rerun::Points3D::new(at).with_labels(names).with_colors(colors::SENSOR.map(rgb)).with_radii([0.002]))?;
+        rec.log_static(format!("{INS_BODY}/axes/labels"), &rerun::Points3D::new(at).with_labels(names).with_colors(colors::SENSOR.map(super::palette::label)).with_radii([0.002]))?;
         if body.reference.is_some() {
             rec.log_static(REFERENCE_BODY, &rerun::Transform3D::IDENTITY)?;
             let longer = tips.map(|[x, y, z]| [x * 1.3, y * 1.3, z * 1.3]);
             rec.log_static(format!("{REFERENCE_BODY}/axes"), &rerun::Arrows3D::from_vectors(longer).with_colors([rgba([170, 170, 170], 200); 3]).with_radii([0.008]))?;
             rec.log_static(
                 format!("{REFERENCE_BODY}/axes/label"),
-                &rerun::Points3D::new([[0.0, 1.3 * 1.1 * 1.1, 0.08]]).with_labels(["reference"]).with_colors([rgb([190, 190, 190])]).with_radii([0.002]),
+                &rerun::Points3D::new([[0.0, 1.3 * 1.1 * 1.1, 0.08]]).with_labels(["reference"]).with_colors([super::palette::label([190, 190, 190])]).with_radii([0.002]),
             )?;
         }
         Ok(())

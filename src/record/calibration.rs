@@ -169,7 +169,7 @@ pub fn log(stream: Stream, params: &Params, cal: &Calibration, report: &Report, 
                 _ => "",
             };
             let label = format!("estimate: α = {}, φ = {:.2}°{note}", fmt_angle(alpha), est.axes[k].swing_phase_rad.to_degrees());
-            rec.log(format!("{mount}/estimated_cone/label"), &rerun::Points3D::new([p3(tip)]).with_labels([label]).with_radii([0.002]).with_colors([rgb(GHOST)]))?;
+            rec.log(format!("{mount}/estimated_cone/label"), &rerun::Points3D::new([p3(tip)]).with_labels([label]).with_radii([0.002]).with_colors([super::palette::label(GHOST)]))?;
         }
     }
 

@@ -104,7 +104,9 @@ fn title_of(plot: &Plot, a: &Axes) -> String {
     if let Some(i) = plot.title.find(", log10 of ") {
         return format!("{} ({})", &plot.title[..i], a.y_label);
     }
-    plot.title.replace("[log10 ", "[").replace("log10 ", "")
+    // The viewer's note on its time axis (which reads log10 τ as seconds) is not the figure's.
+    let title = plot.title.split(" — the axis's").next().unwrap_or(&plot.title);
+    title.replace("[log10 ", "[").replace("log10 ", "")
 }
 
 /// A series' points as the figure plots them (log10 values undone, hours), in segments split at

@@ -163,7 +163,7 @@ impl Recorder {
                 rec.log_static(format!("{path}/needle"), &rerun::Arrows3D::from_vectors([[0.0, 0.42, 0.0]]).with_colors([rgb(colors::algorithm(name))]).with_radii([0.01]))?;
                 items.push(([0.62, 0.0, 0.42 - 0.11 * k as f32], name.clone()));
             }
-            let colors: Vec<rerun::Color> = std::iter::once(rgb([230, 230, 230])).chain(layout.algorithms.iter().map(|n| rgb(colors::algorithm(n)))).collect();
+            let colors: Vec<rerun::Color> = std::iter::once(super::palette::label([230, 230, 230])).chain(layout.algorithms.iter().map(|n| super::palette::label(colors::algorithm(n)))).collect();
             rec.log_static(
                 "world/drift_dial/labels",
                 &rerun::Points3D::new(items.iter().map(|(p, _)| *p)).with_labels(items.iter().map(|(_, t)| t.as_str())).with_colors(colors).with_radii([0.012]),
@@ -181,7 +181,7 @@ impl Recorder {
                 &rerun::Arrows3D::from_vectors([[0.6, 0.0, 0.0], [0.0, 0.6, 0.0], [0.0, 0.0, 0.6]]).with_colors(colors.map(rgb)).with_radii([0.012]),
             )?;
             let at = if path.ends_with("true") { [0.0f32, 0.0, -0.2] } else { [0.0f32, 0.0, 0.75] };
-            rec.log_static(format!("{path}/label"), &rerun::Points3D::new([at]).with_labels([label]).with_radii([0.002]))?;
+            rec.log_static(format!("{path}/label"), &rerun::Points3D::new([at]).with_labels([label]).with_radii([0.002]).with_colors([super::palette::label(colors[0])]))?;
         }
         Ok(())
     }

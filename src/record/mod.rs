@@ -132,7 +132,7 @@ fn floored_peak(peaks: [f64; 3], a: usize) -> f64 {
 }
 
 /// The smallest angle an error class is drawn at, rad (2°): under it a cone or wedge cannot be seen
-/// at the default camera (seed 000's 20″ non-orthogonality is 0.56° at ×100).
+/// at the default camera (Jiang et al. 2017's 20″ non-orthogonality is 0.56° at ×100).
 const MIN_DRAWN_RAD: f64 = 2.0 * crate::math::units::RAD_PER_DEG;
 
 /// The drawing factor of each error class: the scenario's exaggeration `x`, or, for a class whose
@@ -498,7 +498,7 @@ impl Recorder {
                 layout.trace_ins.push(to_rerun_quaternion(&(rotvec::exp(&err) * t)));
             }
             // The needles turn clockwise by the size of each algorithm's attitude error (whichever
-            // axis it is on: heading for a cone about z, pitch for seed 001's wobble), ×N.
+            // axis it is on: heading for a cone about z, pitch for Li et al. 2014's wobble), ×N.
             let due = !layout.dial.is_empty() && out.t_s >= layout.dial_next_t;
             if due {
                 layout.dial_t.push(out.t_s);
@@ -637,7 +637,7 @@ mod tests {
 
     #[test]
     fn each_error_class_is_drawn_large_enough_to_see() {
-        // Seed 000 at ×100: swings of 5′ and 10′ are drawn at 8.3° and 16.7° (×100 kept); the 20″
+        // Jiang et al. 2017 at ×100: swings of 5′ and 10′ are drawn at 8.3° and 16.7° (×100 kept); the 20″
         // non-orthogonality would be 0.56°, so it gets the smallest 1-2-5 factor that draws it at 2°
         // (2°/20″ = 360 → ×500); a class that is absent keeps ×100.
         let p = crate::scenario::presets::load("jiang2017-dual-axis").expect("preset");

@@ -44,3 +44,49 @@ pub(crate) fn rgba(c: [u8; 3], a: u8) -> rerun::Color {
 pub(crate) fn albedo(c: [u8; 3], a: u8) -> rerun::datatypes::Rgba32 {
     rerun::datatypes::Rgba32::from_unmultiplied_rgba(c[0], c[1], c[2], a)
 }
+
+/// WCAG 2 relative luminance of an sRGB colour.
+pub(crate) fn luminance(c: [u8; 3]) -> f64 {
+    let lin = |v: u8| {
+        let v = f64::from(v) / 255.0;
+        if v <= 0.040_45 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) }
+    };
+    0.2126 * lin(c[0]) + 0.7152 * lin(c[1]) + 0.0722 * lin(c[2])
+}
+
+/// The luminance a 3D label's text is drawn at: the viewer draws a label in its colour on a
+/// translucent box of the theme's (measured in both themes on the scene's floor: luminance 0.70 in
+/// the light theme, 0.03 in the dark); the contrast against both is largest, 3.0:1 each, where
+/// (0.70 + 0.05)/(L + 0.05) = (L + 0.05)/(0.03 + 0.05), L ≈ 0.195.
+const LABEL_LUMINANCE: f64 = 0.195;
+
+/// A 3D label's colour: `c`'s hue, half its saturation (a label must not be its arrow's colour),
+/// at [`LABEL_LUMINANCE`]: legible on the light theme and on the dark one.
+pub(crate) fn label(c: [u8; 3]) -> rerun::Color {
+    let grey = (f64::from(c[0]) + f64::from(c[1]) + f64::from(c[2])) / 3.0;
+    let mut x = c.map(|v| (f64::from(v) + grey) / 2.0);
+    // Bisection on a scale factor (towards black below 1, towards white above).
+    let at = |k: f64, x: [f64; 3]| x.map(|v| if k <= 1.0 { v * k } else { v + (255.0 - v) * (k - 1.0) }.round().clamp(0.0, 255.0) as u8);
+    let (mut lo, mut hi) = (0.0, 2.0);
+    for _ in 0..40 {
+        let k = (lo + hi) / 2.0;
+        if luminance(at(k, x)) < LABEL_LUMINANCE { lo = k } else { hi = k }
+    }
+    x = at(hi, x).map(f64::from);
+    rgb(x.map(|v| v as u8))
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn labels_sit_at_three_to_one_against_both_themes_boxes() {
+        // Box luminances measured on web-viewer screenshots (see LABEL_LUMINANCE).
+        let (light, dark) = (0.70, 0.03);
+        for c in [[235, 235, 235], [235, 50, 50], [60, 110, 255], [250, 200, 60], [20, 20, 20]] {
+            let l = super::label(c).to_array();
+            let y = super::luminance([l[0], l[1], l[2]]);
+            let (on_light, on_dark) = ((light + 0.05) / (y + 0.05), (y + 0.05) / (dark + 0.05));
+            assert!(on_light > 2.9 && on_dark > 2.9, "{c:?} -> {l:?}: {on_light:.2}:1 light, {on_dark:.2}:1 dark");
+        }
+    }
+}

@@ -142,9 +142,9 @@ impl Recorder {
             format!("{}/sensor_axes/labels", self.paths.imu),
             &rerun::Points3D::new([[0.55, 0.0, 0.0], [0.0, 0.55, 0.0], [0.0, 0.0, 0.55]])
                 .with_labels(["x_s", "y_s", "z_s"])
-                // Pale tints of the arrows' colours: a label the colour of its arrow vanishes where it
-                // crosses it (x_s red on red, z_s blue on dark blue).
-                .with_colors(colors::SENSOR.map(|c| rgb(c.map(|v| v / 3 + 170))))
+                // Half-saturated tints of the arrows' colours (a label the colour of its arrow
+                // vanishes where it crosses it), legible on both themes (`palette::label`).
+                .with_colors(colors::SENSOR.map(super::palette::label))
                 .with_radii([0.002]),
         )?;
         Ok(())
@@ -181,7 +181,7 @@ impl Recorder {
             &rerun::Points3D::new(items.iter().map(|(p, _)| *p))
                 .with_labels(items.iter().map(|(_, t)| *t))
                 .with_radii([0.002])
-                .with_colors([rgb([230, 230, 230])]),
+                .with_colors([super::palette::label([230, 230, 230])]),
         )
     }
 

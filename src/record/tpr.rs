@@ -1,5 +1,5 @@
 //! The recording of `rinscope tpr`: azimuth and radial position errors of the conventional reset and
-//! of TPR overlaid, the fixes marked, the comparison with seed 003 as a document.
+//! of TPR overlaid, the fixes marked, the comparison with Zheng et al. 2016 as a document.
 
 use rerun::blueprint::components::ContainerKind;
 use rerun::RecordingStreamResult;

@@ -24,7 +24,7 @@ pub fn imu_preset(name: &str) -> Option<InsParams> {
     let mut cfg = InsParams::ideal(200.0, Algorithm::TwoSampleP1);
     match name {
         "none" => {}
-        // Seed 000 Table 1 (the dual-axis RINS of Jiang et al.): biases 1σ, "<" limits taken as 1σ,
+        // Jiang et al. 2017 Table 1 (the dual-axis RINS of Jiang et al.): biases 1σ, "<" limits taken as 1σ,
         // "50 µg/h^½" read as a velocity random walk of 50 µg/√Hz (docs/ins.md).
         "jiang2017-table1" => {
             cfg.errors.gyro = GyroSpec {
@@ -43,12 +43,12 @@ pub fn imu_preset(name: &str) -> Option<InsParams> {
             };
             cfg.errors.g_sensitivity = 0.0001 * DEG_PER_H / STANDARD_GRAVITY_MPS2;
         }
-        // Seed 003 §4.3 simulation: gyro random walk 3e-3 °/√h, accelerometer noise 20 µg/√Hz.
+        // Zheng et al. 2016 §4.3 simulation: gyro random walk 3e-3 °/√h, accelerometer noise 20 µg/√Hz.
         "zheng2016" => {
             cfg.errors.gyro.noise.random_walk_si = 3e-3 * ARW;
             cfg.errors.accel.noise.random_walk_si = 20.0 * UG;
         }
-        // Seed 001 Table 4 (the DAMS laser INS), 2 kHz sampling, three dithered RLGs and the FIR. Its
+        // Li et al. 2014 Table 4 (the DAMS laser INS), 2 kHz sampling, three dithered RLGs and the FIR. Its
         // "bias instability" is modelled as a first-order Gauss-Markov bias of that σ and a 1 h
         // correlation time (the model this preset always had; its Allan curve peaks at 0.62σ near
         // τ = 1.9 h, docs/allan.md).

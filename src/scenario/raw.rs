@@ -133,7 +133,7 @@ pub struct RawMonteCarlo {
 }
 
 impl Default for RawMonteCarlo {
-    /// Seed 000 §6.1: "swaying angle S(−10°, +10°)", "phase A(−1°, +1°)", "non-orthogonal angle
+    /// Jiang et al. 2017 §6.1: "swaying angle S(−10°, +10°)", "phase A(−1°, +1°)", "non-orthogonal angle
     /// Q(−20″, +20″)". Its Table 2 uses α of 5′ and 10′, so the printed "10°" is read as 10′, and a
     /// half-angle is taken in [0, 10′] (a negative half-angle is the same cone with φ + 180°).
     fn default() -> Self {
@@ -147,11 +147,11 @@ impl Default for RawMonteCarlo {
     }
 }
 
-/// `[position_fix]`: position fixes during a navigation run (seed 003 §4).
+/// `[position_fix]`: position fixes during a navigation run (Zheng et al. 2016 §4).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawPositionFix {
-    /// Times of the fixes, hours; `rinscope reset` uses the first two (seed 003: 17 and 21).
+    /// Times of the fixes, hours; `rinscope reset` uses the first two (Zheng et al. 2016: 17 and 21).
     pub at_h: Vec<f64>,
 }
 
@@ -187,7 +187,7 @@ pub struct RawImu {
     /// Model the navigation computer's zero-order hold as a T/2 output delay.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub zero_order_hold: Option<bool>,
-    /// Δt of seed 001's synchronisation: outputs are compared with the truth Δt earlier, ms.
+    /// Δt of Li et al. 2014's synchronisation: outputs are compared with the truth Δt earlier, ms.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub output_compensation_ms: Option<f64>,
     /// Raw and filtered gyro signals are recorded for this long, s.
@@ -333,7 +333,7 @@ pub struct RawNavigation {
     /// "held" or "free".
     #[serde(default = "default_vertical")]
     pub vertical: String,
-    /// Horizontal velocity damping toward zero velocity (seed 003).
+    /// Horizontal velocity damping toward zero velocity (Zheng et al. 2016).
     #[serde(default)]
     pub velocity_damping: bool,
     /// Alignment error (east tilt, north tilt, heading), arcmin.

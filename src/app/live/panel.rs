@@ -479,7 +479,7 @@ mod tests {
     #[test]
     fn the_panel_offers_what_a_teacher_turns_with_the_scenario_values() {
         let p = panel();
-        // Seed 000 Table 2 values from the preset.
+        // Jiang et al. 2017 Table 2 values from the preset.
         assert_eq!(value_of(&p, "outer swing half-angle"), 600.0);
         assert_eq!(value_of(&p, "inner swing half-angle"), 300.0);
         assert_eq!(value_of(&p, "inner non-orthogonality"), 20.0);
