@@ -13,5 +13,6 @@ pub mod playback;
 pub mod replay;
 pub mod reproduce;
 pub mod run;
+pub mod selfcal;
 pub mod terminate;
 pub mod tpr;

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 
-use super::{CalibrateArgs, Failure, LiveArgs, ModulationArgs, MonteCarloAction, MonteCarloArgs, RunArgs, ScenarioSource, TprArgs};
+use super::{CalibrateArgs, Failure, SelfcalArgs, LiveArgs, ModulationArgs, MonteCarloAction, MonteCarloArgs, RunArgs, ScenarioSource, TprArgs};
 use crate::app::calibrate::{calibrate_scenario, estimated_compensation, monte_carlo_runs, monte_carlo_setup, record_outcome, CalibrationOutput};
 use crate::calib::montecarlo::{self, Shard, ShardFile};
 use crate::app::run::run_recorded;
@@ -576,6 +576,66 @@ pub(super) fn bench_peer(python: PathBuf, rounds: usize, samples: u64, json: Opt
     out!("{}", peer::text(&reports));
     if let Some(path) = json {
         write_json("--json", path, &reports)?;
+    }
+    Ok(())
+}
+
+/// `rinscope selfcal`.
+pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
+    use crate::app::selfcal::{self as sc, SequenceChoice};
+    use crate::ins::selfcal::{observability, Sequence};
+    let params = args.source.load("selfcal-nav-grade")?;
+    check_output_dir("--json", args.json.as_deref())?;
+    let choice = match args.sequence.as_str() {
+        "scenario" => SequenceChoice::Scenario,
+        name => SequenceChoice::BuiltIn(Sequence::named(name).ok_or_else(|| {
+            let names: Vec<&str> = Sequence::ALL.iter().map(|(_, n)| *n).collect();
+            Failure::input(format!("--sequence {name}: not a sequence; use one of {names:?} or \"scenario\""))
+        })?),
+    };
+    let setup = sc::setup(&params, choice).map_err(|e| Failure::input(format!("{e:#}")))?;
+    let stop = stop_flag();
+    let interrupted = |e: anyhow::Error| if stop.load(Ordering::SeqCst) { Failure::interrupted("nothing was estimated") } else { Failure::run(format!("selfcal: {e:#}")) };
+    // The plan: the sequence's noise-free motion through the same filter (its 1σ depend on the
+    // motion only), before any IMU is drawn.
+    let plan_run = sc::run_one(&setup, params.meta.seed, true, &stop).map_err(interrupted)?;
+    let plan = observability(&plan_run.estimate);
+    if args.plan || !plan.unobservable.is_empty() || !plan.weak.is_empty() {
+        let list = |v: &Vec<String>| if v.is_empty() { "none".to_owned() } else { v.join(", ") };
+        errln!("rinscope selfcal: plan for {}: not observable: {}; weakly observable: {}", setup.sequence, list(&plan.unobservable), list(&plan.weak));
+        for a in &plan.aliased {
+            errln!("rinscope selfcal: aliased: {a}");
+        }
+    }
+    if args.plan {
+        if let Some(path) = &args.json {
+            write_json("--json", path, &serde_json::json!({ "sequence": setup.sequence, "observability": plan }))?;
+        }
+        return Ok(());
+    }
+    let outcome = sc::run_one(&setup, params.meta.seed, false, &stop).map_err(interrupted)?;
+    let mc = match args.monte_carlo {
+        Some(n) => Some(sc::monte_carlo(&setup, n as usize, params.meta.seed + 1, &stop).map_err(interrupted)?),
+        None => None,
+    };
+    out!("{}", sc::table(&setup, &outcome, &plan, mc.as_ref()));
+    if let Some(path) = &args.json {
+        let names: Vec<String> = (0..crate::ins::selfcal::N_PARAMS).map(|k| crate::ins::selfcal::param(k).1).collect();
+        write_json(
+            "--json",
+            path,
+            &serde_json::json!({
+                "sequence": setup.sequence,
+                "parameters": names,
+                "units": "SI (rad/s, m/s², dimensionless gains)",
+                "truth": outcome.truth.to_params(),
+                "estimate": outcome.estimate.params,
+                "sigma": outcome.estimate.sigma,
+                "estimation_s": outcome.estimation_s,
+                "observability": plan,
+                "monte_carlo": mc,
+            }),
+        )?;
     }
     Ok(())
 }

@@ -62,6 +62,10 @@ enum Command {
     /// Zheng et al. 2016's Twice Position-fix Reset against the conventional reset, from one IMU stream
     /// (default scenario: zheng2016-tpr; needs [imu], [navigation] and two [position_fix] times).
     Tpr(TprArgs),
+    /// Calibrate the IMU on its own gimbals: its 21 errors (gyro and accelerometer biases, scale
+    /// factors, misalignments) from a calibration sequence, with their 1σ and what the sequence
+    /// can see (default scenario selfcal-nav-grade; docs/selfcal.md).
+    Selfcal(SelfcalArgs),
     /// Write a scenario as a log set (docs/logs.md): the IMU's measured increments, the encoder
     /// readings and the true attitude at every sample, the table description and the manifest.
     ExportLog(ExportLogArgs),
@@ -483,6 +487,27 @@ struct TprArgs {
     seeds: Option<u64>,
 }
 
+#[derive(Args)]
+struct SelfcalArgs {
+    // Default selfcal-nav-grade.
+    #[command(flatten)]
+    source: ScenarioSource,
+    /// The sequence: positions-19, dual-axis-29, azimuth-only (a degenerate one), or scenario (the
+    /// scenario's indexed [scheme], for its simulation.duration_s).
+    #[arg(long, default_value = "dual-axis-29")]
+    sequence: String,
+    /// Also calibrate this many random IMUs (seeds after the scenario's, on every core) and
+    /// compare each parameter's reported 1σ with the spread of its errors.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(2..=10_000))]
+    monte_carlo: Option<u64>,
+    /// Only the plan: what the sequence can see, from its noise-free motion (no IMU drawn).
+    #[arg(long)]
+    plan: bool,
+    /// Write the result (estimates, 1σ, truth, observability, Monte Carlo) as JSON.
+    #[arg(long)]
+    json: Option<PathBuf>,
+}
+
 /// A failure with the exit code it deserves (the policy in the module docs): every command maps
 /// its errors through these constructors, never through a code of its own.
 struct Failure {
@@ -561,6 +586,7 @@ pub fn main() -> ExitCode {
         Command::Calibrate(args) => commands::calibrate(&args),
         Command::Montecarlo(args) => commands::montecarlo(&args),
         Command::Tpr(args) => commands::tpr(&args),
+        Command::Selfcal(args) => commands::selfcal(&args),
         Command::Events { file } => commands::events(&file),
         Command::ExportLog(args) => logs::export_log(&args),
         Command::Replay(args) => logs::replay(&args),

@@ -12,6 +12,7 @@ pub mod nav;
 pub mod noise;
 pub mod pipeline;
 pub mod reset;
+pub mod selfcal;
 pub mod sensor;
 pub mod strapdown;
 pub mod trace;

@@ -265,6 +265,13 @@ impl Sensors {
         (g, a)
     }
 
+    /// The drawn gain errors K (measured = (I + K)·true + bias): (gyros, accelerometers), for the
+    /// comparison of a calibration with the truth (no estimator reads them).
+    #[must_use]
+    pub fn drawn_gain_errors(&self) -> (Matrix3<f64>, Matrix3<f64>) {
+        (self.gyro.gain - Matrix3::identity(), self.accel.gain - Matrix3::identity())
+    }
+
     /// Samples clipped by saturation so far, per axis: (gyros, accelerometers).
     #[must_use]
     pub fn saturation_counts(&self) -> ([u64; 3], [u64; 3]) {

@@ -25,6 +25,7 @@ pub const PRESETS: &[(&str, &str)] = &[
     ("rotation-modulation-none", include_str!("../../assets/scenarios/rotation-modulation-none.toml")),
     ("rotation-modulation-continuous", include_str!("../../assets/scenarios/rotation-modulation-continuous.toml")),
     ("rotation-modulation-16-position", include_str!("../../assets/scenarios/rotation-modulation-16-position.toml")),
+    ("selfcal-nav-grade", include_str!("../../assets/scenarios/selfcal-nav-grade.toml")),
 ];
 
 /// The TOML text of a preset.

@@ -1,0 +1,273 @@
+//! `rinscope selfcal`: the scenario's table turns its IMU through a calibration sequence, the
+//! simulated IMU (with the scenario's errors) feeds the self-calibration filter
+//! ([`crate::ins::selfcal`]), and the estimates are compared with the drawn truth; the plan (what
+//! the sequence can see) is computed before, on the sequence's noise-free motion; a Monte Carlo
+//! over random IMUs checks the reported 1σ against the spread.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use anyhow::{anyhow, bail, Result};
+use rayon::prelude::*;
+
+use crate::ins::selfcal::{self, Config, Estimate, ImuErrors, Kind, Sequence, SelfCal, N_PARAMS};
+use crate::ins::sensor::{ImuErrorSpec, Sensors, Spec};
+use crate::ins::truth::TruthImu;
+use crate::model::earth::Earth;
+use crate::model::scheme::Scheme;
+use crate::scenario::Params;
+use crate::sim::{Model, TableParams};
+
+/// Where the sequence comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SequenceChoice {
+    /// A built-in.
+    BuiltIn(Sequence),
+    /// The scenario's own indexed `[scheme]`, for `simulation.duration_s`.
+    Scenario,
+}
+
+/// A self-calibration set up: the table with its sequence, the IMU's errors, the filter's knowledge.
+#[derive(Debug, Clone)]
+pub struct Setup {
+    /// The table turning through the sequence.
+    pub table: TableParams,
+    /// The IMU's error model (truth draws come from it with a seed).
+    pub imu: ImuErrorSpec,
+    /// What the filter knows.
+    pub config: Config,
+    /// Samples in the sequence.
+    pub samples: usize,
+    /// The sequence's name.
+    pub sequence: String,
+    /// The starts of the moves, s.
+    pub move_starts_s: Vec<f64>,
+}
+
+/// One IMU's calibration.
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    /// The filter's result.
+    pub estimate: Estimate,
+    /// The IMU's true errors in the accelerometer frame (what the estimates are compared with).
+    pub truth: ImuErrors,
+    /// Wall time of the estimation alone (the filter's pushes), s.
+    pub estimation_s: f64,
+}
+
+/// Sets up the self-calibration of `p`'s IMU on `p`'s dual-axis table.
+///
+/// # Errors
+/// No `[imu]`, a table that is not dual-axis, a scenario scheme that is not indexed or does not
+/// start at rest.
+pub fn setup(p: &Params, choice: SequenceChoice) -> Result<Setup> {
+    let ins = p.ins.as_ref().ok_or_else(|| anyhow!("{}: selfcal needs an [imu] section (the IMU to calibrate)", p.meta.name))?;
+    let mut table = p.table.clone();
+    let (scheme, duration_s, name) = match choice {
+        SequenceChoice::BuiltIn(s) => {
+            if table.chain.axes().len() != 2 {
+                bail!("{}: the built-in sequences are for a dual-axis table (outer, then inner carrying the IMU about its z); this table has {} axes — use --sequence scenario with an indexed [scheme]", p.meta.name, table.chain.axes().len());
+            }
+            let (dwell, steps) = s.steps();
+            let total = dwell + steps.iter().map(|m| m.angle_rad.abs() / m.rate_rad_per_s + m.rate_rad_per_s / m.accel_rad_per_s2 + m.dwell_s).sum::<f64>();
+            (Scheme::indexed(vec![0.0; 2], dwell, steps, false), total, s.name().to_owned())
+        }
+        SequenceChoice::Scenario => {
+            if table.scheme.steps().is_empty() {
+                bail!("{}: --sequence scenario needs an indexed [scheme] (kind = \"indexed\" with [[scheme.step]])", p.meta.name);
+            }
+            (table.scheme.clone(), p.duration_s, format!("{}'s [scheme]", p.meta.name))
+        }
+    };
+    let move_starts_s = scheme.move_starts_s(duration_s, 10_000);
+    let first_move = move_starts_s.first().copied().unwrap_or(duration_s);
+    if first_move < 60.0 {
+        bail!("{name}: the first move starts at {first_move:.1} s; the IMU must rest at least 60 s first (its coarse alignment)");
+    }
+    table.scheme = scheme;
+    let h = 1.0 / p.step_hz;
+    let sigma = |s: Spec| match s {
+        Spec::Sigma(x) if x > 0.0 => Some(x),
+        _ => None,
+    };
+    let e = &ins.errors;
+    let datasheet: [Option<f64>; N_PARAMS] = std::array::from_fn(|k| match selfcal::param(k).0 {
+        Kind::GyroBias => sigma(e.gyro.bias_rad_per_s),
+        Kind::GyroScale => sigma(e.gyro.scale),
+        Kind::GyroMisalignment => (e.gyro.misalignment_rad > 0.0).then_some(e.gyro.misalignment_rad),
+        Kind::AccelBias => sigma(e.accel.bias_mps2),
+        Kind::AccelScale => sigma(e.accel.scale),
+        Kind::AccelMisalignment => (e.accel.misalignment_rad > 0.0).then_some(e.accel.misalignment_rad),
+    });
+    let samples_per_update = ((0.1 / h).round() as usize).max(1);
+    let config = Config {
+        h,
+        samples_per_update,
+        earth: Earth::at(p.site),
+        random_walk: (e.gyro.noise.random_walk_si.max(1e-9), e.accel.noise.random_walk_si.max(1e-8)),
+        prior: Config::priors(&datasheet),
+        velocity_sigma_mps: 1e-5,
+        align_samples: ((first_move.min(selfcal::INITIAL_DWELL_S) - 1.0) / h) as usize,
+    };
+    Ok(Setup { table, imu: ins.errors, config, samples: (duration_s / h).round() as usize, sequence: name, move_starts_s })
+}
+
+/// Calibrates one IMU drawn with `seed` (`ideal`: no errors and no noise, the plan's run).
+///
+/// # Errors
+/// Interrupted, or an alignment that failed.
+pub fn run_one(s: &Setup, seed: u64, ideal: bool, stop: &AtomicBool) -> Result<Outcome> {
+    let model = Model::new(&s.table, seed);
+    let mut truth_imu = TruthImu::new(model, s.config.earth, 0.0);
+    let spec = if ideal { ImuErrorSpec::default() } else { s.imu };
+    let mut sensors = Sensors::new(&spec, s.config.h, seed, 0.0);
+    let h = s.config.h;
+    let mut sample = |k: usize| {
+        let t1 = (k + 1) as f64 * h;
+        let (g, a) = truth_imu.increments(t1);
+        sensors.measure(&g, &a, t1)
+    };
+    let align: Vec<_> = (0..s.config.align_samples).map(&mut sample).collect();
+    let mut filter = SelfCal::new(s.config, &align).ok_or_else(|| anyhow!("the coarse alignment on the first {:.0} s failed (no Earth-rate signature)", align.len() as f64 * h))?;
+    let mut estimation = std::time::Duration::ZERO;
+    let started = std::time::Instant::now();
+    for m in &align {
+        filter.push(m);
+    }
+    estimation += started.elapsed();
+    let mut buffer = Vec::with_capacity(8192);
+    let mut k = align.len();
+    while k < s.samples {
+        if stop.load(Ordering::Relaxed) {
+            bail!("interrupted");
+        }
+        buffer.clear();
+        let end = (k + 8192).min(s.samples);
+        buffer.extend((k..end).map(&mut sample));
+        let started = std::time::Instant::now();
+        for m in &buffer {
+            filter.push(m);
+        }
+        estimation += started.elapsed();
+        k = end;
+    }
+    let (bg, ba) = sensors.drawn_bias;
+    let (kg, ka) = sensors.drawn_gain_errors();
+    let truth = ImuErrors { bg, kg, ba, ka }.in_accelerometer_frame();
+    Ok(Outcome { estimate: filter.finish(), truth, estimation_s: estimation.as_secs_f64() })
+}
+
+/// Per parameter over a Monte Carlo: mean error, the spread of the errors and the mean reported 1σ.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct MonteCarlo {
+    /// Runs.
+    pub runs: usize,
+    /// Mean of estimate − truth, SI.
+    pub mean_error: Vec<f64>,
+    /// Standard deviation of estimate − truth, SI.
+    pub spread: Vec<f64>,
+    /// Mean reported 1σ, SI.
+    pub reported_sigma: Vec<f64>,
+    /// Wall time, s.
+    pub wall_s: f64,
+}
+
+/// `runs` IMUs drawn with seeds `first_seed..`, on every core.
+///
+/// # Errors
+/// Interrupted, or a run that failed.
+pub fn monte_carlo(s: &Setup, runs: usize, first_seed: u64, stop: &AtomicBool) -> Result<MonteCarlo> {
+    let started = std::time::Instant::now();
+    let outcomes: Vec<Outcome> = (0..runs).into_par_iter().map(|i| run_one(s, first_seed + i as u64, false, stop)).collect::<Result<_>>()?;
+    let n = outcomes.len() as f64;
+    let errors: Vec<[f64; N_PARAMS]> = outcomes.iter().map(|o| std::array::from_fn(|k| o.estimate.params[k] - o.truth.to_params()[k])).collect();
+    let mean_error: Vec<f64> = (0..N_PARAMS).map(|k| errors.iter().map(|e| e[k]).sum::<f64>() / n).collect();
+    let spread = (0..N_PARAMS).map(|k| (errors.iter().map(|e| (e[k] - mean_error[k]).powi(2)).sum::<f64>() / (n - 1.0).max(1.0)).sqrt()).collect();
+    let reported_sigma = (0..N_PARAMS).map(|k| outcomes.iter().map(|o| o.estimate.sigma[k]).sum::<f64>() / n).collect();
+    Ok(MonteCarlo { runs, mean_error, spread, reported_sigma, wall_s: started.elapsed().as_secs_f64() })
+}
+
+/// The accuracy issue 23 asks of a navigation-grade IMU (1σ, in each kind's display unit).
+#[must_use]
+pub fn target(kind: Kind) -> f64 {
+    match kind {
+        Kind::GyroBias => 0.002,
+        Kind::GyroScale => 2.0,
+        Kind::GyroMisalignment | Kind::AccelMisalignment => 2.0,
+        Kind::AccelBias => 5.0,
+        Kind::AccelScale => 10.0,
+    }
+}
+
+/// The terminal table of one calibration (and the Monte Carlo's columns when there is one).
+#[must_use]
+pub fn table(s: &Setup, o: &Outcome, plan: &selfcal::Observability, mc: Option<&MonteCarlo>) -> String {
+    let truth = o.truth.to_params();
+    let e = &o.estimate;
+    let mut out = format!(
+        "self-calibration: {} — {} positions, {:.2} h at {:.0} Hz; estimated in {:.2} s\n\n",
+        s.sequence,
+        s.move_starts_s.len() + 1,
+        s.samples as f64 * s.config.h / 3600.0,
+        1.0 / s.config.h,
+        o.estimation_s
+    );
+    out.push_str(&format!(
+        "  {:<8} {:>5} {:>11} {:>11} {:>9} {:>7} {:>8} {:>9}  {:<14}{}\n",
+        "param",
+        "unit",
+        "true",
+        "estimate",
+        "1σ",
+        "err/σ",
+        "σ/σ0",
+        "target",
+        "observable",
+        if mc.is_some() { "    MC spread  1σ/spread" } else { "" }
+    ));
+    for k in 0..N_PARAMS {
+        let (kind, name) = selfcal::param(k);
+        let (unit, per_si) = kind.unit();
+        let seen = match plan.observable_from_s[k] {
+            Some(t) => {
+                let after = s.move_starts_s.iter().filter(|m| **m < t).count();
+                if after == 0 { "at rest".to_owned() } else { format!("after move {after}") }
+            }
+            None => "NO".to_owned(),
+        };
+        let mut line = format!(
+            "  {:<8} {:>5} {:>11.4} {:>11.4} {:>9.4} {:>7.2} {:>8.1e} {:>9}  {:<14}",
+            name,
+            unit,
+            truth[k] * per_si,
+            e.params[k] * per_si,
+            e.sigma[k] * per_si,
+            (e.params[k] - truth[k]) / e.sigma[k],
+            plan.ratio[k],
+            format!("{}{}", if e.sigma[k] * per_si <= target(kind) { "✓ " } else { "✗ " }, target(kind)),
+            seen
+        );
+        if let Some(m) = mc {
+            line.push_str(&format!(" {:>12.4} {:>10.2}", m.spread[k] * per_si, m.reported_sigma[k] / m.spread[k]));
+        }
+        out.push_str(&line);
+        out.push('\n');
+    }
+    if !plan.unobservable.is_empty() {
+        out.push_str(&format!("\nNOT OBSERVABLE from this sequence (1σ fell by less than half): {}\n", plan.unobservable.join(", ")));
+    }
+    if !plan.weak.is_empty() {
+        out.push_str(&format!("WEAKLY OBSERVABLE (1σ still above a tenth of its prior): {}\n", plan.weak.join(", ")));
+    }
+    for a in &plan.aliased {
+        out.push_str(&format!("ALIASED: {a}\n"));
+    }
+    out.push_str(
+        "\nThe IMU frame is the accelerometer triad's (K_a upper triangular): a rotation of both triads together is the IMU's\n\
+         attitude, not an error (docs/selfcal.md). The table's non-orthogonality and encoder offsets change only where the IMU\n\
+         points, not what it measures: this calibration cannot see them (`rinscope calibrate` estimates them).\n",
+    );
+    if let Some(m) = mc {
+        out.push_str(&format!("Monte Carlo: {} IMUs in {:.1} s; 1σ/spread is the reported 1σ over the spread of the errors (1 = honest).\n", m.runs, m.wall_s));
+    }
+    out
+}
