@@ -613,12 +613,43 @@ pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
         }
         return Ok(());
     }
-    let outcome = sc::run_one(&setup, params.meta.seed, false, &stop).map_err(interrupted)?;
-    let mc = match args.monte_carlo {
-        Some(n) => Some(sc::monte_carlo(&setup, n as usize, params.meta.seed + 1, &stop).map_err(interrupted)?),
-        None => None,
+    let sinks = if args.no_recording {
+        None
+    } else {
+        let request = args.sinks.request(default_recording(&format!("{}-selfcal", params.meta.name)))?;
+        Some(open_sinks(request, &format!("{}-selfcal-seed{}", params.meta.name, params.meta.seed))?)
     };
-    out!("{}", sc::table(&setup, &outcome, &plan, mc.as_ref()));
+    let result = sc::run_one(&setup, params.meta.seed, false, &stop).and_then(|o| match args.monte_carlo {
+        Some(n) => Ok((sc::monte_carlo(&setup, n as usize, params.meta.seed + 1, &stop)?, o)).map(|(m, o)| (o, Some(m))),
+        None => Ok((o, None)),
+    });
+    let (outcome, mc) = match result {
+        Ok(r) => r,
+        Err(e) => {
+            if let Some(s) = sinks {
+                s.abandon();
+            }
+            return Err(interrupted(e));
+        }
+    };
+    let table = sc::table(&setup, &outcome, &plan, mc.as_ref());
+    out!("{table}");
+    if let Some(sinks) = sinks {
+        let view = crate::record::selfcal::SelfcalView {
+            title: format!("{} — {}", params.meta.name, setup.sequence),
+            table: &table,
+            history: &outcome.estimate.history,
+            prior: &outcome.estimate.prior,
+            truth: Some(outcome.truth.to_params()),
+            move_starts_s: &setup.move_starts_s,
+            attitude: &outcome.attitude,
+        };
+        if let Err(e) = crate::record::selfcal::log(&sinks.stream(), &view) {
+            sinks.abandon();
+            return Err(Failure::run(format!("rerun: {e}")));
+        }
+        print_saved(&sinks.finish()?)?;
+    }
     if let Some(path) = &args.json {
         let names: Vec<String> = (0..crate::ins::selfcal::N_PARAMS).map(|k| crate::ins::selfcal::param(k).1).collect();
         write_json(

@@ -503,6 +503,11 @@ struct SelfcalArgs {
     /// Only the plan: what the sequence can see, from its noise-free motion (no IMU drawn).
     #[arg(long)]
     plan: bool,
+    #[command(flatten)]
+    sinks: SinkArgs,
+    /// No recording (the table and --json only).
+    #[arg(long)]
+    no_recording: bool,
     /// Write the result (estimates, 1σ, truth, observability, Monte Carlo) as JSON.
     #[arg(long)]
     json: Option<PathBuf>,

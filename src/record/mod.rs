@@ -35,6 +35,7 @@ use frames::Frames;
 mod rows;
 mod scene;
 pub mod sink;
+pub mod selfcal;
 pub mod tpr;
 
 use crate::ins::pipeline::InsView;
