@@ -46,8 +46,8 @@ impl ConeGizmo {
         rec.log_static("world/cone/rims", &rerun::LineStrips3D::new(rims).with_colors([rgba(color, 160)]).with_radii([0.004]))?;
         rec.log_static("world/cone/nominal", &rerun::LineStrips3D::new([[[0.0, 0.0, -0.7f32], [0.0, 0.0, 0.7]]]).with_colors([rgb([150, 150, 150])]).with_radii([0.005]))?;
         let label = format!("body z on its {} cone, tilt ×{gain}", fmt_angle(alpha_rad));
-        // Below the cone, clear of the labels near the top of the scene.
-        rec.log_static("world/cone/label", &rerun::Points3D::new([[0.0f32, 0.0, -0.85]]).with_labels([label]).with_radii([0.002]).with_colors([super::palette::label(color)]))?;
+        // Above the cone (below it, it sat on the table's deck, where no colour reads).
+        rec.log_static("world/cone/label", &rerun::Points3D::new([[0.0f32, 0.0, 0.85]]).with_labels([label]).with_radii([0.002]).with_colors([super::palette::label(color)]))?;
         for i in 0..TRAIL {
             let alpha = (230.0 * (1.0 - i as f64 / TRAIL as f64)) as u8;
             rec.log_static(

@@ -156,17 +156,19 @@ impl Recorder {
             rec.log_static("world/drift_dial", &rerun::Transform3D::from_translation(DIAL_OFFSET))?;
             rec.log_static("world/drift_dial/rim", &rerun::LineStrips3D::new([circle]).with_colors([rgba([200, 200, 200], 160)]).with_radii([0.004]))?;
             let title = format!("attitude error per algorithm, clockwise ×{} (a turn: {:.0}″)", layout.exaggeration, 360.0 * 3600.0 / layout.exaggeration);
-            let mut items: Vec<([f32; 3], String)> = vec![([0.0, -0.62, 0.0], title)];
+            // The title above the dial (below it, it met the compass's E), the names in a column
+            // to its right, spaced for their boxes, on points too small to cover a neighbour.
+            let mut items: Vec<([f32; 3], String)> = vec![([0.0, 0.62, 0.0], title)];
             for (k, name) in layout.algorithms.iter().enumerate() {
                 let path = dial_path(name);
                 rec.log_static(path.as_str(), &rerun::Transform3D::IDENTITY)?;
                 rec.log_static(format!("{path}/needle"), &rerun::Arrows3D::from_vectors([[0.0, 0.42, 0.0]]).with_colors([rgb(colors::algorithm(name))]).with_radii([0.01]))?;
-                items.push(([0.62, 0.0, 0.42 - 0.11 * k as f32], name.clone()));
+                items.push(([0.7, 0.0, 0.5 - 0.14 * k as f32], name.clone()));
             }
             let colors: Vec<rerun::Color> = std::iter::once(super::palette::label([230, 230, 230])).chain(layout.algorithms.iter().map(|n| super::palette::label(colors::algorithm(n)))).collect();
             rec.log_static(
                 "world/drift_dial/labels",
-                &rerun::Points3D::new(items.iter().map(|(p, _)| *p)).with_labels(items.iter().map(|(_, t)| t.as_str())).with_colors(colors).with_radii([0.012]),
+                &rerun::Points3D::new(items.iter().map(|(p, _)| *p)).with_labels(items.iter().map(|(_, t)| t.as_str())).with_colors(colors).with_radii([0.002]),
             )?;
         }
         if !layout.trace {
@@ -180,8 +182,11 @@ impl Recorder {
                 format!("{path}/axes"),
                 &rerun::Arrows3D::from_vectors([[0.6, 0.0, 0.0], [0.0, 0.6, 0.0], [0.0, 0.0, 0.6]]).with_colors(colors.map(rgb)).with_radii([0.012]),
             )?;
-            let at = if path.ends_with("true") { [0.0f32, 0.0, -0.2] } else { [0.0f32, 0.0, 0.75] };
-            rec.log_static(format!("{path}/label"), &rerun::Points3D::new([at]).with_labels([label]).with_radii([0.002]).with_colors([super::palette::label(colors[0])]))?;
+            // In a frame that does not turn with the axes (turning, the two labels met).
+            let at = if path.ends_with("true") { [0.0f32, 0.0, -0.3] } else { [0.0f32, 0.0, 0.8] };
+            let labels = format!("world/ins_trace_labels/{}", if path.ends_with("true") { "true" } else { "ins" });
+            rec.log_static(labels.as_str(), &rerun::Transform3D::from_translation(TRACE_OFFSET))?;
+            rec.log_static(format!("{labels}/label"), &rerun::Points3D::new([at]).with_labels([label]).with_radii([0.002]).with_colors([super::palette::label(colors[0])]))?;
         }
         Ok(())
     }

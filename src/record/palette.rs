@@ -7,6 +7,8 @@ pub(crate) mod colors {
 
     pub const VARIANT: [[u8; 3]; 3] = [[230, 76, 60], [46, 170, 90], [70, 130, 240]];
     pub const AXES: [[u8; 3]; 3] = [[240, 160, 40], [200, 90, 230], [60, 200, 200]];
+    /// The names of [`AXES`] (the key of the swing cones says which cone is which).
+    pub const AXIS_COLOR_NAMES: [&str; 3] = ["orange", "purple", "cyan"];
     pub const EULER: [[u8; 3]; 3] = [[230, 90, 90], [90, 200, 90], [90, 140, 240]];
     pub const NOMINAL: [u8; 3] = [150, 150, 150];
     /// Event markers on the plots (position fixes, moves, live reloads): a grey that reads on the

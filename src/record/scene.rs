@@ -136,11 +136,12 @@ impl Recorder {
             format!("{}/sensor_axes", self.paths.imu),
             &rerun::Arrows3D::from_vectors([[0.45, 0.0, 0.0], [0.0, 0.45, 0.0], [0.0, 0.0, 0.45]]).with_colors(colors::SENSOR.map(rgb)).with_radii([0.015]),
         )?;
-        // Labels beyond the arrow tips (an arrow's own label sits at its middle, inside the box,
-        // where the three pile up).
+        // Labels beyond the arrow tips and off their lines (an arrow's own label sits at its
+        // middle, inside the box, where the three pile up; on the line past the tip it covered the
+        // arrowhead and, along a gimbal axis, sat in that axis's swing cone).
         rec.log_static(
             format!("{}/sensor_axes/labels", self.paths.imu),
-            &rerun::Points3D::new([[0.55, 0.0, 0.0], [0.0, 0.55, 0.0], [0.0, 0.0, 0.55]])
+            &rerun::Points3D::new([[0.72, 0.0, -0.22], [0.0, 0.72, -0.22], [0.22, 0.0, 0.72]])
                 .with_labels(["x_s", "y_s", "z_s"])
                 // Half-saturated tints of the arrows' colours (a label the colour of its arrow
                 // vanishes where it crosses it), legible on both themes (`palette::label`).
@@ -244,7 +245,8 @@ impl Recorder {
         let first_tilted = draw.base * axes[0].axis;
         let installation = p.table.truth.installation_rad.norm() * ARCSEC_PER_RAD;
         // 1.1 long: at 1.5 the wedge and its label ran off the top of the default view.
-        self.log_wedge(at, &format!("{}/installation", self.paths.vehicle), axes[0].axis, first_tilted, 1.1, installation, f.installation, "installation")?;
+        let mut key: Vec<(String, [u8; 3])> = Vec::new();
+        key.extend(self.log_wedge(at, &format!("{}/installation", self.paths.vehicle), axes[0].axis, first_tilted, 1.1, installation, f.installation, "installation")?);
         for (k, g) in axes.iter().enumerate() {
             let half = ring_radius(k, n) * 1.25;
             let color = colors::AXES[k];
@@ -255,19 +257,15 @@ impl Recorder {
                 let (mesh, rims) = cone(g.axis, g.e1, g.e2, alpha, half);
                 self.put(at, cone_path.as_str(), &rerun::Mesh3D::new(mesh.0).with_triangle_indices(mesh.1).with_albedo_factor(albedo(color, 60)))?;
                 self.put(at, format!("{cone_path}/rims"), &rerun::LineStrips3D::new(rims).with_colors([rgba(color, 200)]).with_radii([0.004]))?;
-                // The label at the cone's lower end for an upright axis, at its far (+axis) end for a
-                // level one: at the lower end of both, the inner and outer labels of a dual-axis table
-                // meet under the table's centre.
-                let end = if g.axis.z.abs() < 0.5 { g.axis } else { -g.axis };
-                let tip = end * half - g.e1 * (half * alpha.tan());
                 let text = format!(
-                    "{} swing α = {}, φ = {:.1}°{}",
+                    "{} cone: {} swing α = {}, φ = {:.1}°{}",
+                    super::palette::colors::AXIS_COLOR_NAMES[k],
                     g.name,
                     fmt_angle(p.table.truth.axes[k].swing_half_angle_rad),
                     p.table.truth.axes[k].swing_phase_rad * DEG_PER_RAD,
                     if f.swing == x { String::new() } else { format!(" (drawn ×{})", f.swing) }
                 );
-                self.label(at, &format!("{cone_path}/label"), &[(p3(tip), text.as_str())])?;
+                key.push((text, color));
             } else {
                 self.clear(at, cone_path.as_str())?;
             }
@@ -276,17 +274,19 @@ impl Recorder {
             if k > 0 {
                 let tilted = draw.mount[k] * g.axis;
                 let eta_arcsec = p.table.truth.axes[k].non_orthogonality_rad * ARCSEC_PER_RAD;
-                self.log_wedge(at, &format!("{}/non_orthogonality", self.paths.gimbals[k - 1]), g.axis, tilted, half, eta_arcsec, f.non_orthogonality, "η non-orthogonality")?;
+                key.extend(self.log_wedge(at, &format!("{}/non_orthogonality", self.paths.gimbals[k - 1]), g.axis, tilted, half, eta_arcsec, f.non_orthogonality, &format!("η non-orthogonality of the {} axis", g.name))?);
             }
         }
-        Ok(())
+        self.log_key(at, &key)
     }
 
-    /// A translucent wedge from `ideal` to `tilted` (both unit, same frame) with a label.
+    /// A translucent wedge from `ideal` to `tilted` (both unit, same frame); its line of the key
+    /// (None when there is no wedge).
     #[allow(clippy::too_many_arguments)]
-    pub(crate) fn log_wedge(&self, at: Option<f64>, path: &str, ideal: Vector3<f64>, tilted: Vector3<f64>, length: f64, true_arcsec: f64, x: f64, what: &str) -> RecordingStreamResult<()> {
+    pub(crate) fn log_wedge(&self, at: Option<f64>, path: &str, ideal: Vector3<f64>, tilted: Vector3<f64>, length: f64, true_arcsec: f64, x: f64, what: &str) -> RecordingStreamResult<Option<(String, [u8; 3])>> {
         if true_arcsec == 0.0 {
-            return self.clear(at, path);
+            self.clear(at, path)?;
+            return Ok(None);
         }
         let mut positions = vec![[0.0f32; 3]];
         let steps = 16;
@@ -295,7 +295,7 @@ impl Recorder {
             positions.push(p3(((1.0 - s) * ideal + s * tilted).normalize() * length));
         }
         let triangles: Vec<[u32; 3]> = (1..=steps as u32).map(|i| [0, i, i + 1]).collect();
-        self.put(at, format!("{path}/wedge"), &rerun::Mesh3D::new(positions).with_triangle_indices(triangles).with_albedo_factor(albedo([255, 200, 60], 110)))?;
+        self.put(at, format!("{path}/wedge"), &rerun::Mesh3D::new(positions).with_triangle_indices(triangles).with_albedo_factor(albedo(WEDGE, 110)))?;
         self.put(
             at,
             format!("{path}/edges"),
@@ -303,14 +303,34 @@ impl Recorder {
                 .with_colors([rgb([255, 255, 255]), rgb([255, 200, 60])])
                 .with_radii([0.004]),
         )?;
-        let text = format!("{what} {} (drawn ×{x})", fmt_angle(true_arcsec / ARCSEC_PER_RAD));
-        // Beyond the wedge's tip, on its open side: on the tip the label hid the wedge it names (a
-        // narrow wedge, η, needs more room than a wide one).
-        let side = (tilted - ideal).try_normalize(1e-12).unwrap_or_else(Vector3::zeros);
-        let beyond = if tilted.angle(&ideal) < 0.1 { 1.3 } else { 1.08 };
-        self.label(at, &format!("{path}/label"), &[(p3(tilted * length * beyond + side * length * 0.35), text.as_str())])
+        Ok(Some((format!("yellow wedge: {what} {} (drawn ×{x})", fmt_angle(true_arcsec / ARCSEC_PER_RAD)), WEDGE)))
+    }
+
+    /// The key of the error classes drawn: one line each, in its object's colour, in a fixed column
+    /// of the world beside the table. Labels on the objects rode with the gimbals into the middle
+    /// of the scene, where five of them piled up (seed preset jiang2017-calibration after 40 s).
+    fn log_key(&self, at: Option<f64>, entries: &[(String, [u8; 3])]) -> RecordingStreamResult<()> {
+        if entries.is_empty() {
+            return self.clear(at, KEY_PATH);
+        }
+        let positions: Vec<[f32; 3]> = (0..entries.len()).map(|i| [KEY_AT[0], KEY_AT[1], KEY_AT[2] - KEY_STEP * i as f32]).collect();
+        self.put(
+            at,
+            KEY_PATH,
+            &rerun::Points3D::new(positions)
+                .with_labels(entries.iter().map(|(t, _)| t.as_str()))
+                .with_colors(entries.iter().map(|(_, c)| super::palette::label(*c)))
+                .with_radii([0.002]),
+        )
     }
 }
+
+/// The entity of the error classes' key, where it stands (world, m) and its line spacing.
+const KEY_PATH: &str = "world/key";
+const KEY_AT: [f32; 3] = [-0.9, 1.6, 1.25];
+const KEY_STEP: f32 = 0.2;
+/// The wedges' colour.
+const WEDGE: [u8; 3] = [255, 200, 60];
 
 /// The table's true errors as a markdown table, from the parameters in force: the description
 /// above was written for the preset's values, this follows every live reload.
