@@ -12,9 +12,12 @@ use crate::scenario::{presets, Params};
 pub const MODULATION_PRESETS: [(&str, &str); 3] =
     [("rotation-modulation-none", "no rotation"), ("rotation-modulation-continuous", "continuous azimuth"), ("rotation-modulation-16-position", "16-position")];
 
-fn simulate(p: &Params, label: &str, sample_s: f64, stop: &AtomicBool) -> NavTrace {
+/// `p`'s INS navigating its whole duration, sampled every `sample_s`; the IMU compensated with
+/// `compensation` (a self-calibration's estimates) if given.
+pub(crate) fn simulate(p: &Params, label: &str, sample_s: f64, stop: &AtomicBool, compensation: Option<crate::ins::selfcal::ImuErrors>) -> NavTrace {
     let mut trace = NavTrace { label: label.to_owned(), samples: Vec::new() };
     let Some(mut ins) = p.ins_run() else { return trace };
+    ins.set_imu_compensation(compensation);
     let steps = p.timeline().intervals();
     let mut next = 0.0;
     for i in 0..steps {
@@ -42,7 +45,7 @@ pub fn simulate_variants(hours: f64, stop: &AtomicBool) -> anyhow::Result<Vec<Na
     }
     let sample_s = (hours * 3600.0 / 2000.0).max(1.0);
     let traces = std::thread::scope(|scope| {
-        let handles: Vec<_> = params.iter().map(|(p, label)| scope.spawn(move || simulate(p, label, sample_s, stop))).collect();
+        let handles: Vec<_> = params.iter().map(|(p, label)| scope.spawn(move || simulate(p, label, sample_s, stop, None))).collect();
         handles.into_iter().map(|h| h.join().map_err(|_| anyhow::anyhow!("a simulation thread panicked"))).collect::<anyhow::Result<Vec<_>>>()
     })?;
     Ok(traces)

@@ -50,6 +50,8 @@ pub struct Outcome {
     pub estimate: Estimate,
     /// The IMU's true errors in the accelerometer frame (what the estimates are compared with).
     pub truth: ImuErrors,
+    /// The IMU's true errors as drawn, in its own frame (the "true values" compensation).
+    pub truth_drawn: ImuErrors,
     /// Wall time of the estimation alone (the filter's pushes), s.
     pub estimation_s: f64,
     /// The IMU's true attitude C_s^n once a second (the recording's 3D).
@@ -160,8 +162,9 @@ pub fn run_one(s: &Setup, seed: u64, ideal: bool, stop: &AtomicBool) -> Result<O
     drop(sample);
     let (bg, ba) = sensors.drawn_bias;
     let (kg, ka) = sensors.drawn_gain_errors();
-    let truth = ImuErrors { bg, kg, ba, ka }.in_accelerometer_frame();
-    Ok(Outcome { estimate: filter.finish(), truth, estimation_s: estimation.as_secs_f64(), attitude })
+    let truth_drawn = ImuErrors { bg, kg, ba, ka };
+    let truth = truth_drawn.in_accelerometer_frame();
+    Ok(Outcome { estimate: filter.finish(), truth, truth_drawn, estimation_s: estimation.as_secs_f64(), attitude })
 }
 
 /// Per parameter over a Monte Carlo: mean error, the spread of the errors and the mean reported 1σ.
@@ -278,4 +281,78 @@ pub fn table(s: &Setup, o: &Outcome, plan: &selfcal::Observability, mc: Option<&
         out.push_str(&format!("Monte Carlo: {} IMUs in {:.1} s; 1σ/spread is the reported 1σ over the spread of the errors (1 = honest).\n", m.runs, m.wall_s));
     }
     out
+}
+
+/// One free-inertial run of the comparison.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct NavRow {
+    /// "at rest" or "16-position".
+    pub motion: &'static str,
+    /// "none", "estimated", "true".
+    pub compensation: &'static str,
+    /// Largest horizontal position error, m.
+    pub peak_radial_m: f64,
+    /// At the end, m.
+    pub final_radial_m: f64,
+    /// Largest heading error, arcsec.
+    pub peak_heading_arcsec: f64,
+    /// The sampled errors (the recording's curves).
+    #[serde(skip)]
+    pub trace: crate::ins::trace::NavTrace,
+}
+
+/// What the calibration buys: the same IMU (the scenario's seed) navigating `hours` free-inertial,
+/// at rest and under the 16-position modulation, with no compensation, with the estimates and
+/// with its true errors — six runs in parallel. Each run starts aligned in the frame its
+/// compensated IMU measures in (a compensation in the accelerometer frame turns the IMU frame by
+/// the ρ of [`ImuErrors::in_accelerometer_frame`]; the INS's own alignment would find that frame).
+///
+/// # Errors
+/// A preset that does not load, or a run thread that panicked.
+pub fn navigation_comparison(p: &Params, o: &Outcome, hours: f64, stop: &AtomicBool) -> Result<Vec<NavRow>> {
+    let modulation = crate::scenario::presets::load("rotation-modulation-16-position")?;
+    let navigation = modulation.ins.as_ref().and_then(|i| i.navigation);
+    let estimated = ImuErrors::from_params(&o.estimate.params);
+    // ρ: the accelerometer frame seen from the IMU's (what the estimates are expressed in).
+    let ka = o.truth_drawn.ka;
+    let rho = nalgebra::Vector3::new(-ka[(2, 1)], ka[(2, 0)], -ka[(1, 0)]);
+    let mut cases = Vec::new();
+    for (motion, scheme) in [("at rest", Scheme::continuous(vec![0.0; 2], vec![0.0; 2])), ("16-position", modulation.table.scheme.clone())] {
+        for (name, comp) in [("none", None), ("estimated", Some(estimated)), ("true", Some(o.truth_drawn))] {
+            let mut q = p.clone();
+            q.table.scheme = scheme.clone();
+            q.set_duration(hours * 3600.0);
+            let c0 = TruthImu::new(q.table_model(), Earth::at(q.site), 0.0).eval(0.0).n_from_s;
+            let c0 = c0.quaternion().to_rotation_matrix().into_inner();
+            let Some(ins) = q.ins.as_mut() else { bail!("{}: no [imu]", p.meta.name) };
+            ins.navigation = navigation;
+            if name == "estimated" {
+                ins.initial_error_rad = -(c0 * rho);
+            }
+            cases.push((motion, name, q, comp));
+        }
+    }
+    let sample_s = (hours * 3600.0 / 2000.0).max(1.0);
+    let rows: Vec<NavRow> = cases
+        .par_iter()
+        .map(|(motion, name, q, comp)| {
+            let trace = crate::app::modulation::simulate(q, &format!("{motion}, {name}"), sample_s, stop, *comp);
+            let last = trace.samples.last().copied().unwrap_or_default();
+            NavRow { motion, compensation: name, peak_radial_m: trace.peak_radial_m(), final_radial_m: last.position_m[2], peak_heading_arcsec: trace.peak_heading_arcsec(), trace }
+        })
+        .collect();
+    if stop.load(Ordering::SeqCst) {
+        bail!("interrupted");
+    }
+    Ok(rows)
+}
+
+/// The comparison as the terminal prints it.
+#[must_use]
+pub fn navigation_table(rows: &[NavRow], hours: f64) -> String {
+    let mut s = format!("\nwhat it buys: {hours:.0} h free-inertial, the same IMU\n  {:<13} {:<13} {:>16} {:>16} {:>18}\n", "motion", "compensation", "peak radial (m)", "final radial (m)", "peak heading (″)");
+    for r in rows {
+        s.push_str(&format!("  {:<13} {:<13} {:>16.1} {:>16.1} {:>18.2}\n", r.motion, r.compensation, r.peak_radial_m, r.final_radial_m, r.peak_heading_arcsec));
+    }
+    s
 }

@@ -632,7 +632,26 @@ pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
             return Err(interrupted(e));
         }
     };
-    let table = sc::table(&setup, &outcome, &plan, mc.as_ref());
+    if !(args.navigate_hours.is_finite() && (0.0..=720.0).contains(&args.navigate_hours)) {
+        return Err(Failure::input(format!("--navigate-hours {}: must be 0 (skip) to 720 h", args.navigate_hours)));
+    }
+    let nav = if args.navigate_hours > 0.0 {
+        match sc::navigation_comparison(&params, &outcome, args.navigate_hours, &stop) {
+            Ok(rows) => rows,
+            Err(e) => {
+                if let Some(s) = sinks {
+                    s.abandon();
+                }
+                return Err(interrupted(e));
+            }
+        }
+    } else {
+        Vec::new()
+    };
+    let mut table = sc::table(&setup, &outcome, &plan, mc.as_ref());
+    if !nav.is_empty() {
+        table.push_str(&sc::navigation_table(&nav, args.navigate_hours));
+    }
     out!("{table}");
     if let Some(sinks) = sinks {
         let view = crate::record::selfcal::SelfcalView {
@@ -643,6 +662,7 @@ pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
             truth: Some(outcome.truth.to_params()),
             move_starts_s: &setup.move_starts_s,
             attitude: &outcome.attitude,
+            navigation: nav.iter().map(|r| &r.trace).collect(),
         };
         if let Err(e) = crate::record::selfcal::log(&sinks.stream(), &view) {
             sinks.abandon();
@@ -665,6 +685,7 @@ pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
                 "estimation_s": outcome.estimation_s,
                 "observability": plan,
                 "monte_carlo": mc,
+                "navigation": nav,
             }),
         )?;
     }

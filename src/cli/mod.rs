@@ -503,6 +503,10 @@ struct SelfcalArgs {
     /// Only the plan: what the sequence can see, from its noise-free motion (no IMU drawn).
     #[arg(long)]
     plan: bool,
+    /// What it buys: the same IMU navigates this many hours free-inertial, at rest and under the
+    /// 16-position modulation, with no, estimated and true compensation (0: skip).
+    #[arg(long, default_value_t = 24.0, value_name = "HOURS")]
+    navigate_hours: f64,
     #[command(flatten)]
     sinks: SinkArgs,
     /// No recording (the table and --json only).

@@ -64,6 +64,9 @@ pub struct InsRun {
     shared: Vec<Shared>,
     /// The compensated chain at the latest corrected angles, one per algorithm at most.
     chains: ChainMemo,
+    /// IMU errors the computer removes from every sample before using it (a self-calibration's
+    /// estimates), if any.
+    compensation: Option<super::selfcal::ImuErrors>,
 }
 
 impl InsRun {
@@ -96,7 +99,7 @@ impl InsRun {
         let demod = vec![DemodState::default(); core.algorithms().len()];
         let demod_len = demod.len();
         let last_error = vec![None; demod_len];
-        Self { truth, sensors, core, h, index: 0, demod, pre_roll, start, last_error, shared: Vec::new(), chains: ChainMemo::new(demod_len) }
+        Self { truth, sensors, core, h, index: 0, demod, pre_roll, start, last_error, shared: Vec::new(), chains: ChainMemo::new(demod_len), compensation: None }
     }
 
     /// The measured (end time, Δθ, Δv) samples before t = 0 that pre-rolled the computer (what a log
@@ -161,13 +164,16 @@ impl InsRun {
     }
 
     /// The measured increments (Δθ, Δv) of the next IMU sample and its end time, without feeding
-    /// them to the computer (for writing a log).
+    /// them to the computer (for writing a log); compensated if [`Self::set_imu_compensation`] was.
     pub fn next_measurement(&mut self) -> (f64, Vector3<f64>, Vector3<f64>) {
-        self.index += 1;
-        let t1 = self.index as f64 * self.h;
-        let (g_true, a_true) = self.truth.increments(t1);
-        let (g, a) = self.sensors.measure(&g_true, &a_true, t1);
+        let (t1, g, a, _, _) = self.next_measurement_and_truth();
         (t1, g, a)
+    }
+
+    /// From the next sample on, the computer removes the IMU errors `c` from every sample
+    /// (`(I + K)⁻¹(measured − b·h)`), or nothing with None.
+    pub fn set_imu_compensation(&mut self, c: Option<super::selfcal::ImuErrors>) {
+        self.compensation = c;
     }
 
     /// Samples the sensors' saturation clipped so far, per axis: (gyros, accelerometers).
@@ -183,6 +189,10 @@ impl InsRun {
         let t1 = self.index as f64 * self.h;
         let (g_true, a_true) = self.truth.increments(t1);
         let (g, a) = self.sensors.measure(&g_true, &a_true, t1);
+        let (g, a) = match &self.compensation {
+            Some(c) => c.compensate(&(g, a), self.h),
+            None => (g, a),
+        };
         (t1, g, a, g_true, a_true)
     }
 

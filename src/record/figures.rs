@@ -257,7 +257,7 @@ fn range(data: (f64, f64), layout: Option<(f64, f64)>, log: bool) -> (f64, f64) 
         // stretch the axis to its first rounding-level value.
         let hi = hi.max(f64::MIN_POSITIVE);
         let lo = lo.max(hi * 1e-6);
-        return (10f64.powf(lo.log10().floor()), 10f64.powf((hi.log10() + 1e-9).ceil().max(lo.log10().floor() + 1.0)));
+        return (10f64.powf(lo.log10().floor()), 10f64.powf((hi.log10() - 1e-9).ceil().max(lo.log10().floor() + 1.0)));
     }
     let pad = ((hi - lo) * 0.05).max(1e-12 * lo.abs().max(hi.abs())).max(1e-12);
     (lo - pad, hi + pad)

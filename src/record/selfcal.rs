@@ -28,6 +28,8 @@ pub struct SelfcalView<'a> {
     pub move_starts_s: &'a [f64],
     /// The IMU's attitude C_s^n, 1 Hz.
     pub attitude: &'a [(f64, UnitQuaternion<f64>)],
+    /// What it buys: free-inertial runs (at rest and modulated × none, estimated, true).
+    pub navigation: Vec<&'a crate::ins::trace::NavTrace>,
 }
 
 /// A parameter's entity: its name with the unit (`selfcal/error/bg_x_deg_per_h`).
@@ -70,6 +72,8 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
         rerun::Transform3D::update_fields().with_many_quaternion(v.attitude.iter().map(|a| to_rerun_quaternion(&a.1))).columns_of_unit_batches()?,
     )?;
     let t: Vec<f64> = v.history.iter().map(|r| r.t_s).collect();
+    // The sequence's plots show the sequence (the free-inertial runs after it share the timeline).
+    let seq_axis = layout::time_axis_range(0.0, t.last().copied().unwrap_or(1.0));
     let mut tabs = Vec::new();
     let mut timeline = Vec::new();
     for (group, slug) in GROUPS {
@@ -83,7 +87,7 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
         let key = names.iter().enumerate().map(|(i, n)| format!("{} {n}", ["red", "green", "blue", "orange", "purple", "cyan", "yellow", "grey", "pink"][i % 9])).collect::<Vec<_>>().join(" · ");
         timeline.push(
             Node::view("TimeSeries", format!("{group}: log10 σ/σ0 — {key} · ▼ moves"), path)
-                .with_property("TimeAxis", &layout::whole_run_time_axis())
+                .with_property("TimeAxis", &seq_axis)
                 .with_property("PlotLegend", &layout::no_legend()),
         );
         for &k in &members {
@@ -104,11 +108,26 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
             let h = crate::math::units::nice_half_range(last.max(1e-12) * 2.0);
             tabs.push(
                 Node::view("TimeSeries", format!("{name} {what} ({unit}), ±3σ grey"), path)
-                    .with_property("TimeAxis", &layout::whole_run_time_axis())
+                    .with_property("TimeAxis", &seq_axis)
                     .with_property("PlotLegend", &layout::no_legend())
                     .with_property("ScalarAxis", &layout::symmetric_range(h)),
             );
         }
+    }
+    if !v.navigation.is_empty() {
+        // On its own timeline (hours of navigation after the calibration, not the sequence's time).
+        let path = "selfcal/navigation/radial_position_error_log10_m";
+        let names: Vec<String> = v.navigation.iter().map(|t| t.label.clone()).collect();
+        let colors = [[230, 90, 90], [250, 200, 60], [90, 200, 90], [230, 150, 150], [250, 230, 150], [160, 230, 160]];
+        rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors.iter().take(names.len()).map(|c| rgb(*c))).with_names(names.clone()))?;
+        let n = v.navigation.iter().map(|t| t.samples.len()).min().unwrap_or(0);
+        let times: Vec<f64> = v.navigation[0].samples.iter().take(n).map(|s| s.t_s).collect();
+        let values: Vec<f64> = (0..n).flat_map(|i| v.navigation.iter().map(move |t| t.samples[i].position_m[2].max(1e-3).log10())).collect();
+        rec.send_columns(path, stream.time_columns(&times), rerun::Scalars::new(values).columns(std::iter::repeat_n(names.len(), n))?)?;
+        timeline.push(
+            Node::view("TimeSeries", "afterwards, free-inertial from t = 0: radial position error, log10 of metres (1 = 10 m, 4 = 10 km)", path)
+                .with_property("TimeAxis", &layout::whole_run_time_axis()),
+        );
     }
     let left = Node::container(ContainerKind::Vertical, vec![Node::view("3D", "the IMU turning through the sequence (true attitude; the grid is level)", "world").with_property("EyeControls3D", &layout::eye([1.5, -1.7, 1.0], [0.0, 0.0, 0.0])), Node::view("TextDocument", "result", "docs/selfcal")], &[1.0, 1.2]);
     let right = Node::container(
