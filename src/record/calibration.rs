@@ -75,8 +75,10 @@ pub fn log(stream: Stream, params: &Params, cal: &Calibration, report: &Report, 
         "docs/calibration",
         &rerun::TextDocument::from_markdown(format!(
             "# Calibration\n\nWhite: the cones and rotor axes as estimated, converging on the coloured true ones \
-             (errors drawn ×{}). Plots: each state's static-Kalman-filter estimate (yellow) inside its ±3σ band (grey), \
-             the true value (green) and the exact least-squares result (blue). docs/calibration.md explains the model.\n\n{}\
+             (errors drawn ×{}). Plots: each state's static-Kalman-filter estimate (yellow) with the filter's own ±3σ band (grey) \
+             about it, the true value (green) and the exact least-squares result (blue). The band covers the noise, not the \
+             bias of the paper's linearised model: where that bias is larger the true value lies outside it (x2 here); the \
+             exact least squares has no such bias. docs/calibration.md explains the model.\n\n{}\
              The whole report as the terminal prints it:\n\n```\n{}```\n",
             params.recording.exaggeration,
             report.markdown(),
