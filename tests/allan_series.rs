@@ -16,6 +16,8 @@ use std::process::{Command, Output};
 
 use serde_json::Value;
 
+use common::nbs14_1000;
+
 fn rinscope() -> Command {
     Command::new(env!("CARGO_BIN_EXE_rinscope"))
 }
@@ -41,17 +43,6 @@ fn analyse(dir: &Path, args: &[&str]) -> (Value, String) {
 /// NBS14's 9 frequency values (NIST SP 1065 §12.2).
 const NBS14_9: [f64; 9] = [892.0, 809.0, 823.0, 798.0, 671.0, 644.0, 883.0, 903.0, 677.0];
 
-/// The 1000-point NBS14 set: n_0 = 1234567890, n_{i+1} = 16807·n_i mod (2³¹ − 1), y_i = n_i/(2³¹ − 1).
-fn nbs14_1000() -> Vec<f64> {
-    let mut n = 1_234_567_890u64;
-    (0..1000)
-        .map(|_| {
-            let y = n as f64 / 2_147_483_647.0;
-            n = 16_807 * n % 2_147_483_647;
-            y
-        })
-        .collect()
-}
 
 /// SP 1065 p. 108: the 1000-point set's deviations at τ = 1, 10, 100 s (TDEV in s, the phase's unit).
 const NBS14_1000_DEVS: [(&str, [f64; 3]); 7] = [

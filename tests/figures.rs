@@ -5,6 +5,11 @@
 //! published values' logarithms), which no linear drawing of the recording's log10 values could
 //! fake without drawing the axes as the viewer does.
 
+// The io tests' helpers (the NBS14 set); test helpers unwrap.
+#[allow(dead_code, clippy::unwrap_used)]
+#[path = "io/common.rs"]
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -19,17 +24,6 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// The 1000-point NBS14 set (SP 1065 §12.2): n_{i+1} = 16807·n_i mod (2³¹ − 1), y_i = n_i/(2³¹ − 1).
-fn nbs14_1000() -> Vec<f64> {
-    let mut n = 1_234_567_890u64;
-    (0..1000)
-        .map(|_| {
-            let y = n as f64 / 2_147_483_647.0;
-            n = 16_807 * n % 2_147_483_647;
-            y
-        })
-        .collect()
-}
 
 /// SP 1065 p. 108: OADEV at τ = 1, 10, 100 s.
 const OADEV: [f64; 3] = [2.922319e-01, 9.159953e-02, 3.241343e-02];
@@ -53,7 +47,7 @@ fn circles(svg: &str) -> Vec<(f64, f64)> {
 fn allan_figures_have_logarithmic_axes_that_place_the_published_values() {
     let dir = scratch("allan");
     let csv = dir.join("nbs14.csv");
-    let body: String = nbs14_1000().iter().map(|y| format!("{y}\n")).collect();
+    let body: String = common::nbs14_1000().iter().map(|y| format!("{y}\n")).collect();
     std::fs::write(&csv, format!("y\n{body}")).expect("csv");
     let figs = dir.join("figs");
     let o = rinscope()

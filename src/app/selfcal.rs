@@ -10,7 +10,7 @@ use anyhow::{anyhow, bail, Result};
 use rayon::prelude::*;
 
 use crate::ins::selfcal::{self, Config, Estimate, ImuErrors, Kind, Sequence, SelfCal, N_PARAMS};
-use crate::ins::sensor::{ImuErrorSpec, Sensors, Spec};
+use crate::ins::sensor::{ImuErrorSpec, Spec};
 use crate::ins::truth::TruthImu;
 use crate::model::earth::Earth;
 use crate::model::scheme::Scheme;
@@ -41,6 +41,10 @@ pub struct Setup {
     pub sequence: String,
     /// The starts of the moves, s.
     pub move_starts_s: Vec<f64>,
+    /// The INS whose IMU is calibrated (its sensors generate the samples, as `export-log` does).
+    pub ins: crate::ins::InsParams,
+    /// The site.
+    pub site: crate::model::earth::Site,
 }
 
 /// One IMU's calibration.
@@ -94,14 +98,7 @@ pub fn setup(p: &Params, choice: SequenceChoice) -> Result<Setup> {
         _ => None,
     };
     let e = &ins.errors;
-    let datasheet: [Option<f64>; N_PARAMS] = std::array::from_fn(|k| match selfcal::param(k).0 {
-        Kind::GyroBias => sigma(e.gyro.bias_rad_per_s),
-        Kind::GyroScale => sigma(e.gyro.scale),
-        Kind::GyroMisalignment => (e.gyro.misalignment_rad > 0.0).then_some(e.gyro.misalignment_rad),
-        Kind::AccelBias => sigma(e.accel.bias_mps2),
-        Kind::AccelScale => sigma(e.accel.scale),
-        Kind::AccelMisalignment => (e.accel.misalignment_rad > 0.0).then_some(e.accel.misalignment_rad),
-    });
+    let datasheet = datasheet_sigmas(e, &sigma);
     let samples_per_update = ((0.1 / h).round() as usize).max(1);
     let config = Config {
         h,
@@ -110,9 +107,9 @@ pub fn setup(p: &Params, choice: SequenceChoice) -> Result<Setup> {
         random_walk: (e.gyro.noise.random_walk_si.max(1e-9), e.accel.noise.random_walk_si.max(1e-8)),
         prior: Config::priors(&datasheet),
         velocity_sigma_mps: 1e-5,
-        align_samples: ((first_move.min(selfcal::INITIAL_DWELL_S) - 1.0) / h) as usize,
+        align_samples: (first_move.min(selfcal::INITIAL_DWELL_S) / h).round() as usize,
     };
-    Ok(Setup { table, imu: ins.errors, config, samples: (duration_s / h).round() as usize, sequence: name, move_starts_s })
+    Ok(Setup { table, imu: ins.errors, config, samples: (duration_s / h).round() as usize, sequence: name, move_starts_s, ins: ins.clone(), site: p.site })
 }
 
 /// Calibrates one IMU drawn with `seed` (`ideal`: no errors and no noise, the plan's run).
@@ -120,51 +117,139 @@ pub fn setup(p: &Params, choice: SequenceChoice) -> Result<Setup> {
 /// # Errors
 /// Interrupted, or an alignment that failed.
 pub fn run_one(s: &Setup, seed: u64, ideal: bool, stop: &AtomicBool) -> Result<Outcome> {
-    let model = Model::new(&s.table, seed);
-    let mut truth_imu = TruthImu::new(model, s.config.earth, 0.0);
-    let spec = if ideal { ImuErrorSpec::default() } else { s.imu };
-    let mut sensors = Sensors::new(&spec, s.config.h, seed, 0.0);
-    let h = s.config.h;
-    let per_second = (1.0 / h).round().max(1.0) as usize;
+    // The samples come from the INS pipeline's own IMU (the one `export-log` writes): a log set
+    // exported from the same scenario holds exactly these increments.
+    let mut cfg = s.ins.clone();
+    if ideal {
+        cfg.errors = ImuErrorSpec::default();
+    }
+    cfg.navigation = None;
+    let mut ins = crate::ins::pipeline::InsRun::new(&cfg, s.site, seed, Model::new(&s.table, seed));
+    let per_second = (1.0 / s.config.h).round().max(1.0) as usize;
     let mut attitude = Vec::with_capacity(s.samples / per_second + 1);
     let mut sample = |k: usize| {
-        let t1 = (k + 1) as f64 * h;
-        let (g, a) = truth_imu.increments(t1);
+        let (t1, g, a) = ins.next_measurement();
         if (k + 1) % per_second == 0 {
-            attitude.push((t1, *truth_imu.n_from_s(t1).quaternion()));
+            attitude.push((t1, *ins.true_n_from_s(t1).quaternion()));
         }
-        sensors.measure(&g, &a, t1)
+        (g, a)
     };
     let align: Vec<_> = (0..s.config.align_samples).map(&mut sample).collect();
-    let mut filter = SelfCal::new(s.config, &align).ok_or_else(|| anyhow!("the coarse alignment on the first {:.0} s failed (no Earth-rate signature)", align.len() as f64 * h))?;
+    let (estimate, estimation_s) = estimate(s.config, &align, (align.len()..s.samples).map(|k| Ok(sample(k))), stop)?;
+    drop(sample);
+    let truth_drawn = ins.drawn_imu_errors();
+    Ok(Outcome { estimate, truth: truth_drawn.in_accelerometer_frame(), truth_drawn, estimation_s, attitude })
+}
+
+/// The filter on `align` (the first samples, at rest) and then `rest`; the estimation's own wall
+/// time (the samples' production is not counted), s.
+///
+/// # Errors
+/// Interrupted, an alignment that failed, or a sample `rest` could not give.
+pub fn estimate(config: Config, align: &[crate::ins::align::Increment], rest: impl Iterator<Item = Result<crate::ins::align::Increment>>, stop: &AtomicBool) -> Result<(Estimate, f64)> {
+    let mut filter = SelfCal::new(config, align).ok_or_else(|| anyhow!("the coarse alignment on the first {:.0} s failed (no Earth-rate signature)", align.len() as f64 * config.h))?;
     let mut estimation = std::time::Duration::ZERO;
     let started = std::time::Instant::now();
-    for m in &align {
+    for m in align {
         filter.push(m);
     }
     estimation += started.elapsed();
     let mut buffer = Vec::with_capacity(8192);
-    let mut k = align.len();
-    while k < s.samples {
+    let mut rest = rest.peekable();
+    while rest.peek().is_some() {
         if stop.load(Ordering::Relaxed) {
             bail!("interrupted");
         }
         buffer.clear();
-        let end = (k + 8192).min(s.samples);
-        buffer.extend((k..end).map(&mut sample));
+        for m in rest.by_ref().take(8192) {
+            buffer.push(m?);
+        }
         let started = std::time::Instant::now();
         for m in &buffer {
             filter.push(m);
         }
         estimation += started.elapsed();
-        k = end;
     }
-    drop(sample);
-    let (bg, ba) = sensors.drawn_bias;
-    let (kg, ka) = sensors.drawn_gain_errors();
-    let truth_drawn = ImuErrors { bg, kg, ba, ka };
-    let truth = truth_drawn.in_accelerometer_frame();
-    Ok(Outcome { estimate: filter.finish(), truth, truth_drawn, estimation_s: estimation.as_secs_f64(), attitude })
+    Ok((filter.finish(), estimation.as_secs_f64()))
+}
+
+/// Self-calibrates the IMU of a logged sequence (a log set: its IMU file, site, rate and the
+/// table description's [imu] as the datasheet). The log must start with at least 60 s at rest
+/// (the coarse alignment) and have no gaps; the vehicle must stand still throughout.
+///
+/// # Errors
+/// An unreadable log, a gap, too short a log, interrupted.
+pub fn run_log(log: &crate::scenario::logset::LogSet, stop: &AtomicBool) -> Result<(Estimate, f64)> {
+    use crate::app::playback::{ImuItem, ImuSamples};
+    let h = 1.0 / log.imu.rate_hz;
+    let e = &log.table.ins.errors;
+    let sigma = |s: Spec| match s {
+        Spec::Sigma(x) if x > 0.0 => Some(x),
+        _ => None,
+    };
+    let datasheet = datasheet_sigmas(e, &sigma);
+    let config = Config {
+        h,
+        samples_per_update: ((0.1 / h).round() as usize).max(1),
+        earth: Earth::at(log.table.site),
+        random_walk: (e.gyro.noise.random_walk_si.max(1e-9), e.accel.noise.random_walk_si.max(1e-8)),
+        prior: Config::priors(&datasheet),
+        velocity_sigma_mps: 1e-5,
+        align_samples: 0,
+    };
+    let mut imu = ImuSamples::open(log).map_err(|e| anyhow!("{e}"))?;
+    let mut next = move || -> Option<Result<crate::ins::align::Increment>> {
+        match imu.next_item() {
+            Ok(None) => None,
+            Ok(Some(ImuItem::Sample { dtheta, dv, .. })) => Some(Ok((dtheta, dv))),
+            Ok(Some(ImuItem::Gap { from_s, to_s })) => Some(Err(anyhow!("{}: a gap in the IMU samples from {from_s:.3} s to {to_s:.3} s: selfcal needs an unbroken sequence", log.imu.path.display()))),
+            Err(e) => Some(Err(anyhow!("{e}"))),
+        }
+    };
+    // The rest at the start: whole half-second blocks until the first whose mean rate exceeds
+    // 0.5°/s (a move; the Earth turns at 0.004°/s), at most the built-in sequences' first dwell.
+    let block = ((0.5 / h).round() as usize).max(1);
+    let cap = (selfcal::INITIAL_DWELL_S / h).round() as usize;
+    let mut align: Vec<crate::ins::align::Increment> = Vec::with_capacity(cap);
+    let mut moving: Vec<crate::ins::align::Increment> = Vec::new();
+    while align.len() < cap {
+        let mut piece = Vec::with_capacity(block);
+        for _ in 0..block {
+            match next() {
+                Some(m) => piece.push(m?),
+                None => break,
+            }
+        }
+        if piece.is_empty() {
+            break;
+        }
+        let turned: nalgebra::Vector3<f64> = piece.iter().map(|m| m.0).sum();
+        if turned.norm() / (piece.len() as f64 * h) > 0.5 * crate::math::units::RAD_PER_DEG {
+            moving = piece;
+            break;
+        }
+        align.extend(piece);
+    }
+    if (align.len() as f64) * h < LOG_ALIGN_S {
+        bail!("{}: {:.1} s at rest before the first move; selfcal needs at least {LOG_ALIGN_S} s at rest first, then the sequence", log.imu.path.display(), align.len() as f64 * h);
+    }
+    let config = Config { align_samples: align.len(), ..config };
+    estimate(config, &align, moving.into_iter().map(Ok).chain(std::iter::from_fn(next)), stop)
+}
+
+/// The least rest at the start of a logged sequence (the coarse alignment's data), s.
+pub const LOG_ALIGN_S: f64 = 60.0;
+
+/// The datasheet's 1σ of each parameter (None where it states none).
+fn datasheet_sigmas(e: &ImuErrorSpec, sigma: &dyn Fn(Spec) -> Option<f64>) -> [Option<f64>; N_PARAMS] {
+    std::array::from_fn(|k| match selfcal::param(k).0 {
+        Kind::GyroBias => sigma(e.gyro.bias_rad_per_s),
+        Kind::GyroScale => sigma(e.gyro.scale),
+        Kind::GyroMisalignment => (e.gyro.misalignment_rad > 0.0).then_some(e.gyro.misalignment_rad),
+        Kind::AccelBias => sigma(e.accel.bias_mps2),
+        Kind::AccelScale => sigma(e.accel.scale),
+        Kind::AccelMisalignment => (e.accel.misalignment_rad > 0.0).then_some(e.accel.misalignment_rad),
+    })
 }
 
 /// Per parameter over a Monte Carlo: mean error, the spread of the errors and the mean reported 1σ.
@@ -212,9 +297,7 @@ pub fn target(kind: Kind) -> f64 {
 /// The terminal table of one calibration (and the Monte Carlo's columns when there is one).
 #[must_use]
 pub fn table(s: &Setup, o: &Outcome, plan: &selfcal::Observability, mc: Option<&MonteCarlo>) -> String {
-    let truth = o.truth.to_params();
-    let e = &o.estimate;
-    let mut out = format!(
+    let head = format!(
         "self-calibration: {} — {} positions, {:.2} h at {:.0} Hz; estimated in {:.2} s\n\n",
         s.sequence,
         s.move_starts_s.len() + 1,
@@ -222,6 +305,13 @@ pub fn table(s: &Setup, o: &Outcome, plan: &selfcal::Observability, mc: Option<&
         1.0 / s.config.h,
         o.estimation_s
     );
+    estimates_table(head, &o.estimate, Some(o.truth.to_params()), plan, &s.move_starts_s, mc)
+}
+
+/// The table of `e` (with the truth when it is known), under `head`.
+#[must_use]
+pub fn estimates_table(head: String, e: &Estimate, truth: Option<[f64; N_PARAMS]>, plan: &selfcal::Observability, move_starts_s: &[f64], mc: Option<&MonteCarlo>) -> String {
+    let mut out = head;
     out.push_str(&format!(
         "  {:<8} {:>5} {:>11} {:>11} {:>9} {:>7} {:>8} {:>10}  {:<14}{}\n",
         "param",
@@ -239,20 +329,25 @@ pub fn table(s: &Setup, o: &Outcome, plan: &selfcal::Observability, mc: Option<&
         let (kind, name) = selfcal::param(k);
         let (unit, per_si) = kind.unit();
         let seen = match plan.observable_from_s[k] {
+            Some(t) if move_starts_s.is_empty() => format!("from {:.0} s", t),
             Some(t) => {
-                let after = s.move_starts_s.iter().filter(|m| **m < t).count();
+                let after = move_starts_s.iter().filter(|m| **m < t).count();
                 if after == 0 { "at rest".to_owned() } else { format!("after move {after}") }
             }
             None => "NO".to_owned(),
         };
+        let (t_text, z_text) = match truth {
+            Some(t) => (format!("{:.4}", t[k] * per_si), format!("{:.2}", (e.params[k] - t[k]) / e.sigma[k])),
+            None => ("—".to_owned(), "—".to_owned()),
+        };
         let mut line = format!(
-            "  {:<8} {:>5} {:>11.4} {:>11.4} {:>9.4} {:>7.2} {:>8.1e} {:>10}  {:<14}",
+            "  {:<8} {:>5} {:>11} {:>11.4} {:>9.4} {:>7} {:>8.1e} {:>10}  {:<14}",
             name,
             unit,
-            truth[k] * per_si,
+            t_text,
             e.params[k] * per_si,
             e.sigma[k] * per_si,
-            (e.params[k] - truth[k]) / e.sigma[k],
+            z_text,
             plan.ratio[k],
             format!("{}{}", if e.sigma[k] * per_si <= target(kind) { "ok " } else { "MISS " }, target(kind)),
             seen

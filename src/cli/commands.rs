@@ -584,6 +584,9 @@ pub(super) fn bench_peer(python: PathBuf, rounds: usize, samples: u64, json: Opt
 pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
     use crate::app::selfcal::{self as sc, SequenceChoice};
     use crate::ins::selfcal::{observability, Sequence};
+    if let Some(dir) = &args.log {
+        return selfcal_log(args, dir);
+    }
     let params = args.source.load("selfcal-nav-grade")?;
     check_output_dir("--json", args.json.as_deref())?;
     let choice = match args.sequence.as_str() {
@@ -688,6 +691,43 @@ pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
                 "navigation": nav,
             }),
         )?;
+    }
+    Ok(())
+}
+
+/// `rinscope selfcal --log DIR`.
+fn selfcal_log(args: &SelfcalArgs, dir: &Path) -> Result<(), Failure> {
+    use crate::app::selfcal as sc;
+    let log = crate::scenario::logset::load(dir)?;
+    check_output_dir("--json", args.json.as_deref())?;
+    let stop = stop_flag();
+    let (estimate, estimation_s) = sc::run_log(&log, &stop).map_err(|e| if stop.load(Ordering::SeqCst) { Failure::interrupted("nothing was estimated") } else { Failure::input(format!("selfcal --log: {e:#}")) })?;
+    let seen = crate::ins::selfcal::observability(&estimate);
+    let hours = estimate.history.last().map_or(0.0, |r| r.t_s) / 3600.0;
+    let head = format!("self-calibration of the log set {}: {hours:.2} h at {:.0} Hz; estimated in {estimation_s:.2} s (no truth: a log)\n\n", dir.display(), log.imu.rate_hz);
+    let table = sc::estimates_table(head, &estimate, None, &seen, &[], None);
+    out!("{table}");
+    if let Some(path) = &args.json {
+        let names: Vec<String> = (0..crate::ins::selfcal::N_PARAMS).map(|k| crate::ins::selfcal::param(k).1).collect();
+        write_json("--json", path, &serde_json::json!({ "log": dir.display().to_string(), "parameters": names, "units": "SI (rad/s, m/s², dimensionless gains)", "estimate": estimate.params, "sigma": estimate.sigma, "estimation_s": estimation_s, "observability": seen }))?;
+    }
+    if !args.no_recording {
+        let sinks = open_sinks(args.sinks.request(PathBuf::from("recordings").join(format!("{}-selfcal.rrd", log.name)))?, &format!("{}-selfcal", log.name))?;
+        let view = crate::record::selfcal::SelfcalView {
+            title: format!("log set {}", log.name),
+            table: &table,
+            history: &estimate.history,
+            prior: &estimate.prior,
+            truth: None,
+            move_starts_s: &[],
+            attitude: &[],
+            navigation: Vec::new(),
+        };
+        if let Err(e) = crate::record::selfcal::log(&sinks.stream(), &view) {
+            sinks.abandon();
+            return Err(Failure::run(format!("rerun: {e}")));
+        }
+        print_saved(&sinks.finish()?)?;
     }
     Ok(())
 }

@@ -492,6 +492,10 @@ struct SelfcalArgs {
     // Default selfcal-nav-grade.
     #[command(flatten)]
     source: ScenarioSource,
+    /// Calibrate from a log set instead (docs/logs.md): the IMU file of a sequence run on a vehicle
+    /// at rest, starting with at least 60 s at rest; the table description's [imu] is the datasheet.
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["scenario", "config", "plan", "monte_carlo"])]
+    log: Option<PathBuf>,
     /// The sequence: positions-19, dual-axis-29, azimuth-only (a degenerate one), or scenario (the
     /// scenario's indexed [scheme], for its simulation.duration_s).
     #[arg(long, default_value = "dual-axis-29")]

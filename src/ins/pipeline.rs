@@ -176,6 +176,15 @@ impl InsRun {
         self.compensation = c;
     }
 
+    /// The IMU's drawn constant errors (gyro bias rad/s, gain error; accelerometer bias m/s², gain
+    /// error), for comparing a calibration with the truth.
+    #[must_use]
+    pub fn drawn_imu_errors(&self) -> super::selfcal::ImuErrors {
+        let (bg, ba) = self.sensors.drawn_bias;
+        let (kg, ka) = self.sensors.drawn_gain_errors();
+        super::selfcal::ImuErrors { bg, kg, ba, ka }
+    }
+
     /// Samples the sensors' saturation clipped so far, per axis: (gyros, accelerometers).
     #[must_use]
     pub fn saturation_counts(&self) -> ([u64; 3], [u64; 3]) {

@@ -66,11 +66,13 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
         &rerun::Points3D::new([[0.72, 0.0, 0.0], [0.0, 0.72, 0.0], [0.0, 0.0, 0.72]]).with_labels(["x", "y", "z"]).with_colors(palette::colors::SENSOR.map(palette::label)).with_radii([0.002]),
     )?;
     let times: Vec<f64> = v.attitude.iter().map(|a| a.0).collect();
+    if !times.is_empty() {
     rec.send_columns(
         "world/imu",
         stream.time_columns(&times),
         rerun::Transform3D::update_fields().with_many_quaternion(v.attitude.iter().map(|a| to_rerun_quaternion(&a.1))).columns_of_unit_batches()?,
     )?;
+    }
     let t: Vec<f64> = v.history.iter().map(|r| r.t_s).collect();
     // The sequence's plots show the sequence (the free-inertial runs after it share the timeline).
     let seq_axis = layout::time_axis_range(0.0, t.last().copied().unwrap_or(1.0));

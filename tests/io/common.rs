@@ -242,3 +242,16 @@ pub fn write_mcap(path: &Path, topics: &[McapTopic<'_>], summary: bool) {
     w.finish().unwrap();
     w.into_inner().flush().unwrap();
 }
+
+/// The 1000-point NBS14 set (NIST SP 1065 §12.2): n_0 = 1234567890,
+/// n_{i+1} = 16807·n_i mod (2³¹ − 1), y_i = n_i/(2³¹ − 1).
+pub fn nbs14_1000() -> Vec<f64> {
+    let mut n = 1_234_567_890u64;
+    (0..1000)
+        .map(|_| {
+            let y = n as f64 / 2_147_483_647.0;
+            n = 16_807 * n % 2_147_483_647;
+            y
+        })
+        .collect()
+}
