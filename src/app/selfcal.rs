@@ -129,14 +129,13 @@ pub fn run_one(s: &Setup, seed: u64, ideal: bool, stop: &AtomicBool) -> Result<O
     let mut attitude = Vec::with_capacity(s.samples / per_second + 1);
     let mut sample = |k: usize| {
         let (t1, g, a) = ins.next_measurement();
-        if (k + 1) % per_second == 0 {
+        if (k + 1).is_multiple_of(per_second) {
             attitude.push((t1, *ins.true_n_from_s(t1).quaternion()));
         }
         (g, a)
     };
     let align: Vec<_> = (0..s.config.align_samples).map(&mut sample).collect();
     let (estimate, estimation_s) = estimate(s.config, &align, (align.len()..s.samples).map(|k| Ok(sample(k))), stop)?;
-    drop(sample);
     let truth_drawn = ins.drawn_imu_errors();
     Ok(Outcome { estimate, truth: truth_drawn.in_accelerometer_frame(), truth_drawn, estimation_s, attitude })
 }

@@ -263,6 +263,9 @@ fn range(data: (f64, f64), layout: Option<(f64, f64)>, log: bool) -> (f64, f64) 
     (lo - pad, hi + pad)
 }
 
+/// Each series with its line as the figure draws it, in pieces.
+type Drawn<'a> = Vec<(&'a PlotSeries, Vec<Vec<(f64, f64)>>)>;
+
 /// The plot as an SVG document.
 fn svg(plot: &Plot) -> anyhow::Result<String> {
     let a = axes(plot);
@@ -270,7 +273,7 @@ fn svg(plot: &Plot) -> anyhow::Result<String> {
         let m = |t: f64| if a.log_x { 10f64.powf(t) } else if a.hours { t / 3600.0 } else { t };
         (m(r[0]), m(r[1]))
     });
-    let drawn: Vec<(&PlotSeries, Vec<Vec<(f64, f64)>>)> = plot.series.iter().map(|s| (s, points(s, &a, x_window))).collect();
+    let drawn: Drawn<'_> = plot.series.iter().map(|s| (s, points(s, &a, x_window))).collect();
     let extent = |f: &dyn Fn(&(f64, f64)) -> f64| {
         drawn.iter().flat_map(|(_, segs)| segs.iter().flatten()).map(f).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)))
     };
@@ -278,7 +281,7 @@ fn svg(plot: &Plot) -> anyhow::Result<String> {
     let layout_y = plot.range.map(|r| if a.log_y { (10f64.powf(r[0]), 10f64.powf(r[1])) } else { (r[0], r[1]) });
     let yr = range(extent(&|p| p.1), layout_y, a.log_y);
     // What leaves the visible box is cut at its edge, not drawn along it.
-    let drawn: Vec<(&PlotSeries, Vec<Vec<(f64, f64)>>)> = drawn.into_iter().map(|(s, segs)| (s, segs.iter().flat_map(|seg| clip(seg, xr, yr, &a)).collect())).collect();
+    let drawn: Drawn<'_> = drawn.into_iter().map(|(s, segs)| (s, segs.iter().flat_map(|seg| clip(seg, xr, yr, &a)).collect())).collect();
     let mut out = String::new();
     {
         let root = SVGBackend::with_string(&mut out, SIZE).into_drawing_area();
@@ -333,7 +336,7 @@ fn draw_error<E: std::fmt::Debug>(e: E) -> anyhow::Error {
 }
 
 /// The chart of `drawn` in `area` on the axes `x`, `y` (linear or logarithmic).
-fn chart<X, Y>(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, x: X, y: Y, a: &Axes, drawn: &[(&PlotSeries, Vec<Vec<(f64, f64)>>)]) -> anyhow::Result<()>
+fn chart<X, Y>(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, x: X, y: Y, a: &Axes, drawn: &Drawn<'_>) -> anyhow::Result<()>
 where
     X: AsRangedCoord<Value = f64>,
     Y: AsRangedCoord<Value = f64>,

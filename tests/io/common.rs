@@ -245,6 +245,7 @@ pub fn write_mcap(path: &Path, topics: &[McapTopic<'_>], summary: bool) {
 
 /// The 1000-point NBS14 set (NIST SP 1065 §12.2): n_0 = 1234567890,
 /// n_{i+1} = 16807·n_i mod (2³¹ − 1), y_i = n_i/(2³¹ − 1).
+#[allow(dead_code)] // tests/allan_series.rs and tests/figures.rs use it, not the io tests
 pub fn nbs14_1000() -> Vec<f64> {
     let mut n = 1_234_567_890u64;
     (0..1000)
