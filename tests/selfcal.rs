@@ -25,8 +25,8 @@ fn every_error_is_recovered_within_its_sigma_and_the_targets_are_met() {
             let (kind, name) = param(k);
             let (unit, per_si) = kind.unit();
             let z = (o.estimate.params[k] - truth[k]) / o.estimate.sigma[k];
-            // Four sigma: 21 parameters of a deterministic seed, none may stray.
-            assert!(z.abs() < 4.0, "{}: {name} off by {z:.2}σ", s.sequence);
+            // Within 3σ, as issue 23 asks (a deterministic seed: its largest is 2.3σ).
+            assert!(z.abs() < 3.0, "{}: {name} off by {z:.2}σ", s.sequence);
             let sigma = o.estimate.sigma[k] * per_si;
             assert!(sigma <= target(kind), "{}: {name} 1σ {sigma:.4} {unit} misses the target {} {unit}", s.sequence, target(kind));
             // Not a prior that barely moved: at least thirtyfold better (priors are 300 ppm, 300″, 0.1°/h, 1 mg).
@@ -108,4 +108,23 @@ fn a_logged_sequence_gives_the_in_loop_result() {
         assert!((s1[k] / s2[k] - 1.0).abs() < 0.01, "{}: 1σ {} vs {}", param(k).1, s1[k], s2[k]);
     }
     std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn the_estimates_buy_most_of_what_the_true_values_would() {
+    // 6 h free-inertial (24 h in the command; the shape is the same, the test four times quicker).
+    let p = presets::load("selfcal-nav-grade").expect("preset");
+    let s = setup(&p, SequenceChoice::BuiltIn(Sequence::DualAxis29)).expect("setup");
+    let stop = AtomicBool::new(false);
+    let o = run_one(&s, p.meta.seed, false, &stop).expect("run");
+    let rows = rinscope::app::selfcal::navigation_comparison(&p, &o, 6.0, &stop).expect("navigate");
+    let peak = |motion: &str, comp: &str| rows.iter().find(|r| r.motion == motion && r.compensation == comp).expect("row").peak_radial_m;
+    for motion in ["at rest", "16-position"] {
+        let (none, est, truth) = (peak(motion, "none"), peak(motion, "estimated"), peak(motion, "true"));
+        // The estimates leave 1σ-level residuals (0.001°/h, 0.2-0.6 ppm, 0.2″): between the
+        // uncompensated IMU and the truth, and nearer the truth.
+        assert!(est < none, "{motion}: estimated {est:.0} m vs none {none:.0} m");
+        assert!(est < 3.0 * truth.max(1.0) + 100.0, "{motion}: estimated {est:.0} m vs true {truth:.0} m");
+    }
+    assert!(peak("at rest", "estimated") < peak("at rest", "none") / 4.0, "at rest the calibration is worth more than a factor 4");
 }

@@ -26,6 +26,7 @@
 mod allan;
 mod commands;
 mod logs;
+mod selfcal;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -599,7 +600,7 @@ pub fn main() -> ExitCode {
         Command::Calibrate(args) => commands::calibrate(&args),
         Command::Montecarlo(args) => commands::montecarlo(&args),
         Command::Tpr(args) => commands::tpr(&args),
-        Command::Selfcal(args) => commands::selfcal(&args),
+        Command::Selfcal(args) => selfcal::selfcal(&args),
         Command::Events { file } => commands::events(&file),
         Command::ExportLog(args) => logs::export_log(&args),
         Command::Replay(args) => logs::replay(&args),

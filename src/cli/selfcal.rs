@@ -1,0 +1,161 @@
+//! `rinscope selfcal`: the IMU's self-calibration on its own gimbals, simulated or from a log set
+//! (the orchestration is `app::selfcal`, the estimator `ins::selfcal`).
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::Ordering;
+
+use super::commands::{check_output_dir, default_recording, open_sinks, print_saved, write_json};
+use super::{Failure, SelfcalArgs};
+use crate::app::terminate::stop_flag;
+
+/// `rinscope selfcal`.
+pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
+    use crate::app::selfcal::{self as sc, SequenceChoice};
+    use crate::ins::selfcal::{observability, Sequence};
+    if let Some(dir) = &args.log {
+        return selfcal_log(args, dir);
+    }
+    let params = args.source.load("selfcal-nav-grade")?;
+    check_output_dir("--json", args.json.as_deref())?;
+    let choice = match args.sequence.as_str() {
+        "scenario" => SequenceChoice::Scenario,
+        name => SequenceChoice::BuiltIn(Sequence::named(name).ok_or_else(|| {
+            let names: Vec<&str> = Sequence::ALL.iter().map(|(_, n)| *n).collect();
+            Failure::input(format!("--sequence {name}: not a sequence; use one of {names:?} or \"scenario\""))
+        })?),
+    };
+    let setup = sc::setup(&params, choice).map_err(|e| Failure::input(format!("{e:#}")))?;
+    let stop = stop_flag();
+    let interrupted = |e: anyhow::Error| if stop.load(Ordering::SeqCst) { Failure::interrupted("nothing was estimated") } else { Failure::run(format!("selfcal: {e:#}")) };
+    // The plan: the sequence's noise-free motion through the same filter (its 1σ depend on the
+    // motion only), before any IMU is drawn.
+    let plan_run = sc::run_one(&setup, params.meta.seed, true, &stop).map_err(interrupted)?;
+    let plan = observability(&plan_run.estimate);
+    if args.plan || !plan.unobservable.is_empty() || !plan.weak.is_empty() {
+        let list = |v: &Vec<String>| if v.is_empty() { "none".to_owned() } else { v.join(", ") };
+        errln!("rinscope selfcal: plan for {}: not observable: {}; weakly observable: {}", setup.sequence, list(&plan.unobservable), list(&plan.weak));
+        for a in &plan.aliased {
+            errln!("rinscope selfcal: aliased: {a}");
+        }
+    }
+    if args.plan {
+        if let Some(path) = &args.json {
+            write_json("--json", path, &serde_json::json!({ "sequence": setup.sequence, "observability": plan }))?;
+        }
+        return Ok(());
+    }
+    let sinks = if args.no_recording {
+        None
+    } else {
+        let request = args.sinks.request(default_recording(&format!("{}-selfcal", params.meta.name)))?;
+        Some(open_sinks(request, &format!("{}-selfcal-seed{}", params.meta.name, params.meta.seed))?)
+    };
+    let result = sc::run_one(&setup, params.meta.seed, false, &stop).and_then(|o| match args.monte_carlo {
+        Some(n) => Ok((sc::monte_carlo(&setup, n as usize, params.meta.seed + 1, &stop)?, o)).map(|(m, o)| (o, Some(m))),
+        None => Ok((o, None)),
+    });
+    let (outcome, mc) = match result {
+        Ok(r) => r,
+        Err(e) => {
+            if let Some(s) = sinks {
+                s.abandon();
+            }
+            return Err(interrupted(e));
+        }
+    };
+    if !(args.navigate_hours.is_finite() && (0.0..=720.0).contains(&args.navigate_hours)) {
+        return Err(Failure::input(format!("--navigate-hours {}: must be 0 (skip) to 720 h", args.navigate_hours)));
+    }
+    let nav = if args.navigate_hours > 0.0 {
+        match sc::navigation_comparison(&params, &outcome, args.navigate_hours, &stop) {
+            Ok(rows) => rows,
+            Err(e) => {
+                if let Some(s) = sinks {
+                    s.abandon();
+                }
+                return Err(interrupted(e));
+            }
+        }
+    } else {
+        Vec::new()
+    };
+    let mut table = sc::table(&setup, &outcome, &plan, mc.as_ref());
+    if !nav.is_empty() {
+        table.push_str(&sc::navigation_table(&nav, args.navigate_hours));
+    }
+    out!("{table}");
+    if let Some(sinks) = sinks {
+        let view = crate::record::selfcal::SelfcalView {
+            title: format!("{} — {}", params.meta.name, setup.sequence),
+            table: &table,
+            history: &outcome.estimate.history,
+            prior: &outcome.estimate.prior,
+            truth: Some(outcome.truth.to_params()),
+            move_starts_s: &setup.move_starts_s,
+            attitude: &outcome.attitude,
+            navigation: nav.iter().map(|r| &r.trace).collect(),
+        };
+        if let Err(e) = crate::record::selfcal::log(&sinks.stream(), &view) {
+            sinks.abandon();
+            return Err(Failure::run(format!("rerun: {e}")));
+        }
+        print_saved(&sinks.finish()?)?;
+    }
+    if let Some(path) = &args.json {
+        let names: Vec<String> = (0..crate::ins::selfcal::N_PARAMS).map(|k| crate::ins::selfcal::param(k).1).collect();
+        write_json(
+            "--json",
+            path,
+            &serde_json::json!({
+                "sequence": setup.sequence,
+                "parameters": names,
+                "units": "SI (rad/s, m/s², dimensionless gains)",
+                "truth": outcome.truth.to_params(),
+                "estimate": outcome.estimate.params,
+                "sigma": outcome.estimate.sigma,
+                "estimation_s": outcome.estimation_s,
+                "observability": plan,
+                "monte_carlo": mc,
+                "navigation": nav,
+            }),
+        )?;
+    }
+    Ok(())
+}
+
+/// `rinscope selfcal --log DIR`.
+fn selfcal_log(args: &SelfcalArgs, dir: &Path) -> Result<(), Failure> {
+    use crate::app::selfcal as sc;
+    let log = crate::scenario::logset::load(dir)?;
+    check_output_dir("--json", args.json.as_deref())?;
+    let stop = stop_flag();
+    let (estimate, estimation_s) = sc::run_log(&log, &stop).map_err(|e| if stop.load(Ordering::SeqCst) { Failure::interrupted("nothing was estimated") } else { Failure::input(format!("selfcal --log: {e:#}")) })?;
+    let seen = crate::ins::selfcal::observability(&estimate);
+    let hours = estimate.history.last().map_or(0.0, |r| r.t_s) / 3600.0;
+    let head = format!("self-calibration of the log set {}: {hours:.2} h at {:.0} Hz; estimated in {estimation_s:.2} s (no truth: a log)\n\n", dir.display(), log.imu.rate_hz);
+    let table = sc::estimates_table(head, &estimate, None, &seen, &[], None);
+    out!("{table}");
+    if let Some(path) = &args.json {
+        let names: Vec<String> = (0..crate::ins::selfcal::N_PARAMS).map(|k| crate::ins::selfcal::param(k).1).collect();
+        write_json("--json", path, &serde_json::json!({ "log": dir.display().to_string(), "parameters": names, "units": "SI (rad/s, m/s², dimensionless gains)", "estimate": estimate.params, "sigma": estimate.sigma, "estimation_s": estimation_s, "observability": seen }))?;
+    }
+    if !args.no_recording {
+        let sinks = open_sinks(args.sinks.request(PathBuf::from("recordings").join(format!("{}-selfcal.rrd", log.name)))?, &format!("{}-selfcal", log.name))?;
+        let view = crate::record::selfcal::SelfcalView {
+            title: format!("log set {}", log.name),
+            table: &table,
+            history: &estimate.history,
+            prior: &estimate.prior,
+            truth: None,
+            move_starts_s: &[],
+            attitude: &[],
+            navigation: Vec::new(),
+        };
+        if let Err(e) = crate::record::selfcal::log(&sinks.stream(), &view) {
+            sinks.abandon();
+            return Err(Failure::run(format!("rerun: {e}")));
+        }
+        print_saved(&sinks.finish()?)?;
+    }
+    Ok(())
+}
