@@ -15,6 +15,10 @@ pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
     if let Some(dir) = &args.log {
         return selfcal_log(args, dir);
     }
+    // Every argument is checked before anything runs.
+    if !(args.navigate_hours.is_finite() && (0.0..=720.0).contains(&args.navigate_hours)) {
+        return Err(Failure::input(format!("--navigate-hours {}: must be 0 (skip) to 720 h", args.navigate_hours)));
+    }
     let params = args.source.load("selfcal-nav-grade")?;
     check_output_dir("--json", args.json.as_deref())?;
     let choice = match args.sequence.as_str() {
@@ -63,9 +67,6 @@ pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
             return Err(interrupted(e));
         }
     };
-    if !(args.navigate_hours.is_finite() && (0.0..=720.0).contains(&args.navigate_hours)) {
-        return Err(Failure::input(format!("--navigate-hours {}: must be 0 (skip) to 720 h", args.navigate_hours)));
-    }
     let nav = if args.navigate_hours > 0.0 {
         match sc::navigation_comparison(&params, &outcome, args.navigate_hours, &stop) {
             Ok(rows) => rows,
