@@ -158,7 +158,7 @@ impl Recorder {
             let title = format!("attitude error per algorithm, clockwise ×{} (a turn: {:.0}″)", layout.exaggeration, 360.0 * 3600.0 / layout.exaggeration);
             // The title above the dial (below it, it met the compass's E), the names in a column
             // to its right, spaced for their boxes, on points too small to cover a neighbour.
-            let mut items: Vec<([f32; 3], String)> = vec![([0.0, 0.62, 0.0], title)];
+            let mut items: Vec<([f32; 3], String)> = vec![([0.0, 0.8, 0.0], title)];
             for (k, name) in layout.algorithms.iter().enumerate() {
                 let path = dial_path(name);
                 rec.log_static(path.as_str(), &rerun::Transform3D::IDENTITY)?;
