@@ -20,7 +20,7 @@ fn every_error_is_recovered_within_its_sigma_and_the_targets_are_met() {
         let s = nav_grade(seq);
         assert!(s.samples as f64 * s.config.h <= 2.0 * 3600.0, "at most 2 h");
         let o = run_one(&s, 2024, false, &stop).expect("run");
-        let truth = o.truth.to_params();
+        let truth = o.truth().to_params();
         for k in 0..N_PARAMS {
             let (kind, name) = param(k);
             let (unit, per_si) = kind.unit();

@@ -10,7 +10,7 @@ use anyhow::{anyhow, bail, Result};
 use rayon::prelude::*;
 
 use crate::ins::selfcal::{self, Config, Estimate, ImuErrors, Kind, Sequence, SelfCal, N_PARAMS};
-use crate::ins::sensor::{ImuErrorSpec, Spec};
+use crate::ins::sensor::ImuErrorSpec;
 use crate::ins::truth::TruthImu;
 use crate::model::earth::Earth;
 use crate::model::scheme::Scheme;
@@ -31,8 +31,6 @@ pub enum SequenceChoice {
 pub struct Setup {
     /// The table turning through the sequence.
     pub table: TableParams,
-    /// The IMU's error model (truth draws come from it with a seed).
-    pub imu: ImuErrorSpec,
     /// What the filter knows.
     pub config: Config,
     /// Samples in the sequence.
@@ -52,14 +50,20 @@ pub struct Setup {
 pub struct Outcome {
     /// The filter's result.
     pub estimate: Estimate,
-    /// The IMU's true errors in the accelerometer frame (what the estimates are compared with).
-    pub truth: ImuErrors,
     /// The IMU's true errors as drawn, in its own frame (the "true values" compensation).
     pub truth_drawn: ImuErrors,
     /// Wall time of the estimation alone (the filter's pushes), s.
     pub estimation_s: f64,
     /// The IMU's true attitude C_s^n once a second (the recording's 3D).
     pub attitude: Vec<(f64, nalgebra::UnitQuaternion<f64>)>,
+}
+
+impl Outcome {
+    /// The IMU's true errors in the accelerometer frame (what the estimates are compared with).
+    #[must_use]
+    pub fn truth(&self) -> ImuErrors {
+        self.truth_drawn.in_accelerometer_frame()
+    }
 }
 
 /// Sets up the self-calibration of `p`'s IMU on `p`'s dual-axis table.
@@ -75,9 +79,7 @@ pub fn setup(p: &Params, choice: SequenceChoice) -> Result<Setup> {
             if table.chain.axes().len() != 2 {
                 bail!("{}: the built-in sequences are for a dual-axis table (outer, then inner carrying the IMU about its z); this table has {} axes — use --sequence scenario with an indexed [scheme]", p.meta.name, table.chain.axes().len());
             }
-            let (dwell, steps) = s.steps();
-            let total = dwell + steps.iter().map(|m| m.angle_rad.abs() / m.rate_rad_per_s + m.rate_rad_per_s / m.accel_rad_per_s2 + m.dwell_s).sum::<f64>();
-            (Scheme::indexed(vec![0.0; 2], dwell, steps, false), total, s.name().to_owned())
+            (s.scheme(), s.duration_s(), s.name().to_owned())
         }
         SequenceChoice::Scenario => {
             if table.scheme.steps().is_empty() {
@@ -93,23 +95,8 @@ pub fn setup(p: &Params, choice: SequenceChoice) -> Result<Setup> {
     }
     table.scheme = scheme;
     let h = 1.0 / p.step_hz;
-    let sigma = |s: Spec| match s {
-        Spec::Sigma(x) if x > 0.0 => Some(x),
-        _ => None,
-    };
-    let e = &ins.errors;
-    let datasheet = datasheet_sigmas(e, &sigma);
-    let samples_per_update = ((0.1 / h).round() as usize).max(1);
-    let config = Config {
-        h,
-        samples_per_update,
-        earth: Earth::at(p.site),
-        random_walk: (e.gyro.noise.random_walk_si.max(1e-9), e.accel.noise.random_walk_si.max(1e-8)),
-        prior: Config::priors(&datasheet),
-        velocity_sigma_mps: 1e-5,
-        align_samples: (first_move.min(selfcal::INITIAL_DWELL_S) / h).round() as usize,
-    };
-    Ok(Setup { table, imu: ins.errors, config, samples: (duration_s / h).round() as usize, sequence: name, move_starts_s, ins: ins.clone(), site: p.site })
+    let config = Config::for_datasheet(&ins.errors, h, Earth::at(p.site), (first_move.min(selfcal::INITIAL_DWELL_S) / h).round() as usize);
+    Ok(Setup { table, config, samples: (duration_s / h).round() as usize, sequence: name, move_starts_s, ins: ins.clone(), site: p.site })
 }
 
 /// Calibrates one IMU drawn with `seed` (`ideal`: no errors and no noise, the plan's run).
@@ -136,8 +123,7 @@ pub fn run_one(s: &Setup, seed: u64, ideal: bool, stop: &AtomicBool) -> Result<O
     };
     let align: Vec<_> = (0..s.config.align_samples).map(&mut sample).collect();
     let (estimate, estimation_s) = estimate(s.config, &align, (align.len()..s.samples).map(|k| Ok(sample(k))), stop)?;
-    let truth_drawn = ins.drawn_imu_errors();
-    Ok(Outcome { estimate, truth: truth_drawn.in_accelerometer_frame(), truth_drawn, estimation_s, attitude })
+    Ok(Outcome { estimate, truth_drawn: ins.drawn_imu_errors(), estimation_s, attitude })
 }
 
 /// The filter on `align` (the first samples, at rest) and then `rest`; the estimation's own wall
@@ -181,21 +167,6 @@ pub fn estimate(config: Config, align: &[crate::ins::align::Increment], rest: im
 pub fn run_log(log: &crate::scenario::logset::LogSet, stop: &AtomicBool) -> Result<(Estimate, f64)> {
     use crate::app::playback::{ImuItem, ImuSamples};
     let h = 1.0 / log.imu.rate_hz;
-    let e = &log.table.ins.errors;
-    let sigma = |s: Spec| match s {
-        Spec::Sigma(x) if x > 0.0 => Some(x),
-        _ => None,
-    };
-    let datasheet = datasheet_sigmas(e, &sigma);
-    let config = Config {
-        h,
-        samples_per_update: ((0.1 / h).round() as usize).max(1),
-        earth: Earth::at(log.table.site),
-        random_walk: (e.gyro.noise.random_walk_si.max(1e-9), e.accel.noise.random_walk_si.max(1e-8)),
-        prior: Config::priors(&datasheet),
-        velocity_sigma_mps: 1e-5,
-        align_samples: 0,
-    };
     let mut imu = ImuSamples::open(log).map_err(|e| anyhow!("{e}"))?;
     let mut next = move || -> Option<Result<crate::ins::align::Increment>> {
         match imu.next_item() {
@@ -232,24 +203,12 @@ pub fn run_log(log: &crate::scenario::logset::LogSet, stop: &AtomicBool) -> Resu
     if (align.len() as f64) * h < LOG_ALIGN_S {
         bail!("{}: {:.1} s at rest before the first move; selfcal needs at least {LOG_ALIGN_S} s at rest first, then the sequence", log.imu.path.display(), align.len() as f64 * h);
     }
-    let config = Config { align_samples: align.len(), ..config };
+    let config = Config::for_datasheet(&log.table.ins.errors, h, Earth::at(log.table.site), align.len());
     estimate(config, &align, moving.into_iter().map(Ok).chain(std::iter::from_fn(next)), stop)
 }
 
 /// The least rest at the start of a logged sequence (the coarse alignment's data), s.
 pub const LOG_ALIGN_S: f64 = 60.0;
-
-/// The datasheet's 1σ of each parameter (None where it states none).
-fn datasheet_sigmas(e: &ImuErrorSpec, sigma: &dyn Fn(Spec) -> Option<f64>) -> [Option<f64>; N_PARAMS] {
-    std::array::from_fn(|k| match selfcal::param(k).0 {
-        Kind::GyroBias => sigma(e.gyro.bias_rad_per_s),
-        Kind::GyroScale => sigma(e.gyro.scale),
-        Kind::GyroMisalignment => (e.gyro.misalignment_rad > 0.0).then_some(e.gyro.misalignment_rad),
-        Kind::AccelBias => sigma(e.accel.bias_mps2),
-        Kind::AccelScale => sigma(e.accel.scale),
-        Kind::AccelMisalignment => (e.accel.misalignment_rad > 0.0).then_some(e.accel.misalignment_rad),
-    })
-}
 
 /// Per parameter over a Monte Carlo: mean error, the spread of the errors and the mean reported 1σ.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -274,7 +233,13 @@ pub fn monte_carlo(s: &Setup, runs: usize, first_seed: u64, stop: &AtomicBool) -
     let started = std::time::Instant::now();
     let outcomes: Vec<Outcome> = (0..runs).into_par_iter().map(|i| run_one(s, first_seed + i as u64, false, stop)).collect::<Result<_>>()?;
     let n = outcomes.len() as f64;
-    let errors: Vec<[f64; N_PARAMS]> = outcomes.iter().map(|o| std::array::from_fn(|k| o.estimate.params[k] - o.truth.to_params()[k])).collect();
+    let errors: Vec<[f64; N_PARAMS]> = outcomes
+        .iter()
+        .map(|o| {
+            let truth = o.truth().to_params();
+            std::array::from_fn(|k| o.estimate.params[k] - truth[k])
+        })
+        .collect();
     let mean_error: Vec<f64> = (0..N_PARAMS).map(|k| errors.iter().map(|e| e[k]).sum::<f64>() / n).collect();
     let spread = (0..N_PARAMS).map(|k| (errors.iter().map(|e| (e[k] - mean_error[k]).powi(2)).sum::<f64>() / (n - 1.0).max(1.0)).sqrt()).collect();
     let reported_sigma = (0..N_PARAMS).map(|k| outcomes.iter().map(|o| o.estimate.sigma[k]).sum::<f64>() / n).collect();
@@ -304,7 +269,7 @@ pub fn table(s: &Setup, o: &Outcome, plan: &selfcal::Observability, mc: Option<&
         1.0 / s.config.h,
         o.estimation_s
     );
-    estimates_table(head, &o.estimate, Some(o.truth.to_params()), plan, &s.move_starts_s, mc)
+    estimates_table(head, &o.estimate, Some(o.truth().to_params()), plan, &s.move_starts_s, mc)
 }
 
 /// The table of `e` (with the truth when it is known), under `head`.
@@ -408,22 +373,25 @@ pub fn navigation_comparison(p: &Params, o: &Outcome, hours: f64, stop: &AtomicB
     let navigation = modulation.ins.as_ref().and_then(|i| i.navigation);
     let estimated = ImuErrors::from_params(&o.estimate.params);
     // ρ: the accelerometer frame seen from the IMU's (what the estimates are expressed in).
-    let ka = o.truth_drawn.ka;
-    let rho = nalgebra::Vector3::new(-ka[(2, 1)], ka[(2, 0)], -ka[(1, 0)]);
+    let rho = o.truth_drawn.accelerometer_frame_rotation();
     let mut cases = Vec::new();
     for (motion, scheme) in [("at rest", Scheme::continuous(vec![0.0; 2], vec![0.0; 2])), ("16-position", modulation.table.scheme.clone())] {
+        let mut q = p.clone();
+        q.table.scheme = scheme;
+        q.set_duration(hours * 3600.0);
+        let Some(ins) = q.ins.as_mut() else { bail!("{}: no [imu]", p.meta.name) };
+        ins.navigation = navigation;
+        // The estimated compensation's run starts in the accelerometer frame: ρ turned into n.
+        let c0 = TruthImu::new(q.table_model(), Earth::at(q.site), 0.0).eval(0.0).n_from_s;
+        let turned = -(c0.quaternion() * rho);
         for (name, comp) in [("none", None), ("estimated", Some(estimated)), ("true", Some(o.truth_drawn))] {
-            let mut q = p.clone();
-            q.table.scheme = scheme.clone();
-            q.set_duration(hours * 3600.0);
-            let c0 = TruthImu::new(q.table_model(), Earth::at(q.site), 0.0).eval(0.0).n_from_s;
-            let c0 = c0.quaternion().to_rotation_matrix().into_inner();
-            let Some(ins) = q.ins.as_mut() else { bail!("{}: no [imu]", p.meta.name) };
-            ins.navigation = navigation;
-            if name == "estimated" {
-                ins.initial_error_rad = -(c0 * rho);
+            let mut case = q.clone();
+            if name == "estimated"
+                && let Some(ins) = case.ins.as_mut()
+            {
+                ins.initial_error_rad = turned;
             }
-            cases.push((motion, name, q, comp));
+            cases.push((motion, name, case, comp));
         }
     }
     let sample_s = (hours * 3600.0 / 2000.0).max(1.0);

@@ -54,11 +54,15 @@ pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
         let request = args.sinks.request(default_recording(&format!("{}-selfcal", params.meta.name)))?;
         Some(open_sinks(request, &format!("{}-selfcal-seed{}", params.meta.name, params.meta.seed))?)
     };
-    let result = sc::run_one(&setup, params.meta.seed, false, &stop).and_then(|o| match args.monte_carlo {
-        Some(n) => Ok((sc::monte_carlo(&setup, n as usize, params.meta.seed + 1, &stop)?, o)).map(|(m, o)| (o, Some(m))),
-        None => Ok((o, None)),
-    });
-    let (outcome, mc) = match result {
+    // The IMU's calibration, the Monte Carlo and the free-inertial comparison; on a failure the
+    // recording is abandoned once, whichever step failed.
+    let result = (|| {
+        let outcome = sc::run_one(&setup, params.meta.seed, false, &stop)?;
+        let mc = args.monte_carlo.map(|n| sc::monte_carlo(&setup, n as usize, params.meta.seed + 1, &stop)).transpose()?;
+        let nav = if args.navigate_hours > 0.0 { sc::navigation_comparison(&params, &outcome, args.navigate_hours, &stop)? } else { Vec::new() };
+        anyhow::Ok((outcome, mc, nav))
+    })();
+    let (outcome, mc, nav) = match result {
         Ok(r) => r,
         Err(e) => {
             if let Some(s) = sinks {
@@ -67,51 +71,34 @@ pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
             return Err(interrupted(e));
         }
     };
-    let nav = if args.navigate_hours > 0.0 {
-        match sc::navigation_comparison(&params, &outcome, args.navigate_hours, &stop) {
-            Ok(rows) => rows,
-            Err(e) => {
-                if let Some(s) = sinks {
-                    s.abandon();
-                }
-                return Err(interrupted(e));
-            }
-        }
-    } else {
-        Vec::new()
-    };
     let mut table = sc::table(&setup, &outcome, &plan, mc.as_ref());
     if !nav.is_empty() {
         table.push_str(&sc::navigation_table(&nav, args.navigate_hours));
     }
     out!("{table}");
+    let truth = outcome.truth().to_params();
     if let Some(sinks) = sinks {
         let view = crate::record::selfcal::SelfcalView {
             title: format!("{} — {}", params.meta.name, setup.sequence),
             table: &table,
             history: &outcome.estimate.history,
             prior: &outcome.estimate.prior,
-            truth: Some(outcome.truth.to_params()),
+            truth: Some(truth),
             move_starts_s: &setup.move_starts_s,
             attitude: &outcome.attitude,
             navigation: nav.iter().map(|r| &r.trace).collect(),
         };
-        if let Err(e) = crate::record::selfcal::log(&sinks.stream(), &view) {
-            sinks.abandon();
-            return Err(Failure::run(format!("rerun: {e}")));
-        }
-        print_saved(&sinks.finish()?)?;
+        record(sinks, &view)?;
     }
     if let Some(path) = &args.json {
-        let names: Vec<String> = (0..crate::ins::selfcal::N_PARAMS).map(|k| crate::ins::selfcal::param(k).1).collect();
         write_json(
             "--json",
             path,
             &serde_json::json!({
                 "sequence": setup.sequence,
-                "parameters": names,
-                "units": "SI (rad/s, m/s², dimensionless gains)",
-                "truth": outcome.truth.to_params(),
+                "parameters": crate::ins::selfcal::param_names(),
+                "units": JSON_UNITS,
+                "truth": truth,
                 "estimate": outcome.estimate.params,
                 "sigma": outcome.estimate.sigma,
                 "estimation_s": outcome.estimation_s,
@@ -137,8 +124,8 @@ fn selfcal_log(args: &SelfcalArgs, dir: &Path) -> Result<(), Failure> {
     let table = sc::estimates_table(head, &estimate, None, &seen, &[], None);
     out!("{table}");
     if let Some(path) = &args.json {
-        let names: Vec<String> = (0..crate::ins::selfcal::N_PARAMS).map(|k| crate::ins::selfcal::param(k).1).collect();
-        write_json("--json", path, &serde_json::json!({ "log": dir.display().to_string(), "parameters": names, "units": "SI (rad/s, m/s², dimensionless gains)", "estimate": estimate.params, "sigma": estimate.sigma, "estimation_s": estimation_s, "observability": seen }))?;
+        let names = crate::ins::selfcal::param_names();
+        write_json("--json", path, &serde_json::json!({ "log": dir.display().to_string(), "parameters": names, "units": JSON_UNITS, "estimate": estimate.params, "sigma": estimate.sigma, "estimation_s": estimation_s, "observability": seen }))?;
     }
     if !args.no_recording {
         let sinks = open_sinks(args.sinks.request(PathBuf::from("recordings").join(format!("{}-selfcal.rrd", log.name)))?, &format!("{}-selfcal", log.name))?;
@@ -152,11 +139,19 @@ fn selfcal_log(args: &SelfcalArgs, dir: &Path) -> Result<(), Failure> {
             attitude: &[],
             navigation: Vec::new(),
         };
-        if let Err(e) = crate::record::selfcal::log(&sinks.stream(), &view) {
-            sinks.abandon();
-            return Err(Failure::run(format!("rerun: {e}")));
-        }
-        print_saved(&sinks.finish()?)?;
+        record(sinks, &view)?;
     }
     Ok(())
+}
+
+/// What `--json` says of its numbers' units.
+const JSON_UNITS: &str = "SI (rad/s, m/s², dimensionless gains)";
+
+/// Logs `view` into `sinks` and says where the recording is; on a failure the partial file goes.
+fn record(sinks: crate::record::sink::OpenSinks, view: &crate::record::selfcal::SelfcalView<'_>) -> Result<(), Failure> {
+    if let Err(e) = crate::record::selfcal::log(&sinks.stream(), view) {
+        sinks.abandon();
+        return Err(Failure::run(format!("rerun: {e}")));
+    }
+    print_saved(&sinks.finish()?)
 }

@@ -21,7 +21,8 @@ use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
 
 use crate::ins::align::Increment;
 use crate::math::rotvec;
-use crate::math::units::{ARCSEC_PER_RAD, RAD_PER_DEG};
+use crate::ins::sensor::{ImuErrorSpec, Spec};
+use crate::math::units::{ARCSEC_PER_RAD, MPS2_PER_UG, RAD_PER_DEG, RAD_PER_S_PER_DEG_PER_H};
 use crate::model::earth::Earth;
 use crate::model::scheme::IndexedStep;
 
@@ -58,10 +59,22 @@ impl Kind {
     #[must_use]
     pub fn unit(self) -> (&'static str, f64) {
         match self {
-            Self::GyroBias => ("°/h", 3600.0 / RAD_PER_DEG),
+            Self::GyroBias => ("°/h", 1.0 / RAD_PER_S_PER_DEG_PER_H),
             Self::GyroScale | Self::AccelScale => ("ppm", 1e6),
             Self::GyroMisalignment | Self::AccelMisalignment => ("″", ARCSEC_PER_RAD),
-            Self::AccelBias => ("µg", 1e6 / 9.806_65),
+            Self::AccelBias => ("µg", 1.0 / MPS2_PER_UG),
+        }
+    }
+
+    /// The unit as an entity or column name suffix (`crate::io::units`): `deg_per_h`, `ppm`,
+    /// `arcsec`, `ug`.
+    #[must_use]
+    pub fn unit_key(self) -> &'static str {
+        match self {
+            Self::GyroBias => "deg_per_h",
+            Self::GyroScale | Self::AccelScale => "ppm",
+            Self::GyroMisalignment | Self::AccelMisalignment => "arcsec",
+            Self::AccelBias => "ug",
         }
     }
 
@@ -95,6 +108,12 @@ pub fn param(k: usize) -> (Kind, String) {
     }
 }
 
+/// The 21 parameters' names, in order (the columns of `--json`).
+#[must_use]
+pub fn param_names() -> Vec<String> {
+    (0..N_PARAMS).map(|k| param(k).1).collect()
+}
+
 /// The IMU's constant errors, SI: measured = (I + K)·true + b.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ImuErrors {
@@ -114,11 +133,16 @@ impl ImuErrors {
     /// attitude, which no calibration on the IMU's own motion can tell from the errors).
     #[must_use]
     pub fn in_accelerometer_frame(&self) -> Self {
-        let (ka, kg) = (self.ka, self.kg);
-        // [ρ×] = [[0, −ρz, ρy], [ρz, 0, −ρx], [−ρy, ρx, 0]] cancels K_a's lower triangle.
-        let rho = Vector3::new(-ka[(2, 1)], ka[(2, 0)], -ka[(1, 0)]);
-        let r = rho.cross_matrix();
-        Self { bg: self.bg, kg: kg + r, ba: self.ba, ka: ka + r }
+        let r = self.accelerometer_frame_rotation().cross_matrix();
+        Self { bg: self.bg, kg: self.kg + r, ba: self.ba, ka: self.ka + r }
+    }
+
+    /// ρ, the small rotation from this IMU's frame to the one its accelerometer triad defines:
+    /// [ρ×] = [[0, −ρz, ρy], [ρz, 0, −ρx], [−ρy, ρx, 0]] cancels K_a's lower triangle.
+    #[must_use]
+    pub fn accelerometer_frame_rotation(&self) -> Vector3<f64> {
+        let ka = &self.ka;
+        Vector3::new(-ka[(2, 1)], ka[(2, 0)], -ka[(1, 0)])
     }
 
     /// The 21 parameters (K_a's lower triangle is dropped: see [`Self::in_accelerometer_frame`]).
@@ -240,6 +264,22 @@ impl Sequence {
     }
 }
 
+impl Sequence {
+    /// The table's motion through the sequence (outer and inner axis from 0°, not repeated).
+    #[must_use]
+    pub fn scheme(self) -> crate::model::scheme::Scheme {
+        let (dwell, steps) = self.steps();
+        crate::model::scheme::Scheme::indexed(vec![0.0; 2], dwell, steps, false)
+    }
+
+    /// Its length, s: the first dwell and every move with its dwell.
+    #[must_use]
+    pub fn duration_s(self) -> f64 {
+        let scheme = self.scheme();
+        self.steps().0 + scheme.period_s()
+    }
+}
+
 /// The dwell before the first move: the coarse alignment's data, s.
 pub const INITIAL_DWELL_S: f64 = 300.0;
 
@@ -264,6 +304,34 @@ pub struct Config {
 }
 
 impl Config {
+    /// The filter for samples every `h` s at `earth`, aligned on the first `align_samples`, knowing
+    /// what the IMU's datasheet `imu` says: its random walks (process noise) and its 1σ (priors).
+    #[must_use]
+    pub fn for_datasheet(imu: &ImuErrorSpec, h: f64, earth: Earth, align_samples: usize) -> Self {
+        let sigma = |s: Spec| match s {
+            Spec::Sigma(x) if x > 0.0 => Some(x),
+            _ => None,
+        };
+        let angle = |a: f64| (a > 0.0).then_some(a);
+        let datasheet: [Option<f64>; N_PARAMS] = std::array::from_fn(|k| match param(k).0 {
+            Kind::GyroBias => sigma(imu.gyro.bias_rad_per_s),
+            Kind::GyroScale => sigma(imu.gyro.scale),
+            Kind::GyroMisalignment => angle(imu.gyro.misalignment_rad),
+            Kind::AccelBias => sigma(imu.accel.bias_mps2),
+            Kind::AccelScale => sigma(imu.accel.scale),
+            Kind::AccelMisalignment => angle(imu.accel.misalignment_rad),
+        });
+        Self {
+            h,
+            samples_per_update: ((0.1 / h).round() as usize).max(1),
+            earth,
+            random_walk: (imu.gyro.noise.random_walk_si.max(1e-9), imu.accel.noise.random_walk_si.max(1e-8)),
+            prior: Self::priors(&datasheet),
+            velocity_sigma_mps: 1e-5,
+            align_samples,
+        }
+    }
+
     /// Priors wide enough for a navigation- to tactical-grade IMU, or three times the datasheet's
     /// 1σ where that is larger (`datasheet` in SI, None where it says nothing).
     #[must_use]
@@ -271,10 +339,10 @@ impl Config {
         let mut p = [0.0; N_PARAMS];
         for (k, out) in p.iter_mut().enumerate() {
             let floor = match param(k).0 {
-                Kind::GyroBias => 0.1 * RAD_PER_DEG / 3600.0,
+                Kind::GyroBias => 0.1 * RAD_PER_S_PER_DEG_PER_H,
                 Kind::GyroScale | Kind::AccelScale => 300e-6,
                 Kind::GyroMisalignment | Kind::AccelMisalignment => 300.0 / ARCSEC_PER_RAD,
-                Kind::AccelBias => 1e-3 * 9.806_65,
+                Kind::AccelBias => 1000.0 * MPS2_PER_UG,
             };
             *out = datasheet[k].map_or(floor, |s| (3.0 * s).max(floor));
         }
@@ -534,8 +602,8 @@ mod tests {
     #[test]
     fn sequences_stay_within_two_hours_and_end_where_they_started() {
         for (s, _) in Sequence::ALL {
-            let (dwell, steps) = s.steps();
-            let total: f64 = dwell + steps.iter().map(|m| m.angle_rad.abs() / m.rate_rad_per_s + m.rate_rad_per_s / m.accel_rad_per_s2 + m.dwell_s).sum::<f64>();
+            let steps = s.steps().1;
+            let total = s.duration_s();
             assert!(total <= 2.0 * 3600.0, "{}: {total} s", s.name());
             for axis in 0..2 {
                 let turned: f64 = steps.iter().filter(|m| m.axis == axis).map(|m| m.angle_rad).sum();

@@ -78,6 +78,24 @@ struct Axes {
     y_label: String,
 }
 
+impl Axes {
+    /// A recorded time as the figure's x: 10^t on a log10-τ timeline, hours on a long run.
+    fn x_of(&self, t: f64) -> f64 {
+        if self.log_x {
+            10f64.powf(t)
+        } else if self.hours {
+            t / 3600.0
+        } else {
+            t
+        }
+    }
+
+    /// A recorded value as the figure's y: 10^v where the recording holds log10 values.
+    fn y_of(&self, v: f64) -> f64 {
+        if self.log_y { 10f64.powf(v) } else { v }
+    }
+}
+
 fn axes(plot: &Plot) -> Axes {
     let log_x = plot.series.iter().all(|s| s.timeline == super::allan::LOG10_TAU_TIMELINE);
     let log_y = plot.series.iter().all(|s| is_log10(&s.entity));
@@ -112,14 +130,9 @@ fn title_of(plot: &Plot, a: &Axes) -> String {
 /// A series' points as the figure plots them (log10 values undone, hours), in segments split at
 /// missing values, long lines reduced to each bucket's extremes.
 fn points(s: &PlotSeries, a: &Axes, x_window: Option<(f64, f64)>) -> Vec<Vec<(f64, f64)>> {
-    let map = |t: f64, y: f64| {
-        let x = if a.log_x { 10f64.powf(t) } else if a.hours { t / 3600.0 } else { t };
-        let y = if a.log_y { 10f64.powf(y) } else { y };
-        (x, y)
-    };
     let mut segments: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
     for (t, y) in s.t.iter().zip(&s.y) {
-        let (x, y) = map(*t, *y);
+        let (x, y) = (a.x_of(*t), a.y_of(*y));
         let inside = x_window.is_none_or(|(lo, hi)| x >= lo && x <= hi);
         if x.is_finite() && y.is_finite() && inside && (!a.log_y || y > 0.0) {
             if let Some(last) = segments.last_mut() {
@@ -217,12 +230,8 @@ fn clip(seg: &[(f64, f64)], xr: (f64, f64), yr: (f64, f64), a: &Axes) -> Vec<Vec
 
 /// `rgb` darkened (hue kept) until its contrast against white is at least 3:1.
 fn on_white(rgb: [u8; 3]) -> RGBColor {
-    let lum = |c: [f64; 3]| {
-        let lin = |v: f64| if v <= 0.040_45 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) };
-        0.2126 * lin(c[0]) + 0.7152 * lin(c[1]) + 0.0722 * lin(c[2])
-    };
     let mut c = rgb.map(|v| f64::from(v) / 255.0);
-    while 1.05 / (lum(c) + 0.05) < 3.0 {
+    while 1.05 / (super::palette::luminance_of(c) + 0.05) < 3.0 {
         c = c.map(|v| v * 0.95);
     }
     let [r, g, b] = c.map(|v| (v * 255.0).round() as u8);
@@ -269,16 +278,13 @@ type Drawn<'a> = Vec<(&'a PlotSeries, Vec<Vec<(f64, f64)>>)>;
 /// The plot as an SVG document.
 fn svg(plot: &Plot) -> anyhow::Result<String> {
     let a = axes(plot);
-    let x_window = plot.time_range.map(|r| {
-        let m = |t: f64| if a.log_x { 10f64.powf(t) } else if a.hours { t / 3600.0 } else { t };
-        (m(r[0]), m(r[1]))
-    });
+    let x_window = plot.time_range.map(|r| (a.x_of(r[0]), a.x_of(r[1])));
     let drawn: Drawn<'_> = plot.series.iter().map(|s| (s, points(s, &a, x_window))).collect();
     let extent = |f: &dyn Fn(&(f64, f64)) -> f64| {
         drawn.iter().flat_map(|(_, segs)| segs.iter().flatten()).map(f).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)))
     };
     let xr = range(extent(&|p| p.0), x_window, a.log_x);
-    let layout_y = plot.range.map(|r| if a.log_y { (10f64.powf(r[0]), 10f64.powf(r[1])) } else { (r[0], r[1]) });
+    let layout_y = plot.range.map(|r| (a.y_of(r[0]), a.y_of(r[1])));
     let yr = range(extent(&|p| p.1), layout_y, a.log_y);
     // What leaves the visible box is cut at its edge, not drawn along it.
     let drawn: Drawn<'_> = drawn.into_iter().map(|(s, segs)| (s, segs.iter().flat_map(|seg| clip(seg, xr, yr, &a)).collect())).collect();
@@ -404,13 +410,7 @@ mod tests {
 
     #[test]
     fn darkened_colours_reach_three_to_one_against_white_and_dark_ones_are_kept() {
-        let contrast = |c: RGBColor| {
-            let lin = |v: u8| {
-                let v = f64::from(v) / 255.0;
-                if v <= 0.040_45 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) }
-            };
-            1.05 / (0.2126 * lin(c.0) + 0.7152 * lin(c.1) + 0.0722 * lin(c.2) + 0.05)
-        };
+        let contrast = |c: RGBColor| 1.05 / (crate::record::palette::luminance([c.0, c.1, c.2]) + 0.05);
         // WCAG 2's definition; white on white is 1:1, black on white 21:1.
         assert!(contrast(on_white([235, 235, 235])) >= 3.0);
         assert!(contrast(on_white([235, 235, 235])) < 3.3, "darkened no further than needed");

@@ -49,10 +49,12 @@ pub(crate) fn albedo(c: [u8; 3], a: u8) -> rerun::datatypes::Rgba32 {
 
 /// WCAG 2 relative luminance of an sRGB colour.
 pub(crate) fn luminance(c: [u8; 3]) -> f64 {
-    let lin = |v: u8| {
-        let v = f64::from(v) / 255.0;
-        if v <= 0.040_45 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) }
-    };
+    luminance_of(c.map(|v| f64::from(v) / 255.0))
+}
+
+/// WCAG 2 relative luminance of an sRGB colour with channels in [0, 1].
+pub(crate) fn luminance_of(c: [f64; 3]) -> f64 {
+    let lin = |v: f64| if v <= 0.040_45 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) };
     0.2126 * lin(c[0]) + 0.7152 * lin(c[1]) + 0.0722 * lin(c[2])
 }
 

@@ -230,8 +230,12 @@ pub fn plots(path: &Path) -> anyhow::Result<Vec<Plot>> {
                     let s = styles.entry(entity.clone()).or_default();
                     if has_lines {
                         s.line = true;
-                        s.names = if ln.is_empty() { s.names.clone() } else { ln };
-                        s.colors = if lc.is_empty() { s.colors.clone() } else { lc };
+                        if !ln.is_empty() {
+                            s.names = ln;
+                        }
+                        if !lc.is_empty() {
+                            s.colors = lc;
+                        }
                         s.widths = widths;
                     }
                     if has_points {

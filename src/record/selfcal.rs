@@ -32,18 +32,19 @@ pub struct SelfcalView<'a> {
     pub navigation: Vec<&'a crate::ins::trace::NavTrace>,
 }
 
-/// A parameter's entity: its name with the unit (`selfcal/error/bg_x_deg_per_h`).
-fn unit_key(unit: &str) -> &'static str {
-    match unit {
-        "°/h" => "deg_per_h",
-        "ppm" => "ppm",
-        "µg" => "ug",
-        _ => "arcsec",
-    }
-}
-
 const GROUPS: [(&str, &str); 4] = [("gyro bias", "gyro_bias"), ("gyro scale and misalignment", "gyro_gain"), ("accelerometer bias", "accel_bias"), ("accelerometer scale and misalignment", "accel_gain")];
-const LINE_COLORS: [[u8; 3]; 9] = [[230, 90, 90], [90, 200, 90], [90, 140, 240], [240, 160, 40], [200, 90, 230], [60, 200, 200], [250, 200, 60], [160, 160, 160], [240, 120, 180]];
+/// The lines of a group's plot, with the names its title gives them (a legend would cover the curves).
+const LINE_COLORS: [(&str, [u8; 3]); 9] = [
+    ("red", [230, 90, 90]),
+    ("green", [90, 200, 90]),
+    ("blue", [90, 140, 240]),
+    ("orange", [240, 160, 40]),
+    ("purple", [200, 90, 230]),
+    ("cyan", [60, 200, 200]),
+    ("yellow", [250, 200, 60]),
+    ("grey", [160, 160, 160]),
+    ("pink", [240, 120, 180]),
+];
 
 /// Logs the self-calibration.
 pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
@@ -82,11 +83,11 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
         let members: Vec<usize> = (0..N_PARAMS).filter(|&k| param(k).0.group() == group).collect();
         let path = format!("selfcal/observability/{slug}/log10_sigma_ratio");
         let names: Vec<String> = members.iter().map(|&k| param(k).1).collect();
-        rec.log_static(path.as_str(), &rerun::SeriesLines::new().with_colors(members.iter().enumerate().map(|(i, _)| rgb(LINE_COLORS[i % 9]))).with_names(names.clone()))?;
+        rec.log_static(path.as_str(), &rerun::SeriesLines::new().with_colors((0..members.len()).map(|i| rgb(LINE_COLORS[i % 9].1))).with_names(names.clone()))?;
         let values: Vec<f64> = v.history.iter().flat_map(|r| members.iter().map(|&k| (r.sigma[k] / v.prior[k]).max(1e-12).log10()).collect::<Vec<_>>()).collect();
         stream.send_series(&path, &names, &t, values, members.len())?;
         stream.mark_events(&path, "moves", "moves", v.move_starts_s, 0.0)?;
-        let key = names.iter().enumerate().map(|(i, n)| format!("{} {n}", ["red", "green", "blue", "orange", "purple", "cyan", "yellow", "grey", "pink"][i % 9])).collect::<Vec<_>>().join(" · ");
+        let key = names.iter().enumerate().map(|(i, n)| format!("{} {n}", LINE_COLORS[i % 9].0)).collect::<Vec<_>>().join(" · ");
         timeline.push(
             Node::view("TimeSeries", format!("{group}: log10 σ/σ0 — {key} · ▼ moves"), path)
                 .with_property("TimeAxis", &seq_axis)
@@ -95,7 +96,7 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
         for &k in &members {
             let (kind, name) = param(k);
             let (unit, per_si) = kind.unit();
-            let path = format!("selfcal/error/{name}_{}", unit_key(unit));
+            let path = format!("selfcal/error/{name}_{}", kind.unit_key());
             let truth = v.truth.map_or(0.0, |t| t[k]);
             let what = if v.truth.is_some() { "estimate − true" } else { "estimate" };
             let series = [what.to_owned(), "+3σ".to_owned(), "−3σ".to_owned()];
