@@ -1,14 +1,164 @@
-"""rinscope from Python (work in progress on branch python-package): the presets and their validation.
+"""rinscope from Python: see the errors of a rotational inertial navigation system.
 
-Everything is computed by the Rust library; this package converts.
+The Rust library computes everything; this package converts. Scenarios in (``load``), results
+out: a summary dict and every recorded series as a pandas DataFrame, in memory::
+
+    import rinscope
+    s = rinscope.load("jiang2017-dual-axis")
+    s.table.inner.swing_half_angle_arcsec = 450
+    r = rinscope.run(s, duration_s=600, save="x.rrd")
+    r.summary["attitude_error_arcsec"]["heading"]["uncompensated"]["peak"]
+    r["attitude_error_arcsec/heading"]          # a DataFrame: t_s, one column per series
+    r.show()                                    # the recording, inline in a notebook
+
+Ctrl-C (a notebook's interrupt) stops a call cleanly: the work finishes what it has (a saved
+recording ends complete up to that moment) and KeyboardInterrupt is raised. The ``rinscope``
+command installed with the package is the command-line program itself.
 """
+from __future__ import annotations
+
 import json as _json
+import os
+from pathlib import Path
+from typing import Any
 
-from ._rinscope import scenarios, preset_toml, check  # noqa: F401
 from . import _rinscope
+from ._result import Result, Tables, result as _result
+from ._scenario import Scenario, Section
+
+__all__ = ["scenarios", "load", "check", "run", "replay", "calibrate", "allan", "montecarlo", "verify_recording", "Scenario", "Section", "Result", "Tables", "DEFAULT_SCENARIO", "__version__"]
+
+__version__ = _rinscope.VERSION
+DEFAULT_SCENARIO = _rinscope.DEFAULT_SCENARIO
 
 
-def run_summary(scenario, save, duration_s=None):
-    """Runs a preset (by name) or a scenario's TOML text, saves the recording, returns the summary dict."""
-    toml = preset_toml(scenario) if "\n" not in scenario else scenario
-    return _json.loads(_rinscope.run_summary(toml, str(save), duration_s))
+def scenarios() -> dict:
+    """The presets: {name: title}, in the order ``rinscope scenarios`` lists them."""
+    return dict(_rinscope.scenarios())
+
+
+def load(source: str | os.PathLike | Scenario = DEFAULT_SCENARIO) -> Scenario:
+    """A scenario: a preset's name (``rinscope.scenarios()``), a ``.toml`` file, or a Scenario (copied).
+    A file is validated as ``rinscope check-config`` validates it (ValueError naming the key)."""
+    if isinstance(source, Scenario):
+        return source.copy()
+    text = str(source)
+    if text in dict(_rinscope.scenarios()):
+        return Scenario(_rinscope.preset_toml(text), f"preset {text}")
+    path = Path(text)
+    if path.is_file():
+        return Scenario(path.read_text(encoding="utf-8"), str(path))
+    if path.suffix == ".toml" or os.sep in text:
+        raise FileNotFoundError(f"{text}: no such scenario file")
+    raise ValueError(f"{text!r} is neither a preset nor a file; the presets are: {', '.join(scenarios())}")
+
+
+def check(source: str | os.PathLike | Scenario) -> Scenario:
+    """Validates a scenario (as ``load``) and returns it with every default written out."""
+    return load(source).resolved()
+
+
+def _toml(scenario: Any, default: str) -> str:
+    return load(default if scenario is None else scenario).toml
+
+
+def _path(p):
+    return None if p is None else str(Path(p))
+
+
+def run(scenario: Any = None, duration_s: float | None = None, save: str | os.PathLike | None = None) -> Result:
+    """Simulates a scenario (a Scenario, a preset's name or a file; default: the default preset)
+    for ``duration_s`` (default: its own), saving the recording to ``save`` if given.
+    ``summary`` is ``rinscope run --summary-json``'s; ``series`` every recorded series."""
+    return _result("run", _rinscope.run(_toml(scenario, DEFAULT_SCENARIO), duration_s, _path(save)), "recording_path")
+
+
+def replay(log_dir: str | os.PathLike, save: str | os.PathLike | None = None, compensation: Any = None) -> Result:
+    """Replays a log set (a folder with ``log.toml``), with its table's compensation or
+    ``compensation``: a ``calibrate`` Result, its summary dict, or the path of a ``calibrate --json``."""
+    if isinstance(compensation, Result):
+        compensation = compensation.summary
+    if isinstance(compensation, dict):
+        compensation = _json.dumps(compensation)
+    elif compensation is not None:
+        compensation = Path(compensation).read_text(encoding="utf-8")
+    return _result("replay", _rinscope.replay(str(log_dir), _path(save), compensation), "recording_path")
+
+
+def calibrate(scenario: Any = None, log_dir: str | os.PathLike | None = None, save: str | os.PathLike | None = None) -> Result:
+    """Calibrates a table: of a scenario (default: jiang2017-calibration) or of a log set
+    (``log_dir``). ``summary`` is ``calibrate --json``'s (with ``estimated_compensation``, which
+    ``replay(..., compensation=result)`` takes); ``series`` the recording's series."""
+    toml = None if log_dir is not None and scenario is None else _toml(scenario, "jiang2017-calibration")
+    return _result("calibrate", _rinscope.calibrate(toml, _path(log_dir), _path(save)), None, save)
+
+
+def allan(data: Any, rate_hz: float | None = None, time_s: Any = None, spec: str | dict = "frequency",
+          taus: str | int = "octave", estimators: str = "oadev", ci_sigma: float = 1.0, decimate: int = 1,
+          save: str | os.PathLike | None = None) -> Result:
+    """The Allan analysis (IEEE 952 fit for inertial columns) of arrays: a 1-D array (one column),
+    a 2-D array (one column per column), a pandas Series or DataFrame, or a dict of arrays;
+    sampled at ``rate_hz`` or at the times ``time_s`` (s, even to 1 %). ``spec`` says what the
+    values are, as ``allan --column`` does after the column's name: ``"KIND[:UNIT]"`` for every
+    column or a dict per column — ``"rate:deg/h"`` (a gyro), ``"rate:m/s^2"``, ``"increment:rad"``,
+    ``"phase:ns"``, ``"frequency"`` (a clock's fractional frequency, the default).
+    ``summary`` is ``allan --json``'s; ``series`` the curves and fits (``allan --export``'s tables)."""
+    import numpy as np
+
+    columns = _columns(data)
+    specs, buffers = [], []
+    for name, values in columns.items():
+        kind = spec.get(name) if isinstance(spec, dict) else spec
+        if kind is None:
+            raise ValueError(f"allan: column {name!r} has no spec (give spec={{{name!r}: 'KIND[:UNIT]'}})")
+        specs.append(f"{name}:{kind}")
+        buffers.append(np.ascontiguousarray(values, dtype="<f8").tobytes())
+    times = None if time_s is None else np.ascontiguousarray(np.asarray(time_s), dtype="<f8").tobytes()
+    out = _rinscope.allan(specs, buffers, rate_hz, times, str(taus), estimators, ci_sigma, decimate, _path(save))
+    return _result("allan", out, None, save)
+
+
+def _columns(data: Any) -> dict:
+    """Named 1-D columns of whatever array-like the user has."""
+    import numpy as np
+
+    try:
+        import pandas as pd
+    except ImportError:  # pandas is a dependency; this only keeps numpy-only use possible
+        pd = None
+    if pd is not None and isinstance(data, pd.DataFrame):
+        return {str(c): data[c].to_numpy() for c in data.columns}
+    if pd is not None and isinstance(data, pd.Series):
+        return {str(data.name) if data.name is not None else "x": data.to_numpy()}
+    if isinstance(data, dict):
+        return {str(k): np.asarray(v) for k, v in data.items()}
+    a = np.asarray(data)
+    if a.ndim == 1:
+        return {"x": a}
+    if a.ndim == 2:
+        return {str(i): a[:, i] for i in range(a.shape[1])}
+    raise ValueError(f"allan: data of shape {a.shape}: give one column (1-D) or one per column (2-D)")
+
+
+def montecarlo(scenario: Any = None, runs: int | None = None, eta_measured_sigma_arcsec: float | None = None) -> Result:
+    """Monte Carlo of the calibration (default scenario: jiang2017-calibration): ``runs``
+    calibrations on every core. ``summary`` is ``montecarlo --json``'s; ``series["runs"]`` each
+    run's estimation errors, one row per run and a column per estimator and parameter ("kf inner α",
+    "nls inner α", "nls_sigma inner α": the least squares' own 1σ); ``series["rows"]`` the
+    summary's table (mean, std, ... of each estimator's errors per parameter, with the paper's)."""
+    import pandas as pd
+
+    summary = _json.loads(_rinscope.montecarlo(_toml(scenario, "jiang2017-calibration"), runs, eta_measured_sigma_arcsec))
+    labels = [row["label"] for row in summary["rows"]]
+    per_run = pd.DataFrame(
+        [{"run": run["index"], **{f"{est} {label}": v for est in ("kf", "nls", "nls_sigma") for label, v in zip(labels, run[est])}} for run in summary.pop("runs")]
+    )
+    rows = pd.json_normalize(summary["rows"], sep="_")
+    r = Result("montecarlo", summary, [], None)
+    r.series = Tables([], {"runs": per_run, "rows": rows})
+    return r
+
+
+def verify_recording(path: str | os.PathLike) -> None:
+    """Raises ValueError unless the ``.rrd`` at ``path`` is complete (header, footer, checksum)."""
+    _rinscope.verify_recording(str(path))

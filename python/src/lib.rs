@@ -1,67 +1,402 @@
-//! rinscope's Python bindings: conversions only; every computation is the library's.
+//! rinscope's Python bindings (the `rinscope._rinscope` module): conversions only. Every
+//! computation is the rinscope library's; this crate turns TOML, JSON and arrays into its types,
+//! runs it on a worker thread while the caller's thread watches for Ctrl-C, and hands the results
+//! back as JSON and Arrow IPC streams (which `rinscope/__init__.py` makes into dicts and pandas
+//! DataFrames).
 
-use pyo3::exceptions::PyValueError;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+
+use pyo3::exceptions::{PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::PyBytes;
+use serde::Serialize;
 
-/// The presets: (name, title) pairs.
+use rinscope::app::allan::AllanRequest;
+use rinscope::record::export::Table;
+use rinscope::record::sink::{self, OpenSinks, SinkRequest};
+use rinscope::record::APPLICATION_ID;
+use rinscope::scenario::{self, logset, presets, Params};
+
+/// What went wrong, as the Python exception it becomes.
+enum Failure {
+    /// Bad input (a config key, a column, a value out of range): ValueError.
+    Input(String),
+    /// A file that cannot be written: OSError.
+    Output(String),
+    /// Anything else: RuntimeError.
+    Run(String),
+    /// Stopped (Ctrl-C) before there was anything to return: KeyboardInterrupt.
+    Interrupted(String),
+}
+
+impl From<Failure> for PyErr {
+    fn from(f: Failure) -> Self {
+        match f {
+            Failure::Input(m) => PyValueError::new_err(m),
+            Failure::Output(m) => PyOSError::new_err(m),
+            Failure::Run(m) => PyRuntimeError::new_err(m),
+            Failure::Interrupted(m) => PyKeyboardInterrupt::new_err(m),
+        }
+    }
+}
+
+impl From<sink::SinkError> for Failure {
+    fn from(e: sink::SinkError) -> Self {
+        match e {
+            sink::SinkError::Write(_) | sink::SinkError::File(_) | sink::SinkError::ExportWrite(_) => Self::Output(e.to_string()),
+            sink::SinkError::Rerun(_) | sink::SinkError::FiguresWrite(_) => Self::Run(e.to_string()),
+            _ => Self::Input(e.to_string()),
+        }
+    }
+}
+
+/// A scenario's TOML text parsed and validated, the error as `rinscope check-config` says it.
+fn parse(toml: &str, origin: &str) -> Result<Params, Failure> {
+    scenario::parse(toml, origin).map_err(|e| Failure::Input(format!("config error: {e}")))
+}
+
+/// Runs `work` on a thread of its own with a stop flag, the GIL released; the caller's thread
+/// wakes every 50 ms to let Python handle signals. Ctrl-C (KeyboardInterrupt) sets the flag, waits
+/// for the work to finish what it has (a recording then ends complete up to that moment, as the
+/// command's does) and raises.
+fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce(&Arc<AtomicBool>) -> T + Send) -> PyResult<T> {
+    use crossbeam_channel::RecvTimeoutError;
+    let stop = Arc::new(AtomicBool::new(false));
+    let (tx, rx) = crossbeam_channel::bounded(1);
+    std::thread::scope(|s| {
+        let flag = Arc::clone(&stop);
+        s.spawn(move || tx.send(work(&flag)).ok());
+        loop {
+            match py.detach(|| rx.recv_timeout(Duration::from_millis(50))) {
+                Ok(v) => return Ok(v),
+                Err(RecvTimeoutError::Timeout) => {
+                    if let Err(e) = py.check_signals() {
+                        stop.store(true, Ordering::SeqCst);
+                        py.detach(|| rx.recv()).ok();
+                        return Err(e);
+                    }
+                }
+                Err(RecvTimeoutError::Disconnected) => return Err(PyRuntimeError::new_err("rinscope: the work ended without a result (see the panic message on stderr)")),
+            }
+        }
+    })
+}
+
+/// The sinks of a call: the recording file if `save`, and the tables in memory.
+fn open_sinks(save: Option<PathBuf>, recording_id: &str, stop: &Arc<AtomicBool>) -> Result<OpenSinks, Failure> {
+    let request = SinkRequest { save, stop_on_failure: Some(Arc::clone(stop)), tables_in_memory: true, ..Default::default() };
+    Ok(sink::open(&request, APPLICATION_ID, recording_id)?)
+}
+
+/// One table as an Arrow IPC stream: float64 columns named as `--export` names them, the entity in
+/// the schema's metadata.
+fn ipc(table: Table) -> Result<(String, Vec<u8>), Failure> {
+    use arrow_array::{ArrayRef, Float64Array, RecordBatch};
+    use arrow_schema::{DataType, Field, Schema};
+    let arrow = |e: arrow_schema::ArrowError| Failure::Run(format!("arrow: {e}"));
+    let fields: Vec<Field> = table.columns.iter().map(|c| Field::new(c, DataType::Float64, false)).collect();
+    let metadata = [("rinscope.entity".to_owned(), table.entity.clone()), ("rinscope.table".to_owned(), table.name.clone())].into_iter().collect();
+    let schema = Arc::new(Schema::new(fields).with_metadata(metadata));
+    let arrays: Vec<ArrayRef> = table.values.into_iter().map(|v| Arc::new(Float64Array::from(v)) as ArrayRef).collect();
+    let batch = RecordBatch::try_new(Arc::clone(&schema), arrays).map_err(arrow)?;
+    let mut bytes = Vec::new();
+    let mut writer = arrow_ipc::writer::StreamWriter::try_new(&mut bytes, &schema).map_err(arrow)?;
+    writer.write(&batch).map_err(arrow)?;
+    writer.finish().map_err(arrow)?;
+    drop(writer);
+    Ok((table.entity, bytes))
+}
+
+/// What a call returns to Python: a JSON document and the tables as (entity, Arrow IPC stream).
+type Output = (String, Vec<(String, Vec<u8>)>);
+
+/// The JSON document and tables as Python objects.
+fn to_python(py: Python<'_>, (json, tables): Output) -> (String, Vec<(String, Py<PyBytes>)>) {
+    (json, tables.into_iter().map(|(entity, bytes)| (entity, PyBytes::new(py, &bytes).unbind())).collect())
+}
+
+/// Finishes the sinks and the call's output; `fill` adds the recording's path and size to the summary.
+fn finish<S: Serialize>(sinks: OpenSinks, mut summary: S, fill: impl FnOnce(&mut S, &sink::Saved)) -> Result<Output, Failure> {
+    let saved = sinks.finish()?;
+    fill(&mut summary, &saved);
+    let json = serde_json::to_string(&summary).map_err(|e| Failure::Run(e.to_string()))?;
+    let tables = saved.tables.into_iter().map(ipc).collect::<Result<_, _>>()?;
+    Ok((json, tables))
+}
+
+/// The presets: (name, title) pairs, in the order `rinscope scenarios` lists them.
 #[pyfunction]
 fn scenarios() -> Vec<(String, String)> {
-    rinscope::scenario::presets::PRESETS
+    presets::PRESETS
         .iter()
-        .map(|(name, _)| {
-            let title = rinscope::scenario::presets::load(name).map(|p| p.meta.title).unwrap_or_default();
-            ((*name).to_owned(), title)
-        })
+        .map(|(name, _)| ((*name).to_owned(), presets::load(name).map(|p| p.meta.title).unwrap_or_else(|e| format!("BROKEN: {e}"))))
         .collect()
 }
 
 /// A preset's TOML text.
 #[pyfunction]
 fn preset_toml(name: &str) -> PyResult<String> {
-    rinscope::scenario::presets::text(name).map(str::to_owned).ok_or_else(|| PyValueError::new_err(format!("{name}: not a preset")))
+    presets::text(name).map(str::to_owned).ok_or_else(|| PyValueError::new_err(format!("{name:?} is not a preset; rinscope.scenarios() lists them: {}", presets::PRESETS.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", "))))
 }
 
-/// Validates a scenario's TOML text; the error names the key, value and unit as the command does.
+/// Validates a scenario's TOML text (`origin` names it in messages); returns the resolved TOML
+/// (every default filled in). The error names the key, value and unit as the command does.
 #[pyfunction]
-fn check(toml: &str) -> PyResult<String> {
-    rinscope::scenario::parse(toml, "python").map(|p| p.resolved_toml).map_err(|e| PyValueError::new_err(format!("config error: {e}")))
+#[pyo3(signature = (toml, origin="python"))]
+fn check(toml: &str, origin: &str) -> PyResult<String> {
+    Ok(parse(toml, origin)?.resolved_toml)
 }
 
-/// Runs a scenario (its TOML text) for `duration_s` (None: its own), saving the recording to
-/// `save`; the run's summary as JSON (the `--summary-json` of `rinscope run`). The GIL is released
-/// while it runs; Ctrl-C is not yet wired to the stop flag.
+/// TOML text as JSON (for the dict-like Scenario); a syntax error is a ValueError.
 #[pyfunction]
-#[pyo3(signature = (toml, save, duration_s=None))]
-fn run_summary(py: Python<'_>, toml: &str, save: std::path::PathBuf, duration_s: Option<f64>) -> PyResult<String> {
-    let mut params = rinscope::scenario::parse(toml, "python").map_err(|e| PyValueError::new_err(format!("config error: {e}")))?;
+fn toml_to_json(text: &str) -> PyResult<String> {
+    let value: toml::Value = toml::from_str(text).map_err(|e| PyValueError::new_err(format!("config error: {}", rinscope::scenario::parse_message(&e))))?;
+    serde_json::to_string(&value).map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+/// JSON (a Scenario's dict) as TOML text; a value TOML cannot hold (null, a mixed array) is a ValueError.
+#[pyfunction]
+fn json_to_toml(json: &str) -> PyResult<String> {
+    let value: toml::Value = serde_json::from_str(json).map_err(|e| PyValueError::new_err(format!("not a TOML document: {e}")))?;
+    toml::to_string(&value).map_err(|e| PyValueError::new_err(format!("not a TOML document: {e}")))
+}
+
+/// `duration_s` checked as `--duration-s` is.
+fn set_duration(params: &mut Params, duration_s: Option<f64>) -> Result<(), Failure> {
     if let Some(d) = duration_s {
-        if !(d.is_finite() && d > 0.0 && d <= rinscope::scenario::MAX_DURATION_S) {
-            return Err(PyValueError::new_err(format!("duration_s {d} s: must be > 0 and at most {} s", rinscope::scenario::MAX_DURATION_S)));
+        if !(d.is_finite() && d > 0.0 && d <= scenario::MAX_DURATION_S) {
+            return Err(Failure::Input(format!("duration_s {d} s: must be > 0 and at most {} s (30 days), as simulation.duration_s", scenario::MAX_DURATION_S)));
         }
         params.set_duration(d);
     }
-    py.detach(|| {
-        let request = rinscope::record::sink::SinkRequest { save: Some(save), ..Default::default() };
-        let sinks = rinscope::record::sink::open(&request, rinscope::record::APPLICATION_ID, &params.meta.name).map_err(|e| e.to_string())?;
-        let stop = std::sync::atomic::AtomicBool::new(false);
-        let summary = match rinscope::app::run::run_recorded(&params, &sinks, &stop, false) {
+    Ok(())
+}
+
+/// Runs a scenario (its TOML text) for `duration_s` (None: its own), saving the recording to
+/// `save` if given: the summary (as `run --summary-json` writes it) and every series as a table.
+#[pyfunction]
+#[pyo3(signature = (toml, duration_s=None, save=None))]
+fn run(py: Python<'_>, toml: &str, duration_s: Option<f64>, save: Option<PathBuf>) -> PyResult<(String, Vec<(String, Py<PyBytes>)>)> {
+    let mut params = parse(toml, "the scenario")?;
+    set_duration(&mut params, duration_s)?;
+    let out = interruptible(py, |stop| -> Result<Output, Failure> {
+        let sinks = open_sinks(save, &format!("{}-seed{}", params.meta.name, params.meta.seed), stop)?;
+        let summary = match rinscope::app::run::run_recorded(&params, &sinks, stop, false) {
             Ok(s) => s,
             Err(e) => {
                 sinks.abandon();
-                return Err(format!("{e:#}"));
+                return Err(Failure::Run(format!("{e:#}")));
             }
         };
-        sinks.finish().map_err(|e| e.to_string())?;
-        serde_json::to_string(&summary).map_err(|e| e.to_string())
-    })
-    .map_err(pyo3::exceptions::PyRuntimeError::new_err)
+        finish(sinks, summary, |s, saved| {
+            if let Some((path, bytes)) = &saved.recording {
+                s.recording_path = Some(path.display().to_string());
+                s.recording_bytes = Some(*bytes);
+            }
+        })
+    })??;
+    Ok(to_python(py, out))
+}
+
+/// Replays the log set in `dir` (its own compensation, or `compensation`: a `calibrate` JSON's
+/// text), saving to `save` if given: the summary and every series as a table.
+#[pyfunction]
+#[pyo3(signature = (dir, save=None, compensation=None))]
+fn replay(py: Python<'_>, dir: PathBuf, save: Option<PathBuf>, compensation: Option<&str>) -> PyResult<(String, Vec<(String, Py<PyBytes>)>)> {
+    let log = logset::load(&dir).map_err(|e| Failure::Input(e.to_string()))?;
+    let compensation = match compensation {
+        None => log.table.compensation.clone(),
+        Some(text) => logset::compensation_from_calibration(&log.raw_table, text, "compensation").map_err(|e| Failure::Input(e.to_string()))?,
+    };
+    let out = interruptible(py, |stop| -> Result<Output, Failure> {
+        let sinks = open_sinks(save, &format!("{}-replay", log.name), stop)?;
+        let summary = match rinscope::app::replay::replay_recorded(&log, &compensation, &sinks, stop, None) {
+            Ok(s) => s,
+            Err(e) => {
+                sinks.abandon();
+                return Err(match e {
+                    rinscope::app::playback::PlaybackError::Record(_) => Failure::Run(e.to_string()),
+                    _ => Failure::Input(e.to_string()),
+                });
+            }
+        };
+        finish(sinks, summary, |s, saved| {
+            if let Some((path, bytes)) = &saved.recording {
+                s.recording_path = Some(path.display().to_string());
+                s.recording_bytes = Some(*bytes);
+            }
+        })
+    })??;
+    Ok(to_python(py, out))
+}
+
+/// Calibrates the table of a scenario (its TOML text) or of the log set in `log_dir`: the report
+/// with the least-squares compensation (as `calibrate --json` writes it) and every series.
+#[pyfunction]
+#[pyo3(signature = (toml=None, log_dir=None, save=None))]
+fn calibrate(py: Python<'_>, toml: Option<&str>, log_dir: Option<PathBuf>, save: Option<PathBuf>) -> PyResult<(String, Vec<(String, Py<PyBytes>)>)> {
+    use rinscope::app::calibrate::{calibrate_log, calibrate_scenario, estimated_compensation, record_outcome, CalibrationOutput};
+    let calib = |e: rinscope::calib::CalibError| Failure::Input(format!("calibrate: {e}"));
+    let out = match (toml, log_dir) {
+        (Some(toml), None) => {
+            let params = parse(toml, "the scenario")?;
+            interruptible(py, |stop| -> Result<Output, Failure> {
+                let outcome = calibrate_scenario(&params, true, stop).map_err(calib)?;
+                let sinks = open_sinks(save, &format!("{}-calibration-seed{}", params.meta.name, params.meta.seed), stop)?;
+                if let Err(e) = record_outcome(sinks.stream(), &params, &outcome, stop) {
+                    sinks.abandon();
+                    return Err(Failure::Run(format!("rerun: {e}")));
+                }
+                let compensation = estimated_compensation(&params.table.chain, &outcome.cal, &params.calibration_known);
+                let json = serde_json::to_value(CalibrationOutput { report: &outcome.report, estimated_compensation: compensation }).map_err(|e| Failure::Run(e.to_string()))?;
+                finish(sinks, json, |_, _| ())
+            })??
+        }
+        (None, Some(dir)) => {
+            let log = logset::load(&dir).map_err(|e| Failure::Input(e.to_string()))?;
+            if log.table.strapdown {
+                return Err(Failure::Input(format!("calibrate: {} has no table description with [turntable] (log.table): there is no table to calibrate", dir.display())).into());
+            }
+            interruptible(py, |stop| -> Result<Output, Failure> {
+                let (cal, report, data, traces) = calibrate_log(&log, true, stop).map_err(|e| Failure::Input(format!("calibrate: {e}")))?;
+                let params = log.recording_params(data.samples.last_t_s().max(1.0)).map_err(|e| Failure::Input(e.to_string()))?;
+                let sinks = open_sinks(save, &format!("{}-calibration", log.name), stop)?;
+                if let Err(e) = rinscope::record::calibration::log(sinks.stream(), &params, &cal, &report, &traces).and_then(|mut r| r.finish()) {
+                    sinks.abandon();
+                    return Err(Failure::Run(format!("rerun: {e}")));
+                }
+                let compensation = estimated_compensation(&log.table.chain, &cal, &log.table.compensation);
+                let json = serde_json::to_value(CalibrationOutput { report: &report, estimated_compensation: compensation }).map_err(|e| Failure::Run(e.to_string()))?;
+                finish(sinks, json, |_, _| ())
+            })??
+        }
+        _ => return Err(PyValueError::new_err("calibrate: give a scenario or log_dir (one of them)")),
+    };
+    Ok(to_python(py, out))
+}
+
+/// Little-endian float64 bytes as values.
+fn floats(bytes: &[u8], what: &str) -> Result<Vec<f64>, Failure> {
+    if bytes.len() % 8 != 0 {
+        return Err(Failure::Input(format!("{what}: {} bytes is not a whole number of float64 values", bytes.len())));
+    }
+    Ok(bytes.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().unwrap_or([0; 8]))).collect())
+}
+
+/// The Allan analysis of arrays: `specs` one `NAME:KIND[:UNIT]` per column (as `allan --column`),
+/// `columns` each column's little-endian float64 bytes, sampled at `rate_hz` or at `time_s`
+/// (float64 bytes, s). The analysis as `allan --json` writes it, and the curves and fits as tables
+/// (as `allan --export` writes them); the recording saved to `save` if given.
+#[pyfunction]
+#[pyo3(signature = (specs, columns, rate_hz=None, time_s=None, taus="octave", estimators="oadev", ci_sigma=1.0, decimate=1, save=None, description=None))]
+#[allow(clippy::too_many_arguments)]
+fn allan(
+    py: Python<'_>,
+    specs: Vec<String>,
+    columns: Vec<Vec<u8>>,
+    rate_hz: Option<f64>,
+    time_s: Option<Vec<u8>>,
+    taus: &str,
+    estimators: &str,
+    ci_sigma: f64,
+    decimate: usize,
+    save: Option<PathBuf>,
+    description: Option<String>,
+) -> PyResult<(String, Vec<(String, Py<PyBytes>)>)> {
+    use rinscope::app::allan::{analyze_series, options, parse_estimators, parse_taus};
+    let spacing = parse_taus(taus).map_err(|e| Failure::Input(format!("allan: taus {e}")))?;
+    let estimators = parse_estimators(estimators).map_err(|e| Failure::Input(format!("allan: estimators {e}")))?;
+    let request = AllanRequest { spacing, estimators, decimate, ci_sigma, errors_only: false };
+    options(&request).map_err(|e| Failure::Input(format!("allan: {}", e.to_string().replace("--ci-sigma", "ci_sigma").replace("--decimate", "decimate"))))?;
+    let specs: Vec<_> = specs.iter().map(|s| rinscope::io::series::SeriesColumn::parse(s).map_err(|e| Failure::Input(format!("allan: {e}")))).collect::<Result<_, _>>()?;
+    if specs.len() != columns.len() {
+        return Err(PyValueError::new_err(format!("allan: {} column specs for {} columns", specs.len(), columns.len())));
+    }
+    let values: Vec<Vec<f64>> = columns.iter().zip(&specs).map(|(b, s)| floats(b, &s.col.to_string())).collect::<Result<_, _>>()?;
+    let times = time_s.map(|b| floats(&b, "time_s")).transpose()?;
+    let out = interruptible(py, |stop| -> Result<Output, Failure> {
+        let data = rinscope::io::series::series_in_memory(&specs, values, rate_hz, times.as_deref()).map_err(|e| Failure::Input(format!("allan: {e}")))?;
+        let result = analyze_series(data, "arrays from Python", &request, 0.0).map_err(|e| Failure::Input(format!("allan: {e}")))?;
+        let mut tables = rinscope::record::export::Exporter::in_memory();
+        rinscope::record::allan::export(&mut tables, &result).map_err(|e| Failure::Run(e.to_string()))?;
+        let tables = tables.finish_in_memory().map_err(|e| Failure::Run(e.to_string()))?;
+        if let Some(path) = save {
+            let sinks = sink::open(&SinkRequest { save: Some(path), stop_on_failure: Some(Arc::clone(stop)), ..Default::default() }, APPLICATION_ID, "python-allan")?;
+            if let Err(e) = rinscope::record::allan::log(&sinks.stream(), &result, description.as_deref().unwrap_or("Arrays analysed from Python.")) {
+                sinks.abandon();
+                return Err(Failure::Run(format!("rerun: {e}")));
+            }
+            sinks.finish()?;
+        }
+        Ok((result.json().to_string(), tables.into_iter().map(ipc).collect::<Result<_, _>>()?))
+    })??;
+    Ok(to_python(py, out))
+}
+
+/// The Monte Carlo of a calibration scenario (its TOML text): `runs` calibrations on every core;
+/// the summary (as `montecarlo --json` writes it) with each run's estimation errors under "runs".
+#[pyfunction]
+#[pyo3(signature = (toml, runs=None, eta_measured_sigma_arcsec=None))]
+fn montecarlo(py: Python<'_>, toml: &str, runs: Option<usize>, eta_measured_sigma_arcsec: Option<f64>) -> PyResult<String> {
+    use rinscope::app::calibrate::{monte_carlo_runs, monte_carlo_setup};
+    use rinscope::calib::montecarlo::{summarize, Shard};
+    let mut params = parse(toml, "the scenario")?;
+    if let Some(s) = eta_measured_sigma_arcsec {
+        if !(s.is_finite() && s > 0.0 && s <= 3600.0) {
+            return Err(PyValueError::new_err(format!("eta_measured_sigma_arcsec {s}: must be > 0 and <= 3600 arcsec")));
+        }
+        params.calibration.montecarlo.eta_measured_sigma_rad = Some(s * rinscope::math::units::RAD_PER_ARCSEC);
+    }
+    let runs = runs.unwrap_or(params.calibration.montecarlo.runs as usize);
+    if runs == 0 || runs > 1_000_000 {
+        return Err(PyValueError::new_err(format!("runs {runs}: must be 1 ..= 1000000")));
+    }
+    let json = interruptible(py, |stop| -> Result<String, Failure> {
+        let started = std::time::Instant::now();
+        let done = monte_carlo_runs(&params, runs, Shard::WHOLE, &|| (), stop).map_err(|e| Failure::Input(format!("montecarlo: {e}")))?;
+        if done.len() < runs {
+            return Err(Failure::Interrupted(format!("montecarlo: stopped after {} of {runs} runs", done.len())));
+        }
+        let summary = summarize(&monte_carlo_setup(&params), runs, &done, started.elapsed().as_secs_f64());
+        let mut value = serde_json::to_value(&summary).map_err(|e| Failure::Run(e.to_string()))?;
+        value["runs"] = serde_json::to_value(&done).map_err(|e| Failure::Run(e.to_string()))?;
+        Ok(value.to_string())
+    })??;
+    Ok(json)
+}
+
+/// Checks that a saved recording is complete (header, footer, checksum).
+#[pyfunction]
+fn verify_recording(path: PathBuf) -> PyResult<()> {
+    sink::verify_recording(&path).map_err(PyValueError::new_err)
+}
+
+/// The `rinscope` command itself on `argv` (the program's name first); its exit code. Runs with
+/// the GIL released, and with the command's own signal handling (the caller resets Python's).
+#[pyfunction]
+fn cli(py: Python<'_>, argv: Vec<String>) -> u8 {
+    py.detach(|| rinscope::cli::main_with(argv))
 }
 
 #[pymodule]
 fn _rinscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("RERUN_VERSION", "0.36.3")?;
+    m.add("VERSION", env!("CARGO_PKG_VERSION"))?;
+    m.add("DEFAULT_SCENARIO", presets::DEFAULT_SCENARIO)?;
     m.add_function(wrap_pyfunction!(scenarios, m)?)?;
     m.add_function(wrap_pyfunction!(preset_toml, m)?)?;
     m.add_function(wrap_pyfunction!(check, m)?)?;
-    m.add_function(wrap_pyfunction!(run_summary, m)?)?;
+    m.add_function(wrap_pyfunction!(toml_to_json, m)?)?;
+    m.add_function(wrap_pyfunction!(json_to_toml, m)?)?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(replay, m)?)?;
+    m.add_function(wrap_pyfunction!(calibrate, m)?)?;
+    m.add_function(wrap_pyfunction!(allan, m)?)?;
+    m.add_function(wrap_pyfunction!(montecarlo, m)?)?;
+    m.add_function(wrap_pyfunction!(verify_recording, m)?)?;
+    m.add_function(wrap_pyfunction!(cli, m)?)?;
     Ok(())
 }

@@ -18,6 +18,40 @@ use crate::math::units::RAD_PER_DEG;
 use crate::scenario::logset::LogSet;
 use crate::scenario::Params;
 
+/// The cluster times `text` asks for: octave, decade, all, or N per decade (1 ..= 1000).
+///
+/// # Errors
+/// Anything else, quoted.
+pub fn parse_taus(text: &str) -> Result<TauSpacing, String> {
+    match text.trim() {
+        "octave" => Ok(TauSpacing::Octave),
+        "decade" => Ok(TauSpacing::Decade),
+        "all" => Ok(TauSpacing::All),
+        t => match t.parse::<u32>() {
+            Ok(n) if (1..=1000).contains(&n) => Ok(TauSpacing::PerDecade(n)),
+            _ => Err(format!("{t:?}: give octave, decade, all, or a number of cluster times per decade (1 ..= 1000)")),
+        },
+    }
+}
+
+/// The estimators of a comma-separated list of Stable32's names, or all.
+///
+/// # Errors
+/// A name that is not an estimator, quoted.
+pub fn parse_estimators(text: &str) -> Result<Vec<Estimator>, String> {
+    if text.trim() == "all" {
+        return Ok(Estimator::ALL.to_vec());
+    }
+    let mut list = Vec::new();
+    for name in text.split(',').map(str::trim).filter(|n| !n.is_empty()) {
+        let e = Estimator::parse(&name.to_lowercase()).ok_or_else(|| format!("{name:?} is not an estimator (adev, oadev, mdev, tdev, hdev, ohdev, totdev, or all)"))?;
+        if !list.contains(&e) {
+            list.push(e);
+        }
+    }
+    Ok(list)
+}
+
 /// How to analyse.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AllanRequest {
@@ -322,11 +356,21 @@ fn finish(g: Gather, source: String, seed: Option<u64>, rate_hz: f64, truth: Opt
 /// # Errors
 /// The file, a column, the sampling, a request out of range, a channel with too few samples.
 pub fn series(path: &std::path::Path, columns: &[SeriesColumn], sampling: &Sampling, req: &AllanRequest) -> Result<ImuAllan, AllanRunError> {
-    let mut opts = options(req)?;
-    opts.min_clusters = 2;
+    options(req)?;
     let started = Instant::now();
     let data = read_series(path, columns, sampling).map_err(|e| AllanRunError::Config(e.to_string()))?;
-    let gather_s = started.elapsed().as_secs_f64();
+    let source = format!("series {}", path.display());
+    analyze_series(data, &source, req, started.elapsed().as_secs_f64())
+}
+
+/// The columns of a series already read (a file's, or arrays in memory: `series_in_memory`),
+/// each its own channel, as [`series`] analyses them; `source` names where they came from.
+///
+/// # Errors
+/// A request out of range, a channel with too few samples.
+pub fn analyze_series(data: crate::io::series::Series, source: &str, req: &AllanRequest, gather_s: f64) -> Result<ImuAllan, AllanRunError> {
+    let mut opts = options(req)?;
+    opts.min_clusters = 2;
     let started = Instant::now();
     let mut notes = Vec::new();
     let mut channels = Vec::new();
@@ -353,7 +397,7 @@ pub fn series(path: &std::path::Path, columns: &[SeriesColumn], sampling: &Sampl
         }
         channels.push(channel);
     }
-    let source = format!("series {} ({})", path.display(), data.columns.iter().zip(&data.names).map(|(c, n)| format!("{n}: {} ({})", c.kind.name(), c.unit_text())).collect::<Vec<_>>().join("; "));
+    let source = format!("{source} ({})", data.columns.iter().zip(&data.names).map(|(c, n)| format!("{n}: {} ({})", c.kind.name(), c.unit_text())).collect::<Vec<_>>().join("; "));
     Ok(ImuAllan {
         source,
         seed: None,

@@ -185,6 +185,24 @@ fn final_state(pb: &Playback) -> FinalState {
     }
 }
 
+/// Replays `log` with `compensation` into `sinks` (a recorder laid out for a replay, its layout
+/// sent again once the length is known: a whole replay plays in about a minute); the sinks stay
+/// open (the caller finishes or abandons them). `stop` and `bar` as in [`replay`].
+///
+/// # Errors
+/// As [`replay`]; the recording's own failures are [`PlaybackError::Record`].
+pub fn replay_recorded(log: &LogSet, compensation: &TableErrors, sinks: &crate::record::sink::OpenSinks, stop: &AtomicBool, bar: Option<&indicatif::ProgressBar>) -> Result<ReplaySummary, PlaybackError> {
+    let rerun = |e: crate::record::RecordError| PlaybackError::Record(e.to_string());
+    let params = log.recording_params(1.0).map_err(|e| PlaybackError::Data(e.to_string()))?;
+    let kind = crate::record::ReplayKind { table: !log.table.strapdown, reference: !matches!(log.reference, Reference::None) };
+    let mut recorder = Recorder::new_replay(sinks.stream(), &params, kind).map_err(rerun)?;
+    let summary = replay(log, compensation, Some(&mut recorder), stop, bar)?;
+    if let Ok(p) = log.recording_params(summary.duration_s) {
+        recorder.resend_layout(&p).map_err(rerun)?;
+    }
+    Ok(summary)
+}
+
 /// Replays `log` with the compensation `compensation` (the table description's, or a calibration's)
 /// into `recorder` if given; `stop` ends it early (the summary says so); `bar`, if given, shows the
 /// replayed time.

@@ -16,34 +16,14 @@ use crate::math::allan::TauSpacing;
 use crate::scenario::{self, logset};
 use std::path::PathBuf;
 
-/// `--taus`: octave, decade, all, or N per decade (1 ..= 1000).
+/// `--taus`.
 fn parse_taus(text: &str) -> Result<TauSpacing, Failure> {
-    match text.trim() {
-        "octave" => Ok(TauSpacing::Octave),
-        "decade" => Ok(TauSpacing::Decade),
-        "all" => Ok(TauSpacing::All),
-        t => match t.parse::<u32>() {
-            Ok(n) if (1..=1000).contains(&n) => Ok(TauSpacing::PerDecade(n)),
-            _ => Err(Failure::input(format!("allan: --taus {t:?}: give octave, decade, all, or a number of cluster times per decade (1 ..= 1000)"))),
-        },
-    }
+    allan::parse_taus(text).map_err(|e| Failure::input(format!("allan: --taus {e}")))
 }
 
-/// `--estimator`: a comma-separated list of Stable32's names, or all.
+/// `--estimator`.
 fn parse_estimators(text: &str) -> Result<Vec<Estimator>, Failure> {
-    if text.trim() == "all" {
-        return Ok(Estimator::ALL.to_vec());
-    }
-    let mut list = Vec::new();
-    for name in text.split(',').map(str::trim).filter(|n| !n.is_empty()) {
-        let e = Estimator::parse(&name.to_lowercase()).ok_or_else(|| {
-            Failure::input(format!("allan: --estimator {name:?} is not an estimator (adev, oadev, mdev, tdev, hdev, ohdev, totdev, or all)"))
-        })?;
-        if !list.contains(&e) {
-            list.push(e);
-        }
-    }
-    Ok(list)
+    allan::parse_estimators(text).map_err(|e| Failure::input(format!("allan: --estimator {e}")))
 }
 
 /// The preset `rinscope allan` simulates when given neither a log set nor a scenario.

@@ -6,9 +6,8 @@ use super::commands::{check_output_dir, open_sinks, print_saved, read_small_file
 use super::{CalibrateArgs, ExportLogArgs, Failure, ReplayArgs};
 use crate::app::calibrate::{self as calibration, estimated_compensation, CalibrationOutput, LogCalibrationError};
 use crate::app::export_log::{export_log as write_log_set, LogFormat};
-use crate::app::replay::replay as replay_log;
+use crate::app::replay::replay_recorded;
 use crate::app::terminate::stop_flag;
-use crate::record::{Recorder, ReplayKind};
 use crate::scenario::logset::{self, RawImuFile, RawInitial, RawLogInfo, RawManifest, RawReference, RawTable};
 use crate::scenario::presets;
 
@@ -142,41 +141,27 @@ pub(super) fn replay(args: &ReplayArgs) -> Result<(), Failure> {
             logset::compensation_from_calibration(&log.raw_table, &text, &path.display().to_string())?
         }
     };
-    let params = log.recording_params(1.0)?;
+    log.recording_params(1.0)?;
     let default_save = PathBuf::from("recordings").join(format!("{}-replay.rrd", log.name));
     let sinks = open_sinks(args.sinks.request(default_save)?, &format!("{}-replay", log.name))?;
     let stop = stop_flag();
-    let kind = ReplayKind { table: !log.table.strapdown, reference: !matches!(log.reference, logset::Reference::None) };
-    let mut recorder = match Recorder::new_replay(sinks.stream(), &params, kind) {
-        Ok(r) => r,
-        Err(e) => {
-            sinks.abandon();
-            return Err(Failure::run(format!("rerun: {e}")));
-        }
-    };
     let bar = std::io::IsTerminal::is_terminal(&std::io::stderr()).then(|| {
         let bar = indicatif::ProgressBar::new_spinner();
         bar.enable_steady_tick(std::time::Duration::from_millis(200));
         bar.set_message("opening the log");
         bar
     });
-    let result = replay_log(&log, &compensation, Some(&mut recorder), &stop, bar.as_ref());
+    let result = replay_recorded(&log, &compensation, &sinks, &stop, bar.as_ref());
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
     let mut summary = match result {
         Ok(s) => s,
         Err(e) => {
-            drop(recorder);
             sinks.abandon();
             return Err(e.into());
         }
     };
-    // The layout again, now that the length is known: a whole replay plays in about a minute.
-    if let Ok(p) = log.recording_params(summary.duration_s) {
-        recorder.resend_layout(&p).map_err(|e| Failure::run(format!("rerun: {e}")))?;
-    }
-    drop(recorder);
     let saved = sinks.finish()?;
     if let Some((p, bytes)) = &saved.recording {
         summary.recording_path = Some(p.display().to_string());

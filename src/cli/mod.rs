@@ -198,6 +198,7 @@ impl SinkArgs {
             export,
             figures: self.figures.clone(),
             stop_on_failure: Some(crate::app::terminate::stop_flag()),
+            tables_in_memory: false,
         })
     }
 }
@@ -593,7 +594,19 @@ impl From<anyhow::Error> for Failure {
 /// Parses the command line, runs the command, maps its outcome to an exit code.
 #[must_use]
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    ExitCode::from(main_with(std::env::args_os()))
+}
+
+/// [`main`] on the command line `args` (the program's name first), its exit code as a number:
+/// what the Python package's `rinscope` command runs. `--help`, `--version` and a malformed
+/// command line end the process, as clap does.
+#[must_use]
+pub fn main_with<I, T>(args: I) -> u8
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    let cli = Cli::parse_from(args);
     let result = match cli.command.unwrap_or(Command::Run(RunArgs::default())) {
         Command::Run(args) => commands::run(&args),
         Command::Live(args) => commands::live(&args),
@@ -617,10 +630,10 @@ pub fn main() -> ExitCode {
         Command::Bench { peer: Some(_), python, rounds, samples, json, .. } => commands::bench_peer(python, rounds, samples, json.as_deref()),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(()) => 0,
         Err(f) => {
             errln!("rinscope: {}", f.message);
-            ExitCode::from(f.code)
+            f.code
         }
     }
 }

@@ -209,38 +209,63 @@ pub fn read_series(path: &Path, columns: &[SeriesColumn], sampling: &Sampling) -
         return Err(bad(format!("{rows} row(s): a series needs at least two samples")));
     }
     let tau0_s = match sampling {
-        Sampling::RateHz(hz) => {
-            if !(hz.is_finite() && *hz > 0.0 && *hz <= 1e9) {
-                return Err(bad(format!("--rate-hz {hz}: must be > 0 and at most 1e9 Hz")));
+        Sampling::RateHz(hz) => tau0_of_rate(*hz).map_err(bad)?,
+        Sampling::TimeColumn(..) => match even_step(&steps) {
+            Ok(_) => {
+                (t_prev - t_first.unwrap_or(0.0)) / (rows - 1) as f64
             }
-            1.0 / hz
-        }
-        Sampling::TimeColumn(..) => {
-            let mut sorted = steps.clone();
-            sorted.sort_by(f64::total_cmp);
-            let median = sorted[sorted.len() / 2];
-            if median.is_nan() || median <= 0.0 {
-                return Err(bad(format!("the time column does not advance (median step {median} s)")));
-            }
-            if let Some((k, d)) = steps.iter().enumerate().find(|(_, d)| (*d / median - 1.0).abs() > EVEN_TOLERANCE) {
+            Err(Uneven::Stalled(median)) => return Err(bad(format!("the time column does not advance (median step {median} s)"))),
+            Err(Uneven::Step { k, step, median }) => {
                 // Step k ends at data row k + 2 (1-based).
                 let at = Location { row: k as u64 + 2, line: None };
                 let time_col = &reader.columns()[columns.len()];
-                return Err(SeriesError::Log(LogError::BadValue {
-                    file: path.to_owned(),
-                    at,
-                    column: time_col.clone(),
-                    value: format!("step {d} s"),
-                    problem: format!(
-                        "where the series steps {median} s: the Allan-type estimators need evenly spaced samples (a gap, or a jitter over {} %); cut the file at the gap or resample it",
-                        EVEN_TOLERANCE * 100.0
-                    ),
-                }));
+                return Err(SeriesError::Log(LogError::BadValue { file: path.to_owned(), at, column: time_col.clone(), value: format!("step {step} s"), problem: uneven_problem(median) }));
             }
-            (t_prev - t_first.unwrap_or(0.0)) / (rows - 1) as f64
-        }
+        },
     };
-    let increments = columns
+    Ok(Series { names, columns: columns.to_vec(), increments: increments(columns, values, tau0_s), tau0_s, rows })
+}
+
+/// The sample interval of a rate, s.
+fn tau0_of_rate(hz: f64) -> Result<f64, String> {
+    if !(hz.is_finite() && hz > 0.0 && hz <= 1e9) {
+        return Err(format!("--rate-hz {hz}: must be > 0 and at most 1e9 Hz"));
+    }
+    Ok(1.0 / hz)
+}
+
+/// Why a time axis is not evenly spaced.
+enum Uneven {
+    /// The median step is not positive.
+    Stalled(f64),
+    /// Step `k` (from sample k to k + 1) is off the median by more than [`EVEN_TOLERANCE`].
+    Step { k: usize, step: f64, median: f64 },
+}
+
+/// The median of `steps` (s) if every step is within [`EVEN_TOLERANCE`] of it.
+fn even_step(steps: &[f64]) -> Result<f64, Uneven> {
+    let mut sorted = steps.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted[sorted.len() / 2];
+    if median.is_nan() || median <= 0.0 {
+        return Err(Uneven::Stalled(median));
+    }
+    match steps.iter().enumerate().find(|(_, d)| (*d / median - 1.0).abs() > EVEN_TOLERANCE) {
+        Some((k, step)) => Err(Uneven::Step { k, step: *step, median }),
+        None => Ok(median),
+    }
+}
+
+fn uneven_problem(median: f64) -> String {
+    format!(
+        "where the series steps {median} s: the Allan-type estimators need evenly spaced samples (a gap, or a jitter over {} %); cut the file at the gap or resample it",
+        EVEN_TOLERANCE * 100.0
+    )
+}
+
+/// Each column's values as increments in SI, one per sample interval `tau0_s`.
+fn increments(columns: &[SeriesColumn], values: Vec<Vec<f64>>, tau0_s: f64) -> Vec<Vec<f64>> {
+    columns
         .iter()
         .zip(values)
         .map(|(c, v)| {
@@ -251,8 +276,55 @@ pub fn read_series(path: &Path, columns: &[SeriesColumn], sampling: &Sampling) -
                 SeriesKind::Phase => v.windows(2).map(|w| (w[1] - w[0]) * f).collect(),
             }
         })
+        .collect()
+}
+
+/// A series given in memory (the Python package's arrays): `values` one vector per column of
+/// `columns` (their `col` a name), sampled at `rate_hz` or at `times_s` (s). The same checks as
+/// [`read_series`]: every value finite (the column and index named), equal lengths, at least two
+/// samples, even sampling.
+///
+/// # Errors
+/// Which column, index and value, or why the sampling is refused.
+pub fn series_in_memory(columns: &[SeriesColumn], values: Vec<Vec<f64>>, rate_hz: Option<f64>, times_s: Option<&[f64]>) -> Result<Series, SeriesError> {
+    let names: Vec<String> = columns
+        .iter()
+        .map(|c| match &c.col {
+            Col::Name(n) => n.clone(),
+            Col::Index(i) => i.to_string(),
+        })
         .collect();
-    Ok(Series { names, columns: columns.to_vec(), increments, tau0_s, rows })
+    let rows = values.first().map_or(0, Vec::len);
+    for (name, v) in names.iter().zip(&values) {
+        if v.len() != rows {
+            return Err(SeriesError::Series(format!("column {name}: {} samples where the first column has {rows}", v.len())));
+        }
+        if let Some((i, x)) = v.iter().enumerate().find(|(_, x)| !x.is_finite()) {
+            return Err(SeriesError::Series(format!("column {name}, sample {i}: {x} is not a finite number")));
+        }
+    }
+    if rows < 2 {
+        return Err(SeriesError::Series(format!("{rows} sample(s): a series needs at least two")));
+    }
+    let tau0_s = match (rate_hz, times_s) {
+        (Some(hz), None) => tau0_of_rate(hz).map_err(|e| SeriesError::Series(e.replace("--rate-hz", "rate_hz")))?,
+        (None, Some(t)) => {
+            if t.len() != rows {
+                return Err(SeriesError::Series(format!("time_s: {} times for {rows} samples", t.len())));
+            }
+            if let Some((i, x)) = t.iter().enumerate().find(|(_, x)| !x.is_finite()) {
+                return Err(SeriesError::Series(format!("time_s, sample {i}: {x} s is not a finite number")));
+            }
+            let steps: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+            match even_step(&steps) {
+                Ok(_) => (t[rows - 1] - t[0]) / (rows - 1) as f64,
+                Err(Uneven::Stalled(median)) => return Err(SeriesError::Series(format!("time_s does not advance (median step {median} s)"))),
+                Err(Uneven::Step { k, step, median }) => return Err(SeriesError::Series(format!("time_s, from sample {k} to {}: step {step} s {}", k + 1, uneven_problem(median)))),
+            }
+        }
+        _ => return Err(SeriesError::Series("give the sampling: rate_hz or time_s (not both)".into())),
+    };
+    Ok(Series { names, columns: columns.to_vec(), increments: increments(columns, values, tau0_s), tau0_s, rows })
 }
 
 #[cfg(test)]

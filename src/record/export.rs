@@ -2,6 +2,9 @@
 //! CSV) file per entity, a `t_s` column and one column per series, the unit in each column's name
 //! — for notebooks, MATLAB and spreadsheets (Rerun's own reader needs a server for .rrd files).
 //! The files go through `FILE.partial` and appear when the run finishes.
+//!
+//! The same tables can be kept in memory instead ([`Exporter::in_memory`]): what the Python
+//! package hands to pandas, with the same table and column names as the files.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -36,11 +39,58 @@ impl ExportFormat {
     }
 }
 
+/// Where the tables go.
+enum Target {
+    /// Files in a folder.
+    Files { dir: PathBuf, format: ExportFormat },
+    /// [`Table`]s in memory.
+    Memory,
+}
+
+/// One table kept in memory: a file's columns, each a vector of values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Table {
+    /// The name its file would have, without the extension (`attitude_error_arcsec__heading`).
+    pub name: String,
+    /// The entity (or table name) it was written under (`attitude_error_arcsec/heading`).
+    pub entity: String,
+    /// The column names, as in the file.
+    pub columns: Vec<String>,
+    /// One vector per column, all the same length.
+    pub values: Vec<Vec<f64>>,
+}
+
+/// A table being written: a file, or columns in memory.
+enum Open {
+    File(TableWriter),
+    Memory(Table),
+}
+
+impl Open {
+    fn columns(&self) -> &[String] {
+        match self {
+            Self::File(w) => w.columns(),
+            Self::Memory(t) => &t.columns,
+        }
+    }
+
+    fn write_row(&mut self, row: &[f64]) -> Result<(), LogError> {
+        match self {
+            Self::File(w) => w.write_row(row),
+            Self::Memory(t) => {
+                for (column, v) in t.values.iter_mut().zip(row) {
+                    column.push(*v);
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
 /// The tables of one recording.
 pub struct Exporter {
-    dir: PathBuf,
-    format: ExportFormat,
-    tables: BTreeMap<String, TableWriter>,
+    target: Target,
+    tables: BTreeMap<String, Open>,
     /// The first write that failed: the recording goes on, the run reports it at the end.
     failed: Option<LogError>,
     /// A replay's t = 0 on the IMU file's clock, s: every table then has `t_file_s` after `t_s`.
@@ -87,7 +137,23 @@ impl Exporter {
     /// Tables into `dir` (created if needed).
     pub fn new(dir: &Path, format: ExportFormat) -> std::io::Result<Self> {
         std::fs::create_dir_all(dir)?;
-        Ok(Self { dir: dir.to_path_buf(), format, tables: BTreeMap::new(), failed: None, file_clock_s: None })
+        Ok(Self { target: Target::Files { dir: dir.to_path_buf(), format }, tables: BTreeMap::new(), failed: None, file_clock_s: None })
+    }
+
+    /// Tables kept in memory, taken with [`Self::finish_in_memory`].
+    #[must_use]
+    pub fn in_memory() -> Self {
+        Self { target: Target::Memory, tables: BTreeMap::new(), failed: None, file_clock_s: None }
+    }
+
+    /// A table named like `entity`'s file with `columns`: a file, or in memory.
+    fn open(&self, entity: &str, columns: &[String], keyed: bool) -> Result<Open, LogError> {
+        let refs: Vec<&str> = columns.iter().map(String::as_str).collect();
+        Ok(match &self.target {
+            Target::Files { dir, .. } if keyed => Open::File(TableWriter::create_keyed(dir.join(self.file_name(entity)), &refs)?),
+            Target::Files { dir, .. } => Open::File(TableWriter::create(dir.join(self.file_name(entity)), &refs)?),
+            Target::Memory => Open::Memory(Table { name: table_name(entity), entity: entity.to_owned(), columns: columns.to_vec(), values: vec![Vec::new(); columns.len()] }),
+        })
     }
 
     /// A replay's t = 0 on the IMU file's clock, s: the tables created from now on have a
@@ -112,7 +178,6 @@ impl Exporter {
     pub fn try_write(&mut self, entity: &str, unit: &str, names: &[String], times: &[f64], values: &[f64]) -> Result<(), LogError> {
         let width = names.len();
         if !self.tables.contains_key(entity) {
-            let file = self.file_name(entity);
             let mut columns = vec!["t_s".to_owned()];
             if self.file_clock_s.is_some() {
                 columns.push("t_file_s".to_owned());
@@ -124,8 +189,7 @@ impl Exporter {
                 }
                 columns.push(c);
             }
-            let refs: Vec<&str> = columns.iter().map(String::as_str).collect();
-            let writer = TableWriter::create(self.dir.join(file), &refs)?;
+            let writer = self.open(entity, &columns, false)?;
             self.tables.insert(entity.to_owned(), writer);
         }
         let Some(writer) = self.tables.get_mut(entity) else { return Ok(()) };
@@ -148,8 +212,7 @@ impl Exporter {
     /// `columns`, the first one its key (`tau_s`, `axis`), and `rows` (see
     /// [`TableWriter::create_keyed`]).
     pub fn write_table(&mut self, name: &str, columns: &[String], rows: &[Vec<f64>]) -> Result<(), LogError> {
-        let refs: Vec<&str> = columns.iter().map(String::as_str).collect();
-        let mut writer = TableWriter::create_keyed(self.dir.join(self.file_name(name)), &refs)?;
+        let mut writer = self.open(name, columns, true)?;
         for row in rows {
             writer.write_row(row)?;
         }
@@ -159,24 +222,55 @@ impl Exporter {
 
     /// The file of the table of `entity`.
     fn file_name(&self, entity: &str) -> String {
-        format!("{}.{}", entity.trim_start_matches('/').replace('/', "__").replace('.', "_"), self.format.extension())
+        let extension = match &self.target {
+            Target::Files { format, .. } => format.extension(),
+            Target::Memory => "",
+        };
+        format!("{}.{extension}", table_name(entity))
     }
 
     /// Finishes every table; returns their paths (the first failed write, if any, instead: the
-    /// unfinished tables are then removed).
+    /// unfinished tables are then removed). Tables in memory are kept for
+    /// [`Self::finish_in_memory`].
     pub fn finish(&mut self) -> Result<Vec<PathBuf>, LogError> {
-        let tables = std::mem::take(&mut self.tables);
         if let Some(e) = self.failed.take() {
+            self.tables.clear();
             return Err(e);
         }
+        let Target::Files { dir, .. } = &self.target else { return Ok(Vec::new()) };
+        let dir = dir.clone();
         let mut out = Vec::new();
-        for (entity, writer) in tables {
-            let file = self.file_name(&entity);
-            writer.finish()?;
-            out.push(self.dir.join(file));
+        for (entity, table) in std::mem::take(&mut self.tables) {
+            if let Open::File(writer) = table {
+                let file = self.file_name(&entity);
+                writer.finish()?;
+                out.push(dir.join(file));
+            }
         }
         Ok(out)
     }
+
+    /// The tables kept in memory, in the order of their names (the first failed write, if any,
+    /// instead).
+    pub fn finish_in_memory(&mut self) -> Result<Vec<Table>, LogError> {
+        if let Some(e) = self.failed.take() {
+            self.tables.clear();
+            return Err(e);
+        }
+        Ok(std::mem::take(&mut self.tables)
+            .into_values()
+            .filter_map(|t| match t {
+                Open::Memory(t) => Some(t),
+                Open::File(_) => None,
+            })
+            .collect())
+    }
+}
+
+/// A table's name, which is its file's name without the extension: the entity path with `/` as
+/// `__` and `.` as `_`.
+fn table_name(entity: &str) -> String {
+    entity.trim_start_matches('/').replace('/', "__").replace('.', "_")
 }
 
 #[cfg(test)]

@@ -256,7 +256,7 @@ pub fn parse(text: &str, origin: &str) -> Result<Params, ConfigError> {
 
 /// The toml crate's message, which quotes the offending line: each quoted line cut to 160
 /// characters and the whole to 40 lines (a 200 kB line of nested brackets is not echoed back).
-pub(crate) fn parse_message(e: &toml::de::Error) -> String {
+pub fn parse_message(e: &toml::de::Error) -> String {
     const LINE: usize = 160;
     let text = e.to_string();
     let mut out: Vec<String> = Vec::new();

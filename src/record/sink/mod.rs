@@ -104,6 +104,8 @@ pub struct SinkRequest {
     pub stop_on_failure: Option<Arc<AtomicBool>>,
     /// Also write every time series as tables into this folder.
     pub export: Option<(PathBuf, ExportFormat)>,
+    /// Keep every time series as tables in memory (with no `export` folder): [`Saved::tables`].
+    pub tables_in_memory: bool,
     /// Draw every plot of the saved recording into this folder when the run ends (needs `save`).
     pub figures: Option<PathBuf>,
 }
@@ -249,12 +251,13 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
     }
 
     let export = match &req.export {
-        None => None,
+        None if !req.tables_in_memory => None,
         Some((dir, format)) => {
             let e = Exporter::new(dir, *format).map_err(|e| SinkError::Export(format!("{}: {e}", dir.display())))?;
             description.push(format!("exporting every time series as {format:?} tables to {}", dir.display()));
             Some(Arc::new(Mutex::new(e)))
         }
+        None => Some(Arc::new(Mutex::new(Exporter::in_memory()))),
     };
     let rec = RecordingStreamBuilder::new(application_id)
         .recording_id(recording_id.to_owned())
@@ -280,6 +283,8 @@ pub struct Saved {
     pub recording: Option<(PathBuf, u64)>,
     /// The export tables.
     pub exported: Vec<PathBuf>,
+    /// The tables kept in memory (`tables_in_memory`).
+    pub tables: Vec<crate::record::export::Table>,
     /// What went wrong with viewers (already reported when it happened).
     pub viewer_problems: Vec<String>,
     /// `--figures`: what was drawn.
@@ -314,9 +319,13 @@ impl OpenSinks {
             None => None,
             Some(f) => Some(f.finish().map_err(SinkError::Write)?),
         };
-        let exported = match export {
-            None => Vec::new(),
-            Some(e) => e.lock().unwrap_or_else(std::sync::PoisonError::into_inner).finish().map_err(|e| SinkError::ExportWrite(e.to_string()))?,
+        let (exported, tables) = match export {
+            None => (Vec::new(), Vec::new()),
+            Some(e) => {
+                let mut e = e.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+                let exported = e.finish().map_err(|e| SinkError::ExportWrite(e.to_string()))?;
+                (exported, e.finish_in_memory().map_err(|e| SinkError::ExportWrite(e.to_string()))?)
+            }
         };
         let viewer_problems = viewer_problems.lock().unwrap_or_else(std::sync::PoisonError::into_inner).clone();
         let figures = match (&figures, &recording) {
@@ -333,7 +342,7 @@ impl OpenSinks {
             drop(w);
         }
         drop(rec);
-        Ok(Saved { recording, exported, viewer_problems, figures })
+        Ok(Saved { recording, exported, tables, viewer_problems, figures })
     }
 
     /// Closes every sink and deletes the partial file (the run failed).
