@@ -59,6 +59,9 @@ def check(source: str | os.PathLike | Scenario) -> Scenario:
 
 
 def _toml(scenario: Any, default: str) -> str:
+    # A Scenario is valid (every write was checked): its text as it is, without a second check.
+    if isinstance(scenario, Scenario):
+        return scenario.toml
     return load(default if scenario is None else scenario).toml
 
 

@@ -36,7 +36,7 @@ class Tables(Mapping):
     def __getitem__(self, key: str):
         entity = self._key(key)
         if entity not in self._frames:
-            self._frames[entity] = self.arrow(entity).to_pandas()
+            self._frames[entity] = self.arrow(entity).to_pandas(split_blocks=True)
         return self._frames[entity]
 
     def __iter__(self) -> Iterator[str]:

@@ -118,13 +118,18 @@ fn to_python(py: Python<'_>, (json, tables): Output) -> (String, Vec<(String, Py
     (json, tables.into_iter().map(|(entity, bytes)| (entity, PyBytes::new(py, &bytes).unbind())).collect())
 }
 
+/// A call's output: its summary as JSON and the tables the sinks kept.
+fn output<S: Serialize>(summary: S, saved: sink::Saved) -> Result<Output, Failure> {
+    let json = serde_json::to_string(&summary).map_err(|e| Failure::Run(e.to_string()))?;
+    let tables = saved.tables.into_iter().map(ipc).collect::<Result<_, _>>()?;
+    Ok((json, tables))
+}
+
 /// Finishes the sinks and the call's output; `fill` adds the recording's path and size to the summary.
 fn finish<S: Serialize>(sinks: OpenSinks, mut summary: S, fill: impl FnOnce(&mut S, &sink::Saved)) -> Result<Output, Failure> {
     let saved = sinks.finish()?;
     fill(&mut summary, &saved);
-    let json = serde_json::to_string(&summary).map_err(|e| Failure::Run(e.to_string()))?;
-    let tables = saved.tables.into_iter().map(ipc).collect::<Result<_, _>>()?;
-    Ok((json, tables))
+    output(summary, saved)
 }
 
 /// The presets: (name, title) pairs, in the order `rinscope scenarios` lists them.
@@ -175,6 +180,46 @@ fn set_duration(params: &mut Params, duration_s: Option<f64>) -> Result<(), Fail
     Ok(())
 }
 
+/// The library's run of `params` into the sinks of a call (the recording if `save`, the tables in
+/// memory), finished: what `run` converts, and what `_time_run` times.
+fn run_to_sinks(params: &Params, save: Option<PathBuf>, stop: &Arc<AtomicBool>) -> Result<(rinscope::app::run::RunSummary, sink::Saved), Failure> {
+    let sinks = open_sinks(save, &format!("{}-seed{}", params.meta.name, params.meta.seed), stop)?;
+    let mut summary = match rinscope::app::run::run_recorded(params, &sinks, stop, false) {
+        Ok(s) => s,
+        Err(e) => {
+            sinks.abandon();
+            return Err(Failure::Run(format!("{e:#}")));
+        }
+    };
+    let saved = sinks.finish()?;
+    if let Some((path, bytes)) = &saved.recording {
+        summary.recording_path = Some(path.display().to_string());
+        summary.recording_bytes = Some(*bytes);
+    }
+    Ok((summary, saved))
+}
+
+/// The reference of the overhead benchmark (python/benchmarks/overhead.py): `repeats` runs of a
+/// scenario through the library, each timed in Rust from its TOML text to its finished tables
+/// (parse, simulate, tables kept in memory), without any conversion for Python; seconds each.
+#[pyfunction]
+fn _time_run(py: Python<'_>, toml: &str, duration_s: Option<f64>, repeats: usize) -> PyResult<Vec<f64>> {
+    py.detach(|| {
+        let stop = Arc::new(AtomicBool::new(false));
+        (0..repeats)
+            .map(|_| {
+                let started = std::time::Instant::now();
+                let mut params = parse(toml, "the scenario")?;
+                set_duration(&mut params, duration_s)?;
+                let (_, saved) = run_to_sinks(&params, None, &stop)?;
+                std::hint::black_box(saved.tables.len());
+                Ok(started.elapsed().as_secs_f64())
+            })
+            .collect::<Result<Vec<f64>, Failure>>()
+    })
+    .map_err(PyErr::from)
+}
+
 /// Runs a scenario (its TOML text) for `duration_s` (None: its own), saving the recording to
 /// `save` if given: the summary (as `run --summary-json` writes it) and every series as a table.
 #[pyfunction]
@@ -183,20 +228,8 @@ fn run(py: Python<'_>, toml: &str, duration_s: Option<f64>, save: Option<PathBuf
     let mut params = parse(toml, "the scenario")?;
     set_duration(&mut params, duration_s)?;
     let out = interruptible(py, |stop| -> Result<Output, Failure> {
-        let sinks = open_sinks(save, &format!("{}-seed{}", params.meta.name, params.meta.seed), stop)?;
-        let summary = match rinscope::app::run::run_recorded(&params, &sinks, stop, false) {
-            Ok(s) => s,
-            Err(e) => {
-                sinks.abandon();
-                return Err(Failure::Run(format!("{e:#}")));
-            }
-        };
-        finish(sinks, summary, |s, saved| {
-            if let Some((path, bytes)) = &saved.recording {
-                s.recording_path = Some(path.display().to_string());
-                s.recording_bytes = Some(*bytes);
-            }
-        })
+        let (summary, saved) = run_to_sinks(&params, save, stop)?;
+        output(summary, saved)
     })??;
     Ok(to_python(py, out))
 }
@@ -398,5 +431,6 @@ fn _rinscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(montecarlo, m)?)?;
     m.add_function(wrap_pyfunction!(verify_recording, m)?)?;
     m.add_function(wrap_pyfunction!(cli, m)?)?;
+    m.add_function(wrap_pyfunction!(_time_run, m)?)?;
     Ok(())
 }

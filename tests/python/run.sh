@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# The Python package on a real CPython: builds the wheel with maturin (from PyPI) into a venv, on the
+# same release profile and target directory as the Rust tests (only the bindings crate and the link
+# are new), installs it, runs the pytest tests (python/tests), the example script
+# (examples/sweep_inner_swing.py) and, once, the overhead benchmark (python/benchmarks/overhead.py,
+# printed, not asserted: speed targets are benchmarks, not tests).
+#
+#   tests/python/run.sh
+#
+# The venv is kept at $RINSCOPE_PY_VENV (default ~/.cache/rinscope-py-venv) so that rerun-sdk, pandas
+# and maturin are downloaded once; RINSCOPE_SKIP_PYTHON=1 skips all this and says so. Last line:
+# "python: N passed, M failed". About 1-2 min warm.
+set -euo pipefail
+if [[ ${RINSCOPE_SKIP_PYTHON:-} == 1 ]]; then
+  echo "python: SKIPPED (RINSCOPE_SKIP_PYTHON=1): the Python package was not built or tested"
+  exit 0
+fi
+root=$(cd "$(dirname "$0")/../.." && pwd)
+export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$HOME/.cache/rinscope-target}"
+venv=${RINSCOPE_PY_VENV:-$HOME/.cache/rinscope-py-venv}
+py=${PYTHON:-python3}
+if ! { [ -x "$venv/bin/python" ] && "$venv/bin/python" -c "import maturin, pytest, pandas, matplotlib, rerun, rerun_notebook" 2>/dev/null; }; then
+  rm -rf "$venv"
+  "$py" -m venv "$venv"
+  "$venv/bin/pip" install -q --upgrade pip
+  "$venv/bin/pip" install -q "maturin>=1.9,<2" pytest matplotlib pandas numpy "rerun-sdk[notebook]==0.36.3"
+fi
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+started=$(date +%s)
+# The wheel, as a user without Rust would get it: maturin build, then pip install of the file.
+(cd "$root/python" && "$venv/bin/maturin" build --release --quiet -o "$work/wheels" 2>&1 | tail -2)
+wheel=$(ls "$work"/wheels/rinscope-*.whl)
+echo "python: built $(basename "$wheel") ($(du -k "$wheel" | cut -f1) kB) in $(( $(date +%s) - started )) s"
+"$venv/bin/pip" install -q --force-reinstall --no-deps "$wheel"
+"$venv/bin/pip" install -q "$wheel"   # its declared dependencies, if any is missing
+# The tests run from a folder outside the repository, on the installed package.
+mkdir -p "$work/run"
+cd "$work/run"
+set +e
+"$venv/bin/python" -m pytest -q -p no:cacheprovider "$root/python/tests" 2>&1 | tee "$work/pytest.txt" | tail -25
+tests=${PIPESTATUS[0]}
+"$venv/bin/python" "$root/examples/sweep_inner_swing.py" > "$work/example.txt" 2>&1
+example=$?
+set -e
+tail -4 "$work/example.txt"
+[[ $example == 0 && -s sweep_inner_swing.png ]] && "$venv/bin/python" -c "import rinscope; rinscope.verify_recording('recordings/sweep_inner_swing.rrd')" || example=1
+"$venv/bin/python" "$root/python/benchmarks/overhead.py" --rounds 20 || true
+passed=$(grep -oE '[0-9]+ passed' "$work/pytest.txt" | awk '{s += $1} END {print s + 0}')
+failed=$(grep -oE '[0-9]+ (failed|errors?)' "$work/pytest.txt" | awk '{s += $1} END {print s + 0}')
+if [[ $tests != 0 || $example != 0 ]]; then
+  [[ $example != 0 ]] && { echo "python: examples/sweep_inner_swing.py failed:"; tail -20 "$work/example.txt"; }
+  echo "python: $passed passed, $(( ${failed:-0} + (example != 0) )) failed"
+  exit 1
+fi
+echo "python: $((passed + 1)) passed, 0 failed (pytest and the example script)"
