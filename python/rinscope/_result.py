@@ -69,7 +69,10 @@ class Result:
 
     def show(self, width: int | str = "auto", height: int | str = 640, theme: str = "dark"):
         """Shows the saved recording inline in a Jupyter notebook with Rerun's notebook viewer
-        (``pip install "rerun-sdk[notebook]==0.36.3"``); returns the viewer widget."""
+        (``pip install "rerun-sdk[notebook]==0.36.3"``); returns the viewer widget.
+
+        The widget loads the viewer from app.rerun.io; offline, set the environment variable
+        ``RERUN_NOTEBOOK_ASSET=serve-local`` before the first call (the kernel then serves it)."""
         if self.recording is None:
             raise ValueError("this result has no recording: run it with save=\"x.rrd\" to view it")
         from rerun.notebook import Viewer

@@ -302,6 +302,21 @@ def test_allan_refuses_bad_input_by_name(kwargs, says):
         assert word in str(e.value), f"{word!r} not in: {e.value}"
 
 
+def test_allan_of_arrays_is_the_commands_allan_of_the_file(tmp_path):
+    # The same gyro samples written by pandas as CSV and analysed by `rinscope allan --series`: the
+    # command reads the file, the package takes the arrays; the tables agree to the CSV's digits.
+    rng = np.random.default_rng(3)
+    df = pd.DataFrame({"t": np.arange(20_000) * 0.01, "gz": rng.normal(0.0, 6.0, 20_000) + 0.5})
+    df.to_csv(tmp_path / "gyro.csv", index=False, float_format="%.17g")
+    command("allan", "--series", "gyro.csv", "--column", "gz:rate:deg/h", "--time-column", "t", "--estimator", "oadev,mdev",
+            "--export", "tables", "--no-recording", cwd=tmp_path)
+    a = rinscope.allan(df[["gz"]], time_s=df.t, spec="rate:deg/h", estimators="oadev,mdev")
+    files = {f.stem: f for f in (tmp_path / "tables").glob("*.parquet")}
+    assert {e.replace("/", "__") for e in a.series} == set(files)
+    for entity in a.series:
+        pd.testing.assert_frame_equal(a[entity], pd.read_parquet(files[entity.replace("/", "__")]), rtol=1e-12)
+
+
 def test_allan_with_times_equals_allan_with_a_rate():
     y = nbs14_1000()
     by_rate = rinscope.allan(y, rate_hz=2.0)

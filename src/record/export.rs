@@ -290,4 +290,40 @@ mod tests {
         assert_eq!(column_base("-3σ"), "minus_3_sigma");
         assert_eq!(column_base("nominal − compensated table"), "nominal_minus_compensated_table");
     }
+
+    /// The tables kept in memory are the files' tables: the same names, columns (the file clock, a
+    /// repeated series name made unique) and values, checked against the CSV text the file target wrote.
+    #[test]
+    fn tables_in_memory_are_the_files_tables() {
+        let dir = std::env::temp_dir().join(format!("rinscope-export-memory-{}", std::process::id()));
+        let mut file = Exporter::new(&dir, ExportFormat::Csv).expect("folder");
+        let mut memory = Exporter::in_memory();
+        let names = vec!["uncompensated".to_owned(), "uncompensated".to_owned()];
+        for e in [&mut file, &mut memory] {
+            e.set_file_clock(100.0);
+            e.write("attitude_error_arcsec/heading", "arcsec", &names, &[0.0, 0.5], &[1.0, 2.0, 3.0, 4.0]);
+            e.write("attitude_error_arcsec/heading", "arcsec", &names, &[1.0], &[5.0, 6.0]);
+            e.write_table("allan/gyro_fit", &["axis".to_owned(), "n_deg_per_sqrt_h".to_owned()], &[vec![0.0, 0.01]]).expect("table");
+        }
+        let written = file.finish().expect("files");
+        assert!(memory.finish().expect("no files").is_empty());
+        let tables = memory.finish_in_memory().expect("tables");
+        assert_eq!(tables.len(), written.len());
+        for t in &tables {
+            let path = dir.join(format!("{}.csv", t.name));
+            assert!(written.contains(&path), "{}", path.display());
+            let text = std::fs::read_to_string(&path).expect("csv");
+            let mut lines = text.lines();
+            assert_eq!(lines.next().expect("header").split(',').collect::<Vec<_>>(), t.columns, "{}", t.name);
+            for (row, line) in lines.enumerate() {
+                let cells: Vec<f64> = line.split(',').map(|c| c.parse().expect("number")).collect();
+                let want: Vec<f64> = t.values.iter().map(|c| c[row]).collect();
+                assert_eq!(cells, want, "{} row {row}", t.name);
+            }
+        }
+        let heading = tables.iter().find(|t| t.entity == "attitude_error_arcsec/heading").expect("heading");
+        assert_eq!(heading.columns, ["t_s", "t_file_s", "uncompensated_arcsec", "uncompensated_3_arcsec"]);
+        assert_eq!(heading.values[1], [100.0, 100.5, 101.0]);
+        std::fs::remove_dir_all(&dir).ok();
+    }
 }
