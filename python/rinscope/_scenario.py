@@ -24,6 +24,28 @@ def _dotted(path: tuple) -> str:
     return out
 
 
+def _plain(value: Any, path: tuple) -> Any:
+    """A value as TOML holds it: numpy scalars and arrays, tuples and paths become Python numbers,
+    lists and strings; what TOML cannot hold is refused naming the key."""
+    if isinstance(value, Section):
+        return value.to_dict()
+    if isinstance(value, SectionList):
+        return value.to_list()
+    if isinstance(value, (bool, int, float, str)):
+        return value
+    if isinstance(value, dict):
+        return {str(k): _plain(v, path + (str(k),)) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v, path + (i,)) for i, v in enumerate(value)]
+    if isinstance(value, os.PathLike):
+        return os.fspath(value)
+    if hasattr(value, "tolist"):  # numpy scalars and arrays
+        return _plain(value.tolist(), path)
+    if value is None:
+        raise ValueError(f"`{_dotted(path)}` = None: TOML has no null; to take the default, delete the key (del ...)")
+    raise ValueError(f"`{_dotted(path)}` = {value!r}: a {type(value).__name__} is not a TOML value (numbers, strings, booleans, lists, tables)")
+
+
 def _non_finite(node: Any, path: tuple = ()):
     """The path and value of the first NaN or infinity in ``node`` (JSON cannot carry them)."""
     if isinstance(node, float) and node != node or node in (float("inf"), float("-inf")):
@@ -78,6 +100,9 @@ class Section:
 
     def __setattr__(self, key: str, value: Any) -> None:
         self[key] = value
+
+    def __delattr__(self, key: str) -> None:
+        del self[key]
 
     def __contains__(self, key: str) -> bool:
         return key in self._node()
@@ -216,14 +241,10 @@ class Scenario(Section):
                 node = node[key] if isinstance(node, list) else node.setdefault(key, {})
                 if not isinstance(node, (dict, list)):
                     raise ValueError(f"{'.'.join(map(str, path[:-1]))} is a value, not a table")
-            if isinstance(value, Section):
-                value = value.to_dict()
-            elif isinstance(value, SectionList):
-                value = value.to_list()
             if value is _DELETE:
                 node.pop(path[-1], None)
             else:
-                node[path[-1]] = _copy.deepcopy(value)
+                node[path[-1]] = _plain(value, path)
         try:
             self._check(data)
         except ValueError as e:

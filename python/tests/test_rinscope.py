@@ -89,6 +89,14 @@ def test_keys_read_and_write_as_items_and_attributes(tmp_path):
     s["simulation"]["duration_s"] = 30.0
     s.scheme.rate["outer"].rate_deg_per_s = -5.0
     assert s.scheme.rate[0].rate_deg_per_s == -5.0
+    s.turntable.axis["inner"].swing_half_angle_arcsec = np.arange(10)[4] * 100  # a numpy integer is a number
+    assert s.turntable.axis["inner"].swing_half_angle_arcsec == 400 and "400" in s.toml
+    s.recording.error_unit = "arcsec"
+    del s.recording.error_unit  # back to the default
+    assert "error_unit" not in s.recording
+    with pytest.raises(ValueError, match="error_unit"):
+        s.recording.error_unit = None
+    s.turntable.axis["inner"].swing_half_angle_arcsec = 450
     s.simulation.update(duration_s=20.0, step_hz=100.0)
     assert (s.simulation.duration_s, s.simulation.step_hz) == (20.0, 100.0)
     path = s.save(tmp_path / "mine.toml")

@@ -46,8 +46,8 @@ set -e
 tail -4 "$work/example.txt"
 [[ $example == 0 && -s sweep_inner_swing.png ]] && "$venv/bin/python" -c "import rinscope; rinscope.verify_recording('recordings/sweep_inner_swing.rrd')" || example=1
 "$venv/bin/python" "$root/python/benchmarks/overhead.py" --rounds 20 || true
-passed=$(grep -oE '[0-9]+ passed' "$work/pytest.txt" | awk '{s += $1} END {print s + 0}')
-failed=$(grep -oE '[0-9]+ (failed|errors?)' "$work/pytest.txt" | awk '{s += $1} END {print s + 0}')
+passed=$(grep -oE '[0-9]+ passed' "$work/pytest.txt" | awk '{s += $1} END {print s + 0}' || true)
+failed=$(grep -oE '[0-9]+ (failed|errors?)' "$work/pytest.txt" | awk '{s += $1} END {print s + 0}' || true)
 if [[ $tests != 0 || $example != 0 ]]; then
   [[ $example != 0 ]] && { echo "python: examples/sweep_inner_swing.py failed:"; tail -20 "$work/example.txt"; }
   echo "python: $passed passed, $(( ${failed:-0} + (example != 0) )) failed"
