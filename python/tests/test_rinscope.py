@@ -105,6 +105,7 @@ def test_keys_read_and_write_as_items_and_attributes(tmp_path):
     again = rinscope.load(path)
     assert again.turntable.axis["inner"].swing_half_angle_arcsec == 450 and again.to_dict() == s.to_dict()
     assert rinscope.load(s) is not s and rinscope.load(s).to_dict() == s.to_dict()
+    assert rinscope.check(path).to_dict() == s.resolved().to_dict()
     resolved = s.resolved()
     assert "scene_hz" not in s.recording and resolved.recording.scene_hz > 0  # a default written out
 
@@ -203,6 +204,35 @@ def test_ctrl_c_stops_a_run_cleanly(tmp_path):
     assert time.time() - sent < 10, "the run did not stop promptly"
     rinscope.verify_recording(tmp_path / "long.rrd")  # complete up to that moment
     assert not (tmp_path / "long.rrd.partial").exists()
+
+
+def test_a_notebooks_interrupt_stops_a_run_and_the_kernel_lives_on(tmp_path):
+    # A real Jupyter kernel (ipykernel) driven by jupyter_client, interrupted as a notebook's
+    # "interrupt the kernel" button does it (km.interrupt_kernel: SIGINT to the kernel).
+    jupyter_client = pytest.importorskip("jupyter_client")
+    pytest.importorskip("ipykernel")
+    km, kc = jupyter_client.manager.start_new_kernel(kernel_name="python3", cwd=str(tmp_path))
+    try:
+        msg_id = kc.execute("import rinscope\nr = rinscope.run(duration_s=2_000_000, save='nb.rrd')")
+        deadline = time.time() + 60
+        while not (tmp_path / "nb.rrd.partial").exists() and time.time() < deadline:
+            time.sleep(0.05)
+        time.sleep(1.0)
+        sent = time.time()
+        km.interrupt_kernel()
+        while True:
+            reply = kc.get_shell_msg(timeout=60)
+            if reply["parent_header"].get("msg_id") == msg_id:
+                break
+        assert reply["content"]["status"] == "error" and reply["content"]["ename"] == "KeyboardInterrupt", reply["content"]
+        assert time.time() - sent < 10
+        rinscope.verify_recording(tmp_path / "nb.rrd")  # complete up to that moment
+        # The kernel goes on: the next cell runs.
+        after = kc.execute_interactive("r = rinscope.run(duration_s=5)\nassert not r.summary['interrupted']", timeout=60)
+        assert after["content"]["status"] == "ok", after["content"]
+    finally:
+        kc.stop_channels()
+        km.shutdown_kernel(now=True)
 
 
 # --- replay and calibrate ------------------------------------------------------------------------------

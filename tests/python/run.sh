@@ -19,11 +19,10 @@ root=$(cd "$(dirname "$0")/../.." && pwd)
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$HOME/.cache/rinscope-target}"
 venv=${RINSCOPE_PY_VENV:-$HOME/.cache/rinscope-py-venv}
 py=${PYTHON:-python3}
-if ! { [ -x "$venv/bin/python" ] && "$venv/bin/python" -c "import maturin, pytest, pandas, matplotlib, rerun, rerun_notebook" 2>/dev/null; }; then
-  rm -rf "$venv"
-  "$py" -m venv "$venv"
-  "$venv/bin/pip" install -q --upgrade pip
-  "$venv/bin/pip" install -q "maturin>=1.9,<2" pytest matplotlib pandas numpy "rerun-sdk[notebook]==0.36.3"
+[ -x "$venv/bin/python" ] || { "$py" -m venv "$venv" && "$venv/bin/pip" install -q --upgrade pip; }
+# ipykernel: a test interrupts a run in a real Jupyter kernel (jupyter_client comes with rerun-notebook).
+if ! "$venv/bin/python" -c "import maturin, pytest, pandas, matplotlib, rerun, rerun_notebook, ipykernel, jupyter_client" 2>/dev/null; then
+  "$venv/bin/pip" install -q "maturin>=1.9,<2" pytest matplotlib pandas numpy "rerun-sdk[notebook]==0.36.3" ipykernel jupyter_client
 fi
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
