@@ -174,6 +174,27 @@ def test_run_without_a_recording_and_a_scenario_object():
     assert r["attitude_error_arcsec/heading"].iloc[:, 1:].abs().max().max() < 1e-6
 
 
+def test_runs_in_threads_are_the_runs_one_after_the_other():
+    from concurrent.futures import ThreadPoolExecutor
+
+    base = rinscope.load("jiang2017-dual-axis")
+
+    def peak(alpha):
+        s = base.copy()
+        s.turntable.axis["inner"].swing_half_angle_arcsec = alpha
+        r = rinscope.run(s, duration_s=120)
+        return r.summary["attitude_error_arcsec"]["uncompensated"]["heading"]["peak_arcsec"], r["attitude_error_arcmin/heading"]
+
+    alphas = [0.0, 300.0, 600.0, 900.0]
+    serial = [peak(a) for a in alphas]
+    with ThreadPoolExecutor(4) as ex:
+        parallel = list(ex.map(peak, alphas))
+    for (p1, t1), (p2, t2) in zip(serial, parallel):
+        assert p1 == p2
+        pd.testing.assert_frame_equal(t1, t2, check_exact=True)
+    assert len({p for p, _ in serial}) == len(alphas)  # the sweep changed something
+
+
 @pytest.mark.parametrize("duration_s", [-1.0, 0.0, float("nan"), 1e9])
 def test_run_refuses_a_bad_duration(duration_s):
     with pytest.raises(ValueError, match="duration_s"):

@@ -50,6 +50,15 @@ pub enum OutputError {
         /// What it is.
         problem: &'static str,
     },
+    /// The path is a FIFO, a socket or a device: the atomic rename would replace it with a file
+    /// (`--json /dev/null` as root would replace /dev/null).
+    #[error("{}: is {kind}, not a regular file; an output replaces its file when complete, which would remove it: give a file name", .path.display())]
+    NotRegular {
+        /// The output path.
+        path: PathBuf,
+        /// What it is ("a FIFO", "a device", ...).
+        kind: &'static str,
+    },
     /// The output would replace a file this run reads.
     #[error("{}: is an input of this run; choose another name for the output", .0.display())]
     IsInput(PathBuf),
@@ -158,6 +167,9 @@ fn check_path(path: &Path, may_replace_input: bool) -> Result<(), OutputError> {
     if !may_replace_input && is_input(path, dir) {
         return Err(OutputError::IsInput(path.to_path_buf()));
     }
+    if let Some(kind) = std::fs::metadata(path).ok().and_then(|m| special_kind(&m.file_type())) {
+        return Err(OutputError::NotRegular { path: path.to_path_buf(), kind });
+    }
     // Checked again when the partial is opened (O_NOFOLLOW); here so that a long run is not
     // wasted on an output that will be refused at its end.
     let partial = partial_path(path);
@@ -165,6 +177,25 @@ fn check_path(path: &Path, may_replace_input: bool) -> Result<(), OutputError> {
         return Err(OutputError::NotAFile { partial, problem: "is a symlink" });
     }
     Ok(())
+}
+
+/// What a file that is neither a regular file nor a directory is ("a FIFO", ...), or None.
+fn special_kind(t: &std::fs::FileType) -> Option<&'static str> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt as _;
+        if t.is_fifo() {
+            return Some("a FIFO (named pipe)");
+        }
+        if t.is_socket() {
+            return Some("a socket");
+        }
+        if t.is_char_device() || t.is_block_device() {
+            return Some("a device");
+        }
+    }
+    let _ = t;
+    None
 }
 
 /// The partials this process is writing (removed by [`remove_unfinished`]).
@@ -368,6 +399,22 @@ fn write_through(out: PartialFile, bytes: &[u8]) -> Result<(), OutputError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[cfg(unix)]
+    #[test]
+    fn a_device_or_a_fifo_is_not_replaced_by_an_output() {
+        let e = check_output_path(Path::new("/dev/null")).expect_err("a device");
+        assert!(e.to_string().contains("/dev/null: is a device, not a regular file"), "{e}");
+        let d = scratch("fifo");
+        let fifo = d.join("out.json");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status().is_ok_and(|s| s.success());
+        if made {
+            let e = write_atomically(&fifo, b"{}").expect_err("a FIFO");
+            assert!(e.to_string().contains("FIFO"), "{e}");
+            assert!(std::fs::symlink_metadata(&fifo).is_ok_and(|m| special_kind(&m.file_type()).is_some()), "the FIFO is still there");
+        }
+        std::fs::remove_dir_all(&d).ok();
+    }
 
     fn scratch(name: &str) -> PathBuf {
         let d = std::env::temp_dir().join(format!("rinscope-files-{name}-{}", std::process::id()));
