@@ -26,7 +26,7 @@ from . import _rinscope
 from ._result import Result, Tables, result as _result
 from ._scenario import Scenario, Section
 
-__all__ = ["scenarios", "load", "check", "run", "replay", "calibrate", "allan", "montecarlo", "verify_recording", "Scenario", "Section", "Result", "Tables", "DEFAULT_SCENARIO", "__version__"]
+__all__ = ["scenarios", "load", "check", "run", "replay", "calibrate", "allan", "montecarlo", "selfcal", "verify_recording", "Scenario", "Section", "Result", "Tables", "DEFAULT_SCENARIO", "__version__"]
 
 __version__ = _rinscope.VERSION
 DEFAULT_SCENARIO = _rinscope.DEFAULT_SCENARIO
@@ -160,6 +160,19 @@ def montecarlo(scenario: Any = None, runs: int | None = None, eta_measured_sigma
     r = Result("montecarlo", summary, [], None)
     r.series = Tables([], {"runs": per_run, "rows": rows})
     return r
+
+
+def selfcal(scenario: Any = None, sequence: str = "dual-axis-29", monte_carlo: int | None = None, navigate_hours: float = 24.0,
+            save: str | os.PathLike | None = None) -> Result:
+    """Self-calibrates a scenario's IMU on its own gimbals (default scenario: selfcal-nav-grade;
+    ``rinscope selfcal``): ``sequence`` "dual-axis-29", "positions-19", "azimuth-only" or
+    "scenario" (its own indexed [scheme]); ``monte_carlo`` runs over random IMUs (1σ against
+    spread); ``navigate_hours`` of free-inertial comparison (none / estimated / true compensation;
+    0 skips it, 24 h take about 10 s). ``summary`` is ``selfcal --json``'s (21 parameters in SI:
+    ``parameters``, ``estimate``, ``sigma``, ``truth``, the plan under ``observability``) with the
+    printed table under ``"table"``; ``series`` the recording's (σ histories, estimate − truth)."""
+    out = _rinscope.selfcal(_toml(scenario, "selfcal-nav-grade"), sequence, monte_carlo, navigate_hours, _path(save))
+    return _result("selfcal", out, None, save)
 
 
 def verify_recording(path: str | os.PathLike) -> None:

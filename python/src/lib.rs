@@ -15,6 +15,7 @@ use pyo3::types::PyBytes;
 use serde::Serialize;
 
 use rinscope::app::allan::AllanRequest;
+
 use rinscope::record::export::Table;
 use rinscope::record::sink::{self, OpenSinks, SinkRequest};
 use rinscope::record::APPLICATION_ID;
@@ -401,6 +402,39 @@ fn montecarlo(py: Python<'_>, toml: &str, runs: Option<usize>, eta_measured_sigm
     Ok(json)
 }
 
+/// Self-calibrates the IMU of a scenario (its TOML text) on its own gimbals through `sequence`
+/// (`dual-axis-29`, `positions-19`, `azimuth-only`, `scenario`), with `monte_carlo` runs and
+/// `navigate_hours` of free-inertial comparison (0: none): the document `selfcal --json` writes
+/// (with the printed table under "table") and the recording's series.
+#[pyfunction]
+#[pyo3(signature = (toml, sequence="dual-axis-29", monte_carlo=None, navigate_hours=24.0, save=None))]
+fn selfcal(py: Python<'_>, toml: &str, sequence: &str, monte_carlo: Option<usize>, navigate_hours: f64, save: Option<PathBuf>) -> PyResult<(String, Vec<(String, Py<PyBytes>)>)> {
+    use rinscope::app::selfcal::{self as sc, SequenceChoice};
+    let params = parse(toml, "the scenario")?;
+    if !(navigate_hours.is_finite() && (0.0..=720.0).contains(&navigate_hours)) {
+        return Err(PyValueError::new_err(format!("navigate_hours {navigate_hours}: must be 0 (skip) to 720 h")));
+    }
+    if monte_carlo.is_some_and(|n| n == 0 || n > 100_000) {
+        return Err(PyValueError::new_err(format!("monte_carlo {}: must be 1 ..= 100000 runs (or None)", monte_carlo.unwrap_or(0))));
+    }
+    let choice = SequenceChoice::parse(sequence).map_err(|e| PyValueError::new_err(format!("sequence {e}")))?;
+    let setup = sc::setup(&params, choice).map_err(|e| PyValueError::new_err(format!("{e:#}")))?;
+    let out = interruptible(py, |stop| -> Result<Output, Failure> {
+        let failed = |e: anyhow::Error| if stop.load(Ordering::SeqCst) { Failure::Interrupted("selfcal: stopped; nothing was estimated".into()) } else { Failure::Run(format!("selfcal: {e:#}")) };
+        let plan = sc::plan(&setup, params.meta.seed, stop).map_err(failed)?;
+        let report = sc::calibrate(&params, setup, plan, monte_carlo, navigate_hours, stop).map_err(failed)?;
+        let sinks = open_sinks(save, &format!("{}-selfcal-seed{}", params.meta.name, params.meta.seed), stop)?;
+        if let Err(e) = rinscope::record::selfcal::log(&sinks.stream(), &report.view(&params.meta.name)) {
+            sinks.abandon();
+            return Err(Failure::Run(format!("rerun: {e}")));
+        }
+        let mut json = report.json();
+        json["table"] = serde_json::Value::String(report.table.clone());
+        finish(sinks, json, |_, _| ())
+    })??;
+    Ok(to_python(py, out))
+}
+
 /// Checks that a saved recording is complete (header, footer, checksum).
 #[pyfunction]
 fn verify_recording(path: PathBuf) -> PyResult<()> {
@@ -429,6 +463,7 @@ fn _rinscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(allan, m)?)?;
     m.add_function(wrap_pyfunction!(montecarlo, m)?)?;
+    m.add_function(wrap_pyfunction!(selfcal, m)?)?;
     m.add_function(wrap_pyfunction!(verify_recording, m)?)?;
     m.add_function(wrap_pyfunction!(cli, m)?)?;
     m.add_function(wrap_pyfunction!(_time_run, m)?)?;

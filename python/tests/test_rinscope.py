@@ -404,6 +404,29 @@ def test_montecarlo_refuses_zero_runs():
         rinscope.montecarlo(runs=0)
 
 
+# --- selfcal ---------------------------------------------------------------------------------------
+
+
+def test_selfcal_gives_the_commands_document(tmp_path):
+    r = rinscope.selfcal(navigate_hours=0, save=tmp_path / "s.rrd")
+    rinscope.verify_recording(tmp_path / "s.rrd")
+    command("selfcal", "--navigate-hours", 0, "--no-recording", "--json", "s.json", cwd=tmp_path)
+    want = json.loads((tmp_path / "s.json").read_text())
+    for key in ("sequence", "parameters", "truth", "estimate", "sigma", "observability"):
+        assert r.summary[key] == want[key], key
+    assert "Kg_xx" in r.summary["table"]
+    err = r["selfcal/error/Kg_xx_ppm"]
+    assert err.columns[0] == "t_s" and len(err) > 100
+
+
+@pytest.mark.parametrize("kwargs, says", [(dict(sequence="dual-axis-30"), ["dual-axis-30", "positions-19"]), (dict(navigate_hours=-1), ["navigate_hours", "-1"]), (dict(monte_carlo=0), ["monte_carlo", "0"])])
+def test_selfcal_refuses_bad_input_by_name(kwargs, says):
+    with pytest.raises(ValueError) as e:
+        rinscope.selfcal(**kwargs)
+    for word in says:
+        assert word in str(e.value), f"{word!r} not in: {e.value}"
+
+
 # --- the command and the viewer --------------------------------------------------------------------------
 
 

@@ -26,6 +26,101 @@ pub enum SequenceChoice {
     Scenario,
 }
 
+impl SequenceChoice {
+    /// A sequence by its name (`dual-axis-29`, `positions-19`, `azimuth-only`) or `scenario`.
+    ///
+    /// # Errors
+    /// Any other name, with the list.
+    pub fn parse(name: &str) -> std::result::Result<Self, String> {
+        match name {
+            "scenario" => Ok(Self::Scenario),
+            name => Sequence::named(name).map(Self::BuiltIn).ok_or_else(|| {
+                let names: Vec<&str> = Sequence::ALL.iter().map(|(_, n)| *n).collect();
+                format!("{name}: not a sequence; use one of {names:?} or \"scenario\"")
+            }),
+        }
+    }
+}
+
+/// What the documents say of their numbers' units.
+pub const JSON_UNITS: &str = "SI (rad/s, m/s², dimensionless gains)";
+
+/// A simulated self-calibration, whole: the plan, the estimate, the Monte Carlo and the
+/// free-inertial comparison, with the table the terminal prints ([`calibrate`]).
+pub struct Report {
+    /// The setup.
+    pub setup: Setup,
+    /// The plan: what the sequence's noise-free motion lets the filter see.
+    pub plan: selfcal::Observability,
+    /// The estimate of the scenario's IMU.
+    pub outcome: Outcome,
+    /// The Monte Carlo, if asked for.
+    pub monte_carlo: Option<MonteCarlo>,
+    /// The free-inertial comparison (empty if not asked for).
+    pub navigation: Vec<NavRow>,
+    /// The result as the terminal prints it.
+    pub table: String,
+}
+
+/// The plan of `setup`: its noise-free motion through the same filter (its 1σ depend on the
+/// motion only), before any IMU is drawn.
+///
+/// # Errors
+/// Stopped, or the filter failed.
+pub fn plan(setup: &Setup, seed: u64, stop: &AtomicBool) -> Result<selfcal::Observability> {
+    Ok(selfcal::observability(&run_one(setup, seed, true, stop)?.estimate))
+}
+
+/// Self-calibrates `p`'s IMU on `setup` with its `plan`, then `monte_carlo` runs and
+/// `navigate_hours` of free-inertial comparison (0: none).
+///
+/// # Errors
+/// Stopped, or a run failed.
+pub fn calibrate(p: &Params, setup: Setup, plan: selfcal::Observability, monte_carlo: Option<usize>, navigate_hours: f64, stop: &AtomicBool) -> Result<Report> {
+    let outcome = run_one(&setup, p.meta.seed, false, stop)?;
+    let monte_carlo = monte_carlo.map(|n| self::monte_carlo(&setup, n, p.meta.seed + 1, stop)).transpose()?;
+    let navigation = if navigate_hours > 0.0 { navigation_comparison(p, &outcome, navigate_hours, stop)? } else { Vec::new() };
+    let mut table = self::table(&setup, &outcome, &plan, monte_carlo.as_ref());
+    if !navigation.is_empty() {
+        table.push_str(&navigation_table(&navigation, navigate_hours));
+    }
+    Ok(Report { setup, plan, outcome, monte_carlo, navigation, table })
+}
+
+impl Report {
+    /// The recording's view of it, titled with the scenario's name.
+    #[must_use]
+    pub fn view(&self, name: &str) -> crate::record::selfcal::SelfcalView<'_> {
+        crate::record::selfcal::SelfcalView {
+            title: format!("{name} — {}", self.setup.sequence),
+            table: &self.table,
+            history: &self.outcome.estimate.history,
+            prior: &self.outcome.estimate.prior,
+            truth: Some(self.outcome.truth().to_params()),
+            move_starts_s: &self.setup.move_starts_s,
+            attitude: &self.outcome.attitude,
+            navigation: self.navigation.iter().map(|r| &r.trace).collect(),
+        }
+    }
+
+    /// The document `selfcal --json` writes.
+    #[must_use]
+    pub fn json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "sequence": self.setup.sequence,
+            "parameters": selfcal::param_names(),
+            "units": JSON_UNITS,
+            "truth": self.outcome.truth().to_params(),
+            "estimate": self.outcome.estimate.params,
+            "sigma": self.outcome.estimate.sigma,
+            "estimation_s": self.outcome.estimation_s,
+            "observability": self.plan,
+            "monte_carlo": self.monte_carlo,
+            "navigation": self.navigation,
+        })
+    }
+}
+
 /// A self-calibration set up: the table with its sequence, the IMU's errors, the filter's knowledge.
 #[derive(Debug, Clone)]
 pub struct Setup {

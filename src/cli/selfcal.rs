@@ -11,7 +11,6 @@ use crate::app::terminate::stop_flag;
 /// `rinscope selfcal`.
 pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
     use crate::app::selfcal::{self as sc, SequenceChoice};
-    use crate::ins::selfcal::{observability, Sequence};
     if let Some(dir) = &args.log {
         return selfcal_log(args, dir);
     }
@@ -21,20 +20,11 @@ pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
     }
     let params = args.source.load("selfcal-nav-grade")?;
     check_output_dir("--json", args.json.as_deref())?;
-    let choice = match args.sequence.as_str() {
-        "scenario" => SequenceChoice::Scenario,
-        name => SequenceChoice::BuiltIn(Sequence::named(name).ok_or_else(|| {
-            let names: Vec<&str> = Sequence::ALL.iter().map(|(_, n)| *n).collect();
-            Failure::input(format!("--sequence {name}: not a sequence; use one of {names:?} or \"scenario\""))
-        })?),
-    };
+    let choice = SequenceChoice::parse(&args.sequence).map_err(|e| Failure::input(format!("--sequence {e}")))?;
     let setup = sc::setup(&params, choice).map_err(|e| Failure::input(format!("{e:#}")))?;
     let stop = stop_flag();
     let interrupted = |e: anyhow::Error| if stop.load(Ordering::SeqCst) { Failure::interrupted("nothing was estimated") } else { Failure::run(format!("selfcal: {e:#}")) };
-    // The plan: the sequence's noise-free motion through the same filter (its 1σ depend on the
-    // motion only), before any IMU is drawn.
-    let plan_run = sc::run_one(&setup, params.meta.seed, true, &stop).map_err(interrupted)?;
-    let plan = observability(&plan_run.estimate);
+    let plan = sc::plan(&setup, params.meta.seed, &stop).map_err(interrupted)?;
     if args.plan || !plan.unobservable.is_empty() || !plan.weak.is_empty() {
         let list = |v: &Vec<String>| if v.is_empty() { "none".to_owned() } else { v.join(", ") };
         errln!("rinscope selfcal: plan for {}: not observable: {}; weakly observable: {}", setup.sequence, list(&plan.unobservable), list(&plan.weak));
@@ -56,13 +46,7 @@ pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
     };
     // The IMU's calibration, the Monte Carlo and the free-inertial comparison; on a failure the
     // recording is abandoned once, whichever step failed.
-    let result = (|| {
-        let outcome = sc::run_one(&setup, params.meta.seed, false, &stop)?;
-        let mc = args.monte_carlo.map(|n| sc::monte_carlo(&setup, n as usize, params.meta.seed + 1, &stop)).transpose()?;
-        let nav = if args.navigate_hours > 0.0 { sc::navigation_comparison(&params, &outcome, args.navigate_hours, &stop)? } else { Vec::new() };
-        anyhow::Ok((outcome, mc, nav))
-    })();
-    let (outcome, mc, nav) = match result {
+    let report = match sc::calibrate(&params, setup, plan, args.monte_carlo.map(|n| n as usize), args.navigate_hours, &stop) {
         Ok(r) => r,
         Err(e) => {
             if let Some(s) = sinks {
@@ -71,42 +55,12 @@ pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
             return Err(interrupted(e));
         }
     };
-    let mut table = sc::table(&setup, &outcome, &plan, mc.as_ref());
-    if !nav.is_empty() {
-        table.push_str(&sc::navigation_table(&nav, args.navigate_hours));
-    }
-    out!("{table}");
-    let truth = outcome.truth().to_params();
+    out!("{}", report.table);
     if let Some(sinks) = sinks {
-        let view = crate::record::selfcal::SelfcalView {
-            title: format!("{} — {}", params.meta.name, setup.sequence),
-            table: &table,
-            history: &outcome.estimate.history,
-            prior: &outcome.estimate.prior,
-            truth: Some(truth),
-            move_starts_s: &setup.move_starts_s,
-            attitude: &outcome.attitude,
-            navigation: nav.iter().map(|r| &r.trace).collect(),
-        };
-        record(sinks, &view)?;
+        record(sinks, &report.view(&params.meta.name))?;
     }
     if let Some(path) = &args.json {
-        write_json(
-            "--json",
-            path,
-            &serde_json::json!({
-                "sequence": setup.sequence,
-                "parameters": crate::ins::selfcal::param_names(),
-                "units": JSON_UNITS,
-                "truth": truth,
-                "estimate": outcome.estimate.params,
-                "sigma": outcome.estimate.sigma,
-                "estimation_s": outcome.estimation_s,
-                "observability": plan,
-                "monte_carlo": mc,
-                "navigation": nav,
-            }),
-        )?;
+        write_json("--json", path, &report.json())?;
     }
     Ok(())
 }
@@ -125,7 +79,7 @@ fn selfcal_log(args: &SelfcalArgs, dir: &Path) -> Result<(), Failure> {
     out!("{table}");
     if let Some(path) = &args.json {
         let names = crate::ins::selfcal::param_names();
-        write_json("--json", path, &serde_json::json!({ "log": dir.display().to_string(), "parameters": names, "units": JSON_UNITS, "estimate": estimate.params, "sigma": estimate.sigma, "estimation_s": estimation_s, "observability": seen }))?;
+        write_json("--json", path, &serde_json::json!({ "log": dir.display().to_string(), "parameters": names, "units": sc::JSON_UNITS, "estimate": estimate.params, "sigma": estimate.sigma, "estimation_s": estimation_s, "observability": seen }))?;
     }
     if !args.no_recording {
         let sinks = open_sinks(args.sinks.request(PathBuf::from("recordings").join(format!("{}-selfcal.rrd", log.name)))?, &format!("{}-selfcal", log.name))?;
@@ -143,9 +97,6 @@ fn selfcal_log(args: &SelfcalArgs, dir: &Path) -> Result<(), Failure> {
     }
     Ok(())
 }
-
-/// What `--json` says of its numbers' units.
-const JSON_UNITS: &str = "SI (rad/s, m/s², dimensionless gains)";
 
 /// Logs `view` into `sinks` and says where the recording is; on a failure the partial file goes.
 fn record(sinks: crate::record::sink::OpenSinks, view: &crate::record::selfcal::SelfcalView<'_>) -> Result<(), Failure> {
