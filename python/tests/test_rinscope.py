@@ -47,6 +47,14 @@ def same_tables(result, export_dir: Path):
         pd.testing.assert_frame_equal(result[entity].reset_index(drop=True), want.reset_index(drop=True), check_exact=True)
 
 
+def raises_naming(call, says, **kwargs):
+    """`call(**kwargs)` raises ValueError whose message contains every word of `says`."""
+    with pytest.raises(ValueError) as e:
+        call(**kwargs)
+    for word in says:
+        assert word in str(e.value), f"{word!r} not in: {e.value}"
+
+
 def without_timing(summary: dict) -> dict:
     """A summary without what depends on the machine (wall time, memory, the file's path)."""
     drop = {"wall_time_s", "steps_per_second", "samples_per_second", "peak_rss_mb", "recording_path", "recording_bytes", "gather_s", "analysis_s"}
@@ -126,10 +134,7 @@ def test_a_bad_write_raises_with_the_key_and_changes_nothing(section, key, value
     target = s
     for k in section:
         target = target[k]
-    with pytest.raises(ValueError) as e:
-        target[key] = value
-    for word in says:
-        assert word in str(e.value), f"{word!r} not in: {e.value}"
+    raises_naming(lambda: target.__setitem__(key, value), says)
     assert s.toml == before
 
 
@@ -355,10 +360,7 @@ def test_allan_of_a_gyro_array_fits_the_angle_random_walk():
     ],
 )
 def test_allan_refuses_bad_input_by_name(kwargs, says):
-    with pytest.raises(ValueError) as e:
-        rinscope.allan(**kwargs)
-    for word in says:
-        assert word in str(e.value), f"{word!r} not in: {e.value}"
+    raises_naming(rinscope.allan, says, **kwargs)
 
 
 def test_allan_of_arrays_is_the_commands_allan_of_the_file(tmp_path):
@@ -421,10 +423,7 @@ def test_selfcal_gives_the_commands_document(tmp_path):
 
 @pytest.mark.parametrize("kwargs, says", [(dict(sequence="dual-axis-30"), ["dual-axis-30", "positions-19"]), (dict(navigate_hours=-1), ["navigate_hours", "-1"]), (dict(monte_carlo=0), ["monte_carlo", "0"])])
 def test_selfcal_refuses_bad_input_by_name(kwargs, says):
-    with pytest.raises(ValueError) as e:
-        rinscope.selfcal(**kwargs)
-    for word in says:
-        assert word in str(e.value), f"{word!r} not in: {e.value}"
+    raises_naming(rinscope.selfcal, says, **kwargs)
 
 
 # --- the command and the viewer --------------------------------------------------------------------------
