@@ -43,14 +43,14 @@ def load(source: str | os.PathLike | Scenario = DEFAULT_SCENARIO) -> Scenario:
     if isinstance(source, Scenario):
         return source.copy()
     text = str(source)
-    if text in dict(_rinscope.scenarios()):
+    if text in _rinscope.PRESETS:
         return Scenario(_rinscope.preset_toml(text), f"preset {text}")
     path = Path(text)
     if path.is_file():
         return Scenario(path.read_text(encoding="utf-8"), str(path))
     if path.suffix == ".toml" or os.sep in text:
         raise FileNotFoundError(f"{text}: no such scenario file")
-    raise ValueError(f"{text!r} is neither a preset nor a file; the presets are: {', '.join(scenarios())}")
+    raise ValueError(f"{text!r} is neither a preset nor a file; the presets are: {', '.join(_rinscope.PRESETS)}")
 
 
 def check(source: str | os.PathLike | Scenario) -> Scenario:
@@ -157,9 +157,7 @@ def montecarlo(scenario: Any = None, runs: int | None = None, eta_measured_sigma
         [{"run": run["index"], **{f"{est} {label}": v for est in ("kf", "nls", "nls_sigma") for label, v in zip(labels, run[est])}} for run in summary.pop("runs")]
     )
     rows = pd.json_normalize(summary["rows"], sep="_")
-    r = Result("montecarlo", summary, [], None)
-    r.series = Tables([], {"runs": per_run, "rows": rows})
-    return r
+    return Result("montecarlo", summary, Tables([], {"runs": per_run, "rows": rows}), None)
 
 
 def selfcal(scenario: Any = None, sequence: str = "dual-axis-29", monte_carlo: int | None = None, navigate_hours: float = 24.0,

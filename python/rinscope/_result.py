@@ -14,7 +14,10 @@ class Tables(Mapping):
     as Arrow IPC streams in memory and become DataFrames the first time they are read."""
 
     def __init__(self, streams: list, frames: dict | None = None):
-        self._streams = dict(streams)
+        # (entity, export name, Arrow IPC stream) from the library; DataFrames made here (their
+        # entity is their name).
+        self._streams = {entity: stream for entity, _, stream in streams}
+        self._names = {name: entity for entity, name, _ in streams}
         self._frames: dict = dict(frames or {})
         for key in self._frames:
             self._streams.setdefault(key, None)
@@ -22,16 +25,18 @@ class Tables(Mapping):
     def _key(self, key: str) -> str:
         if key in self._streams:
             return key
-        for entity in self._streams:
-            if entity.strip("/").replace("/", "__").replace(".", "_") == key:
-                return entity
+        if key in self._names:
+            return self._names[key]
         raise KeyError(f"{key!r}: no such table; the tables are: {', '.join(self._streams)}")
 
     def arrow(self, key: str):
         """The table as a pyarrow Table (no pandas)."""
         import pyarrow as pa
 
-        return pa.ipc.open_stream(self._streams[self._key(key)]).read_all()
+        entity = self._key(key)
+        if self._streams[entity] is None:
+            return pa.Table.from_pandas(self._frames[entity], preserve_index=False)
+        return pa.ipc.open_stream(self._streams[entity]).read_all()
 
     def __getitem__(self, key: str):
         entity = self._key(key)
@@ -58,10 +63,10 @@ class Result:
     - ``recording``: the saved ``.rrd`` (``save=...``), or None; ``show()`` puts it in a notebook.
     """
 
-    def __init__(self, kind: str, summary: dict, tables: list, recording: str | None):
+    def __init__(self, kind: str, summary: dict, series: Tables, recording: str | None):
         self.kind = kind
         self.summary = summary
-        self.series = Tables(tables)
+        self.series = series
         self.recording = Path(recording) if recording else None
 
     def __getitem__(self, key: str):
@@ -92,4 +97,4 @@ def result(kind: str, out: tuple, recording_key: str | None = None, save=None) -
     summary_json, tables = out
     summary = _json.loads(summary_json)
     recording = summary.get(recording_key) if recording_key else (str(save) if save else None)
-    return Result(kind, summary, tables, recording)
+    return Result(kind, summary, Tables(tables), recording)

@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import copy as _copy
 import json as _json
+import math
 import os
-import os as _os
 import tempfile as _tempfile
 from pathlib import Path
 from typing import Any, Iterator
@@ -31,6 +31,9 @@ def _plain(value: Any, path: tuple) -> Any:
         return value.to_dict()
     if isinstance(value, SectionList):
         return value.to_list()
+    if isinstance(value, float) and not math.isfinite(value):
+        # JSON, which carries the document to the library, has no NaN or infinity.
+        raise ValueError(f"`{_dotted(path)}` = {value}: not a finite number")
     if isinstance(value, (bool, int, float, str)):
         return value
     if isinstance(value, dict):
@@ -39,30 +42,23 @@ def _plain(value: Any, path: tuple) -> Any:
         return [_plain(v, path + (i,)) for i, v in enumerate(value)]
     if isinstance(value, os.PathLike):
         return os.fspath(value)
-    if hasattr(value, "tolist"):  # numpy scalars and arrays
+    if hasattr(value, "tolist"):  # numpy scalars and arrays (a numpy float is a float: above)
         return _plain(value.tolist(), path)
     if value is None:
         raise ValueError(f"`{_dotted(path)}` = None: TOML has no null; to take the default, delete the key (del ...)")
     raise ValueError(f"`{_dotted(path)}` = {value!r}: a {type(value).__name__} is not a TOML value (numbers, strings, booleans, lists, tables)")
 
 
-def _non_finite(node: Any, path: tuple = ()):
-    """The path and value of the first NaN or infinity in ``node`` (JSON cannot carry them)."""
-    if isinstance(node, float) and node != node or node in (float("inf"), float("-inf")):
-        return path, node
-    items = node.items() if isinstance(node, dict) else enumerate(node) if isinstance(node, list) else ()
-    for k, v in items:
-        found = _non_finite(v, path + (k,))
-        if found:
-            return found
-    return None
-
-
 def _toml_of_dict(data: dict) -> str:
-    bad = _non_finite(data)
-    if bad:
-        raise ValueError(f"`{_dotted(bad[0])}` = {bad[1]}: not a finite number")
     return _rinscope.json_to_toml(_json.dumps(data))
+
+
+def _at(root: "Scenario", path: tuple) -> Any:
+    """The table (or array of tables) at `path` in the scenario's document."""
+    node = root._doc
+    for key in path:
+        node = node[key]
+    return node
 
 
 class Section:
@@ -77,10 +73,7 @@ class Section:
         object.__setattr__(self, "_path", path)
 
     def _node(self) -> dict:
-        node = self._root._doc
-        for key in self._path:
-            node = node[key]
-        return node
+        return _at(self._root, self._path)
 
     def __getitem__(self, key: str) -> Any:
         return _wrap(self._root, self._path + (key,), self._node()[key])
@@ -163,10 +156,7 @@ class SectionList:
         self._root, self._path = root, path
 
     def _node(self) -> list:
-        node = self._root._doc
-        for key in self._path:
-            node = node[key]
-        return node
+        return _at(self._root, self._path)
 
     def _index(self, key: Any) -> int:
         items = self._node()
@@ -282,9 +272,9 @@ class Scenario(Section):
         text = self.toml
         fd, tmp = _tempfile.mkstemp(dir=path.parent if str(path.parent) else ".", prefix=path.name, suffix=".partial")
         try:
-            with _os.fdopen(fd, "w", encoding="utf-8") as f:
+            with os.fdopen(fd, "w", encoding="utf-8") as f:
                 f.write(text)
-            _os.replace(tmp, path)
+            os.replace(tmp, path)
         except BaseException:
             Path(tmp).unlink(missing_ok=True)
             raise

@@ -15,6 +15,7 @@ use pyo3::types::PyBytes;
 use serde::Serialize;
 
 use rinscope::app::allan::AllanRequest;
+use rinscope::calib::MonteCarloConfig;
 
 use rinscope::record::export::Table;
 use rinscope::record::sink::{self, OpenSinks, SinkRequest};
@@ -94,7 +95,7 @@ fn open_sinks(save: Option<PathBuf>, recording_id: &str, stop: &Arc<AtomicBool>)
 
 /// One table as an Arrow IPC stream: float64 columns named as `--export` names them, the entity in
 /// the schema's metadata.
-fn ipc(table: Table) -> Result<(String, Vec<u8>), Failure> {
+fn ipc(table: Table) -> Result<(String, String, Vec<u8>), Failure> {
     use arrow_array::{ArrayRef, Float64Array, RecordBatch};
     use arrow_schema::{DataType, Field, Schema};
     let arrow = |e: arrow_schema::ArrowError| Failure::Run(format!("arrow: {e}"));
@@ -108,15 +109,19 @@ fn ipc(table: Table) -> Result<(String, Vec<u8>), Failure> {
     writer.write(&batch).map_err(arrow)?;
     writer.finish().map_err(arrow)?;
     drop(writer);
-    Ok((table.entity, bytes))
+    Ok((table.entity, table.name, bytes))
 }
 
-/// What a call returns to Python: a JSON document and the tables as (entity, Arrow IPC stream).
-type Output = (String, Vec<(String, Vec<u8>)>);
+/// What a call returns to Python: a JSON document and the tables as (entity, export name, Arrow
+/// IPC stream).
+type Output = (String, Vec<(String, String, Vec<u8>)>);
+
+/// [`Output`] as Python objects.
+type PyOutput = (String, Vec<(String, String, Py<PyBytes>)>);
 
 /// The JSON document and tables as Python objects.
-fn to_python(py: Python<'_>, (json, tables): Output) -> (String, Vec<(String, Py<PyBytes>)>) {
-    (json, tables.into_iter().map(|(entity, bytes)| (entity, PyBytes::new(py, &bytes).unbind())).collect())
+fn to_python(py: Python<'_>, (json, tables): Output) -> PyOutput {
+    (json, tables.into_iter().map(|(entity, name, bytes)| (entity, name, PyBytes::new(py, &bytes).unbind())).collect())
 }
 
 /// A call's output: its summary as JSON and the tables the sinks kept.
@@ -131,6 +136,18 @@ fn finish<S: Serialize>(sinks: OpenSinks, mut summary: S, fill: impl FnOnce(&mut
     let saved = sinks.finish()?;
     fill(&mut summary, &saved);
     output(summary, saved)
+}
+
+/// `sinks` once `logged` (the logging into them) succeeded; on a failure they are abandoned (the
+/// partial recording removed).
+fn logged<E: std::fmt::Display>(logged: Result<(), E>, sinks: OpenSinks) -> Result<OpenSinks, Failure> {
+    match logged {
+        Ok(()) => Ok(sinks),
+        Err(e) => {
+            sinks.abandon();
+            Err(Failure::Run(format!("rerun: {e}")))
+        }
+    }
 }
 
 /// The presets: (name, title) pairs, in the order `rinscope scenarios` lists them.
@@ -173,10 +190,7 @@ fn json_to_toml(json: &str) -> PyResult<String> {
 /// `duration_s` checked as `--duration-s` is.
 fn set_duration(params: &mut Params, duration_s: Option<f64>) -> Result<(), Failure> {
     if let Some(d) = duration_s {
-        if !(d.is_finite() && d > 0.0 && d <= scenario::MAX_DURATION_S) {
-            return Err(Failure::Input(format!("duration_s {d} s: must be > 0 and at most {} s (30 days), as simulation.duration_s", scenario::MAX_DURATION_S)));
-        }
-        params.set_duration(d);
+        params.set_duration(scenario::check_duration(d).map_err(|e| Failure::Input(format!("duration_s {e}")))?);
     }
     Ok(())
 }
@@ -193,10 +207,7 @@ fn run_to_sinks(params: &Params, save: Option<PathBuf>, stop: &Arc<AtomicBool>) 
         }
     };
     let saved = sinks.finish()?;
-    if let Some((path, bytes)) = &saved.recording {
-        summary.recording_path = Some(path.display().to_string());
-        summary.recording_bytes = Some(*bytes);
-    }
+    (summary.recording_path, summary.recording_bytes) = saved.recording_fields();
     Ok((summary, saved))
 }
 
@@ -225,7 +236,7 @@ fn _time_run(py: Python<'_>, toml: &str, duration_s: Option<f64>, repeats: usize
 /// `save` if given: the summary (as `run --summary-json` writes it) and every series as a table.
 #[pyfunction]
 #[pyo3(signature = (toml, duration_s=None, save=None))]
-fn run(py: Python<'_>, toml: &str, duration_s: Option<f64>, save: Option<PathBuf>) -> PyResult<(String, Vec<(String, Py<PyBytes>)>)> {
+fn run(py: Python<'_>, toml: &str, duration_s: Option<f64>, save: Option<PathBuf>) -> PyResult<PyOutput> {
     let mut params = parse(toml, "the scenario")?;
     set_duration(&mut params, duration_s)?;
     let out = interruptible(py, |stop| -> Result<Output, Failure> {
@@ -239,7 +250,7 @@ fn run(py: Python<'_>, toml: &str, duration_s: Option<f64>, save: Option<PathBuf
 /// text), saving to `save` if given: the summary and every series as a table.
 #[pyfunction]
 #[pyo3(signature = (dir, save=None, compensation=None))]
-fn replay(py: Python<'_>, dir: PathBuf, save: Option<PathBuf>, compensation: Option<&str>) -> PyResult<(String, Vec<(String, Py<PyBytes>)>)> {
+fn replay(py: Python<'_>, dir: PathBuf, save: Option<PathBuf>, compensation: Option<&str>) -> PyResult<PyOutput> {
     let log = logset::load(&dir).map_err(|e| Failure::Input(e.to_string()))?;
     let compensation = match compensation {
         None => log.table.compensation.clone(),
@@ -257,12 +268,7 @@ fn replay(py: Python<'_>, dir: PathBuf, save: Option<PathBuf>, compensation: Opt
                 });
             }
         };
-        finish(sinks, summary, |s, saved| {
-            if let Some((path, bytes)) = &saved.recording {
-                s.recording_path = Some(path.display().to_string());
-                s.recording_bytes = Some(*bytes);
-            }
-        })
+        finish(sinks, summary, |s, saved| (s.recording_path, s.recording_bytes) = saved.recording_fields())
     })??;
     Ok(to_python(py, out))
 }
@@ -271,7 +277,7 @@ fn replay(py: Python<'_>, dir: PathBuf, save: Option<PathBuf>, compensation: Opt
 /// with the least-squares compensation (as `calibrate --json` writes it) and every series.
 #[pyfunction]
 #[pyo3(signature = (toml=None, log_dir=None, save=None))]
-fn calibrate(py: Python<'_>, toml: Option<&str>, log_dir: Option<PathBuf>, save: Option<PathBuf>) -> PyResult<(String, Vec<(String, Py<PyBytes>)>)> {
+fn calibrate(py: Python<'_>, toml: Option<&str>, log_dir: Option<PathBuf>, save: Option<PathBuf>) -> PyResult<PyOutput> {
     use rinscope::app::calibrate::{calibrate_log, calibrate_scenario, estimated_compensation, record_outcome, CalibrationOutput};
     let calib = |e: rinscope::calib::CalibError| Failure::Input(format!("calibrate: {e}"));
     let out = match (toml, log_dir) {
@@ -280,10 +286,7 @@ fn calibrate(py: Python<'_>, toml: Option<&str>, log_dir: Option<PathBuf>, save:
             interruptible(py, |stop| -> Result<Output, Failure> {
                 let outcome = calibrate_scenario(&params, true, stop).map_err(calib)?;
                 let sinks = open_sinks(save, &format!("{}-calibration-seed{}", params.meta.name, params.meta.seed), stop)?;
-                if let Err(e) = record_outcome(sinks.stream(), &params, &outcome, stop) {
-                    sinks.abandon();
-                    return Err(Failure::Run(format!("rerun: {e}")));
-                }
+                let sinks = logged(record_outcome(sinks.stream(), &params, &outcome, stop), sinks)?;
                 let compensation = estimated_compensation(&params.table.chain, &outcome.cal, &params.calibration_known);
                 let json = serde_json::to_value(CalibrationOutput { report: &outcome.report, estimated_compensation: compensation }).map_err(|e| Failure::Run(e.to_string()))?;
                 finish(sinks, json, |_, _| ())
@@ -298,10 +301,7 @@ fn calibrate(py: Python<'_>, toml: Option<&str>, log_dir: Option<PathBuf>, save:
                 let (cal, report, data, traces) = calibrate_log(&log, true, stop).map_err(|e| Failure::Input(format!("calibrate: {e}")))?;
                 let params = log.recording_params(data.samples.last_t_s().max(1.0)).map_err(|e| Failure::Input(e.to_string()))?;
                 let sinks = open_sinks(save, &format!("{}-calibration", log.name), stop)?;
-                if let Err(e) = rinscope::record::calibration::log(sinks.stream(), &params, &cal, &report, &traces).and_then(|mut r| r.finish()) {
-                    sinks.abandon();
-                    return Err(Failure::Run(format!("rerun: {e}")));
-                }
+                let sinks = logged(rinscope::record::calibration::log(sinks.stream(), &params, &cal, &report, &traces).and_then(|mut r| r.finish()), sinks)?;
                 let compensation = estimated_compensation(&log.table.chain, &cal, &log.table.compensation);
                 let json = serde_json::to_value(CalibrationOutput { report: &report, estimated_compensation: compensation }).map_err(|e| Failure::Run(e.to_string()))?;
                 finish(sinks, json, |_, _| ())
@@ -339,7 +339,7 @@ fn allan(
     decimate: usize,
     save: Option<PathBuf>,
     description: Option<String>,
-) -> PyResult<(String, Vec<(String, Py<PyBytes>)>)> {
+) -> PyResult<PyOutput> {
     use rinscope::app::allan::{analyze_series, options, parse_estimators, parse_taus};
     let spacing = parse_taus(taus).map_err(|e| Failure::Input(format!("allan: taus {e}")))?;
     let estimators = parse_estimators(estimators).map_err(|e| Failure::Input(format!("allan: estimators {e}")))?;
@@ -356,14 +356,10 @@ fn allan(
         let result = analyze_series(data, "arrays from Python", &request, 0.0).map_err(|e| Failure::Input(format!("allan: {e}")))?;
         let mut tables = rinscope::record::export::Exporter::in_memory();
         rinscope::record::allan::export(&mut tables, &result).map_err(|e| Failure::Run(e.to_string()))?;
-        let tables = tables.finish_in_memory().map_err(|e| Failure::Run(e.to_string()))?;
+        let tables = tables.finish().map_err(|e| Failure::Run(e.to_string()))?.tables;
         if let Some(path) = save {
             let sinks = sink::open(&SinkRequest { save: Some(path), stop_on_failure: Some(Arc::clone(stop)), ..Default::default() }, APPLICATION_ID, "python-allan")?;
-            if let Err(e) = rinscope::record::allan::log(&sinks.stream(), &result, description.as_deref().unwrap_or("Arrays analysed from Python.")) {
-                sinks.abandon();
-                return Err(Failure::Run(format!("rerun: {e}")));
-            }
-            sinks.finish()?;
+            logged(rinscope::record::allan::log(&sinks.stream(), &result, description.as_deref().unwrap_or("Arrays analysed from Python.")), sinks)?.finish()?;
         }
         Ok((result.json().to_string(), tables.into_iter().map(ipc).collect::<Result<_, _>>()?))
     })??;
@@ -379,15 +375,9 @@ fn montecarlo(py: Python<'_>, toml: &str, runs: Option<usize>, eta_measured_sigm
     use rinscope::calib::montecarlo::{summarize, Shard};
     let mut params = parse(toml, "the scenario")?;
     if let Some(s) = eta_measured_sigma_arcsec {
-        if !(s.is_finite() && s > 0.0 && s <= 3600.0) {
-            return Err(PyValueError::new_err(format!("eta_measured_sigma_arcsec {s}: must be > 0 and <= 3600 arcsec")));
-        }
-        params.calibration.montecarlo.eta_measured_sigma_rad = Some(s * rinscope::math::units::RAD_PER_ARCSEC);
+        params.calibration.montecarlo.set_eta_measured_sigma_arcsec(s).map_err(|e| PyValueError::new_err(format!("eta_measured_sigma_arcsec {e}")))?;
     }
-    let runs = runs.unwrap_or(params.calibration.montecarlo.runs as usize);
-    if runs == 0 || runs > 1_000_000 {
-        return Err(PyValueError::new_err(format!("runs {runs}: must be 1 ..= 1000000")));
-    }
+    let runs = MonteCarloConfig::check_runs(runs.unwrap_or(params.calibration.montecarlo.runs as usize)).map_err(|e| PyValueError::new_err(format!("runs {e}")))?;
     let json = interruptible(py, |stop| -> Result<String, Failure> {
         let started = std::time::Instant::now();
         let done = monte_carlo_runs(&params, runs, Shard::WHOLE, &|| (), stop).map_err(|e| Failure::Input(format!("montecarlo: {e}")))?;
@@ -408,14 +398,15 @@ fn montecarlo(py: Python<'_>, toml: &str, runs: Option<usize>, eta_measured_sigm
 /// (with the printed table under "table") and the recording's series.
 #[pyfunction]
 #[pyo3(signature = (toml, sequence="dual-axis-29", monte_carlo=None, navigate_hours=24.0, save=None))]
-fn selfcal(py: Python<'_>, toml: &str, sequence: &str, monte_carlo: Option<usize>, navigate_hours: f64, save: Option<PathBuf>) -> PyResult<(String, Vec<(String, Py<PyBytes>)>)> {
+fn selfcal(py: Python<'_>, toml: &str, sequence: &str, monte_carlo: Option<usize>, navigate_hours: f64, save: Option<PathBuf>) -> PyResult<PyOutput> {
     use rinscope::app::selfcal::{self as sc, SequenceChoice};
     let params = parse(toml, "the scenario")?;
     if !(navigate_hours.is_finite() && (0.0..=720.0).contains(&navigate_hours)) {
         return Err(PyValueError::new_err(format!("navigate_hours {navigate_hours}: must be 0 (skip) to 720 h")));
     }
-    if monte_carlo.is_some_and(|n| n == 0 || n > 100_000) {
-        return Err(PyValueError::new_err(format!("monte_carlo {}: must be 1 ..= 100000 runs (or None)", monte_carlo.unwrap_or(0))));
+    if let Some(n) = monte_carlo.filter(|n| !sc::MONTE_CARLO_RUNS.contains(&(*n as u64))) {
+        let (lo, hi) = (sc::MONTE_CARLO_RUNS.start(), sc::MONTE_CARLO_RUNS.end());
+        return Err(PyValueError::new_err(format!("monte_carlo {n}: must be {lo} ..= {hi} runs (or None), as --monte-carlo")));
     }
     let choice = SequenceChoice::parse(sequence).map_err(|e| PyValueError::new_err(format!("sequence {e}")))?;
     let setup = sc::setup(&params, choice).map_err(|e| PyValueError::new_err(format!("{e:#}")))?;
@@ -424,10 +415,7 @@ fn selfcal(py: Python<'_>, toml: &str, sequence: &str, monte_carlo: Option<usize
         let plan = sc::plan(&setup, params.meta.seed, stop).map_err(failed)?;
         let report = sc::calibrate(&params, setup, plan, monte_carlo, navigate_hours, stop).map_err(failed)?;
         let sinks = open_sinks(save, &format!("{}-selfcal-seed{}", params.meta.name, params.meta.seed), stop)?;
-        if let Err(e) = rinscope::record::selfcal::log(&sinks.stream(), &report.view(&params.meta.name)) {
-            sinks.abandon();
-            return Err(Failure::Run(format!("rerun: {e}")));
-        }
+        let sinks = logged(rinscope::record::selfcal::log(&sinks.stream(), &report.view(&params.meta.name)), sinks)?;
         let mut json = report.json();
         json["table"] = serde_json::Value::String(report.table.clone());
         finish(sinks, json, |_, _| ())
@@ -453,6 +441,8 @@ fn _rinscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("RERUN_VERSION", "0.36.3")?;
     m.add("VERSION", env!("CARGO_PKG_VERSION"))?;
     m.add("DEFAULT_SCENARIO", presets::DEFAULT_SCENARIO)?;
+    // The presets' names without loading them (scenarios() validates each for its title).
+    m.add("PRESETS", presets::PRESETS.iter().map(|(name, _)| *name).collect::<Vec<_>>())?;
     m.add_function(wrap_pyfunction!(scenarios, m)?)?;
     m.add_function(wrap_pyfunction!(preset_toml, m)?)?;
     m.add_function(wrap_pyfunction!(check, m)?)?;

@@ -42,6 +42,10 @@ impl SequenceChoice {
     }
 }
 
+/// How many random IMUs a self-calibration's Monte Carlo may take (`--monte-carlo`): a spread
+/// needs two.
+pub const MONTE_CARLO_RUNS: std::ops::RangeInclusive<u64> = 2..=10_000;
+
 /// What the documents say of their numbers' units.
 pub const JSON_UNITS: &str = "SI (rad/s, m/s², dimensionless gains)";
 

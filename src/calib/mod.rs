@@ -74,6 +74,29 @@ pub struct MonteCarloConfig {
     pub eta_measured_sigma_rad: Option<f64>,
 }
 
+impl MonteCarloConfig {
+    /// Sets the 1σ of an independent η measurement a user gives beside the file
+    /// (`--eta-measured-sigma-arcsec`); the message says the value and the range, the caller names the flag.
+    ///
+    /// # Errors
+    /// Not finite, not positive, or over 3600″.
+    pub fn set_eta_measured_sigma_arcsec(&mut self, sigma_arcsec: f64) -> Result<(), String> {
+        if !(sigma_arcsec.is_finite() && sigma_arcsec > 0.0 && sigma_arcsec <= 3600.0) {
+            return Err(format!("{sigma_arcsec}: must be > 0 and <= 3600 arcsec"));
+        }
+        self.eta_measured_sigma_rad = Some(sigma_arcsec * crate::math::units::RAD_PER_ARCSEC);
+        Ok(())
+    }
+
+    /// Checks a number of runs a user gives beside the file (`--runs`).
+    ///
+    /// # Errors
+    /// 0, or over a million.
+    pub fn check_runs(runs: usize) -> Result<usize, String> {
+        if runs == 0 || runs > 1_000_000 { Err(format!("{runs}: must be 1 ..= 1000000")) } else { Ok(runs) }
+    }
+}
+
 /// `[calibration]`, validated, SI.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CalibConfig {

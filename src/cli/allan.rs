@@ -81,10 +81,7 @@ pub(super) fn allan(args: &AllanArgs) -> Result<(), Failure> {
         (None, None) => {
             let mut params = args.source.load(DEFAULT_SCENARIO)?;
             if let Some(d) = args.duration_s {
-                if !(d.is_finite() && d > 0.0 && d <= scenario::MAX_DURATION_S) {
-                    return Err(Failure::input(format!("--duration-s {d} s: must be > 0 and at most {} s (30 days), as simulation.duration_s", scenario::MAX_DURATION_S)));
-                }
-                params.set_duration(d);
+                params.set_duration(super::commands::duration_flag(d)?);
             }
             allan::check_scenario(&params)?;
             let (name, description) = (params.meta.name.clone(), format!("*{}*\n\n{}", params.meta.title, params.meta.description));
@@ -146,7 +143,7 @@ pub(super) fn allan(args: &AllanArgs) -> Result<(), Failure> {
         write_json("--json", path, &result.json())?;
     }
     if let Some(e) = exporter.as_mut() {
-        let written = crate::record::allan::export(e, &result).and_then(|()| e.finish()).map_err(|e| Failure::run(format!("--export: {e}")))?;
+        let written = crate::record::allan::export(e, &result).and_then(|()| e.finish()).map_err(|e| Failure::run(format!("--export: {e}")))?.files;
         print_tables(&written);
     }
     if let Some(sinks) = sinks {

@@ -7,12 +7,12 @@ use std::sync::atomic::Ordering;
 use super::{CalibrateArgs, Failure, LiveArgs, ModulationArgs, MonteCarloAction, MonteCarloArgs, RunArgs, ScenarioSource, TprArgs};
 use crate::app::calibrate::{calibrate_scenario, estimated_compensation, monte_carlo_runs, monte_carlo_setup, record_outcome, CalibrationOutput};
 use crate::calib::montecarlo::{self, Shard, ShardFile};
+use crate::calib::MonteCarloConfig;
 use crate::app::run::run_recorded;
 use crate::app::terminate::stop_flag;
 use crate::app::{live, modulation, reproduce, tpr};
 use crate::ins::reset::sweep_text;
 use crate::io::files::write_atomically;
-use crate::math::units::RAD_PER_ARCSEC;
 use crate::record::sink::{self, SinkRequest};
 use crate::record::APPLICATION_ID;
 use crate::scenario::{self, presets, Params};
@@ -20,12 +20,14 @@ use crate::scenario::{self, presets, Params};
 fn load(args: &RunArgs) -> Result<Params, Failure> {
     let mut params = args.source.load(presets::DEFAULT_SCENARIO)?;
     if let Some(d) = args.duration_s {
-        if !(d.is_finite() && d > 0.0 && d <= scenario::MAX_DURATION_S) {
-            return Err(Failure::input(format!("--duration-s {d} s: must be > 0 and at most {} s (30 days), as simulation.duration_s", scenario::MAX_DURATION_S)));
-        }
-        params.set_duration(d);
+        params.set_duration(duration_flag(d)?);
     }
     Ok(params)
+}
+
+/// `--duration-s`, checked.
+pub(super) fn duration_flag(d: f64) -> Result<f64, Failure> {
+    scenario::check_duration(d).map_err(|e| Failure::input(format!("--duration-s {e}")))
 }
 
 /// `rinscope run`.
@@ -43,10 +45,7 @@ pub(super) fn run(args: &RunArgs) -> Result<(), Failure> {
         }
     };
     let saved = sinks.finish()?;
-    if let Some((path, bytes)) = &saved.recording {
-        summary.recording_path = Some(path.display().to_string());
-        summary.recording_bytes = Some(*bytes);
-    }
+    (summary.recording_path, summary.recording_bytes) = saved.recording_fields();
     summary.peak_rss_mb = crate::app::bench::peak_rss_bytes() as f64 / 1e6;
     out!("{}", summary.table());
     print_exported(&saved);
@@ -86,10 +85,8 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
     {
         return Err(Failure::input(format!("--speed {s}: must be > 0 and <= 10000 (x real time)")));
     }
-    if let Some(d) = args.duration_s
-        && !(d.is_finite() && d > 0.0 && d <= scenario::MAX_DURATION_S)
-    {
-        return Err(Failure::input(format!("--duration-s {d} s: must be > 0 and at most {} s (30 days)", scenario::MAX_DURATION_S)));
+    if let Some(d) = args.duration_s {
+        duration_flag(d)?;
     }
     let viewer_given = args.sinks.viewer_asked();
     if args.sinks.figures.is_some() && args.sinks.save.is_none() {
@@ -337,10 +334,7 @@ pub(super) fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
 fn monte_carlo_params(source: &ScenarioSource, eta_measured_sigma_arcsec: Option<f64>) -> Result<Params, Failure> {
     let mut params = source.load("jiang2017-calibration")?;
     if let Some(s) = eta_measured_sigma_arcsec {
-        if !(s.is_finite() && s > 0.0 && s <= 3600.0) {
-            return Err(Failure::input(format!("--eta-measured-sigma-arcsec {s}: must be > 0 and <= 3600 arcsec")));
-        }
-        params.calibration.montecarlo.eta_measured_sigma_rad = Some(s * RAD_PER_ARCSEC);
+        params.calibration.montecarlo.set_eta_measured_sigma_arcsec(s).map_err(|e| Failure::input(format!("--eta-measured-sigma-arcsec {e}")))?;
     }
     Ok(params)
 }
@@ -352,10 +346,7 @@ pub(super) fn montecarlo(args: &MonteCarloArgs) -> Result<(), Failure> {
     }
     let params = monte_carlo_params(&args.source, args.eta_measured_sigma_arcsec)?;
     check_output_dir("--json", args.json.as_deref())?;
-    let runs = args.runs.unwrap_or(params.calibration.montecarlo.runs as usize);
-    if runs == 0 || runs > 1_000_000 {
-        return Err(Failure::input(format!("--runs {runs}: must be 1 ..= 1000000")));
-    }
+    let runs = MonteCarloConfig::check_runs(args.runs.unwrap_or(params.calibration.montecarlo.runs as usize)).map_err(|e| Failure::input(format!("--runs {e}")))?;
     let shard = match &args.shard {
         Some(text) => Shard::parse(text).map_err(|e| Failure::input(format!("--shard {e}")))?,
         None => Shard::WHOLE,

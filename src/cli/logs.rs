@@ -163,10 +163,7 @@ pub(super) fn replay(args: &ReplayArgs) -> Result<(), Failure> {
         }
     };
     let saved = sinks.finish()?;
-    if let Some((p, bytes)) = &saved.recording {
-        summary.recording_path = Some(p.display().to_string());
-        summary.recording_bytes = Some(*bytes);
-    }
+    (summary.recording_path, summary.recording_bytes) = saved.recording_fields();
     out!("{}", summary.text());
     if let Some(path) = &args.summary_json {
         write_json("--summary-json", path, &summary)?;

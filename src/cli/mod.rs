@@ -504,7 +504,7 @@ struct SelfcalArgs {
     sequence: String,
     /// Also calibrate this many random IMUs (seeds after the scenario's, on every core) and
     /// compare each parameter's reported 1σ with the spread of its errors.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(2..=10_000))]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(crate::app::selfcal::MONTE_CARLO_RUNS))]
     monte_carlo: Option<u64>,
     /// Only the plan: what the sequence can see, from its noise-free motion (no IMU drawn).
     #[arg(long)]

@@ -209,11 +209,9 @@ pub fn read_series(path: &Path, columns: &[SeriesColumn], sampling: &Sampling) -
         return Err(bad(format!("{rows} row(s): a series needs at least two samples")));
     }
     let tau0_s = match sampling {
-        Sampling::RateHz(hz) => tau0_of_rate(*hz).map_err(bad)?,
+        Sampling::RateHz(hz) => tau0_of_rate(*hz, "--rate-hz").map_err(bad)?,
         Sampling::TimeColumn(..) => match even_step(&steps) {
-            Ok(_) => {
-                (t_prev - t_first.unwrap_or(0.0)) / (rows - 1) as f64
-            }
+            Ok(()) => (t_prev - t_first.unwrap_or(0.0)) / (rows - 1) as f64,
             Err(Uneven::Stalled(median)) => return Err(bad(format!("the time column does not advance (median step {median} s)"))),
             Err(Uneven::Step { k, step, median }) => {
                 // Step k ends at data row k + 2 (1-based).
@@ -226,10 +224,10 @@ pub fn read_series(path: &Path, columns: &[SeriesColumn], sampling: &Sampling) -
     Ok(Series { names, columns: columns.to_vec(), increments: increments(columns, values, tau0_s), tau0_s, rows })
 }
 
-/// The sample interval of a rate, s.
-fn tau0_of_rate(hz: f64) -> Result<f64, String> {
+/// The sample interval of a rate given as `name`, s.
+fn tau0_of_rate(hz: f64, name: &str) -> Result<f64, String> {
     if !(hz.is_finite() && hz > 0.0 && hz <= 1e9) {
-        return Err(format!("--rate-hz {hz}: must be > 0 and at most 1e9 Hz"));
+        return Err(format!("{name} {hz}: must be > 0 and at most 1e9 Hz"));
     }
     Ok(1.0 / hz)
 }
@@ -242,8 +240,8 @@ enum Uneven {
     Step { k: usize, step: f64, median: f64 },
 }
 
-/// The median of `steps` (s) if every step is within [`EVEN_TOLERANCE`] of it.
-fn even_step(steps: &[f64]) -> Result<f64, Uneven> {
+/// Whether every step of `steps` (s) is within [`EVEN_TOLERANCE`] of their median.
+fn even_step(steps: &[f64]) -> Result<(), Uneven> {
     let mut sorted = steps.to_vec();
     sorted.sort_by(f64::total_cmp);
     let median = sorted[sorted.len() / 2];
@@ -252,7 +250,7 @@ fn even_step(steps: &[f64]) -> Result<f64, Uneven> {
     }
     match steps.iter().enumerate().find(|(_, d)| (*d / median - 1.0).abs() > EVEN_TOLERANCE) {
         Some((k, step)) => Err(Uneven::Step { k, step: *step, median }),
-        None => Ok(median),
+        None => Ok(()),
     }
 }
 
@@ -307,7 +305,7 @@ pub fn series_in_memory(columns: &[SeriesColumn], values: Vec<Vec<f64>>, rate_hz
         return Err(SeriesError::Series(format!("{rows} sample(s): a series needs at least two")));
     }
     let tau0_s = match (rate_hz, times_s) {
-        (Some(hz), None) => tau0_of_rate(hz).map_err(|e| SeriesError::Series(e.replace("--rate-hz", "rate_hz")))?,
+        (Some(hz), None) => tau0_of_rate(hz, "rate_hz").map_err(SeriesError::Series)?,
         (None, Some(t)) => {
             if t.len() != rows {
                 return Err(SeriesError::Series(format!("time_s: {} times for {rows} samples", t.len())));
@@ -317,7 +315,7 @@ pub fn series_in_memory(columns: &[SeriesColumn], values: Vec<Vec<f64>>, rate_hz
             }
             let steps: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
             match even_step(&steps) {
-                Ok(_) => (t[rows - 1] - t[0]) / (rows - 1) as f64,
+                Ok(()) => (t[rows - 1] - t[0]) / (rows - 1) as f64,
                 Err(Uneven::Stalled(median)) => return Err(SeriesError::Series(format!("time_s does not advance (median step {median} s)"))),
                 Err(Uneven::Step { k, step, median }) => return Err(SeriesError::Series(format!("time_s, from sample {k} to {}: step {step} s {}", k + 1, uneven_problem(median)))),
             }

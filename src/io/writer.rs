@@ -169,6 +169,12 @@ impl TableWriter {
         Ok(this)
     }
 
+    /// The file it becomes when finished.
+    #[must_use]
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
     /// The columns.
     #[must_use]
     pub fn columns(&self) -> &[String] {

@@ -140,7 +140,7 @@ impl Exporter {
         Ok(Self { target: Target::Files { dir: dir.to_path_buf(), format }, tables: BTreeMap::new(), failed: None, file_clock_s: None })
     }
 
-    /// Tables kept in memory, taken with [`Self::finish_in_memory`].
+    /// Tables kept in memory, taken with [`Self::finish`].
     #[must_use]
     pub fn in_memory() -> Self {
         Self { target: Target::Memory, tables: BTreeMap::new(), failed: None, file_clock_s: None }
@@ -150,8 +150,8 @@ impl Exporter {
     fn open(&self, entity: &str, columns: &[String], keyed: bool) -> Result<Open, LogError> {
         let refs: Vec<&str> = columns.iter().map(String::as_str).collect();
         Ok(match &self.target {
-            Target::Files { dir, .. } if keyed => Open::File(TableWriter::create_keyed(dir.join(self.file_name(entity)), &refs)?),
-            Target::Files { dir, .. } => Open::File(TableWriter::create(dir.join(self.file_name(entity)), &refs)?),
+            Target::Files { dir, format } if keyed => Open::File(TableWriter::create_keyed(dir.join(format!("{}.{}", table_name(entity), format.extension())), &refs)?),
+            Target::Files { dir, format } => Open::File(TableWriter::create(dir.join(format!("{}.{}", table_name(entity), format.extension())), &refs)?),
             Target::Memory => Open::Memory(Table { name: table_name(entity), entity: entity.to_owned(), columns: columns.to_vec(), values: vec![Vec::new(); columns.len()] }),
         })
     }
@@ -220,51 +220,35 @@ impl Exporter {
         Ok(())
     }
 
-    /// The file of the table of `entity`.
-    fn file_name(&self, entity: &str) -> String {
-        let extension = match &self.target {
-            Target::Files { format, .. } => format.extension(),
-            Target::Memory => "",
-        };
-        format!("{}.{extension}", table_name(entity))
-    }
-
-    /// Finishes every table; returns their paths (the first failed write, if any, instead: the
-    /// unfinished tables are then removed). Tables in memory are kept for
-    /// [`Self::finish_in_memory`].
-    pub fn finish(&mut self) -> Result<Vec<PathBuf>, LogError> {
+    /// Finishes every table, in the order of their names: the files' paths, or the tables kept in
+    /// memory (the first failed write, if any, instead: the unfinished files are then removed).
+    pub fn finish(&mut self) -> Result<Finished, LogError> {
+        let tables = std::mem::take(&mut self.tables);
         if let Some(e) = self.failed.take() {
-            self.tables.clear();
             return Err(e);
         }
-        let Target::Files { dir, .. } = &self.target else { return Ok(Vec::new()) };
-        let dir = dir.clone();
-        let mut out = Vec::new();
-        for (entity, table) in std::mem::take(&mut self.tables) {
-            if let Open::File(writer) = table {
-                let file = self.file_name(&entity);
-                writer.finish()?;
-                out.push(dir.join(file));
+        let mut done = Finished::default();
+        for table in tables.into_values() {
+            match table {
+                Open::File(writer) => {
+                    let path = writer.path().to_path_buf();
+                    writer.finish()?;
+                    done.files.push(path);
+                }
+                Open::Memory(t) => done.tables.push(t),
             }
         }
-        Ok(out)
+        Ok(done)
     }
+}
 
-    /// The tables kept in memory, in the order of their names (the first failed write, if any,
-    /// instead).
-    pub fn finish_in_memory(&mut self) -> Result<Vec<Table>, LogError> {
-        if let Some(e) = self.failed.take() {
-            self.tables.clear();
-            return Err(e);
-        }
-        Ok(std::mem::take(&mut self.tables)
-            .into_values()
-            .filter_map(|t| match t {
-                Open::Memory(t) => Some(t),
-                Open::File(_) => None,
-            })
-            .collect())
-    }
+/// What [`Exporter::finish`] leaves: the files written, or the tables kept in memory.
+#[derive(Debug, Default)]
+pub struct Finished {
+    /// The files' paths.
+    pub files: Vec<PathBuf>,
+    /// The tables kept in memory.
+    pub tables: Vec<Table>,
 }
 
 /// A table's name, which is its file's name without the extension: the entity path with `/` as
@@ -306,8 +290,11 @@ mod tests {
             e.write_table("allan/gyro_fit", &["axis".to_owned(), "n_deg_per_sqrt_h".to_owned()], &[vec![0.0, 0.01]]).expect("table");
         }
         let written = file.finish().expect("files");
-        assert!(memory.finish().expect("no files").is_empty());
-        let tables = memory.finish_in_memory().expect("tables");
+        assert!(written.tables.is_empty());
+        let written = written.files;
+        let in_memory = memory.finish().expect("tables");
+        assert!(in_memory.files.is_empty());
+        let tables = in_memory.tables;
         assert_eq!(tables.len(), written.len());
         for t in &tables {
             let path = dir.join(format!("{}.csv", t.name));

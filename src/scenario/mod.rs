@@ -7,6 +7,19 @@
 /// The longest simulation a scenario (or `--duration-s`) may ask for: 30 days, s.
 pub const MAX_DURATION_S: f64 = 30.0 * 86_400.0;
 
+/// Checks a run length a user gives beside the file (`--duration-s`, Python's `duration_s`); the
+/// message says the value and the range, the caller names the flag.
+///
+/// # Errors
+/// Not finite, not positive, or over [`MAX_DURATION_S`].
+pub fn check_duration(duration_s: f64) -> Result<f64, String> {
+    if duration_s.is_finite() && duration_s > 0.0 && duration_s <= MAX_DURATION_S {
+        Ok(duration_s)
+    } else {
+        Err(format!("{duration_s} s: must be > 0 and at most {MAX_DURATION_S} s (30 days), as simulation.duration_s"))
+    }
+}
+
 pub mod instruments;
 pub mod logset;
 pub mod presets;

@@ -291,6 +291,14 @@ pub struct Saved {
     pub figures: Option<crate::record::figures::Written>,
 }
 
+impl Saved {
+    /// The recording's path as text and its size in bytes, as a summary states them (None without one).
+    #[must_use]
+    pub fn recording_fields(&self) -> (Option<String>, Option<u64>) {
+        self.recording.as_ref().map_or((None, None), |(path, bytes)| (Some(path.display().to_string()), Some(*bytes)))
+    }
+}
+
 impl OpenSinks {
     /// The stream (and export tables) the recorders log into.
     #[must_use]
@@ -319,13 +327,9 @@ impl OpenSinks {
             None => None,
             Some(f) => Some(f.finish().map_err(SinkError::Write)?),
         };
-        let (exported, tables) = match export {
-            None => (Vec::new(), Vec::new()),
-            Some(e) => {
-                let mut e = e.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-                let exported = e.finish().map_err(|e| SinkError::ExportWrite(e.to_string()))?;
-                (exported, e.finish_in_memory().map_err(|e| SinkError::ExportWrite(e.to_string()))?)
-            }
+        let crate::record::export::Finished { files: exported, tables } = match export {
+            None => Default::default(),
+            Some(e) => e.lock().unwrap_or_else(std::sync::PoisonError::into_inner).finish().map_err(|e| SinkError::ExportWrite(e.to_string()))?,
         };
         let viewer_problems = viewer_problems.lock().unwrap_or_else(std::sync::PoisonError::into_inner).clone();
         let figures = match (&figures, &recording) {
