@@ -401,9 +401,7 @@ fn montecarlo(py: Python<'_>, toml: &str, runs: Option<usize>, eta_measured_sigm
 fn selfcal(py: Python<'_>, toml: &str, sequence: &str, monte_carlo: Option<usize>, navigate_hours: f64, save: Option<PathBuf>) -> PyResult<PyOutput> {
     use rinscope::app::selfcal::{self as sc, SequenceChoice};
     let params = parse(toml, "the scenario")?;
-    if !(navigate_hours.is_finite() && (0.0..=720.0).contains(&navigate_hours)) {
-        return Err(PyValueError::new_err(format!("navigate_hours {navigate_hours}: must be 0 (skip) to 720 h")));
-    }
+    sc::check_navigate_hours(navigate_hours).map_err(|e| PyValueError::new_err(format!("navigate_hours {e}")))?;
     if let Some(n) = monte_carlo.filter(|n| !sc::MONTE_CARLO_RUNS.contains(&(*n as u64))) {
         let (lo, hi) = (sc::MONTE_CARLO_RUNS.start(), sc::MONTE_CARLO_RUNS.end());
         return Err(PyValueError::new_err(format!("monte_carlo {n}: must be {lo} ..= {hi} runs (or None), as --monte-carlo")));

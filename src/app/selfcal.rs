@@ -46,6 +46,14 @@ impl SequenceChoice {
 /// needs two.
 pub const MONTE_CARLO_RUNS: std::ops::RangeInclusive<u64> = 2..=10_000;
 
+/// Checks the hours of free-inertial comparison asked for (`--navigate-hours`: 0 skips it).
+///
+/// # Errors
+/// Not finite, negative, or over 720 h.
+pub fn check_navigate_hours(hours: f64) -> std::result::Result<f64, String> {
+    if hours.is_finite() && (0.0..=720.0).contains(&hours) { Ok(hours) } else { Err(format!("{hours}: must be 0 (skip) to 720 h")) }
+}
+
 /// What the documents say of their numbers' units.
 pub const JSON_UNITS: &str = "SI (rad/s, m/s², dimensionless gains)";
 

@@ -15,9 +15,7 @@ pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
         return selfcal_log(args, dir);
     }
     // Every argument is checked before anything runs.
-    if !(args.navigate_hours.is_finite() && (0.0..=720.0).contains(&args.navigate_hours)) {
-        return Err(Failure::input(format!("--navigate-hours {}: must be 0 (skip) to 720 h", args.navigate_hours)));
-    }
+    sc::check_navigate_hours(args.navigate_hours).map_err(|e| Failure::input(format!("--navigate-hours {e}")))?;
     let params = args.source.load("selfcal-nav-grade")?;
     check_output_dir("--json", args.json.as_deref())?;
     let choice = SequenceChoice::parse(&args.sequence).map_err(|e| Failure::input(format!("--sequence {e}")))?;
