@@ -5,7 +5,6 @@ import copy as _copy
 import json as _json
 import math
 import os
-import tempfile as _tempfile
 from pathlib import Path
 from typing import Any, Iterator
 
@@ -266,18 +265,11 @@ class Scenario(Section):
         return Scenario(self.toml, self._origin)
 
     def save(self, path: str | os.PathLike) -> Path:
-        """Writes the TOML to ``path`` atomically (a temporary file renamed over it): a file that
-        was there is replaced only by a complete one."""
+        """Writes the TOML to ``path`` through the library's atomic writer (``PATH.partial``, then
+        renamed): a file that was there is replaced only by a complete one, and a FIFO, a device or
+        a folder is refused (OSError naming it)."""
         path = Path(path)
-        text = self.toml
-        fd, tmp = _tempfile.mkstemp(dir=path.parent if str(path.parent) else ".", prefix=path.name, suffix=".partial")
-        try:
-            with os.fdopen(fd, "w", encoding="utf-8") as f:
-                f.write(text)
-            os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
+        _rinscope.write_atomically(str(path), self.toml)
         return path
 
     def __repr__(self) -> str:

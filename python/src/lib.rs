@@ -421,6 +421,13 @@ fn selfcal(py: Python<'_>, toml: &str, sequence: &str, monte_carlo: Option<usize
     Ok(to_python(py, out))
 }
 
+/// Writes `text` to `path` as every output of the library is written (`PATH.partial`, renamed when
+/// complete; a FIFO, a device, a folder or a missing folder refused): OSError naming the path.
+#[pyfunction]
+fn write_atomically(path: PathBuf, text: &str) -> PyResult<()> {
+    rinscope::io::files::write_atomically(&path, text.as_bytes()).map_err(|e| PyOSError::new_err(e.to_string()))
+}
+
 /// Checks that a saved recording is complete (header, footer, checksum).
 #[pyfunction]
 fn verify_recording(path: PathBuf) -> PyResult<()> {
@@ -453,6 +460,7 @@ fn _rinscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(montecarlo, m)?)?;
     m.add_function(wrap_pyfunction!(selfcal, m)?)?;
     m.add_function(wrap_pyfunction!(verify_recording, m)?)?;
+    m.add_function(wrap_pyfunction!(write_atomically, m)?)?;
     m.add_function(wrap_pyfunction!(cli, m)?)?;
     m.add_function(wrap_pyfunction!(_time_run, m)?)?;
     Ok(())

@@ -12,6 +12,7 @@ import math
 import os
 import shutil
 import signal
+import stat
 import subprocess
 import sys
 import time
@@ -136,6 +137,19 @@ def test_a_bad_write_raises_with_the_key_and_changes_nothing(section, key, value
         target = target[k]
     raises_naming(lambda: target.__setitem__(key, value), says)
     assert s.toml == before
+
+
+def test_saving_a_scenario_over_a_fifo_or_into_a_missing_folder_is_refused(tmp_path):
+    s = rinscope.load()
+    fifo = tmp_path / "fifo.toml"
+    os.mkfifo(fifo)
+    with pytest.raises(OSError, match="FIFO"):
+        s.save(fifo)
+    assert stat.S_ISFIFO(os.stat(fifo).st_mode)  # still there, not replaced by a file
+    with pytest.raises(OSError, match="does not exist"):
+        s.save(tmp_path / "missing" / "s.toml")
+    good = s.save(tmp_path / "s.toml")
+    assert rinscope.load(good).to_dict() == s.to_dict() and not list(tmp_path.glob("*.partial"))
 
 
 def test_a_bad_file_or_name_is_refused_with_its_key(tmp_path):
