@@ -137,22 +137,31 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
     }
     let status = live::new_status(&params, args.speed.unwrap_or(params.live_speed));
     // `--serve-web`: the class page, the viewer beside the sliders, on the port asked for.
+    // Its viewer is the web viewer opened above (the next port), the viewer's stream the one after.
     let class_page = match (args.sinks.serve_web, viewer_sinks.as_ref().and_then(sink::OpenSinks::web_page)) {
-        (Some(port), Some(viewer_url)) => {
+        (Some(port), Some(_)) => {
             let ip = args.sinks.bind.unwrap_or(std::net::IpAddr::V4(std::net::Ipv4Addr::LOCALHOST));
             let token = if ip.is_loopback() { None } else { Some(live::web::random_token().map_err(|e| Failure::run(format!("no random token for the class page: {e}")))?) };
-            let host = if ip.is_unspecified() { "127.0.0.1".to_owned() } else { ip.to_string() };
-            let cfg = live::web::PageConfig { addr: std::net::SocketAddr::new(ip, port), host, viewer_url: viewer_url.to_owned(), config_path: path.clone(), token: token.clone() };
+            let cfg = live::web::PageConfig { addr: std::net::SocketAddr::new(ip, port), host: sink::address::local_host(ip), config_path: path.clone(), token: token.clone() };
             let page = live::web::start(cfg, status.clone(), format!("{} — {}", params.meta.name, params.meta.title)).map_err(|e| Failure::input(format!("--serve-web: {e:#}")))?;
             errln!("rinscope live: the class page (viewer and sliders): {}", page.url);
+            // Every address: 127.0.0.1 above names each reader's own machine; others open this one's.
+            let network_url = if ip.is_unspecified() { sink::address::network_host(ip).map(|h| page.url_at(&h)) } else { None };
+            match &network_url {
+                Some(url) => errln!("rinscope live: from other machines: {url}"),
+                None if ip.is_unspecified() => errln!("rinscope live: from other machines: that URL with this machine's address in place of {} (it has no route out and no name to print)", sink::address::local_host(ip)),
+                None => {}
+            }
             if token.is_some() {
                 errln!("rinscope live: shared beyond this machine: anyone who reaches the page can watch; changing a parameter needs the token in that URL (give it only to whom may)");
             }
-            Some(page)
+            Some((page, network_url))
         }
         _ => None,
     };
-    let options = live::LiveOptions { config_path: path, speed: args.speed, duration_s: args.duration_s, panel, log_to_stderr: true, page_url: class_page.as_ref().map(|p| p.url.clone()) };
+    // The panel's title shows the URL the class opens.
+    let page_url = class_page.as_ref().map(|(p, network)| network.clone().unwrap_or_else(|| p.url.clone()));
+    let options = live::LiveOptions { config_path: path, speed: args.speed, duration_s: args.duration_s, panel, log_to_stderr: true, page_url };
     let outputs = live::Outputs { viewer: viewer_sinks.as_ref().map(sink::OpenSinks::stream), file: file_sinks.as_ref().map(sink::OpenSinks::stream) };
     let result = live::run_session_with_status(&options, params, outputs, &stop, &status);
     drop(class_page);

@@ -22,6 +22,7 @@ use super::export::{ExportFormat, Exporter, SharedExporter};
 use super::Stream;
 use std::sync::{Arc, Mutex};
 
+pub mod address;
 mod file;
 pub mod viewer;
 
@@ -202,14 +203,15 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
         let options = rerun::ServerOptions { memory_limit: rerun::MemoryLimit::from_bytes(1 << 30), ..Default::default() };
         let sink = rerun::grpc_server::GrpcServerSink::new(&ip.to_string(), port, options).map_err(|e| SinkError::Serve { addr, reason: e.to_string() })?;
         sinks.push(Box::new(sink));
-        let host = if ip.is_unspecified() { "127.0.0.1".to_owned() } else { ip.to_string() };
+        // For an unspecified address, a host other machines reach (127.0.0.1 would name theirs).
+        let host = address::network_host(ip).unwrap_or_else(|| address::local_host(ip));
         let url = format!("rerun+http://{host}:{port}/proxy");
         if !ip.is_loopback() {
             errln!("rinscope: WARNING: --bind {ip}: anyone who can reach port {port} of this machine can watch this session (there is no authentication)");
         }
         description.push(format!(
             "serving on {addr}: `rerun --connect {url}`, or in a browser https://app.rerun.io/version/0.36.3/index.html?url={}",
-            url.replace(':', "%3A").replace('/', "%2F").replace('+', "%2B")
+            url.replace(':', "%3A").replace('/', "%2F").replace('+', "%2B").replace('[', "%5B").replace(']', "%5D")
         ));
     }
 
@@ -224,17 +226,24 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
         let options = rerun::ServerOptions { memory_limit: rerun::MemoryLimit::from_bytes(1 << 30), ..Default::default() };
         let sink = rerun::grpc_server::GrpcServerSink::new(&ip.to_string(), grpc_port, options).map_err(|e| SinkError::Serve { addr: SocketAddr::new(ip, grpc_port), reason: e.to_string() })?;
         sinks.push(Box::new(sink));
-        let host = if ip.is_unspecified() { "127.0.0.1".to_owned() } else { ip.to_string() };
+        let host = address::local_host(ip);
         let grpc_url = format!("rerun+http://{host}:{grpc_port}/proxy");
         let config = rerun::web_viewer::WebViewerConfig { bind_ip: ip.to_string(), web_port: web_port.into(), connect_to: vec![grpc_url], open_browser: false, ..Default::default() };
         let server = config.host_web_viewer().map_err(|e| SinkError::Serve { addr: web_addr, reason: e.to_string() })?;
         // The viewer's dark theme whatever the browser's: the recording's 3D labels and colours are made
         // for it (on the light one white and yellow labels all but vanish).
-        let page = format!("http://{host}:{web_port}/?url={}&theme=dark", format!("rerun+http://{host}:{grpc_port}/proxy").replace(':', "%3A").replace('/', "%2F").replace('+', "%2B"));
+        let page = address::web_viewer_page(&host, web_port, grpc_port);
         if !ip.is_loopback() {
             errln!("rinscope: WARNING: --bind {ip}: anyone who can reach ports {web_port} and {grpc_port} of this machine can watch this session (there is no authentication)");
         }
         description.push(format!("viewer in the browser: open {page} (in its dark theme; Rerun 0.36 ignores that on a browser's very first start: reload once if it opens light)"));
+        // For an unspecified address, the page other machines open names this one (the stream's URL too).
+        if ip.is_unspecified() {
+            match address::network_host(ip) {
+                Some(h) => description.push(format!("from other machines: open {}", address::web_viewer_page(&h, web_port, grpc_port))),
+                None => description.push(format!("from other machines: open this machine's address in place of {host} (it has no route out and no name to print)")),
+            }
+        }
         web = Some(WebServer { _server: Box::new(server), page });
     }
 
