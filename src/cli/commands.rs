@@ -106,11 +106,22 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
             Some(p) => Some(p.checked_add(1).filter(|p| p.checked_add(1).is_some()).ok_or_else(|| Failure::input(format!("--serve-web {p}: the class page needs this port and the next two")))?),
             None => None,
         },
+        // The class page serves the session so far to late viewers; the stream then keeps none.
+        serve_web_history: args.sinks.serve_web,
         stop_on_failure: Some(stop_flag()),
         export: if args.sinks.save.is_none() { export.clone() } else { None },
         ..Default::default()
     };
     let recording_id = format!("{}-seed{}-live", params.meta.name, params.meta.seed);
+    // `--serve-web`: the session kept compact in memory for the class page's late viewers.
+    let (history, history_requests) = match args.sinks.serve_web {
+        Some(_) => {
+            let (stream, store) = sink::open_history(APPLICATION_ID, &recording_id)?;
+            let (tx, requests) = crossbeam_channel::unbounded();
+            (Some(live::History { stream, store, requests }), Some(tx))
+        }
+        None => (None, None),
+    };
     let viewer_sinks = if viewer_request.spawn || viewer_request.connect.is_some() || viewer_request.serve.is_some() || viewer_request.serve_web.is_some() {
         let implicit = !viewer_given;
         Some(sink::open(&viewer_request, APPLICATION_ID, &recording_id).map_err(|e| {
@@ -142,7 +153,7 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
         (Some(port), Some(_)) => {
             let ip = args.sinks.bind.unwrap_or(std::net::IpAddr::V4(std::net::Ipv4Addr::LOCALHOST));
             let token = if ip.is_loopback() { None } else { Some(live::web::random_token().map_err(|e| Failure::run(format!("no random token for the class page: {e}")))?) };
-            let cfg = live::web::PageConfig { addr: std::net::SocketAddr::new(ip, port), host: sink::address::local_host(ip), config_path: path.clone(), token: token.clone() };
+            let cfg = live::web::PageConfig { addr: std::net::SocketAddr::new(ip, port), host: sink::address::local_host(ip), config_path: path.clone(), token: token.clone(), history: history_requests.clone() };
             let page = live::web::start(cfg, status.clone(), format!("{} — {}", params.meta.name, params.meta.title)).map_err(|e| Failure::input(format!("--serve-web: {e:#}")))?;
             errln!("rinscope live: the class page (viewer and sliders): {}", page.url);
             // Every address: 127.0.0.1 above names each reader's own machine; others open this one's.
@@ -162,7 +173,7 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
     // The panel's title shows the URL the class opens.
     let page_url = class_page.as_ref().map(|(p, network)| network.clone().unwrap_or_else(|| p.url.clone()));
     let options = live::LiveOptions { config_path: path, speed: args.speed, duration_s: args.duration_s, panel, log_to_stderr: true, page_url };
-    let outputs = live::Outputs { viewer: viewer_sinks.as_ref().map(sink::OpenSinks::stream), file: file_sinks.as_ref().map(sink::OpenSinks::stream) };
+    let outputs = live::Outputs { viewer: viewer_sinks.as_ref().map(sink::OpenSinks::stream), file: file_sinks.as_ref().map(sink::OpenSinks::stream), history };
     let result = live::run_session_with_status(&options, params, outputs, &stop, &status);
     drop(class_page);
     // Whatever happened, complete the saved file: it holds everything simulated so far.
@@ -190,6 +201,10 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
         outln!("recording: {} ({:.2} MB) — open with `rerun {}`, list its events with `rinscope events {}`", p.display(), bytes as f64 / 1e6, p.display(), p.display());
     }
     print_tables(&exported);
+    // Ended by a signal (not by `q` or its length): 128 + the signal, as every command.
+    if crate::app::terminate::stop_reason().is_some() {
+        return Err(Failure::interrupted("the session's recording is complete up to that moment"));
+    }
     Ok(())
 }
 

@@ -195,6 +195,7 @@ impl SinkArgs {
             serve: self.serve,
             bind: self.bind,
             serve_web: self.serve_web,
+            serve_web_history: None,
             export,
             figures: self.figures.clone(),
             stop_on_failure: Some(crate::app::terminate::stop_flag()),

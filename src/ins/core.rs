@@ -183,6 +183,32 @@ impl InsCore {
         }
     }
 
+    /// True when every algorithm has just completed an update (none holds part of the next).
+    #[must_use]
+    pub fn between_updates(&self) -> bool {
+        self.acc.2 == 0 && self.upd_len == 0 && self.integrators.iter().all(AttitudeIntegrator::between_updates)
+    }
+
+    /// Each algorithm goes on from `from`'s attitude (the same algorithms, between two updates):
+    /// a computer started anew at another rate continues the attitudes of the one it replaces.
+    ///
+    /// # Errors
+    /// The algorithms differ, or `from` is in the middle of an update.
+    pub fn continue_attitudes(&mut self, from: &Self) -> Result<(), String> {
+        if self.algorithms() != from.algorithms() {
+            return Err("the algorithms changed".into());
+        }
+        if !from.between_updates() {
+            return Err("the computer is in the middle of an update".into());
+        }
+        for (k, integ) in self.integrators.iter_mut().enumerate() {
+            integ.n_from_s = from.integrators[k].n_from_s;
+            let latest = from.history[k][1];
+            self.history[k] = [latest, latest];
+        }
+        Ok(())
+    }
+
     /// Replaces the primary attitude.
     pub fn set_primary_attitude(&mut self, n_from_s: Rot<N, S>) {
         if let Some(i) = self.integrators.first_mut() {

@@ -67,6 +67,11 @@ pub struct InsRun {
     /// IMU errors the computer removes from every sample before using it (a self-calibration's
     /// estimates), if any.
     compensation: Option<super::selfcal::ImuErrors>,
+    /// The instant sample 0 ends at, s (0, or where a computer at another rate took over).
+    t0_s: f64,
+    /// The site and the noise seed it was built with (a computer at another rate takes them on).
+    site: Site,
+    seed: u64,
 }
 
 impl InsRun {
@@ -75,9 +80,14 @@ impl InsRun {
     /// algorithms that use previous samples have them.
     #[must_use]
     pub fn new(cfg: &InsParams, site: Site, seed: u64, model: Model) -> Self {
+        Self::new_at(cfg, site, seed, model, 0.0)
+    }
+
+    /// [`Self::new`] with its samples ending at `t0_s` + k·h.
+    fn new_at(cfg: &InsParams, site: Site, seed: u64, model: Model, t0_s: f64) -> Self {
         let h = 1.0 / cfg.rate_hz;
         let pre = InsCore::pre_roll_samples(cfg);
-        let t_start = -(pre as f64) * h;
+        let t_start = t0_s - (pre as f64) * h;
         let mut truth = TruthImu::new(model, Earth::at(site), t_start);
         let mut sensors = Sensors::new(&cfg.errors, h, seed, t_start);
         let pre_roll: Vec<(f64, Vector3<f64>, Vector3<f64>)> = (0..pre)
@@ -91,7 +101,7 @@ impl InsRun {
         // The filtered stream now stands at the truth of t = −d: start the attitude there, with the
         // alignment error φ applied as C = (I − [φ×]) C_true.
         let fir_delay_s = super::fir::Fir::new(&cfg.fir_taps).group_delay_samples() * h;
-        let start = truth.eval(-fir_delay_s).n_from_s;
+        let start = truth.eval(t0_s - fir_delay_s).n_from_s;
         // FRAME: the alignment error is a small rotation of the navigation frame (C = (I − [φ×]) C_true).
         let start: Rot<N, S> = Rot::<N, N>::from_quaternion(rotvec::exp(&-cfg.initial_error_rad)) * start;
         let samples: Vec<(Vector3<f64>, Vector3<f64>)> = pre_roll.iter().map(|(_, g, a)| (*g, *a)).collect();
@@ -99,7 +109,36 @@ impl InsRun {
         let demod = vec![DemodState::default(); core.algorithms().len()];
         let demod_len = demod.len();
         let last_error = vec![None; demod_len];
-        Self { truth, sensors, core, h, index: 0, demod, pre_roll, start, last_error, shared: Vec::new(), chains: ChainMemo::new(demod_len), compensation: None }
+        Self { truth, sensors, core, h, index: 0, demod, pre_roll, start, last_error, shared: Vec::new(), chains: ChainMemo::new(demod_len), compensation: None, t0_s, site, seed }
+    }
+
+    /// True when every algorithm has just completed an update: where the sample rate can change
+    /// ([`Self::at_rate`]).
+    #[must_use]
+    pub fn between_updates(&self) -> bool {
+        self.core.between_updates()
+    }
+
+    /// This INS going on at the rate of `cfg` from the end of its latest sample: a live session's
+    /// new sample rate. Each algorithm keeps its attitude (its error goes on from where it was);
+    /// the algorithms that use previous samples get them from the truth at the new rate, as a new
+    /// run's do; the sensor noise is drawn anew at the new rate.
+    ///
+    /// # Errors
+    /// Between two updates only; and not with a FIR or a decimation (their state is in samples of
+    /// the old rate), with navigation (its state too), or with other algorithms.
+    pub fn at_rate(&self, cfg: &InsParams) -> Result<Self, String> {
+        if cfg.fir_taps.len() > 1 || cfg.decimation != 1 {
+            return Err("the sample rate of an IMU with a FIR or a decimation cannot change in a running session".into());
+        }
+        if cfg.navigation.is_some() {
+            return Err("the sample rate of a navigating INS cannot change in a running session".into());
+        }
+        let t0 = self.truth.t_last_s();
+        let mut next = Self::new_at(cfg, self.site, self.seed, self.truth.model().clone(), t0);
+        next.core.continue_attitudes(&self.core)?;
+        next.compensation = self.compensation;
+        Ok(next)
     }
 
     /// The measured (end time, Δθ, Δv) samples before t = 0 that pre-rolled the computer (what a log
@@ -195,7 +234,7 @@ impl InsRun {
     /// (end time, Δθ, Δv, true Δθ, true Δv).
     pub fn next_measurement_and_truth(&mut self) -> (f64, Vector3<f64>, Vector3<f64>, Vector3<f64>, Vector3<f64>) {
         self.index += 1;
-        let t1 = self.index as f64 * self.h;
+        let t1 = self.t0_s + self.index as f64 * self.h;
         let (g_true, a_true) = self.truth.increments(t1);
         let (g, a) = self.sensors.measure(&g_true, &a_true, t1);
         let (g, a) = match &self.compensation {

@@ -78,6 +78,12 @@ impl AttitudeIntegrator {
         self.n
     }
 
+    /// True between two updates (no sample of the next one taken yet).
+    #[must_use]
+    pub fn between_updates(&self) -> bool {
+        self.filled == 0
+    }
+
     /// True if the next sample completes an update (the navigation-frame rotation is needed then only).
     #[must_use]
     #[inline]

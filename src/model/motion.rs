@@ -112,23 +112,61 @@ pub struct Coning {
 }
 
 impl Coning {
-    /// (cos α/2, sin α/2, sin α, 2 sin²(α/2)): the constants of [`Self::rotation`] and [`Self::rate`].
+    /// (cos α/2, sin α/2, sin α, 2 sin²(α/2)) of half-angle `alpha`: the constants of the cone's
+    /// rotation and rate.
+    fn constants_of(alpha: f64) -> [f64; 4] {
+        let (s, c) = (0.5 * alpha).sin_cos();
+        [c, s, alpha.sin(), 2.0 * s * s]
+    }
+
     fn constants(&self) -> [f64; 4] {
-        let (s, c) = (0.5 * self.half_angle_rad).sin_cos();
-        [c, s, self.half_angle_rad.sin(), 2.0 * s * s]
-    }
-
-    fn rotation(&self, k: &[f64; 4], t: f64) -> UnitQuaternion<f64> {
-        let (so, co) = (self.omega_rad_per_s * t).sin_cos();
-        UnitQuaternion::new_normalize(Quaternion::new(k[0], k[1] * co, k[1] * so, 0.0))
-    }
-
-    fn rate(&self, k: &[f64; 4], t: f64) -> Vector3<f64> {
-        let (so, co) = (self.omega_rad_per_s * t).sin_cos();
-        let w = self.omega_rad_per_s;
-        Vector3::new(-w * k[2] * so, w * k[2] * co, -w * k[3])
+        Self::constants_of(self.half_angle_rad)
     }
 }
+
+/// An oscillation (a cone, a wobble) changed while the body was moving (a live session): it goes
+/// on from where the body is. Its size (the cone's half-angle, the wobble's amplitude) and its
+/// angular frequency ease from the old values to the new over [`CONE_RAMP_S`] along
+/// s(u) = (1 − cos πu)/2, and its phase is their integral — the attitude, the rate and the rate's
+/// start and end are continuous (a jump in either would be a motion no real body makes: the INS
+/// would integrate a jump it never felt, or the algorithms that use previous samples would see a
+/// step in the rate). docs/coning.md, "A cone that changes".
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Transition {
+    /// Start and end, s.
+    pub start_s: f64,
+    /// End of the transition, s.
+    pub end_s: f64,
+    /// The phase at the start, rad.
+    pub phase_rad: f64,
+    /// Size and angular frequency at the start (rad, rad/s).
+    pub from: (f64, f64),
+    /// Size and angular frequency from the end on.
+    pub to: (f64, f64),
+}
+
+impl Transition {
+    /// (size, its rate, phase, its rate = the angular frequency) at `t_s` ≥ `start_s`.
+    #[must_use]
+    pub fn at(&self, t_s: f64) -> (f64, f64, f64, f64) {
+        let span = self.end_s - self.start_s;
+        let tau = (t_s - self.start_s).max(0.0);
+        let (da, dw) = (self.to.0 - self.from.0, self.to.1 - self.from.1);
+        if tau >= span {
+            // ∫ s over the whole transition is span/2.
+            let phase_end = self.phase_rad + self.from.1 * span + dw * 0.5 * span;
+            return (self.to.0, 0.0, phase_end + self.to.1 * (tau - span), self.to.1);
+        }
+        let u = std::f64::consts::PI * tau / span;
+        let s = 0.5 * (1.0 - u.cos());
+        let s_dot = 0.5 * std::f64::consts::PI / span * u.sin();
+        let integral_s = 0.5 * tau - span / (2.0 * std::f64::consts::PI) * u.sin();
+        (self.from.0 + da * s, da * s_dot, self.phase_rad + self.from.1 * tau + dw * integral_s, self.from.1 + dw * s)
+    }
+}
+
+/// How long a changed cone or wobble takes to reach its new size and frequency, s.
+pub const CONE_RAMP_S: f64 = 1.0;
 
 /// The vehicle's attitude over time.
 #[derive(Debug, Clone)]
@@ -136,9 +174,13 @@ pub struct VehicleMotion {
     base: Attitude,
     knots: [Knots; 3],
     wobble: Vec<Wobble>,
+    /// Per wobble, its change in a running session ([`Self::continuing_from`]).
+    wobble_ramps: Vec<Option<Transition>>,
     coning: Option<Coning>,
     /// The constants of the cone ([`Coning::constants`]), computed once.
     cone_constants: [f64; 4],
+    /// A cone changed in a running session.
+    cone_continuation: Option<Transition>,
     /// C_b^n of the Euler part when it never changes (no ramp, no wobble), computed once.
     euler_fixed: Option<Rot<N, B>>,
 }
@@ -163,13 +205,13 @@ impl VehicleMotion {
             k.t_s.push(r.start_s + duration);
             k.value_rad.push(r.target_rad);
         }
-        Ok(Self { base, knots, wobble, coning: None, cone_constants: [1.0, 0.0, 0.0, 0.0], euler_fixed: None }.with_constants())
+        Ok(Self { base, knots, wobble_ramps: vec![None; wobble.len()], wobble, coning: None, cone_constants: [1.0, 0.0, 0.0, 0.0], cone_continuation: None, euler_fixed: None }.with_constants())
     }
 
     /// A vehicle at rest at `base`.
     #[must_use]
     pub fn fixed(base: Attitude) -> Self {
-        Self { base, knots: Default::default(), wobble: Vec::new(), coning: None, cone_constants: [1.0, 0.0, 0.0, 0.0], euler_fixed: None }.with_constants()
+        Self { base, knots: Default::default(), wobble: Vec::new(), wobble_ramps: Vec::new(), coning: None, cone_constants: [1.0, 0.0, 0.0, 0.0], cone_continuation: None, euler_fixed: None }.with_constants()
     }
 
     /// Computes the constant rotations and trigonometry once.
@@ -192,6 +234,78 @@ impl VehicleMotion {
     pub fn with_coning(mut self, coning: Coning) -> Self {
         self.coning = (coning.half_angle_rad != 0.0 && coning.omega_rad_per_s != 0.0).then_some(coning);
         self.with_constants()
+    }
+
+    /// This motion continued from `old`'s at `t_s` (a live session's reload): its cone and each
+    /// wobble that drives the same angle as `old`'s at the same place in the list go from `old`'s
+    /// size and frequency to this one's through a [`Transition`] — the body goes on from where it
+    /// is. A cone set to zero (half-angle or frequency) eases down to a standstill; a cone where
+    /// there was none eases up from zero.
+    #[must_use]
+    pub fn continuing_from(mut self, old: &Self, t_s: f64) -> Self {
+        for i in 0..self.wobble.len() {
+            if old.wobble.get(i).is_none_or(|o| o.angle != self.wobble[i].angle) {
+                continue;
+            }
+            let (amplitude, _, phase, omega) = old.wobble_state(i, t_s);
+            let w = &self.wobble[i];
+            self.wobble_ramps[i] = Some(Transition { start_s: t_s, end_s: t_s + CONE_RAMP_S, phase_rad: phase, from: (amplitude, omega), to: (w.amplitude_rad, w.omega_rad_per_s) });
+        }
+        if old.coning.is_none() && self.coning.is_none() {
+            return self;
+        }
+        let (alpha, _, phase, omega) = old.cone_state_full(t_s);
+        let to = self.coning.map_or((0.0, omega), |c| (c.half_angle_rad, c.omega_rad_per_s));
+        self.coning = Some(Coning { half_angle_rad: to.0, omega_rad_per_s: to.1 });
+        self.cone_continuation = Some(Transition { start_s: t_s, end_s: t_s + CONE_RAMP_S, phase_rad: phase, from: (alpha, omega), to });
+        self.with_constants()
+    }
+
+    /// Wobble `i`'s (amplitude, its rate, phase, angular frequency) at `t_s`.
+    fn wobble_state(&self, i: usize, t_s: f64) -> (f64, f64, f64, f64) {
+        let w = &self.wobble[i];
+        match self.wobble_ramps.get(i).copied().flatten() {
+            Some(k) if t_s >= k.start_s => k.at(t_s),
+            _ => (w.amplitude_rad, 0.0, w.omega_rad_per_s * t_s + w.phase_rad, w.omega_rad_per_s),
+        }
+    }
+
+    /// The cone's half-angle and phase at `t_s` (0, 0 without a cone).
+    #[must_use]
+    pub fn cone_state(&self, t_s: f64) -> (f64, f64) {
+        let (alpha, _, phase, _) = self.cone_state_full(t_s);
+        (alpha, phase)
+    }
+
+    /// The cone's (half-angle, its rate, phase, angular frequency) at `t_s`.
+    fn cone_state_full(&self, t_s: f64) -> (f64, f64, f64, f64) {
+        match (self.coning, self.cone_continuation) {
+            (None, _) => (0.0, 0.0, 0.0, 0.0),
+            (Some(_), Some(k)) if t_s >= k.start_s => k.at(t_s),
+            (Some(c), _) => (c.half_angle_rad, 0.0, c.omega_rad_per_s * t_s, c.omega_rad_per_s),
+        }
+    }
+
+    /// The cone's rotation K at `t_s` (body side of the Euler frame).
+    fn cone_rotation(&self, c: &Coning, t_s: f64) -> UnitQuaternion<f64> {
+        let (alpha, _, phase, _) = self.cone_state_full(t_s);
+        let k = if alpha == c.half_angle_rad { self.cone_constants } else { Coning::constants_of(alpha) };
+        let (so, co) = phase.sin_cos();
+        UnitQuaternion::new_normalize(Quaternion::new(k[0], k[1] * co, k[1] * so, 0.0))
+    }
+
+    /// The cone's rate of K relative to the Euler frame, in b, at `t_s`: with φ̇ the angular
+    /// frequency now, (α̇ cos φ − φ̇ sin α sin φ, α̇ sin φ + φ̇ sin α cos φ, −2 φ̇ sin²(α/2)).
+    fn cone_rate(&self, c: &Coning, t_s: f64) -> Vector3<f64> {
+        let (alpha, alpha_dot, phase, w) = self.cone_state_full(t_s);
+        let k = if alpha == c.half_angle_rad { self.cone_constants } else { Coning::constants_of(alpha) };
+        let (so, co) = phase.sin_cos();
+        Vector3::new(alpha_dot * co - w * k[2] * so, alpha_dot * so + w * k[2] * co, -w * k[3])
+    }
+
+    /// Whether a cone or wobble is changing at `t_s` (inside a [`Transition`]).
+    fn in_transition(&self, t_s: f64) -> bool {
+        self.cone_continuation.iter().chain(self.wobble_ramps.iter().flatten()).any(|k| t_s >= k.start_s && t_s < k.end_s)
     }
 
     /// True when the vehicle never moves (no ramp, no wobble, no coning).
@@ -231,7 +345,7 @@ impl VehicleMotion {
         match self.coning {
             None => e,
             // FRAME: the coned body b is the Euler frame turned by the cone rotation K (body side).
-            Some(c) => Rot::from_quaternion(*e.quaternion() * c.rotation(&self.cone_constants, t_s)),
+            Some(c) => Rot::from_quaternion(*e.quaternion() * self.cone_rotation(&c, t_s)),
         }
     }
 
@@ -239,7 +353,7 @@ impl VehicleMotion {
     #[must_use]
     pub fn omega_nb_b(&self, t_s: f64) -> Vector3<f64> {
         if self.euler_fixed.is_some() {
-            return self.coning.map_or_else(Vector3::zeros, |c| c.rate(&self.cone_constants, t_s));
+            return self.coning.map_or_else(Vector3::zeros, |c| self.cone_rate(&c, t_s));
         }
         let a = self.euler(t_s);
         let [dp, dr, dh] = self.euler_rates(t_s);
@@ -250,7 +364,7 @@ impl VehicleMotion {
         let w_e = a.n_from_b().quaternion().inverse() * w_n;
         match self.coning {
             None => w_e,
-            Some(c) => c.rotation(&self.cone_constants, t_s).inverse() * w_e + c.rate(&self.cone_constants, t_s),
+            Some(c) => self.cone_rotation(&c, t_s).inverse() * w_e + self.cone_rate(&c, t_s),
         }
     }
 
@@ -269,7 +383,11 @@ impl VehicleMotion {
         let turning = |axis: Vector3<f64>, angle_rad: f64, rate_rad_per_s: f64| Link::Turning { axis, angle_rad, rate_rad_per_s };
         let mut links = vec![turning(Vector3::z(), -a.heading_rad, -dh), turning(Vector3::x(), a.pitch_rad, dp), turning(Vector3::y(), a.roll_rad, dr)];
         if let Some(c) = self.coning {
-            links.push(Link::Cone { half_angle_rad: c.half_angle_rad, phase_rad: c.omega_rad_per_s * t_s, rate_rad_per_s: c.omega_rad_per_s });
+            // A cone changing is not a link turning at a constant rate.
+            if self.in_transition(rates_at_s) {
+                return None;
+            }
+            links.push(Link::Cone { half_angle_rad: c.half_angle_rad, phase_rad: self.cone_state(t_s).1, rate_rad_per_s: c.omega_rad_per_s });
         }
         Some(links)
     }
@@ -278,8 +396,10 @@ impl VehicleMotion {
     #[must_use]
     pub fn euler_rates(&self, t_s: f64) -> [f64; 3] {
         let mut r = [self.knots[0].slope(t_s), self.knots[1].slope(t_s), self.knots[2].slope(t_s)];
-        for w in &self.wobble {
-            r[w.angle.index()] += w.amplitude_rad * w.omega_rad_per_s * (w.omega_rad_per_s * t_s + w.phase_rad).cos();
+        for (i, w) in self.wobble.iter().enumerate() {
+            let (amplitude, amplitude_rate, phase, omega) = self.wobble_state(i, t_s);
+            let (s, c) = phase.sin_cos();
+            r[w.angle.index()] += amplitude * omega * c + amplitude_rate * s;
         }
         r
     }
@@ -288,13 +408,16 @@ impl VehicleMotion {
     #[must_use]
     pub fn max_angular_frequency(&self) -> f64 {
         let w = self.wobble.iter().map(|w| w.omega_rad_per_s).fold(0.0, f64::max);
-        w.max(self.coning.map_or(0.0, |c| c.omega_rad_per_s))
+        // A transition passes through the frequencies between its ends.
+        let changing = self.cone_continuation.iter().chain(self.wobble_ramps.iter().flatten()).map(|k| k.from.1.abs().max(k.to.1.abs())).fold(0.0, f64::max);
+        w.max(self.coning.map_or(0.0, |c| c.omega_rad_per_s.abs())).max(changing)
     }
 
     /// First time after `t_s` where a rate jumps (a ramp starts or ends).
     #[must_use]
     pub fn next_breakpoint_after(&self, t_s: f64) -> f64 {
-        self.knots.iter().map(|k| k.next_after(t_s)).fold(f64::INFINITY, f64::min)
+        let ramp = self.cone_continuation.iter().chain(self.wobble_ramps.iter().flatten()).flat_map(|k| [k.start_s, k.end_s]).filter(|b| *b > t_s).fold(f64::INFINITY, f64::min);
+        self.knots.iter().map(|k| k.next_after(t_s)).fold(ramp, f64::min)
     }
 
     /// The Euler-angle part of the motion.
@@ -305,8 +428,9 @@ impl VehicleMotion {
             self.knots[1].value(t_s, self.base.roll_rad),
             self.knots[2].value(t_s, self.base.heading_rad),
         ];
-        for w in &self.wobble {
-            a[w.angle.index()] += w.amplitude_rad * (w.omega_rad_per_s * t_s + w.phase_rad).sin();
+        for (i, w) in self.wobble.iter().enumerate() {
+            let (amplitude, _, phase, _) = self.wobble_state(i, t_s);
+            a[w.angle.index()] += amplitude * phase.sin();
         }
         Attitude { pitch_rad: a[0], roll_rad: a[1], heading_rad: a[2] }
     }
@@ -382,6 +506,53 @@ mod tests {
             let w = m.omega_nb_b(t);
             assert!((fd - w).norm() < 1e-6 * w.norm().max(1.0), "t={t}: {fd:?} vs {w:?}");
         }
+    }
+
+    #[test]
+    fn a_changed_cone_goes_on_from_where_the_body_is() {
+        // A live session's cone 1° at 5 Hz changed to 2° at 10 Hz at t = 3.217 s: the attitude is
+        // the same on both sides of the change (no jump the INS does not feel), and the rate is the
+        // attitude's derivative (finite differences, as above) inside the ramp and after it.
+        let cone = |deg: f64, hz: f64| VehicleMotion::fixed(Attitude::default()).with_coning(Coning { half_angle_rad: deg * RAD_PER_DEG, omega_rad_per_s: std::f64::consts::TAU * hz });
+        let (old, t_c) = (cone(1.0, 5.0), 3.217);
+        let new = cone(2.0, 10.0).continuing_from(&old, t_c);
+        let jump = (old.n_from_b(t_c).inverse() * new.n_from_b(t_c)).quaternion().angle();
+        assert!(jump < 1e-12, "the body jumps by {jump} rad at the change");
+        for t in [t_c + 0.3, t_c + 0.9, t_c + CONE_RAMP_S + 0.7] {
+            let h = 1e-6;
+            let fd = (new.n_from_b(t - h).inverse() * new.n_from_b(t + h)).quaternion().scaled_axis() / (2.0 * h);
+            let w = new.omega_nb_b(t);
+            assert!((fd - w).norm() < 1e-6 * w.norm(), "t={t}: {fd:?} vs {w:?}");
+        }
+        // Halfway up the ramp 1.5°; after it the new cone's 2°; the phase goes on at 10 Hz.
+        let deg = |t: f64| new.cone_state(t).0 / RAD_PER_DEG;
+        assert!((deg(t_c + 0.5 * CONE_RAMP_S) - 1.5).abs() < 1e-12 && (deg(t_c + 5.0) - 2.0).abs() < 1e-12);
+        let phase_rate = (new.cone_state(t_c + 4.0).1 - new.cone_state(t_c + 3.0).1) / std::f64::consts::TAU;
+        assert!((phase_rate - 10.0).abs() < 1e-9, "{phase_rate}");
+        // A cone set to zero ramps down and stops there, from where it was.
+        let off = VehicleMotion::fixed(Attitude::default()).continuing_from(&old, t_c);
+        assert!((old.n_from_b(t_c).inverse() * off.n_from_b(t_c)).quaternion().angle() < 1e-12);
+        assert!(off.n_from_b(t_c + CONE_RAMP_S + 0.1).quaternion().angle() < 1e-12);
+    }
+
+    #[test]
+    fn a_changed_wobble_goes_on_from_where_the_body_is() {
+        // Li et al. 2014's two-axis wobble (6°, 1 Hz, 90° apart) changed to 3° at 2 Hz at t = 1.3 s:
+        // no jump in the attitude, the rate its derivative inside the ramp and after.
+        let wobble = |deg: f64, hz: f64| {
+            let w = |angle, phase_rad| Wobble { angle, amplitude_rad: deg * RAD_PER_DEG, omega_rad_per_s: std::f64::consts::TAU * hz, phase_rad };
+            VehicleMotion::new(Attitude::default(), vec![], vec![w(AngleKind::Heading, 0.0), w(AngleKind::Roll, std::f64::consts::FRAC_PI_2)]).expect("valid")
+        };
+        let (old, t_c) = (wobble(6.0, 1.0), 1.3);
+        let new = wobble(3.0, 2.0).continuing_from(&old, t_c);
+        assert!((old.n_from_b(t_c).inverse() * new.n_from_b(t_c)).quaternion().angle() < 1e-12);
+        for t in [t_c + 0.4, t_c + CONE_RAMP_S + 0.3] {
+            let h = 1e-6;
+            let fd = (new.n_from_b(t - h).inverse() * new.n_from_b(t + h)).quaternion().scaled_axis() / (2.0 * h);
+            let w = new.omega_nb_b(t);
+            assert!((fd - w).norm() < 1e-6 * w.norm().max(1e-3), "t={t}: {fd:?} vs {w:?}");
+        }
+        assert!(new.next_breakpoint_after(t_c + 0.1) == t_c + CONE_RAMP_S);
     }
 
     #[test]

@@ -115,7 +115,7 @@ impl Recorder {
                     let rest = s.split_off(s.len().min(3));
                     (s, rest)
                 };
-                if let Some((_, rates)) = &layout.coning_log {
+                if let Some(rates) = layout.coning_log.as_ref().map(|l| &l.rates) {
                     // Whole decades, from a tenth of the run (the lines' left part is their steep
                     // start) to the end, of the slowest to the fastest analytic drift.
                     let logs = rates.iter().filter(|r| **r > 0.0).map(|r| (r * p.duration_s).log10());
@@ -124,7 +124,12 @@ impl Recorder {
                         .with_property("PlotLegend", &layout::no_legend());
                     // Once measured lines exist, their whole extent (their steep start too: no
                     // fixed range hides a series); before, the analytic lines'.
-                    let range = self.data_range(super::ins_view::CONING_LOG_PATH).or_else(|| lo.is_finite().then(|| ((lo - 1.0).floor(), hi.ceil())));
+                    // (A viewer watching live fits it itself: the session has no length to frame on.)
+                    let range = if self.live.is_some_and(super::LiveOutput::watched) {
+                        None
+                    } else {
+                        self.data_range(super::ins_view::CONING_LOG_PATH).or_else(|| lo.is_finite().then(|| ((lo - 1.0).floor(), hi.ceil())))
+                    };
                     tabs.push(match range {
                         Some((a, b)) => view.with_property("ScalarAxis", &layout::scalar_range(a, b)),
                         None => view,
@@ -158,13 +163,14 @@ impl Recorder {
             }
         };
         let mut root = Node::container(ContainerKind::Horizontal, vec![left, right], &[1.1, 1.0]);
-        if self.live {
-            // Every plot framed on its data so far (the viewer would keep ±1 from before them).
+        if self.live == Some(super::LiveOutput::File) {
+            // A saved session's plots framed on its data, as a run's are (a viewer watching live
+            // fits each plot's value axis to the data as they arrive: no range is sent to it).
             root.frame_plots_without_range(&|origin| self.data_range(origin));
         }
         // Play a whole run in about a minute; a live session follows the newest data.
-        let speed = if self.live { 1.0 } else { (p.duration_s / 60.0).max(1.0).round() };
-        layout::send(&self.rec, APPLICATION_ID, &root, &layout::Playback { timeline: TIMELINE, speed, follow: self.live || p.recording.open_at_end })
+        let speed = if self.live.is_some() { 1.0 } else { (p.duration_s / 60.0).max(1.0).round() };
+        layout::send(&self.rec, APPLICATION_ID, &root, &layout::Playback { timeline: TIMELINE, speed, follow: self.live.is_some() || p.recording.open_at_end })
     }
 }
 

@@ -5,10 +5,10 @@
 use std::collections::VecDeque;
 
 use nalgebra::{UnitQuaternion, Vector3};
-use rerun::{RecordingStream, RecordingStreamResult, TimeColumn};
+use rerun::{RecordingStream, RecordingStreamResult};
 
 use super::palette::{albedo, rgb, rgba};
-use super::{to_rerun_quaternion, TIMELINE};
+use super::TIMELINE;
 use crate::math::frames::{Rot, B, N};
 use crate::math::units::{fmt_angle, RAD_PER_DEG};
 
@@ -25,39 +25,66 @@ const HALF: f64 = 0.6;
 pub(crate) struct ConeGizmo {
     /// Magnification of the tilt.
     gain: f64,
-    /// The last `TRAIL` rotations, newest last.
-    history: VecDeque<rerun::Quaternion>,
-    /// Per trail position, the rotation per buffered scene frame.
-    columns: Vec<Vec<rerun::Quaternion>>,
+    /// The last `TRAIL` directions of the drawn axis (unit vectors), newest last.
+    history: VecDeque<Vector3<f64>>,
+    /// Per buffered scene frame, the trail's `TRAIL` lines, newest first.
+    strips: Vec<Vec<[f32; 3]>>,
 }
 
-fn path(i: usize) -> String {
-    format!("world/cone/axis_{i}")
-}
+/// The axis and its trail: one entity, a line per trail position (newest first).
+const AXIS_PATH: &str = "world/cone/axis";
 
 impl ConeGizmo {
-    /// The gizmo for a cone of half-angle `alpha_rad` (> 0); logs its fixed parts.
-    pub(crate) fn new(rec: &RecordingStream, alpha_rad: f64) -> RecordingStreamResult<Self> {
-        let gain = (DRAWN_HALF_ANGLE_RAD / alpha_rad).max(1.0).round();
+    /// The gizmo for a cone of half-angle `alpha_rad` (> 0); logs its fixed parts (in live mode,
+    /// those that depend on the cone at `at_s` on the timeline: a change of the cone redraws them).
+    pub(crate) fn new(rec: &RecordingStream, alpha_rad: f64, at_s: Option<f64>) -> RecordingStreamResult<Self> {
+        let gain = Self::gain_for(alpha_rad);
         rec.log_static("world/cone", &rerun::Transform3D::from_translation(OFFSET))?;
-        let (mesh, rims) = super::scene::cone(Vector3::z(), Vector3::x(), Vector3::y(), (alpha_rad * gain).min(1.4), HALF);
-        let color = [120, 200, 255];
-        rec.log_static("world/cone/surface", &rerun::Mesh3D::new(mesh.0).with_triangle_indices(mesh.1).with_albedo_factor(albedo(color, 35)))?;
-        rec.log_static("world/cone/rims", &rerun::LineStrips3D::new(rims).with_colors([rgba(color, 160)]).with_radii([0.004]))?;
         rec.log_static("world/cone/nominal", &rerun::LineStrips3D::new([[[0.0, 0.0, -0.7f32], [0.0, 0.0, 0.7]]]).with_colors([rgb([150, 150, 150])]).with_radii([0.005]))?;
-        let label = format!("body z on its {} cone, tilt ×{gain}", fmt_angle(alpha_rad));
+        // The trail's colours and widths; its lines go on the timeline.
+        let colors = (0..TRAIL).map(|i| rgba([255, 230, 120], (230.0 * (1.0 - i as f64 / TRAIL as f64)) as u8));
+        let radii = (0..TRAIL).map(|i| if i == 0 { 0.012f32 } else { 0.007 });
+        rec.log_static(AXIS_PATH, &rerun::LineStrips3D::update_fields().with_colors(colors).with_radii(radii))?;
+        let me = Self { gain, history: VecDeque::with_capacity(TRAIL), strips: Vec::new() };
+        me.log_cone(rec, alpha_rad, at_s)?;
+        Ok(me)
+    }
+
+    fn gain_for(alpha_rad: f64) -> f64 {
+        (DRAWN_HALF_ANGLE_RAD / alpha_rad).max(1.0).round()
+    }
+
+    /// The drawn cone and its label for half-angle `alpha_rad`: static, or in live mode at `at_s`.
+    fn log_cone(&self, rec: &RecordingStream, alpha_rad: f64, at_s: Option<f64>) -> RecordingStreamResult<()> {
+        let (mesh, rims) = super::scene::cone(Vector3::z(), Vector3::x(), Vector3::y(), (alpha_rad * self.gain).min(1.4), HALF);
+        let color = [120, 200, 255];
+        let label = if alpha_rad > 0.0 { format!("body z on its {} cone, tilt ×{}", fmt_angle(alpha_rad), self.gain) } else { "body z: no cone (half-angle 0)".to_owned() };
+        let surface = rerun::Mesh3D::new(mesh.0).with_triangle_indices(mesh.1).with_albedo_factor(albedo(color, 35));
+        let rims = rerun::LineStrips3D::new(rims).with_colors([rgba(color, 160)]).with_radii([0.004]);
         // Above the cone (below it, it sat on the table's deck, where no colour reads).
-        rec.log_static("world/cone/label", &rerun::Points3D::new([[0.0f32, 0.0, 0.85]]).with_labels([label]).with_radii([0.002]).with_colors([super::palette::label(color)]))?;
-        for i in 0..TRAIL {
-            let alpha = (230.0 * (1.0 - i as f64 / TRAIL as f64)) as u8;
-            rec.log_static(
-                format!("{}/line", path(i)),
-                &rerun::LineStrips3D::new([[[0.0, 0.0, -HALF as f32 * 1.1], [0.0, 0.0, HALF as f32 * 1.1]]])
-                    .with_colors([rgba([255, 230, 120], alpha)])
-                    .with_radii([if i == 0 { 0.012 } else { 0.007 }]),
-            )?;
+        let label = rerun::Points3D::new([[0.0f32, 0.0, 0.85]]).with_labels([label]).with_radii([0.002]).with_colors([super::palette::label(color)]);
+        match at_s {
+            None => {
+                rec.log_static("world/cone/surface", &surface)?;
+                rec.log_static("world/cone/rims", &rims)?;
+                rec.log_static("world/cone/label", &label)
+            }
+            Some(t) => {
+                rec.set_duration_secs(TIMELINE, t);
+                rec.log("world/cone/surface", &surface)?;
+                rec.log("world/cone/rims", &rims)?;
+                rec.log("world/cone/label", &label)
+            }
         }
-        Ok(Self { gain, history: VecDeque::with_capacity(TRAIL), columns: vec![Vec::new(); TRAIL] })
+    }
+
+    /// Live mode: the cone is now of half-angle `alpha_rad` from `t_s` on (its magnification
+    /// follows, as a new gizmo's would).
+    pub(crate) fn reshape(&mut self, rec: &RecordingStream, alpha_rad: f64, t_s: f64) -> RecordingStreamResult<()> {
+        if alpha_rad > 0.0 {
+            self.gain = Self::gain_for(alpha_rad);
+        }
+        self.log_cone(rec, alpha_rad, Some(t_s))
     }
 
     /// Buffers one scene frame of the body attitude `n_from_b`.
@@ -66,27 +93,27 @@ impl ConeGizmo {
         let z: Vector3<f64> = n_from_b.quaternion() * Vector3::z();
         let tilt = z.z.clamp(-1.0, 1.0).acos();
         let about = Vector3::z().cross(&z);
-        let q = match nalgebra::Unit::try_new(about, 1e-15) {
-            Some(axis) => UnitQuaternion::from_axis_angle(&axis, (tilt * self.gain).min(1.4)),
-            None => UnitQuaternion::identity(),
+        let drawn = match nalgebra::Unit::try_new(about, 1e-15) {
+            Some(axis) => UnitQuaternion::from_axis_angle(&axis, (tilt * self.gain).min(1.4)) * Vector3::z(),
+            None => Vector3::z(),
         };
         if self.history.len() == TRAIL {
             self.history.pop_front();
         }
-        self.history.push_back(to_rerun_quaternion(&q));
-        let newest = self.history.len() - 1;
-        for (i, col) in self.columns.iter_mut().enumerate() {
-            col.push(self.history[newest.saturating_sub(i)]);
-        }
+        self.history.push_back(drawn);
+        let end = HALF * 1.1;
+        let frame: Vec<[f32; 3]> = (0..TRAIL)
+            .map(|i| self.history[self.history.len() - 1 - i.min(self.history.len() - 1)])
+            .flat_map(|d| [(-end * d), (end * d)].map(|p| [p.x as f32, p.y as f32, p.z as f32]))
+            .collect();
+        self.strips.push(frame);
     }
 
     /// Sends the buffered frames at `times`.
-    pub(crate) fn flush(&mut self, rec: &RecordingStream, times: &[f64]) -> RecordingStreamResult<()> {
-        for (i, col) in self.columns.iter_mut().enumerate() {
-            let q = std::mem::take(col);
-            let time = TimeColumn::new_duration_secs(TIMELINE, times.iter().copied());
-            rec.send_columns(path(i), [time], rerun::Transform3D::update_fields().with_many_quaternion(q).columns_of_unit_batches()?)?;
-        }
+    pub(crate) fn flush(&mut self, stream: &super::Stream, times: &[f64]) -> RecordingStreamResult<()> {
+        let frames = std::mem::take(&mut self.strips);
+        let strips = frames.iter().flat_map(|f| f.chunks(2).map(<[[f32; 3]]>::to_vec));
+        stream.rec().send_columns(AXIS_PATH, stream.time_columns(times), rerun::LineStrips3D::update_fields().with_strips(strips).columns(std::iter::repeat_n(TRAIL, frames.len()))?)?;
         Ok(())
     }
 }

@@ -1,36 +1,31 @@
-//! How the plots are framed on their data: each series' extent as it grows, the range a plot of
-//! it shows ([`frame`]), and in live mode the layout sent again when a series leaves its frame.
+//! How the plots are framed on their data: each series' extent as it grows and the range a plot of
+//! it shows ([`frame`]).
 
 use std::collections::BTreeMap;
-use std::time::{Duration, Instant};
 
 use rerun::RecordingStreamResult;
 
 use super::rows;
 use super::Recorder;
-use crate::scenario::Params;
 
-/// Every plot framed on its data: each series' extent as it grows. The viewer fits a plot's value
-/// axis once, when the plot first appears — before a live session has data — and keeps ±1 after;
-/// so a live layout carries each plot's range itself, on the 1-2-5 grid the saved recordings use
-/// ([`frame`]), and is sent again when a series leaves it (at most once every
-/// [`REFRAME_MIN_INTERVAL`]). A run's layout, sent once its data are in, takes the same ranges.
+/// Every plot framed on its data: each series' extent as it grows. A run's layout, sent once its
+/// data are in, and a saved live session's final layout take each plot's range from it ([`frame`],
+/// on the 1-2-5 grid the saved recordings use). A viewer watching a live session gets no range: it
+/// fits each plot's value axis to the data as they arrive (measured in Rerun 0.36's web viewer:
+/// a plot sent before its data, with no range, shows them framed).
+#[derive(Default)]
 pub(super) struct Frames {
     /// Each series' value extent so far (entity path → min, max), finite values only.
     extents: BTreeMap<String, (f64, f64)>,
-    /// The range each series' extent gave when the layout was last sent (live mode).
-    drawn: BTreeMap<String, (f64, f64)>,
-    /// Live mode: the parameters the layout is rebuilt from, and when it was last sent.
-    live: Option<(Box<Params>, Instant)>,
+    /// A live viewer's plots: the range each was last held at by its frame points.
+    held: BTreeMap<String, (f64, f64)>,
 }
 
-impl Frames {
-    /// Framing for a recorder; `live_params` in live mode (the layout is then sent again as the
-    /// data grow).
-    pub(super) fn new(live_params: Option<&Params>) -> Self {
-        Self { extents: BTreeMap::new(), drawn: BTreeMap::new(), live: live_params.map(|p| (Box::new(p.clone()), Instant::now())) }
-    }
+/// The child entity of a plot that holds its value axis in a live viewer: two points nobody sees
+/// at the plot's range (the viewer fits the axis to everything plotted, these included).
+const FRAME_SLUG: &str = "frame";
 
+impl Frames {
     /// Takes `values` (any width, row-major) of the series at `path` into its extent.
     pub(super) fn observe(&mut self, path: &str, values: &[f64]) {
         let e = self.extents.entry(path.to_owned()).or_insert((f64::INFINITY, f64::NEG_INFINITY));
@@ -40,8 +35,11 @@ impl Frames {
     }
 }
 
-/// Least wall time between two live re-framings.
-const REFRAME_MIN_INTERVAL: Duration = Duration::from_millis(500);
+/// Whether a plot of `what` is framed symmetrically about zero (an error).
+fn symmetric(what: rows::Quantity) -> bool {
+    use rows::Quantity as Q;
+    matches!(what, Q::TableError(_) | Q::InsError(_) | Q::ClosedForm | Q::PositionError | Q::VelocityError | Q::Swing(_))
+}
 
 /// The value range a plot of `what` shows for data in `[lo, hi]`: error plots symmetric about
 /// zero (±1.25 h, h on the 1-2-3-10 grid of [`crate::math::units::nice_half_range`], as the saved
@@ -49,8 +47,7 @@ const REFRAME_MIN_INTERVAL: Duration = Duration::from_millis(500);
 /// about eight steps over the data.
 pub(crate) fn frame(what: rows::Quantity, lo: f64, hi: f64) -> (f64, f64) {
     use crate::math::units::{nice_at_least, nice_half_range};
-    use rows::Quantity as Q;
-    if matches!(what, Q::TableError(_) | Q::InsError(_) | Q::ClosedForm | Q::PositionError | Q::VelocityError | Q::Swing(_)) {
+    if symmetric(what) {
         let h = nice_half_range(lo.abs().max(hi.abs()));
         return (-1.25 * h, 1.25 * h);
     }
@@ -61,23 +58,28 @@ pub(crate) fn frame(what: rows::Quantity, lo: f64, hi: f64) -> (f64, f64) {
 }
 
 impl Recorder {
-    /// Live mode: sends the layout again when a series has left the range it was framed at.
-    pub(super) fn reframe_live(&mut self) -> RecordingStreamResult<()> {
-        let f = &self.frames;
-        let Some((params, sent)) = &f.live else { return Ok(()) };
-        let outside = self.series.iter().any(|s| match (f.extents.get(&s.path), f.drawn.get(&s.path)) {
-            (Some(&(lo, hi)), Some(&(a, b))) => lo.is_finite() && (lo < a || hi > b),
-            (Some(&(lo, _)), None) => lo.is_finite(),
-            _ => false,
-        });
-        if !outside || sent.elapsed() < REFRAME_MIN_INTERVAL {
-            return Ok(());
+    /// A live viewer's error plots framed as a saved recording's are (symmetric, ±1.25 h, with
+    /// labelled ticks), without sending the layout again: the viewer fits each plot to what it
+    /// plots, so each error plot whose data have left their range gets two invisible points at the
+    /// new range's ends, at the newest time `t_s`. (A layout sent again re-activates every view —
+    /// tabs jump back, the web viewer stalls; see docs/live.md. Other plots are left to the
+    /// viewer's own fit, which labels them well.)
+    pub(super) fn hold_live_frames(&mut self, t_s: f64) -> RecordingStreamResult<()> {
+        let mut moved = Vec::new();
+        for s in self.series.iter().filter(|s| symmetric(s.what)) {
+            let Some(&(lo, hi)) = self.frames.extents.get(&s.path).filter(|e| e.0.is_finite()) else { continue };
+            let range = frame(s.what, lo, hi);
+            if self.frames.held.get(&s.path).is_none_or(|&(a, b)| lo < a || hi > b) {
+                moved.push((s.path.clone(), range));
+            }
         }
-        self.send_blueprint(params, self.custom.clone())?;
-        let drawn = self.series.iter().filter_map(|s| f.extents.get(&s.path).filter(|e| e.0.is_finite()).map(|&(lo, hi)| (s.path.clone(), frame(s.what, lo, hi)))).collect();
-        self.frames.drawn = drawn;
-        if let Some((_, sent)) = &mut self.frames.live {
-            *sent = Instant::now();
+        for (path, (lo, hi)) in moved {
+            let entity = format!("{path}/{FRAME_SLUG}");
+            if !self.frames.held.contains_key(&path) {
+                self.rec.log_static(entity.as_str(), &rerun::SeriesPoints::new().with_marker_sizes([0.0]).with_colors([rerun::Color::from_unmultiplied_rgba(0, 0, 0, 0)]))?;
+            }
+            self.rec.send_columns(entity, self.stream.time_columns(&[t_s, t_s]), rerun::Scalars::new([lo, hi]).columns_of_unit_batches()?)?;
+            self.frames.held.insert(path, (lo, hi));
         }
         Ok(())
     }

@@ -20,35 +20,100 @@ pub(crate) struct InsLayout {
     pub(crate) signal_t: Vec<f64>,
     pub(crate) raw: Vec<f64>,
     pub(crate) filtered: Vec<f64>,
-    pub(crate) trace_true: Vec<rerun::Quaternion>,
-    pub(crate) trace_ins: Vec<rerun::Quaternion>,
+    /// Per buffered scene frame, the true IMU axes then the computed ones (six arrows).
+    pub(crate) trace_axes: Vec<[f32; 3]>,
     pub(crate) exaggeration: f64,
     pub(crate) fir_taps: Vec<f64>,
     pub(crate) rate_hz: f64,
     pub(crate) signal_window_s: f64,
     /// Largest |rate| in the raw and the filtered gyro window, deg/s (their plots' framing).
     pub(crate) signal_peak_deg_per_s: [f64; 2],
-    /// Pure coning: the series index of the log10 drift plot and each algorithm's analytic drift
-    /// rate about the cone axis, arcsec/s (`ins::coning::coning_drift_rate`).
-    pub(crate) coning_log: Option<(usize, Vec<f64>)>,
-    /// With two algorithms or more: per algorithm, the drift dial needle's rotation, at most
-    /// [`DIAL_HZ`] (the errors grow slowly; at the scene's rate the dial would add 13 MB/h).
-    pub(crate) dial: Vec<Vec<rerun::Quaternion>>,
+    /// Pure coning: each algorithm's analytic drift about the cone axis, drawn beside its
+    /// measured error on the log10 drift plot.
+    pub(crate) coning_log: Option<ConingLines>,
+    /// With two algorithms or more: the drift dial, a needle per algorithm.
+    pub(crate) dial_on: bool,
+    /// The algorithms not shown (`[recording.show]`), by name.
+    pub(crate) hidden: Vec<String>,
+    /// Per buffered dial frame (at most [`DIAL_HZ`]: the errors grow slowly; at the scene's rate
+    /// the dial would add 13 MB/h), each algorithm's needle.
+    pub(crate) dial: Vec<[f32; 3]>,
     /// The dial's frame times, s, and the time of the next.
     pub(crate) dial_t: Vec<f64>,
     pub(crate) dial_next_t: f64,
 }
 
+/// Pure coning's analytic drift lines: each algorithm's |heading error| grows at its rate
+/// (`ins::coning::coning_drift_rate`, arcsec/s); in a live session whose cone or sample rate
+/// changed, from what it had reached at the change (`base` at `since_s`) at the new rate.
+#[derive(Debug, Clone)]
+pub(crate) struct ConingLines {
+    /// Each algorithm's analytic drift rate now, arcsec/s.
+    pub(crate) rates: Vec<f64>,
+    /// Since when, s.
+    pub(crate) since_s: f64,
+    /// Each line's value then, arcsec.
+    pub(crate) base: Vec<f64>,
+}
+
+impl ConingLines {
+    /// Lines from t = 0 at `rates`.
+    pub(crate) fn new(rates: Vec<f64>) -> Self {
+        let base = vec![0.0; rates.len()];
+        Self { rates, since_s: 0.0, base }
+    }
+
+    /// Algorithm `j`'s analytic |heading error| at `t_s`, arcsec.
+    pub(crate) fn at(&self, j: usize, t_s: f64) -> f64 {
+        self.base[j] + self.rates[j] * (t_s - self.since_s)
+    }
+
+    /// From `t_s` on, the lines grow at `rates` from where they are.
+    pub(crate) fn change(&mut self, t_s: f64, rates: Vec<f64>) {
+        self.base = (0..self.rates.len()).map(|j| self.at(j, t_s)).collect();
+        self.since_s = t_s;
+        self.rates = rates;
+    }
+}
+
+/// Each algorithm's analytic drift rate about the cone axis for the pure cone of `params` at its
+/// step rate, arcsec/s (None without one).
+pub(crate) fn coning_rates(params: &crate::scenario::Params, algorithms: &[crate::ins::coning::Algorithm]) -> Option<Vec<f64>> {
+    let cone = params.table.vehicle.pure_coning()?;
+    let freq_hz = cone.omega_rad_per_s / std::f64::consts::TAU;
+    Some(algorithms.iter().map(|a| crate::ins::coning::coning_drift_rate(*a, cone.half_angle_rad, freq_hz, 1.0 / params.step_hz).abs() * crate::math::units::ARCSEC_PER_RAD).collect())
+}
+
 /// Frames per second of the drift dial, at most.
 pub(crate) const DIAL_HZ: f64 = 4.0;
 
+impl InsLayout {
+    /// Whether the drift dial is drawn.
+    pub(crate) fn dial_shown(&self) -> bool {
+        self.dial_on
+    }
+}
+
+/// The needles of the drift dial (one arrow per algorithm, in the dial's frame).
+pub(crate) const DIAL_NEEDLES_PATH: &str = "world/drift_dial/needles";
+
+/// Length of a dial needle.
+const NEEDLE_LENGTH: f64 = 0.42;
+
+/// A dial needle turned by `angle_rad` about the dial's axis (counter-clockwise when positive).
+pub(crate) fn needle(angle_rad: f64) -> [f32; 3] {
+    let (s, c) = angle_rad.sin_cos();
+    [(-NEEDLE_LENGTH * s) as f32, (NEEDLE_LENGTH * c) as f32, 0.0]
+}
+
+/// The INS trace's arrows: the true IMU axes, then the computed ones (error ×N).
+pub(crate) const TRACE_AXES_PATH: &str = "world/ins_trace/axes";
+
+/// Length of a trace arrow.
+pub(crate) const TRACE_AXIS_LENGTH: f64 = 0.6;
+
 /// Where the drift dial (one needle per algorithm, turned by the size of its attitude error ×N) stands.
 pub(crate) const DIAL_OFFSET: [f32; 3] = [2.3, 0.2, -0.5];
-
-/// The needle of algorithm `k` on the drift dial.
-pub(crate) fn dial_path(name: &str) -> String {
-    format!("world/drift_dial/{name}")
-}
 
 /// The log10 plot of the coning drift: each algorithm's |heading error| beside its analytic rate × t.
 pub(crate) const CONING_LOG_PATH: &str = "ins/coning_drift_log10_arcsec";
@@ -95,6 +160,20 @@ impl Recorder {
         Ok(())
     }
 
+    /// Which algorithms' lines are shown (`[recording.show]`): the whole line of a hidden one, on
+    /// every INS error plot and the coning plot (its needle on the dial stands at zero).
+    pub(crate) fn log_shown_algorithms(&self) -> RecordingStreamResult<()> {
+        let Some(layout) = &self.ins else { return Ok(()) };
+        let shown: Vec<bool> = layout.algorithms.iter().map(|a| !layout.hidden.contains(a)).collect();
+        for axis in ERROR_AXES.iter().filter(|_| layout.errors && layout.algorithms.len() > 1) {
+            self.rec.log_static(format!("ins/attitude_error_arcsec/{axis}"), &rerun::SeriesLines::update_fields().with_visible_series(shown.iter().copied()))?;
+        }
+        if layout.coning_log.is_some() {
+            self.rec.log_static(CONING_LOG_PATH, &rerun::SeriesLines::update_fields().with_visible_series(shown.iter().flat_map(|v| [*v; 2])))?;
+        }
+        Ok(())
+    }
+
     /// Static parts of an INS run: series styles, the FIR's amplitude response, the trace's axes.
     pub(crate) fn log_ins_once(&self) -> RecordingStreamResult<()> {
         let Some(layout) = &self.ins else { return Ok(()) };
@@ -111,6 +190,7 @@ impl Recorder {
             let widths: Vec<f32> = layout.algorithms.iter().flat_map(|_| [2.5, 1.0]).collect();
             rec.log_static(CONING_LOG_PATH, &rerun::SeriesLines::new().with_colors(colors).with_widths(widths).with_names(self.series_names(CONING_LOG_PATH)))?;
         }
+        self.log_shown_algorithms()?;
         // Pitch/roll/heading and east/north/up: red, green, blue.
         let three = ["ins/position_error_m", "ins/velocity_error_mps", rows::BODY_ATTITUDE_PATH, rows::VELOCITY_PATH, rows::POSITION_PATH, rows::LAT_LON_PATH, rows::HEIGHT_PATH];
         for path in three.into_iter().filter(|p| self.has_series(p)) {
@@ -148,7 +228,7 @@ impl Recorder {
         }
         // The drift dial: a student sees the heading error of each algorithm accumulate, ×N, and
         // why a higher-order algorithm helps (the needles of the good ones barely move).
-        if !layout.dial.is_empty() {
+        if layout.dial_on {
             let circle: Vec<[f32; 3]> = (0..=72).map(|i| {
                 let a = f64::from(i) * std::f64::consts::TAU / 72.0;
                 [(0.45 * a.cos()) as f32, (0.45 * a.sin()) as f32, 0.0]
@@ -160,11 +240,10 @@ impl Recorder {
             // to its right, spaced for their boxes, on points too small to cover a neighbour.
             let mut items: Vec<([f32; 3], String)> = vec![([0.0, 0.8, 0.0], title)];
             for (k, name) in layout.algorithms.iter().enumerate() {
-                let path = dial_path(name);
-                rec.log_static(path.as_str(), &rerun::Transform3D::IDENTITY)?;
-                rec.log_static(format!("{path}/needle"), &rerun::Arrows3D::from_vectors([[0.0, 0.42, 0.0]]).with_colors([rgb(colors::algorithm(name))]).with_radii([0.01]))?;
                 items.push(([0.7, 0.0, 0.5 - 0.14 * k as f32], name.clone()));
             }
+            // The needles' colours and widths; their directions go on the timeline.
+            rec.log_static(DIAL_NEEDLES_PATH, &rerun::Arrows3D::update_fields().with_colors(layout.algorithms.iter().map(|n| rgb(colors::algorithm(n)))).with_radii([0.01]))?;
             let colors: Vec<rerun::Color> = std::iter::once(super::palette::label([230, 230, 230])).chain(layout.algorithms.iter().map(|n| super::palette::label(colors::algorithm(n)))).collect();
             rec.log_static(
                 "world/drift_dial/labels",
@@ -174,20 +253,18 @@ impl Recorder {
         if !layout.trace {
             return Ok(());
         }
-        // The INS trace: true IMU axes (grey) and computed (coloured, error ×N), beside the table.
+        // The INS trace: true IMU axes (grey) and computed (coloured, error ×N), beside the table,
+        // as six arrows of one entity (their directions on the timeline).
+        rec.log_static("world/ins_trace", &rerun::Transform3D::from_translation(TRACE_OFFSET))?;
+        let trace_colors = [[170, 170, 170]; 3].into_iter().chain(colors::SENSOR).map(rgb);
+        rec.log_static(TRACE_AXES_PATH, &rerun::Arrows3D::update_fields().with_colors(trace_colors).with_radii([0.012]))?;
         let ins_label = format!("INS IMU axes (error ×{})", layout.exaggeration);
-        for (path, colors, label) in [("world/ins_trace/true", [[170, 170, 170]; 3], "true IMU axes"), ("world/ins_trace/ins", colors::SENSOR, ins_label.as_str())] {
-            rec.log_static(path, &rerun::Transform3D::from_translation(TRACE_OFFSET))?;
-            rec.log_static(
-                format!("{path}/axes"),
-                &rerun::Arrows3D::from_vectors([[0.6, 0.0, 0.0], [0.0, 0.6, 0.0], [0.0, 0.0, 0.6]]).with_colors(colors.map(rgb)).with_radii([0.012]),
-            )?;
-            // In a frame that does not turn with the axes (turning, the two labels met).
-            let at = if path.ends_with("true") { [0.0f32, 0.0, -0.3] } else { [0.0f32, 0.0, 0.8] };
-            let labels = format!("world/ins_trace_labels/{}", if path.ends_with("true") { "true" } else { "ins" });
-            rec.log_static(labels.as_str(), &rerun::Transform3D::from_translation(TRACE_OFFSET))?;
-            rec.log_static(format!("{labels}/label"), &rerun::Points3D::new([at]).with_labels([label]).with_radii([0.002]).with_colors([super::palette::label(colors[0])]))?;
-        }
+        // In a frame that does not turn with the axes (turning, the two labels met).
+        let labels = [([0.0f32, 0.0, -0.3], "true IMU axes".to_owned(), [170, 170, 170]), ([0.0f32, 0.0, 0.8], ins_label, colors::SENSOR[0])];
+        rec.log_static(
+            "world/ins_trace/labels",
+            &rerun::Points3D::new(labels.iter().map(|(p, _, _)| *p)).with_labels(labels.iter().map(|(_, l, _)| l.as_str())).with_radii([0.002]).with_colors(labels.iter().map(|(_, _, c)| super::palette::label(*c))),
+        )?;
         Ok(())
     }
 }

@@ -44,7 +44,7 @@ use crate::math::units::ARCSEC_PER_RAD;
 use crate::model::gimbal::{Chain, ClassFactors, ErrorRotations, TableErrors};
 use crate::scenario::Params;
 use crate::sim::{StepOutput, ERROR_AXES};
-use ins_view::{InsLayout, TRACE_OFFSET};
+use ins_view::InsLayout;
 use rows::Series;
 pub use rows::Solution;
 use export::SharedExporter;
@@ -87,6 +87,11 @@ impl Stream {
     /// The Rerun stream.
     pub(crate) fn rec(&self) -> &RecordingStream {
         &self.rec
+    }
+
+    /// Whether its series also go to export tables.
+    pub(crate) fn exports(&self) -> bool {
+        self.export.is_some()
     }
 
     /// Sends `width` series of `path` (values row-major, one row per time) to Rerun, and to the
@@ -214,8 +219,13 @@ pub struct Recorder {
     cone: Option<cone::ConeGizmo>,
     /// Chunks sent since the sinks last caught up.
     chunks_in_flight: usize,
-    /// Live mode: geometry on the timeline instead of static.
-    live: bool,
+    /// Live mode (geometry on the timeline instead of static), and what this recorder feeds.
+    live: Option<LiveOutput>,
+    /// A live session's parameters in force (its final layout is framed on them).
+    live_params: Option<Box<Params>>,
+    /// The last frame sent of each moving transform (vehicle, then gimbals): a transform that has
+    /// not moved since is not sent again (a vehicle at rest, a gimbal the scheme holds still).
+    last_motion: Vec<Option<rerun::Quaternion>>,
     /// A replayed log (None: a simulation): what it has decides the series and the scene.
     replay: Option<ReplayKind>,
     /// With an IMU in the loop.
@@ -229,8 +239,32 @@ pub struct Recorder {
     ranges: Option<PlotRanges>,
     /// The command's own panels, kept for when the layout is sent again.
     custom: Option<CustomLayout>,
-    /// Each series' extent, and in live mode how the plots are framed as their data grow.
+    /// Each series' extent (the plots framed on their data).
     frames: Frames,
+}
+
+/// What a live session's recorder feeds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LiveOutput {
+    /// Viewers watching as it runs: small chunks sent at a wall-clock cadence
+    /// ([`Recorder::flush_series_held`]); the layout is sent once, each plot's value axis left to
+    /// the viewer, which fits it to the data as they arrive (error plots held at symmetric ranges
+    /// by two invisible points, `frames.rs`).
+    Viewer,
+    /// The session so far for viewers that open it late (the class page's `/history.rrd`):
+    /// full-size chunks, flushed when asked for, and what a viewer watching from the start has
+    /// (the same layout and frame points).
+    History,
+    /// A saved file: full-size chunks like a run's, and at the end the layout again, every plot
+    /// framed on its data.
+    File,
+}
+
+impl LiveOutput {
+    /// Whether viewers see it as it comes (the layout sent once, plots fitted by the viewer).
+    fn watched(self) -> bool {
+        matches!(self, Self::Viewer | Self::History)
+    }
 }
 
 
@@ -266,20 +300,20 @@ pub(crate) struct CustomLayout {
 impl Recorder {
     /// Logs everything static (documents, styles, geometry, blueprint) and prepares the buffers.
     pub fn new(stream: Stream, params: &Params) -> RecordingStreamResult<Self> {
-        Self::build(stream, params, false, None)
+        Self::build(stream, params, None, None)
     }
 
     /// A recorder whose layout has `custom.right` as its right column and `custom.docs` as extra
     /// document tabs (commands that add their own panels to the table's 3D scene).
     pub(crate) fn with_layout(stream: Stream, params: &Params, custom: CustomLayout) -> RecordingStreamResult<Self> {
-        Self::build(stream, params, false, Some(custom))
+        Self::build(stream, params, None, Some(custom))
     }
 
-    fn build(stream: Stream, params: &Params, live: bool, custom: Option<CustomLayout>) -> RecordingStreamResult<Self> {
+    fn build(stream: Stream, params: &Params, live: Option<LiveOutput>, custom: Option<CustomLayout>) -> RecordingStreamResult<Self> {
         Self::build_with(stream, params, live, None, custom)
     }
 
-    fn build_with(stream: Stream, params: &Params, live: bool, replay: Option<ReplayKind>, custom: Option<CustomLayout>) -> RecordingStreamResult<Self> {
+    fn build_with(stream: Stream, params: &Params, live: Option<LiveOutput>, replay: Option<ReplayKind>, custom: Option<CustomLayout>) -> RecordingStreamResult<Self> {
         let rec = stream.rec.clone();
         let chain = params.table.chain.clone();
         let factors = drawing_factors(&params.table.truth, params.recording.exaggeration);
@@ -309,22 +343,24 @@ impl Recorder {
             cone: None,
             chunks_in_flight: 0,
             live,
+            live_params: live.map(|_| Box::new(params.clone())),
+            last_motion: vec![None; 1 + n],
             replay,
             ins,
             body,
             error_unit: unit,
             ranges: None,
             custom: custom.clone(),
-            frames: Frames::new(live.then_some(params)),
+            frames: Frames::default(),
         };
         me.log_once(params)?;
         me.log_ins_once()?;
         if let Some(c) = params.table.vehicle.pure_coning().filter(|c| c.half_angle_rad > 0.0) {
-            me.cone = Some(cone::ConeGizmo::new(&me.rec, c.half_angle_rad)?);
+            me.cone = Some(cone::ConeGizmo::new(&me.rec, c.half_angle_rad, me.geometry_at(0.0))?);
         }
         me.log_error_geometry(params, me.geometry_at(0.0))?;
         me.send_blueprint(params, custom)?;
-        let started = if live {
+        let started = if live.is_some() {
             // A live session has no length of its own: it runs until it is stopped.
             format!("live session started: {} at {} Hz, seed {} (it runs until stopped)", params.meta.name, params.step_hz, params.meta.seed)
         } else {
@@ -339,7 +375,7 @@ impl Recorder {
     /// the log's reference); a strapdown IMU, its axes at the INS's attitude and the INS's plots
     /// only. Both add the INS's own solution (attitude, velocity, position).
     pub fn new_replay(stream: Stream, params: &Params, kind: ReplayKind) -> RecordingStreamResult<Self> {
-        Self::build_with(stream, params, false, Some(kind), None)
+        Self::build_with(stream, params, None, Some(kind), None)
     }
 
     /// A replay's t = 0 on the IMU file's own clock, s: the series also go on the timeline
@@ -350,13 +386,14 @@ impl Recorder {
         self.event(0.0, &format!("t = 0 is {t0_file_s:.6} s on the IMU file's clock (the timeline `{FILE_CLOCK_TIMELINE}` shows the file's times; the export has them as t_file_s)"), "INFO")
     }
 
-    /// A recorder for live mode: everything that a reload can change is logged on the timeline.
-    pub fn new_live(stream: Stream, params: &Params) -> RecordingStreamResult<Self> {
-        Self::build(stream, params, true, None)
+    /// A recorder for live mode feeding `output`: everything that a reload can change is logged
+    /// on the timeline.
+    pub fn new_live(stream: Stream, params: &Params, output: LiveOutput) -> RecordingStreamResult<Self> {
+        Self::build(stream, params, Some(output), None)
     }
 
     fn geometry_at(&self, t_s: f64) -> Option<f64> {
-        self.live.then_some(t_s)
+        self.live.map(|_| t_s)
     }
 
     /// Sends the layout again for `params` (a replay knows its length only at the end).
@@ -407,15 +444,43 @@ impl Recorder {
     /// True for a live session's recorder.
     #[must_use]
     pub fn is_live(&self) -> bool {
-        self.live
+        self.live.is_some()
     }
 
     /// Live mode: new parameters apply from simulated time `t_s` on (buffered rows go out first).
     pub fn reconfigure(&mut self, t_s: f64, params: &Params) -> RecordingStreamResult<()> {
         self.flush_now()?;
         self.truth = params.table.truth.clone();
-        self.factors = drawing_factors(&self.truth, params.recording.exaggeration);
+        let factors = drawing_factors(&self.truth, params.recording.exaggeration);
+        // The 3D view's title names each class's drawing factor: the layout follows a change of it.
+        let retitle = factors != self.factors || self.live_params.as_ref().is_some_and(|p| p.recording.exaggeration != params.recording.exaggeration);
+        self.factors = factors;
         self.drawing = self.chain.error_rotations(&self.truth.exaggerated(&self.factors));
+        let old = self.live_params.replace(Box::new(params.clone()));
+        // Pure coning: the drawn cone and its label, and the analytic drift lines, follow a new
+        // cone or sample rate (the lines from where they stand: the drift goes on at the new rate).
+        let alpha = |p: &Params| p.table.vehicle.pure_coning().map_or(0.0, |c| c.half_angle_rad);
+        if let Some(gizmo) = self.cone.as_mut()
+            && old.as_ref().is_none_or(|p| alpha(p) != alpha(params))
+        {
+            gizmo.reshape(&self.rec, alpha(params), t_s)?;
+        }
+        if let Some(layout) = self.ins.as_mut() {
+            let algorithms = params.ins.as_ref().map(crate::ins::InsParams::algorithms).unwrap_or_default();
+            if let (Some(lines), Some(rates)) = (layout.coning_log.as_mut(), ins_view::coning_rates(params, &algorithms))
+                && rates != lines.rates
+            {
+                lines.change(t_s, rates);
+            }
+            let hidden: Vec<String> = layout.algorithms.iter().filter(|a| !params.recording.shows(a)).cloned().collect();
+            if hidden != layout.hidden {
+                layout.hidden = hidden;
+                self.log_shown_algorithms()?;
+            }
+        }
+        if retitle {
+            self.send_blueprint(params, self.custom.clone())?;
+        }
         // Where the parameters changed, on every error plot (at 0: the plots' range is not known).
         for axis in ERROR_AXES {
             self.stream.mark_events(&error_path(self.error_unit, axis), "reloads", "config reloaded", &[t_s], 0.0)?;
@@ -428,6 +493,7 @@ impl Recorder {
 
     /// Sends every buffered row now (live mode: low latency over large chunks).
     pub fn flush_now(&mut self) -> RecordingStreamResult<()> {
+        self.flush_signal()?;
         self.flush_series()?;
         self.flush_scene()
     }
@@ -490,24 +556,30 @@ impl Recorder {
         if let Some(c) = self.cone.as_mut() {
             c.push(&out.n_from_b);
         }
-        if let Some(layout) = self.ins.as_mut().filter(|l| l.trace || !l.dial.is_empty()) {
+        if let Some(layout) = self.ins.as_mut().filter(|l| l.trace || l.dial_shown()) {
             // Without an INS view (or without its truth) the trace stands still at the identity.
             if layout.trace {
                 let (t, c) = ins.and_then(|v| Some((*v.imu_true?.quaternion(), *v.imu_ins.quaternion()))).unwrap_or((UnitQuaternion::identity(), UnitQuaternion::identity()));
                 let err = rotvec::log(&(c * t.inverse())) * layout.exaggeration;
-                layout.trace_true.push(to_rerun_quaternion(&t));
-                layout.trace_ins.push(to_rerun_quaternion(&(rotvec::exp(&err) * t)));
+                let ins_q = rotvec::exp(&err) * t;
+                // The true axes, then the computed ones, as arrows in the trace's (unturned) frame.
+                for q in [t, ins_q] {
+                    for axis in [Vector3::x(), Vector3::y(), Vector3::z()] {
+                        let v = q * (axis * ins_view::TRACE_AXIS_LENGTH);
+                        layout.trace_axes.push([v.x as f32, v.y as f32, v.z as f32]);
+                    }
+                }
             }
             // The needles turn clockwise by the size of each algorithm's attitude error (whichever
             // axis it is on: heading for a cone about z, pitch for Li et al. 2014's wobble), ×N.
-            let due = !layout.dial.is_empty() && out.t_s >= layout.dial_next_t;
+            let due = layout.dial_shown() && out.t_s >= layout.dial_next_t;
             if due {
                 layout.dial_t.push(out.t_s);
                 layout.dial_next_t = out.t_s + 1.0 / ins_view::DIAL_HZ - 1e-9;
-            }
-            for (k, needle) in layout.dial.iter_mut().enumerate().filter(|_| due) {
-                let size = ins.and_then(|v| v.errors.get(k)).map_or(0.0, |e| e.as_array().iter().map(|x| x * x).sum::<f64>().sqrt());
-                needle.push(to_rerun_quaternion(&UnitQuaternion::from_axis_angle(&Vector3::z_axis(), -size * layout.exaggeration)));
+                for (k, name) in layout.algorithms.iter().enumerate() {
+                    let size = ins.and_then(|v| v.errors.get(k)).filter(|_| !layout.hidden.contains(name)).map_or(0.0, |e| e.as_array().iter().map(|x| x * x).sum::<f64>().sqrt());
+                    layout.dial.push(ins_view::needle(-size * layout.exaggeration));
+                }
             }
         }
         if self.scene_t.len() >= SERIES_CHUNK_ROWS {
@@ -531,72 +603,104 @@ impl Recorder {
 
     /// Sends the buffered time-series rows.
     pub fn flush_series(&mut self) -> RecordingStreamResult<()> {
+        self.flush_series_with(None)
+    }
+
+    /// Sends the buffered time-series rows to viewers watching live: a series whose rows all
+    /// repeat the last row it sent (a table error that is zero, a vehicle at rest) sends nothing
+    /// for up to `hold`, then its newest row only — the same line, drawn flat to the same end, with
+    /// a chunk every `hold` instead of every flush (a web viewer ingests a few dozen chunks a
+    /// second). Every row is sent when the stream also exports its tables.
+    pub fn flush_series_held(&mut self, hold: std::time::Duration) -> RecordingStreamResult<()> {
+        self.flush_series_with(Some(hold))
+    }
+
+    fn flush_series_with(&mut self, hold: Option<std::time::Duration>) -> RecordingStreamResult<()> {
         if self.series_t.is_empty() {
             return Ok(());
         }
-        self.throttle(self.series.len());
+        let hold = hold.filter(|_| !self.stream.exports());
         let times = std::mem::take(&mut self.series_t);
+        let now = std::time::Instant::now();
+        let mut sent = 0;
         for s in &mut self.series {
             let values = std::mem::take(&mut s.values);
-            debug_assert_eq!(values.len(), s.width() * times.len());
+            let width = s.width();
+            debug_assert_eq!(values.len(), width * times.len());
             self.frames.observe(&s.path, &values);
-            self.stream.send_series(&s.path, &s.names, &times, values, s.width())?;
+            let last_row = values.len().checked_sub(width).map(|i| values[i..].to_vec()).unwrap_or_default();
+            let (t, v) = match (hold, &s.last_sent) {
+                (Some(hold), Some((row, at))) if values.chunks(width).all(|r| rows::same_row(r, row)) => {
+                    if now.duration_since(*at) < hold {
+                        s.held_until_s = times.last().copied();
+                        continue;
+                    }
+                    (vec![times[times.len() - 1]], last_row.clone())
+                }
+                // After rows held back, the newest of them first: the line stays flat up to it
+                // instead of sloping from the last row sent to the first new one.
+                (_, Some((row, _))) if s.held_until_s.is_some() => {
+                    let held = s.held_until_s.unwrap_or_default();
+                    (std::iter::once(held).chain(times.iter().copied()).collect(), row.iter().copied().chain(values).collect())
+                }
+                _ => (times.clone(), values),
+            };
+            s.held_until_s = None;
+            self.stream.send_series(&s.path, &s.names, &t, v, width)?;
+            s.last_sent = Some((last_row, now));
+            sent += 1;
         }
-        self.reframe_live()
+        self.throttle(sent);
+        match (self.live, times.last()) {
+            (Some(out), Some(&t)) if out.watched() => self.hold_live_frames(t),
+            _ => Ok(()),
+        }
     }
 
 
-    /// Sends the buffered scene frames.
+    /// Sends the buffered scene frames. A transform that has not moved since the frame last sent
+    /// of it is not sent again (a vehicle at rest, a gimbal the scheme holds still).
     pub fn flush_scene(&mut self) -> RecordingStreamResult<()> {
         if self.scene_t.is_empty() {
             return Ok(());
         }
-        self.throttle(1 + self.scene_gimbals.len());
         let times = std::mem::take(&mut self.scene_t);
-        let time = || self.stream.time_columns(&times);
-        let vehicle = std::mem::take(&mut self.scene_vehicle);
+        let mut sent = 0;
         if let Some(c) = self.cone.as_mut() {
-            c.flush(&self.rec, &times)?;
+            c.flush(&self.stream, &times)?;
+            sent += 1;
         }
         if let Some(body) = self.body.as_mut() {
             body.flush(&self.stream, &times)?;
+            sent += 1;
         }
-        if !vehicle.is_empty() {
-            self.rec.send_columns(
-                self.paths.vehicle.as_str(),
-                time(),
-                rerun::Transform3D::update_fields().with_many_quaternion(vehicle).columns_of_unit_batches()?,
-            )?;
-        }
-        for k in 0..self.scene_gimbals.len() {
-            let q = std::mem::take(&mut self.scene_gimbals[k]);
-            self.rec.send_columns(
-                self.paths.gimbals[k].as_str(),
-                time(),
-                rerun::Transform3D::update_fields().with_many_quaternion(q).columns_of_unit_batches()?,
-            )?;
+        let motion = std::iter::once((self.paths.vehicle.as_str(), std::mem::take(&mut self.scene_vehicle)))
+            .chain(self.paths.gimbals.iter().map(String::as_str).zip(self.scene_gimbals.iter_mut().map(std::mem::take)));
+        for ((path, q), last) in motion.zip(self.last_motion.iter_mut()) {
+            let Some(newest) = q.last().copied() else { continue };
+            if q.iter().all(|x| Some(*x) == *last) {
+                continue;
+            }
+            *last = Some(newest);
+            self.rec.send_columns(path, self.stream.time_columns(&times), rerun::Transform3D::update_fields().with_many_quaternion(q).columns_of_unit_batches()?)?;
+            sent += 1;
         }
         if let Some(layout) = self.ins.as_mut() {
-            for (path, q) in [("world/ins_trace/true", std::mem::take(&mut layout.trace_true)), ("world/ins_trace/ins", std::mem::take(&mut layout.trace_ins))] {
-                let n = q.len();
-                if n == 0 {
-                    continue;
-                }
-                self.rec.send_columns(
-                    path,
-                    self.stream.time_columns(&times),
-                    rerun::Transform3D::update_fields()
-                        .with_many_translation(std::iter::repeat_n(TRACE_OFFSET, n))
-                        .with_many_quaternion(q)
-                        .columns_of_unit_batches()?,
-                )?;
+            let trace = std::mem::take(&mut layout.trace_axes);
+            if !trace.is_empty() {
+                debug_assert_eq!(trace.len(), 6 * times.len());
+                self.rec.send_columns(ins_view::TRACE_AXES_PATH, self.stream.time_columns(&times), rerun::Arrows3D::update_fields().with_vectors(trace).columns(std::iter::repeat_n(6, times.len()))?)?;
+                sent += 1;
             }
             let dial_t = std::mem::take(&mut layout.dial_t);
-            for (k, name) in layout.algorithms.iter().enumerate().take(layout.dial.len()) {
-                let q = std::mem::take(&mut layout.dial[k]);
-                self.rec.send_columns(ins_view::dial_path(name).as_str(), self.stream.time_columns(&dial_t), rerun::Transform3D::update_fields().with_many_quaternion(q).columns_of_unit_batches()?)?;
+            let needles = std::mem::take(&mut layout.dial);
+            if !dial_t.is_empty() {
+                let k = layout.algorithms.len();
+                self.rec.send_columns(ins_view::DIAL_NEEDLES_PATH, self.stream.time_columns(&dial_t), rerun::Arrows3D::update_fields().with_vectors(needles).columns(std::iter::repeat_n(k, dial_t.len()))?)?;
+                sent += 1;
             }
         }
+        self.throttle(sent);
         Ok(())
     }
 
@@ -609,11 +713,14 @@ impl Recorder {
         self.rec.log("events", &rerun::TextLog::new(text).with_level(level))
     }
 
-    /// Sends everything still buffered.
+    /// Sends everything still buffered; a saved live session's layout again, every plot framed on
+    /// its data (as a run's).
     pub fn finish(&mut self) -> RecordingStreamResult<()> {
-        self.flush_signal()?;
-        self.flush_series()?;
-        self.flush_scene()
+        self.flush_now()?;
+        match (&self.live, &self.live_params) {
+            (Some(LiveOutput::File), Some(p)) => self.send_blueprint(&p.clone(), self.custom.clone()),
+            _ => Ok(()),
+        }
     }
 }
 

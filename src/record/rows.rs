@@ -66,11 +66,20 @@ pub(crate) struct Series {
     pub(crate) names: Vec<String>,
     pub(crate) values: Vec<f64>,
     pub(crate) what: Quantity,
+    /// The last row sent and when (a live viewer's stream holds rows that repeat it).
+    pub(crate) last_sent: Option<(Vec<f64>, std::time::Instant)>,
+    /// The time of the newest row held back since (equal to the last row sent), s.
+    pub(crate) held_until_s: Option<f64>,
+}
+
+/// Whether two rows hold the same values, bit for bit (a NaN row repeats a NaN row).
+pub(crate) fn same_row(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
 }
 
 impl Series {
     fn new(path: impl Into<String>, names: Vec<String>, what: Quantity) -> Self {
-        Self { path: path.into(), names, values: Vec::new(), what }
+        Self { path: path.into(), names, values: Vec::new(), what, last_sent: None, held_until_s: None }
     }
 
     pub(crate) fn width(&self) -> usize {
@@ -156,21 +165,16 @@ pub(crate) fn ins_layout(params: &Params, replay: Option<ReplayKind>, series: &m
     }
     // Pure coning on a table at rest: the drifts span decades, a log10 plot with the
     // analytic rates shows each algorithm on its line.
-    let coning_log = params.table.vehicle.pure_coning().filter(|_| errors && params.table.scheme.max_rate() == 0.0).map(|cone| {
+    let coning_log = params.table.vehicle.pure_coning().filter(|_| errors && params.table.scheme.max_rate() == 0.0).and_then(|_| {
         let lines = algorithms.iter().flat_map(|a| [format!("{a}: log10 |heading error|"), format!("{a}: analytic coning drift")]).collect();
         series.push(Series::new(ins_view::CONING_LOG_PATH, lines, Quantity::ConingLog));
-        let rates: Vec<f64> = cfg
-            .algorithms()
-            .iter()
-            .map(|a| crate::ins::coning::coning_drift_rate(*a, cone.half_angle_rad, cone.omega_rad_per_s / std::f64::consts::TAU, 1.0 / params.step_hz).abs() * ARCSEC_PER_RAD)
-            .collect();
-        (series.len() - 1, rates)
+        ins_view::coning_rates(params, &cfg.algorithms()).map(ins_view::ConingLines::new)
     });
     // The INS trace and the drift dial draw the INS's error ×N: where the largest error of
     // the run is known in advance (pure coning: the analytic drifts), N is lowered to the
     // largest 1-2-5 factor that keeps it under 150°, so the picture never wraps round.
-    let exaggeration = coning_log.as_ref().map_or(params.recording.exaggeration, |(_, rates)| {
-        let worst_rad = rates.iter().fold(0.0_f64, |m, r| m.max(*r)) * params.duration_s / ARCSEC_PER_RAD;
+    let exaggeration = coning_log.as_ref().map_or(params.recording.exaggeration, |lines| {
+        let worst_rad = lines.rates.iter().fold(0.0_f64, |m, r| m.max(*r)) * params.duration_s / ARCSEC_PER_RAD;
         let limit = 150.0 * crate::math::units::RAD_PER_DEG;
         if worst_rad * params.recording.exaggeration <= limit {
             return params.recording.exaggeration;
@@ -178,6 +182,7 @@ pub(crate) fn ins_layout(params: &Params, replay: Option<ReplayKind>, series: &m
         crate::math::units::nice_at_most(limit / worst_rad).max(1e-3)
     });
     Some(InsLayout {
+        hidden: algorithms.iter().filter(|a| !params.recording.shows(a)).cloned().collect(),
         algorithms,
         errors,
         // A strapdown IMU's axes are drawn as the body (`body_view`), not as a trace beside a table.
@@ -185,12 +190,12 @@ pub(crate) fn ins_layout(params: &Params, replay: Option<ReplayKind>, series: &m
         signal_t: Vec::new(),
         raw: Vec::new(),
         filtered: Vec::new(),
-        trace_true: Vec::new(),
+        trace_axes: Vec::new(),
         // The dial turns by the errors: none without them.
-        dial: if n_algorithms >= 2 && errors { vec![Vec::new(); n_algorithms] } else { Vec::new() },
+        dial_on: n_algorithms >= 2 && errors,
+        dial: Vec::new(),
         dial_t: Vec::new(),
         dial_next_t: f64::NEG_INFINITY,
-        trace_ins: Vec::new(),
         exaggeration,
         fir_taps: cfg.fir_taps.clone(),
         rate_hz: params.step_hz,
@@ -209,7 +214,7 @@ impl Recorder {
     pub(crate) fn push_values(&mut self, out: &StepOutput, ins: Option<&InsView>, solution: Option<&Solution>) {
         let Self { series, chain, truth, error_unit, ins: layout, .. } = self;
         let per_rad = error_unit.per_rad();
-        let rates: &[f64] = layout.as_ref().and_then(|l| l.coning_log.as_ref()).map_or(&[], |(_, r)| r.as_slice());
+        let lines = layout.as_ref().and_then(|l| l.coning_log.as_ref());
         let nav = ins.and_then(|v| v.nav).unwrap_or(NO_NAV);
         let state = solution.and_then(|s| s.nav);
         for s in series.iter_mut() {
@@ -234,9 +239,9 @@ impl Recorder {
                 },
                 Quantity::ConingLog => {
                     let log10 = |x: f64| if x > 0.0 && x.is_finite() { x.log10() } else { f64::NAN };
-                    for (j, rate) in rates.iter().enumerate() {
+                    for j in 0..lines.map_or(0, |l| l.rates.len()) {
                         let measured = ins.map_or(f64::NAN, |view| log10(view.errors[j].heading_rad.abs() * ARCSEC_PER_RAD));
-                        v.extend([measured, log10(rate * out.t_s)]);
+                        v.extend([measured, log10(lines.map_or(f64::NAN, |l| l.at(j, out.t_s)))]);
                     }
                 }
                 Quantity::PositionError => v.extend([nav.east_m, nav.north_m, nav.radial_m]),

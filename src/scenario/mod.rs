@@ -121,10 +121,21 @@ pub struct RecordingParams {
     pub error_unit: crate::math::units::AngleUnit,
     /// The recording opens at the end of the run (the time cursor follows the newest data).
     pub open_at_end: bool,
+    /// Per attitude algorithm (in `Algorithm::ALL`'s order), whether its lines and needle are
+    /// hidden (`[recording.show]`).
+    pub hidden_algorithms: [bool; 5],
     /// What the rates not given in the file were chosen from (series, scene: `true` if chosen).
     pub chosen: (bool, bool),
     /// The motion's bandwidth the chosen rates follow.
     pub bandwidth: validate::Bandwidth,
+}
+
+impl RecordingParams {
+    /// Whether the attitude algorithm named `name` is shown.
+    #[must_use]
+    pub fn shows(&self, name: &str) -> bool {
+        crate::ins::coning::Algorithm::ALL.iter().position(|a| a.name() == name).is_none_or(|i| !self.hidden_algorithms[i])
+    }
 }
 
 /// A validated scenario in SI units.
@@ -264,6 +275,11 @@ pub fn parse(text: &str, origin: &str) -> Result<Params, ConfigError> {
         origin: origin.to_owned(),
         message: parse_message(&e),
     })?;
+    validate::validate(raw, origin)
+}
+
+/// Validates an already parsed configuration (a resolved one a live session holds, say).
+pub fn from_raw(raw: RawConfig, origin: &str) -> Result<Params, ConfigError> {
     validate::validate(raw, origin)
 }
 

@@ -411,11 +411,15 @@ pub struct RawRecording {
     /// final state, the time cursor following the newest data). Default "start".
     #[serde(skip_serializing_if = "Option::is_none")]
     pub open_at: Option<String>,
+    /// Which attitude algorithms' lines and needles are shown, by name (`"two-sample" = false`
+    /// hides it; absent: shown). All of them run either way.
+    #[serde(skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub show: std::collections::BTreeMap<String, bool>,
 }
 
 impl Default for RawRecording {
     fn default() -> Self {
-        Self { series_hz: None, scene_hz: None, error_unit: None, exaggeration: 60.0, open_at: None }
+        Self { series_hz: None, scene_hz: None, error_unit: None, exaggeration: 60.0, open_at: None, show: std::collections::BTreeMap::new() }
     }
 }
 

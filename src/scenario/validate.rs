@@ -472,6 +472,18 @@ pub(super) fn recording(c: &Checker<'_>, raw: &RawRecording, step_hz: f64, bandw
         },
         chosen: (raw.series_hz.is_none(), raw.scene_hz.is_none()),
         bandwidth,
+        hidden_algorithms: {
+            use crate::ins::coning::Algorithm;
+            let mut hidden = [false; 5];
+            for (name, shown) in &raw.show {
+                let Some(i) = Algorithm::ALL.iter().position(|a| a.name() == name) else {
+                    let names: Vec<&str> = Algorithm::ALL.iter().map(|a| a.name()).collect();
+                    return Err(c.invalid(&format!("recording.show.{name}"), format!("\"{name}\" is not an attitude algorithm; the names are {}", names.join(", "))));
+                };
+                hidden[i] = !shown;
+            }
+            hidden
+        },
     })
 }
 

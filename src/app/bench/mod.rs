@@ -364,7 +364,7 @@ fn live_latency(dir: &std::path::Path, figs: &mut Figures, interrupt: &AtomicBoo
     let sinks = sink::open(&SinkRequest { save: Some(rec_path), ..Default::default() }, "rinscope-bench", "live")?;
     let session = {
         let (status, stop) = (status.clone(), stop.clone());
-        let outputs = live::Outputs { viewer: None, file: Some(sinks.stream()) };
+        let outputs = live::Outputs { viewer: None, file: Some(sinks.stream()), history: None };
         std::thread::spawn(move || live::run_session_with_status(&opts, params, outputs, &stop, &status))
     };
     std::thread::sleep(std::time::Duration::from_millis(300));

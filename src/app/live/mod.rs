@@ -18,7 +18,7 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::{Receiver, Sender};
 
 use crate::math::timeline::decimation;
-use crate::record::{Recorder, Stream};
+use crate::record::{LiveOutput, Recorder, Stream};
 use crate::scenario::{Params, RawConfig};
 use crate::ins::pipeline::InsView;
 use crate::sim::StepOutput;
@@ -211,11 +211,34 @@ pub fn sim_loop(mut sim: LiveSim, reloads: &Receiver<WatchEvent>, out: &Sender<R
     sim
 }
 
-/// How often the recorder hands buffered scene frames to Rerun in live mode: the 3D view moves at
-/// 10 Hz; each chunk carries its own schema (~1 kB), so chunks must hold several rows.
-pub const SCENE_FLUSH: Duration = Duration::from_millis(100);
+/// How often the recorder hands the 3D scene's buffered frames to viewers. A web viewer drawing
+/// without a GPU paints about 2-3 frames a second and ingests a few dozen chunks a second (Rerun
+/// 0.36, headless Chromium on 2 cores: `tests/web/latency.py`), and every flush is a chunk per
+/// moving entity: 30 chunks a second left it minutes behind, so the scene goes out 4 times a
+/// second, the plots twice.
+pub const SCENE_FLUSH: Duration = Duration::from_millis(250);
 /// Same for the plots, which a user reads rather than watches move.
 pub const SERIES_FLUSH: Duration = Duration::from_millis(500);
+/// A plot whose rows repeat its last one (a zero error, a vehicle at rest) sends its newest row
+/// to viewers this often, not at every flush ([`Recorder::flush_series_held`]).
+pub const SERIES_HOLD: Duration = Duration::from_secs(2);
+
+/// A request for the session so far as one recording (the class page's `/history.rrd`), answered
+/// by the recorder thread with the `.rrd` bytes or why not.
+pub struct HistoryRequest {
+    /// Where the answer goes.
+    pub reply: tokio::sync::oneshot::Sender<Result<Vec<u8>, String>>,
+}
+
+/// The session kept compact in memory for viewers that open it late (`--serve-web`).
+pub struct History {
+    /// Its stream.
+    pub stream: Stream,
+    /// What it holds.
+    pub store: crate::record::sink::HistoryStore,
+    /// Requests for it (the class page's).
+    pub requests: Receiver<HistoryRequest>,
+}
 
 /// Where a live session's data goes.
 pub struct Outputs {
@@ -224,20 +247,22 @@ pub struct Outputs {
     /// The saved file: full-size chunks like a plain run, so the file stays compact and its footer
     /// (chunk manifest, kept in memory until the file closes) small — an hour-long session stays flat.
     pub file: Option<Stream>,
+    /// The session so far for late viewers (full-size chunks, flushed when asked for).
+    pub history: Option<History>,
 }
 
 /// Turns [`RecorderMsg`]s into Rerun calls until the channel closes. `viewer` flushes on a timer,
-/// `file` only when its chunks are full.
-pub fn recorder_loop(mut viewer: Option<Recorder>, mut file: Option<Recorder>, msgs: &Receiver<RecorderMsg>) -> anyhow::Result<()> {
+/// `file` only when its chunks are full, `history` when a late viewer asks for it.
+pub fn recorder_loop(mut viewer: Option<Recorder>, mut file: Option<Recorder>, mut history: Option<(Recorder, History)>, msgs: &Receiver<RecorderMsg>) -> anyhow::Result<()> {
     let (mut last_scene, mut last_series) = (Instant::now(), Instant::now());
     loop {
-        let msg = match msgs.recv_timeout(SCENE_FLUSH) {
+        let msg = match msgs.recv_timeout(SCENE_FLUSH / 2) {
             Ok(m) => Some(m),
             Err(crossbeam_channel::RecvTimeoutError::Timeout) => None,
             Err(crossbeam_channel::RecvTimeoutError::Disconnected) => break,
         };
         if let Some(msg) = msg {
-            for recorder in viewer.iter_mut().chain(file.iter_mut()) {
+            for recorder in viewer.iter_mut().chain(file.iter_mut()).chain(history.iter_mut().map(|(r, _)| r)) {
                 match &msg {
                     RecorderMsg::Series(rows) => rows.iter().try_for_each(|(r, ins)| recorder.push_row(r, ins.as_ref()))?,
                     RecorderMsg::Scene(rows) => rows.iter().try_for_each(|(r, ins)| recorder.push_scene_row(r, ins.as_ref()))?,
@@ -253,12 +278,20 @@ pub fn recorder_loop(mut viewer: Option<Recorder>, mut file: Option<Recorder>, m
                 last_scene = Instant::now();
             }
             if last_series.elapsed() >= SERIES_FLUSH {
-                v.flush_series()?;
+                v.flush_signal()?;
+                v.flush_series_held(SERIES_HOLD)?;
                 last_series = Instant::now();
             }
         }
+        if let Some((recorder, h)) = history.as_mut() {
+            while let Ok(request) = h.requests.try_recv() {
+                // Everything buffered first: the late viewer gets the session up to now.
+                let answer = recorder.flush_now().map_err(|e| e.to_string()).and_then(|()| h.store.rrd_bytes());
+                request.reply.send(answer).ok();
+            }
+        }
     }
-    for recorder in viewer.iter_mut().chain(file.iter_mut()) {
+    for recorder in viewer.iter_mut().chain(file.iter_mut()).chain(history.iter_mut().map(|(r, _)| r)) {
         recorder.finish()?;
     }
     Ok(())
@@ -369,8 +402,12 @@ pub fn run_session_with_status(opts: &LiveOptions, params: Params, outputs: Outp
     let text = read_text(&opts.config_path)?;
     let (reload_tx, reload_rx) = crossbeam_channel::unbounded();
     let _watcher = watch::watch(&opts.config_path, text, reload_tx).map_err(|e| anyhow::anyhow!("cannot watch {}: {e}", opts.config_path.display()))?;
-    let viewer = outputs.viewer.map(|rec| Recorder::new_live(rec, &params)).transpose()?;
-    let file = outputs.file.map(|rec| Recorder::new_live(rec, &params)).transpose()?;
+    let viewer = outputs.viewer.map(|rec| Recorder::new_live(rec, &params, LiveOutput::Viewer)).transpose()?;
+    let file = outputs.file.map(|rec| Recorder::new_live(rec, &params, LiveOutput::File)).transpose()?;
+    let history = match outputs.history {
+        Some(h) => Some((Recorder::new_live(h.stream.clone(), &params, LiveOutput::History)?, h)),
+        None => None,
+    };
     // Bounded: a recorder that falls behind slows the simulation instead of growing memory.
     let (out_tx, out_rx) = crossbeam_channel::bounded::<RecorderMsg>(64);
     let title = match &opts.page_url {
@@ -379,7 +416,7 @@ pub fn run_session_with_status(opts: &LiveOptions, params: Params, outputs: Outp
     };
     let resolved = params.resolved.clone();
 
-    let recorder_thread = std::thread::Builder::new().name("recorder".into()).spawn(move || recorder_loop(viewer, file, &out_rx))?;
+    let recorder_thread = std::thread::Builder::new().name("recorder".into()).spawn(move || recorder_loop(viewer, file, history, &out_rx))?;
     let sim_thread = {
         let (status, stop) = (status.clone(), stop.clone());
         let (duration, log) = (opts.duration_s, opts.log_to_stderr && !opts.panel);

@@ -97,29 +97,23 @@ fn slider(label: String, key: &str, unit: &'static str, (min, max): (f64, f64), 
 }
 
 impl Panel {
-    /// The controls for a configuration.
+    /// The controls for a configuration: those that act on it. The table's errors where there is a
+    /// table to speak of (a scheme that turns it, or errors already set); the cone's half-angle and
+    /// frequency (a wobble's amplitude and frequency) where the body cones; the IMU's sample rate
+    /// where the INS can change it running; each attitude algorithm's visibility where several run.
     #[must_use]
     pub fn new(raw: &RawConfig, title: String) -> Self {
         let mut controls = Vec::new();
-        for (i, a) in raw.turntable.axis.iter().enumerate() {
-            let n = &a.name;
-            let k = |f: &str| format!("turntable.axis[{i}].{f}");
-            controls.push(slider(format!("{n} swing half-angle"), &k("swing_half_angle_arcsec"), "″", (0.0, 3600.0), 10.0));
-            controls.push(slider(format!("{n} swing phase"), &k("swing_phase_deg"), "°", (-180.0, 180.0), 5.0));
-            if i > 0 {
-                controls.push(slider(format!("{n} non-orthogonality"), &k("non_orthogonality_arcsec"), "″", (-600.0, 600.0), 5.0));
-            }
-            controls.push(slider(format!("{n} encoder offset"), &k("encoder_offset_arcsec"), "″", (-600.0, 600.0), 5.0));
-            controls.push(slider(format!("{n} encoder scale"), &k("encoder_scale_ppm"), " ppm", (-1000.0, 1000.0), 10.0));
-            controls.push(slider(format!("{n} encoder delay"), &k("encoder_delay_ms"), " ms", (0.0, 50.0), 0.5));
-            controls.push(slider(format!("{n} encoder noise"), &k("encoder_noise_arcsec"), "″ 1σ", (0.0, 60.0), 1.0));
+        let turns = raw.scheme.kind != "static";
+        let t = &raw.turntable;
+        let has_errors = [t.installation_x_arcsec, t.installation_y_arcsec, t.installation_z_arcsec, t.imu_mount_x_arcsec, t.imu_mount_y_arcsec, t.imu_mount_z_arcsec]
+            .into_iter()
+            .chain(t.axis.iter().flat_map(|a| [a.swing_half_angle_arcsec, a.non_orthogonality_arcsec, a.encoder_offset_arcsec, a.encoder_scale_ppm, a.encoder_delay_ms, a.encoder_noise_arcsec]))
+            .any(|x| x != 0.0);
+        if turns || has_errors {
+            Self::table_controls(raw, turns, &mut controls);
         }
-        for about in ["x", "y", "z"] {
-            controls.push(slider(format!("installation about {about}"), &format!("turntable.installation_{about}_arcsec"), "″", (-1800.0, 1800.0), 10.0));
-        }
-        for about in ["x", "y", "z"] {
-            controls.push(slider(format!("IMU mounting about {about}"), &format!("turntable.imu_mount_{about}_arcsec"), "″", (-1800.0, 1800.0), 10.0));
-        }
+        Self::motion_controls(raw, &mut controls);
         match raw.scheme.kind.as_str() {
             "continuous" => {
                 for (j, r) in raw.scheme.rate.iter().enumerate() {
@@ -151,8 +145,12 @@ impl Panel {
             initial: 1.0,
         };
         controls.push(log("speed (× real time)", "live.speed", (0.1, 1000.0)));
-        controls.push(log("3D exaggeration", "recording.exaggeration", (1.0, 10_000.0)));
-        controls.push(Control::Toggle { label: "compensation".into(), key: KeyPath::parse("compensation.enabled"), value: true, initial: true });
+        // The table's drawing factor and its compensation act where its errors do (a coning
+        // lesson's INS trace and dial take a factor of their own, from the analytic drift).
+        if turns || has_errors {
+            controls.push(log("3D exaggeration", "recording.exaggeration", (1.0, 10_000.0)));
+            controls.push(Control::Toggle { label: "compensation".into(), key: KeyPath::parse("compensation.enabled"), value: true, initial: true });
+        }
         let axis_names = raw.turntable.axis.iter().map(|a| a.name.clone()).collect();
         let mut panel = Self { controls, selected: 0, show_help: false, title, axis_names };
         panel.sync(raw);
@@ -163,6 +161,73 @@ impl Panel {
             }
         }
         panel
+    }
+
+    /// Per axis its swing, non-orthogonality and encoder errors (scale and delay only when the
+    /// table turns: a still axis reads no scale or delay), then installation and IMU mounting.
+    fn table_controls(raw: &RawConfig, turns: bool, controls: &mut Vec<Control>) {
+        for (i, a) in raw.turntable.axis.iter().enumerate() {
+            let n = &a.name;
+            let k = |f: &str| format!("turntable.axis[{i}].{f}");
+            controls.push(slider(format!("{n} swing half-angle"), &k("swing_half_angle_arcsec"), "″", (0.0, 3600.0), 10.0));
+            controls.push(slider(format!("{n} swing phase"), &k("swing_phase_deg"), "°", (-180.0, 180.0), 5.0));
+            if i > 0 {
+                controls.push(slider(format!("{n} non-orthogonality"), &k("non_orthogonality_arcsec"), "″", (-600.0, 600.0), 5.0));
+            }
+            controls.push(slider(format!("{n} encoder offset"), &k("encoder_offset_arcsec"), "″", (-600.0, 600.0), 5.0));
+            if turns {
+                controls.push(slider(format!("{n} encoder scale"), &k("encoder_scale_ppm"), " ppm", (-1000.0, 1000.0), 10.0));
+                controls.push(slider(format!("{n} encoder delay"), &k("encoder_delay_ms"), " ms", (0.0, 50.0), 0.5));
+            }
+            controls.push(slider(format!("{n} encoder noise"), &k("encoder_noise_arcsec"), "″ 1σ", (0.0, 60.0), 1.0));
+        }
+        for about in ["x", "y", "z"] {
+            controls.push(slider(format!("installation about {about}"), &format!("turntable.installation_{about}_arcsec"), "″", (-1800.0, 1800.0), 10.0));
+        }
+        for about in ["x", "y", "z"] {
+            controls.push(slider(format!("IMU mounting about {about}"), &format!("turntable.imu_mount_{about}_arcsec"), "″", (-1800.0, 1800.0), 10.0));
+        }
+    }
+
+    /// The coning lesson's controls: the cone (or the wobble, all its axes at once), the IMU's
+    /// sample rate where the INS can change it running (no FIR, no decimation, no navigation),
+    /// and which algorithms are shown where several run.
+    fn motion_controls(raw: &RawConfig, controls: &mut Vec<Control>) {
+        let v = &raw.vehicle;
+        let cones = v.coning_half_angle_deg != 0.0 && v.coning_frequency_hz != 0.0;
+        if cones {
+            controls.push(slider("cone half-angle".into(), "vehicle.coning_half_angle_deg", "°", (0.0, 10.0), 0.1));
+            controls.push(slider("cone frequency".into(), "vehicle.coning_frequency_hz", " Hz", (0.1, 50.0), 0.1));
+        }
+        if !v.wobble.is_empty() {
+            let all = |field: &str| (0..v.wobble.len()).map(|j| KeyPath::parse(&format!("vehicle.wobble[{j}].{field}"))).collect::<Vec<_>>();
+            let many = |label: &str, keys, unit, (min, max), step| Control::Slider { label: label.into(), keys, unit, min, max, step, log: false, value: 0.0, initial: 0.0 };
+            controls.push(many("wobble amplitude (every axis)", all("amplitude_deg"), "°", (0.0, 20.0), 0.5));
+            controls.push(many("wobble frequency (every axis)", all("frequency_hz"), " Hz", (0.1, 20.0), 0.1));
+        }
+        let Some(imu) = &raw.imu else { return };
+        // The validated INS says what the file's keys and its preset make of it.
+        let ins = scenario::from_raw(raw.clone(), "the panel").ok().and_then(|p| p.ins);
+        let plain = ins.is_some_and(|cfg| cfg.fir_taps.len() <= 1 && cfg.decimation == 1 && cfg.navigation.is_none());
+        if (cones || !v.wobble.is_empty()) && plain {
+            controls.push(Control::Slider {
+                label: "IMU sample rate".into(),
+                keys: vec![KeyPath::parse("simulation.step_hz")],
+                unit: " Hz",
+                min: 10.0,
+                max: 2000.0,
+                step: 0.0, // the 1-2-5 ladder (`ladder`)
+                log: true,
+                value: 100.0,
+                initial: 100.0,
+            });
+        }
+        if imu.compare == Some(true) {
+            for a in crate::ins::coning::Algorithm::ALL {
+                let key = KeyPath::parse(&format!("recording.show.{}", a.name()));
+                controls.push(Control::Toggle { label: format!("show {}", a.name()), key, value: true, initial: true });
+            }
+        }
     }
 
     /// Takes the values of a configuration (after a reload: the file may have been edited elsewhere).
@@ -318,11 +383,11 @@ impl Panel {
         let Some(Control::Slider { keys, value, min, max, step, log, .. }) = self.controls.get_mut(self.selected) else {
             return Action::None;
         };
-        let mut v = f(*value, *min, *max).clamp(*min, *max);
-        if !*log {
-            // Land on the step grid so repeated presses do not accumulate rounding noise.
-            v = (v / *step).round() * *step;
-        }
+        // Land on the control's grid (the step, or 1-2-5 for a logarithmic slider), whoever set it
+        // (a key, the class page): repeated presses do not accumulate rounding noise, and the file
+        // only ever gets values a slider can show.
+        let v = f(*value, *min, *max).clamp(*min, *max);
+        let v = if *log { ladder(v, 0.0) } else { (v / *step).round() * *step }.clamp(*min, *max);
         if (v - *value).abs() < 1e-12 {
             return Action::None;
         }

@@ -26,6 +26,11 @@ pub struct LiveSim {
     /// The IMU samples of the signal window (the first seconds' raw and filtered gyro plots) not
     /// yet handed to the recorder.
     signal: Vec<crate::ins::core::SampleOut>,
+    /// The step rate in force, Hz, and the instant and step from which it counts.
+    step_hz: f64,
+    rate_since: (f64, u64),
+    /// A new step rate waiting for the INS to finish its updates in progress.
+    pending_rate_hz: Option<f64>,
 }
 
 impl LiveSim {
@@ -35,13 +40,34 @@ impl LiveSim {
         let model = params.table_model();
         let last_gimbal_rad = model.scheme.state(0.0).0;
         let ins = params.ins_run();
-        Self { params, model, state: DemodState::default(), step_index: 0, stats: ErrorStats::default(), since_change: ErrorStats::default(), last_gimbal_rad, ins, ins_update_s: None, signal: Vec::new() }
+        let step_hz = params.step_hz;
+        Self {
+            params,
+            model,
+            state: DemodState::default(),
+            step_index: 0,
+            stats: ErrorStats::default(),
+            since_change: ErrorStats::default(),
+            last_gimbal_rad,
+            ins,
+            ins_update_s: None,
+            signal: Vec::new(),
+            step_hz,
+            rate_since: (0.0, 0),
+            pending_rate_hz: None,
+        }
     }
 
     /// Simulated time of the next step, s.
     #[must_use]
     pub fn t_s(&self) -> f64 {
-        self.step_index as f64 / self.params.step_hz
+        self.rate_since.0 + (self.step_index - self.rate_since.1) as f64 / self.step_hz
+    }
+
+    /// The step rate in force, Hz (a new one applies once the INS is between two updates).
+    #[must_use]
+    pub fn step_hz(&self) -> f64 {
+        self.step_hz
     }
 
     /// Number of steps taken.
@@ -67,7 +93,26 @@ impl LiveSim {
         self.since_change.add(&out);
         self.last_gimbal_rad = out.gimbal_rad;
         self.step_index += 1;
+        if let Some(hz) = self.pending_rate_hz
+            && self.ins.as_ref().is_none_or(InsRun::between_updates)
+        {
+            self.switch_rate(hz);
+        }
         out
+    }
+
+    /// From the next step on, the table and the INS step at `hz`; each algorithm goes on from its
+    /// attitude ([`InsRun::at_rate`], whose conditions `apply` checked).
+    fn switch_rate(&mut self, hz: f64) {
+        self.rate_since = (self.t_s(), self.step_index);
+        self.step_hz = hz;
+        self.pending_rate_hz = None;
+        let cfg = self.params.ins.clone();
+        if let (Some(ins), Some(cfg)) = (self.ins.as_mut(), cfg)
+            && let Ok(next) = ins.at_rate(&cfg)
+        {
+            *ins = next;
+        }
     }
 
     /// The signal window's samples since the last call.
@@ -90,8 +135,18 @@ impl LiveSim {
         if axes(old) != axes(&new) {
             return Err("the turntable's axes (names, number or directions) cannot change in a running session; restart `rinscope live`".into());
         }
-        if old.step_hz != new.step_hz {
-            return Err(format!("simulation.step_hz cannot change in a running session ({} Hz -> {} Hz); restart `rinscope live`", old.step_hz, new.step_hz));
+        let rate_changed = old.step_hz != new.step_hz;
+        if rate_changed && let Some(cfg) = &new.ins {
+            let why = if cfg.fir_taps.len() > 1 || cfg.decimation != 1 {
+                Some("its IMU has a FIR or a decimation, whose state is in samples of the old rate")
+            } else if cfg.navigation.is_some() {
+                Some("its INS navigates, and the navigation's state is in samples of the old rate")
+            } else {
+                None
+            };
+            if let Some(why) = why {
+                return Err(format!("simulation.step_hz cannot change in this running session ({} Hz -> {} Hz): {why}; restart `rinscope live`", old.step_hz, new.step_hz));
+            }
         }
         let changes = describe_changes(&old.written, &new.written);
         if changes.is_empty() {
@@ -99,10 +154,13 @@ impl LiveSim {
         }
         let (a, b) = (scenario::flatten(&old.written), scenario::flatten(&new.written));
         let instrument = |k: &String| k.starts_with("imu.") || k.starts_with("navigation.");
+        // (What the INS computes from the step rate — its sample period — follows the rate below.)
         if let Some(key) = a.keys().chain(b.keys()).filter(|k| instrument(k)).find(|k| a.get(*k) != b.get(*k)) {
             return Err(format!("{key} cannot change in a running session (the INS has been integrating with the old one); restart `rinscope live`"));
         }
         let mut model = new.table_model();
+        // The body goes on from where it is (a changed cone or wobble ramps, its phase kept).
+        model.vehicle = model.vehicle.continuing_from(&self.model.vehicle, self.t_s());
         let initial_changed = old.resolved.turntable.axis.iter().zip(&new.resolved.turntable.axis).any(|(a, b)| a.initial_angle_deg != b.initial_angle_deg);
         if old.resolved.scheme == new.resolved.scheme && !initial_changed {
             // Same motion: keep its clock, so nothing jumps.
@@ -111,12 +169,16 @@ impl LiveSim {
         } else {
             // A new motion starts from where the gimbals were at the last step, at that step's time.
             model.scheme = new.table.scheme.with_initial(&self.last_gimbal_rad);
-            model.scheme_t0_s = self.step_index.saturating_sub(1) as f64 / self.params.step_hz;
+            model.scheme_t0_s = self.t_s() - 1.0 / self.step_hz;
         }
         if let Some(ins) = self.ins.as_mut() {
             ins.replace_model(model.clone());
         }
         self.model = model;
+        if rate_changed {
+            // Once the INS has finished the updates in progress (at most a few samples).
+            self.pending_rate_hz = Some(new.step_hz);
+        }
         self.params = new;
         self.since_change = ErrorStats::default();
         Ok(changes)

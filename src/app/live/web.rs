@@ -125,7 +125,16 @@ pub struct PageConfig {
     pub config_path: PathBuf,
     /// Control requests need this token (None: loopback only, no token).
     pub token: Option<String>,
+    /// Where to ask for the session so far (`GET /history.rrd`, which the viewer loads beside
+    /// the live stream); None: the route answers 404 and the viewer gets the stream only.
+    pub history: Option<crossbeam_channel::Sender<super::HistoryRequest>>,
 }
+
+/// How long a late viewer's copy of the session so far is served again to the next one (a class
+/// opening the page at once is one encoding, not thirty).
+const HISTORY_REUSE: Duration = Duration::from_secs(1);
+/// How long the page waits for the recorder's copy of the session so far.
+const HISTORY_WAIT: Duration = Duration::from_secs(5);
 
 /// A random token of 128 bits from the operating system's generator, hex.
 ///
@@ -173,7 +182,7 @@ pub fn start(cfg: PageConfig, status: SharedStatus, title: String) -> anyhow::Re
     let panel = Panel::new(&lock(&status).resolved, title.clone());
     let state = State { panel, seen_generation: u64::MAX, window: Instant::now(), served: 0, changes: 0 };
     let token = cfg.token.clone();
-    let server = Arc::new(Server { hostname: address::this_hostname(), cfg, port, title, status, state: Mutex::new(state) });
+    let server = Arc::new(Server { hostname: address::this_hostname(), cfg, port, title, status, state: Mutex::new(state), history: tokio::sync::Mutex::new(None) });
     let (stop, stopped) = oneshot::channel();
     let (finished_tx, finished) = mpsc::channel::<()>();
     let thread = std::thread::Builder::new().name("class page".into()).spawn(move || {
@@ -195,6 +204,9 @@ struct Server {
     title: String,
     status: SharedStatus,
     state: Mutex<State>,
+    /// The last copy of the session so far and when it was made (held across the wait for a new
+    /// one, so that concurrent late viewers share it).
+    history: tokio::sync::Mutex<Option<(Instant, Bytes)>>,
 }
 
 /// The panel and the rate counters (locked briefly, never across a wait).
@@ -331,6 +343,7 @@ impl Server {
                 let body = self.with_panel(|panel, st| controls_json(panel, st, &self.cfg.config_path));
                 reply(StatusCode::OK, body.to_string(), JSON)
             }
+            (&Method::GET, address::HISTORY_PATH) => self.history(&host).await,
             (&Method::POST, "/set") => self.change(req, &host, Change::Set).await,
             (&Method::POST, "/calibrate") => self.change(req, &host, Change::Calibrate).await,
             (method, _) => error(
@@ -387,13 +400,59 @@ impl Server {
         f(&mut state.panel, &st)
     }
 
+    /// The session so far as one `.rrd` (compact chunks), for the viewer this page shows: it
+    /// loads it beside the live stream, which keeps no history (a late viewer would otherwise
+    /// replay every small chunk of it, slower than the session runs). Readable by the viewer's
+    /// page (the next port, another origin).
+    async fn history(&self, host: &Host) -> Answer {
+        let Some(requests) = &self.cfg.history else {
+            return error(StatusCode::NOT_FOUND, "this session keeps no history for late viewers");
+        };
+        let mut cached = self.history.lock().await;
+        let bytes = match cached.as_ref().filter(|(at, _)| at.elapsed() < HISTORY_REUSE) {
+            Some((_, bytes)) => bytes.clone(),
+            None => {
+                let (reply, answer) = oneshot::channel();
+                if requests.send(super::HistoryRequest { reply }).is_err() {
+                    return error(StatusCode::SERVICE_UNAVAILABLE, "the session has ended");
+                }
+                match tokio::time::timeout(HISTORY_WAIT, answer).await {
+                    Ok(Ok(Ok(bytes))) => {
+                        let bytes = Bytes::from(bytes);
+                        *cached = Some((Instant::now(), bytes.clone()));
+                        bytes
+                    }
+                    Ok(Ok(Err(e))) => return error(StatusCode::INTERNAL_SERVER_ERROR, &format!("the session so far could not be encoded: {e}")),
+                    Ok(Err(_)) => return error(StatusCode::SERVICE_UNAVAILABLE, "the session has ended"),
+                    Err(_) => return error(StatusCode::SERVICE_UNAVAILABLE, "the session did not answer in time"),
+                }
+            }
+        };
+        drop(cached);
+        let mut r = Response::new(Full::new(bytes));
+        let h = r.headers_mut();
+        h.insert(header::CONTENT_TYPE, HeaderValue::from_static("application/octet-stream"));
+        h.insert(header::CACHE_CONTROL, HeaderValue::from_static("no-store"));
+        h.insert(header::X_CONTENT_TYPE_OPTIONS, HeaderValue::from_static("nosniff"));
+        if let Ok(origin) = HeaderValue::from_str(&format!("http://{}:{}", self.viewer_host(host), self.port.saturating_add(1))) {
+            h.insert(header::ACCESS_CONTROL_ALLOW_ORIGIN, origin);
+        }
+        r
+    }
+
+    /// The host of the viewer's and the stream's URLs: the one the browser asked for when the
+    /// server listens on every address, the one it listens on otherwise.
+    fn viewer_host(&self, host: &Host) -> String {
+        let ip = self.cfg.addr.ip();
+        if ip.is_unspecified() { host.name.clone() } else { address::url_host(ip) }
+    }
+
     /// The page, its viewer on the host the browser asked for when the server listens on every
     /// address (the one it listens on otherwise). The viewer's URL asks for its dark theme (the
     /// page's script works around Rerun's first start).
     fn page(&self, host: &Host) -> String {
-        let ip = self.cfg.addr.ip();
-        let viewer_host = if ip.is_unspecified() { host.name.clone() } else { address::url_host(ip) };
-        let viewer = address::web_viewer_page(&viewer_host, self.port.saturating_add(1), self.port.saturating_add(2));
+        let history = self.cfg.history.as_ref().map(|_| self.port);
+        let viewer = address::web_viewer_page(&self.viewer_host(host), self.port.saturating_add(1), self.port.saturating_add(2), history);
         PAGE.replace("{{VIEWER_URL}}", &html_escape(&viewer)).replace("{{TITLE}}", &html_escape(&self.title))
     }
 

@@ -63,14 +63,19 @@ pub fn this_hostname() -> Option<String> {
     plain.then_some(name)
 }
 
-/// The Rerun web viewer's page at `host:web_port`, showing the stream at `host:grpc_port`, in its
-/// dark theme (the stream's URL percent-encoded in the page's `?url=`).
+/// The Rerun web viewer's page at `host:web_port`, showing the stream at `host:grpc_port` (and,
+/// with `history_port`, first the session so far from `http://host:history_port/history.rrd`), in
+/// its dark theme (each URL percent-encoded in a `url=` of the page's query).
 #[must_use]
-pub fn web_viewer_page(host: &str, web_port: u16, grpc_port: u16) -> String {
-    let stream = format!("rerun+http://{host}:{grpc_port}/proxy");
-    let encoded = stream.replace(':', "%3A").replace('/', "%2F").replace('+', "%2B").replace('[', "%5B").replace(']', "%5D");
-    format!("http://{host}:{web_port}/?url={encoded}&theme=dark")
+pub fn web_viewer_page(host: &str, web_port: u16, grpc_port: u16, history_port: Option<u16>) -> String {
+    let encode = |url: String| url.replace(':', "%3A").replace('/', "%2F").replace('+', "%2B").replace('[', "%5B").replace(']', "%5D");
+    let history = history_port.map_or_else(String::new, |p| format!("url={}&", encode(format!("http://{host}:{p}{HISTORY_PATH}"))));
+    let stream = encode(format!("rerun+http://{host}:{grpc_port}/proxy"));
+    format!("http://{host}:{web_port}/?{history}url={stream}&theme=dark")
 }
+
+/// Where a live session's class page serves the session so far as one recording.
+pub const HISTORY_PATH: &str = "/history.rrd";
 
 #[cfg(test)]
 mod tests {
@@ -85,7 +90,7 @@ mod tests {
             assert!(h != "127.0.0.1" && h != "0.0.0.0", "{h}");
         }
         assert_eq!(
-            web_viewer_page("[::1]", 9091, 9092),
+            web_viewer_page("[::1]", 9091, 9092, None),
             "http://[::1]:9091/?url=rerun%2Bhttp%3A%2F%2F%5B%3A%3A1%5D%3A9092%2Fproxy&theme=dark"
         );
     }

@@ -101,6 +101,10 @@ pub struct SinkRequest {
     pub bind: Option<IpAddr>,
     /// Serve the viewer itself (Wasm, for a browser) on this HTTP port, with the stream.
     pub serve_web: Option<u16>,
+    /// A live session's class page port, which serves the session so far as one compact
+    /// recording (`/history.rrd`, [`HistorySnapshot`]): the web viewer loads it beside the stream,
+    /// and the stream keeps no history of its own (see [`open`]).
+    pub serve_web_history: Option<u16>,
     /// Set when the saved file cannot be written, so the run stops at its next check.
     pub stop_on_failure: Option<Arc<AtomicBool>>,
     /// Also write every time series as tables into this folder.
@@ -223,7 +227,18 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
         // The stream on the next port (known in advance: a firewall can be opened for both); the
         // page connects to it.
         let grpc_port = web_port.checked_add(1).ok_or(SinkError::Serve { addr: web_addr, reason: "the stream needs the next port too".into() })?;
-        let options = rerun::ServerOptions { memory_limit: rerun::MemoryLimit::from_bytes(1 << 30), ..Default::default() };
+        // A late viewer is sent everything the server kept. A live stream is many small chunks (low
+        // latency), which a web viewer ingests at a few dozen a second: 10 minutes of it took it
+        // longer to replay than the session lasted. With the class page's compact history beside it,
+        // the stream keeps none (static data and the layout are kept by the server anyway).
+        let history_limit = if req.serve_web_history.is_some() { 0 } else { 1 << 30 };
+        // The viewer's page (next port, any host the browser used) may read the stream: Rerun's
+        // server allows only localhost and 127.0.0.1 by default, which a class beyond loopback is not.
+        let options = rerun::ServerOptions {
+            memory_limit: rerun::MemoryLimit::from_bytes(history_limit),
+            cors_allowed_origins: vec![format!("http://*:{web_port}")],
+            ..Default::default()
+        };
         let sink = rerun::grpc_server::GrpcServerSink::new(&ip.to_string(), grpc_port, options).map_err(|e| SinkError::Serve { addr: SocketAddr::new(ip, grpc_port), reason: e.to_string() })?;
         sinks.push(Box::new(sink));
         let host = address::local_host(ip);
@@ -232,7 +247,7 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
         let server = config.host_web_viewer().map_err(|e| SinkError::Serve { addr: web_addr, reason: e.to_string() })?;
         // The viewer's dark theme whatever the browser's: the recording's 3D labels and colours are made
         // for it (on the light one white and yellow labels all but vanish).
-        let page = address::web_viewer_page(&host, web_port, grpc_port);
+        let page = address::web_viewer_page(&host, web_port, grpc_port, req.serve_web_history);
         if !ip.is_loopback() {
             errln!("rinscope: WARNING: --bind {ip}: anyone who can reach ports {web_port} and {grpc_port} of this machine can watch this session (there is no authentication)");
         }
@@ -240,7 +255,7 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
         // For an unspecified address, the page other machines open names this one (the stream's URL too).
         if ip.is_unspecified() {
             match address::network_host(ip) {
-                Some(h) => description.push(format!("from other machines: open {}", address::web_viewer_page(&h, web_port, grpc_port))),
+                Some(h) => description.push(format!("from other machines: open {}", address::web_viewer_page(&h, web_port, grpc_port, req.serve_web_history))),
                 None => description.push(format!("from other machines: open this machine's address in place of {host} (it has no route out and no name to print)")),
             }
         }
@@ -273,6 +288,32 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
         .set_sinks(sinks)
         .map_err(|e| SinkError::Rerun(e.to_string()))?;
     Ok(OpenSinks { rec, export, file, viewer_problems: problems, description, web, stop: req.stop_on_failure.clone(), figures: req.figures.clone() })
+}
+
+/// A live session kept in memory as one compact recording (full-size chunks, like a saved file),
+/// for viewers that open the session late: the class page serves it as `/history.rrd`
+/// ([`address::HISTORY_PATH`]) beside the live stream, which then keeps no history of its own.
+pub struct HistoryStore {
+    storage: rerun::sink::MemorySinkStorage,
+}
+
+impl HistoryStore {
+    /// Everything logged so far, as the bytes of an `.rrd` file.
+    ///
+    /// # Errors
+    /// Rerun's encoder failed.
+    pub fn rrd_bytes(&self) -> Result<Vec<u8>, String> {
+        rerun::sink::MemorySinkStorage::concat_memory_sinks_as_bytes(&[&self.storage]).map_err(|e| e.to_string())
+    }
+}
+
+/// Opens the in-memory recording `recording_id` of a live session ([`HistoryStore`]).
+///
+/// # Errors
+/// Rerun could not create the stream.
+pub fn open_history(application_id: &'static str, recording_id: &str) -> Result<(Stream, HistoryStore), SinkError> {
+    let (rec, storage) = RecordingStreamBuilder::new(application_id).recording_id(recording_id.to_owned()).memory().map_err(|e| SinkError::Rerun(e.to_string()))?;
+    Ok((Stream::new(rec, None), HistoryStore { storage }))
 }
 
 /// Checks that the `.rrd` at `path` is complete: its header, its stream footer and the footer's

@@ -21,7 +21,7 @@ fn page_on(addr: &str, token: Option<&str>, name: &str) -> (ClassPage, PathBuf) 
     std::fs::write(&path, PRESET).expect("config");
     let params = scenario::parse(PRESET, "test").expect("preset");
     let status = super::super::new_status(&params, 1.0);
-    let cfg = PageConfig { addr: addr.parse().expect("addr"), host: "127.0.0.1".into(), config_path: path.clone(), token: token.map(str::to_owned) };
+    let cfg = PageConfig { addr: addr.parse().expect("addr"), host: "127.0.0.1".into(), config_path: path.clone(), token: token.map(str::to_owned), history: None };
     (start(cfg, status, "test page".into()).expect("listens"), path)
 }
 
