@@ -175,6 +175,8 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
     let options = live::LiveOptions { config_path: path, speed: args.speed, duration_s: args.duration_s, panel, log_to_stderr: true, page_url };
     let outputs = live::Outputs { viewer: viewer_sinks.as_ref().map(sink::OpenSinks::stream), file: file_sinks.as_ref().map(sink::OpenSinks::stream), history };
     let result = live::run_session_with_status(&options, params, outputs, &stop, &status);
+    // A signal that ended the session (not one that ends the wait of a viewer left open after it).
+    let interrupted = crate::app::terminate::stop_reason().is_some();
     drop(class_page);
     // Whatever happened, complete the saved file: it holds everything simulated so far.
     let mut exported = Vec::new();
@@ -202,7 +204,7 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
     }
     print_tables(&exported);
     // Ended by a signal (not by `q` or its length): 128 + the signal, as every command.
-    if crate::app::terminate::stop_reason().is_some() {
+    if interrupted {
         return Err(Failure::interrupted("the session's recording is complete up to that moment"));
     }
     Ok(())

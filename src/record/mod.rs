@@ -27,6 +27,8 @@ pub mod export;
 pub mod figures;
 mod ins_view;
 mod layout;
+mod live;
+pub use live::LiveOutput;
 pub mod modulation;
 mod palette;
 pub mod read;
@@ -243,31 +245,6 @@ pub struct Recorder {
     frames: Frames,
 }
 
-/// What a live session's recorder feeds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum LiveOutput {
-    /// Viewers watching as it runs: small chunks sent at a wall-clock cadence
-    /// ([`Recorder::flush_series_held`]); the layout is sent once, each plot's value axis left to
-    /// the viewer, which fits it to the data as they arrive (error plots held at symmetric ranges
-    /// by two invisible points, `frames.rs`).
-    Viewer,
-    /// The session so far for viewers that open it late (the class page's `/history.rrd`):
-    /// full-size chunks, flushed when asked for, and what a viewer watching from the start has
-    /// (the same layout and frame points).
-    History,
-    /// A saved file: full-size chunks like a run's, and at the end the layout again, every plot
-    /// framed on its data.
-    File,
-}
-
-impl LiveOutput {
-    /// Whether viewers see it as it comes (the layout sent once, plots fitted by the viewer).
-    fn watched(self) -> bool {
-        matches!(self, Self::Viewer | Self::History)
-    }
-}
-
-
 /// The error plots' symmetric ranges, from a run's peaks (see [`crate::math::units::nice_half_range`]).
 #[derive(Debug, Clone, Copy)]
 pub struct PlotRanges {
@@ -386,12 +363,6 @@ impl Recorder {
         self.event(0.0, &format!("t = 0 is {t0_file_s:.6} s on the IMU file's clock (the timeline `{FILE_CLOCK_TIMELINE}` shows the file's times; the export has them as t_file_s)"), "INFO")
     }
 
-    /// A recorder for live mode feeding `output`: everything that a reload can change is logged
-    /// on the timeline.
-    pub fn new_live(stream: Stream, params: &Params, output: LiveOutput) -> RecordingStreamResult<Self> {
-        Self::build(stream, params, Some(output), None)
-    }
-
     fn geometry_at(&self, t_s: f64) -> Option<f64> {
         self.live.map(|_| t_s)
     }
@@ -439,56 +410,6 @@ impl Recorder {
     #[must_use]
     pub fn error_unit(&self) -> crate::math::units::AngleUnit {
         self.error_unit
-    }
-
-    /// True for a live session's recorder.
-    #[must_use]
-    pub fn is_live(&self) -> bool {
-        self.live.is_some()
-    }
-
-    /// Live mode: new parameters apply from simulated time `t_s` on (buffered rows go out first).
-    pub fn reconfigure(&mut self, t_s: f64, params: &Params) -> RecordingStreamResult<()> {
-        self.flush_now()?;
-        self.truth = params.table.truth.clone();
-        let factors = drawing_factors(&self.truth, params.recording.exaggeration);
-        // The 3D view's title names each class's drawing factor: the layout follows a change of it.
-        let retitle = factors != self.factors || self.live_params.as_ref().is_some_and(|p| p.recording.exaggeration != params.recording.exaggeration);
-        self.factors = factors;
-        self.drawing = self.chain.error_rotations(&self.truth.exaggerated(&self.factors));
-        let old = self.live_params.replace(Box::new(params.clone()));
-        // Pure coning: the drawn cone and its label, and the analytic drift lines, follow a new
-        // cone or sample rate (the lines from where they stand: the drift goes on at the new rate).
-        let alpha = |p: &Params| p.table.vehicle.pure_coning().map_or(0.0, |c| c.half_angle_rad);
-        if let Some(gizmo) = self.cone.as_mut()
-            && old.as_ref().is_none_or(|p| alpha(p) != alpha(params))
-        {
-            gizmo.reshape(&self.rec, alpha(params), t_s)?;
-        }
-        if let Some(layout) = self.ins.as_mut() {
-            let algorithms = params.ins.as_ref().map(crate::ins::InsParams::algorithms).unwrap_or_default();
-            if let (Some(lines), Some(rates)) = (layout.coning_log.as_mut(), ins_view::coning_rates(params, &algorithms))
-                && rates != lines.rates
-            {
-                lines.change(t_s, rates);
-            }
-            let hidden: Vec<String> = layout.algorithms.iter().filter(|a| !params.recording.shows(a)).cloned().collect();
-            if hidden != layout.hidden {
-                layout.hidden = hidden;
-                self.log_shown_algorithms()?;
-            }
-        }
-        if retitle {
-            self.send_blueprint(params, self.custom.clone())?;
-        }
-        // Where the parameters changed, on every error plot (at 0: the plots' range is not known).
-        for axis in ERROR_AXES {
-            self.stream.mark_events(&error_path(self.error_unit, axis), "reloads", "config reloaded", &[t_s], 0.0)?;
-            if self.ins.as_ref().is_some_and(|l| l.errors) {
-                self.stream.mark_events(&format!("ins/attitude_error_arcsec/{axis}"), "reloads", "config reloaded", &[t_s], 0.0)?;
-            }
-        }
-        self.log_error_geometry(params, self.geometry_at(t_s))
     }
 
     /// Sends every buffered row now (live mode: low latency over large chunks).
@@ -604,15 +525,6 @@ impl Recorder {
     /// Sends the buffered time-series rows.
     pub fn flush_series(&mut self) -> RecordingStreamResult<()> {
         self.flush_series_with(None)
-    }
-
-    /// Sends the buffered time-series rows to viewers watching live: a series whose rows all
-    /// repeat the last row it sent (a table error that is zero, a vehicle at rest) sends nothing
-    /// for up to `hold`, then its newest row only — the same line, drawn flat to the same end, with
-    /// a chunk every `hold` instead of every flush (a web viewer ingests a few dozen chunks a
-    /// second). Every row is sent when the stream also exports its tables.
-    pub fn flush_series_held(&mut self, hold: std::time::Duration) -> RecordingStreamResult<()> {
-        self.flush_series_with(Some(hold))
     }
 
     fn flush_series_with(&mut self, hold: Option<std::time::Duration>) -> RecordingStreamResult<()> {

@@ -64,6 +64,26 @@ pub fn events(path: &Path) -> anyhow::Result<Vec<Event>> {
     Ok(out)
 }
 
+/// The labels of the 3D points at `entity` (without the leading `/`) in the recording at `path`,
+/// each with its simulated time, s (None for static), in time order: what a label said when (a
+/// live session relabels what a reload changed).
+pub fn point_labels(path: &Path, entity: &str) -> anyhow::Result<Vec<(Option<f64>, String)>> {
+    let labels = rerun::Points3D::descriptor_labels().component;
+    let mut out = Vec::new();
+    for item in chunks(path)? {
+        let (store_id, e, chunk) = item?;
+        if store_id.kind() != StoreKind::Recording || e != entity {
+            continue;
+        }
+        let times: Vec<Option<f64>> = chunk.iter_component_indices(TIMELINE.into(), labels).map(|(t, _)| if t.is_static() { None } else { Some(t.as_i64() as f64 / 1e9) }).collect();
+        for (i, v) in chunk.iter_component::<rerun::components::Text>(labels).enumerate() {
+            out.push((times.get(i).copied().flatten(), v.iter().map(|t| t.as_str().to_owned()).collect::<Vec<_>>().join("\n")));
+        }
+    }
+    out.sort_by(|a, b| a.0.unwrap_or(-1.0).total_cmp(&b.0.unwrap_or(-1.0)));
+    Ok(out)
+}
+
 /// The entities a recording holds and the space origins of its layout's views (paths without the
 /// leading `/`).
 #[derive(Debug, Clone, Default)]

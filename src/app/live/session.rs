@@ -263,6 +263,15 @@ fn label_of(key: &str, raw: &RawConfig) -> String {
             format!("{axis} rotation {name}")
         }
         ["scheme", s, _] if s.starts_with("step[") => format!("scheme step {} {name}", index(s).map_or(0, |i| i + 1)),
+        // The panel's words for the coning lesson's controls.
+        ["vehicle", "coning_half_angle_deg"] => "cone half-angle".to_owned(),
+        ["vehicle", "coning_frequency_hz"] => "cone frequency".to_owned(),
+        ["vehicle", w, _] if w.starts_with("wobble[") => {
+            let wobble = index(w).and_then(|i| raw.vehicle.wobble.get(i)).map_or("", |w| w.angle.as_str());
+            format!("{wobble} wobble {name}")
+        }
+        ["simulation", "step_hz"] => "IMU sample rate (step rate)".to_owned(),
+        ["recording", "show", algorithm] => format!("show {algorithm}"),
         _ => key.to_owned(),
     }
 }

@@ -1,0 +1,101 @@
+//! A live session's recorders (`rinscope live`): what each feeds (viewers as it runs, the class
+//! page's history for late viewers, the saved file), and what a reload changes in a recording.
+
+use rerun::RecordingStreamResult;
+
+use super::{drawing_factors, error_path, ins_view, Recorder, Stream};
+use crate::scenario::Params;
+use crate::sim::ERROR_AXES;
+
+/// What a live session's recorder feeds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LiveOutput {
+    /// Viewers watching as it runs: small chunks sent at a wall-clock cadence
+    /// ([`Recorder::flush_series_held`]); the layout is sent once, each plot's value axis left to
+    /// the viewer, which fits it to the data as they arrive (error plots held at symmetric ranges
+    /// by two invisible points, `frames.rs`).
+    Viewer,
+    /// The session so far for viewers that open it late (the class page's `/history.rrd`):
+    /// full-size chunks, flushed when asked for, and what a viewer watching from the start has
+    /// (the same layout and frame points).
+    History,
+    /// A saved file: full-size chunks like a run's, and at the end the layout again, every plot
+    /// framed on its data.
+    File,
+}
+
+impl LiveOutput {
+    /// Whether viewers see it as it comes (the layout sent once, plots fitted by the viewer).
+    pub(super) fn watched(self) -> bool {
+        matches!(self, Self::Viewer | Self::History)
+    }
+}
+
+
+impl Recorder {
+    /// A recorder for live mode feeding `output`: everything that a reload can change is logged
+    /// on the timeline.
+    pub fn new_live(stream: Stream, params: &Params, output: LiveOutput) -> RecordingStreamResult<Self> {
+        Self::build(stream, params, Some(output), None)
+    }
+
+    /// True for a live session's recorder.
+    #[must_use]
+    pub fn is_live(&self) -> bool {
+        self.live.is_some()
+    }
+
+    /// Live mode: new parameters apply from simulated time `t_s` on (buffered rows go out first).
+    pub fn reconfigure(&mut self, t_s: f64, params: &Params) -> RecordingStreamResult<()> {
+        self.flush_now()?;
+        self.truth = params.table.truth.clone();
+        let factors = drawing_factors(&self.truth, params.recording.exaggeration);
+        // The 3D view's title names each class's drawing factor: the layout follows a change of it.
+        let retitle = factors != self.factors || self.live_params.as_ref().is_some_and(|p| p.recording.exaggeration != params.recording.exaggeration);
+        self.factors = factors;
+        self.drawing = self.chain.error_rotations(&self.truth.exaggerated(&self.factors));
+        let old = self.live_params.replace(Box::new(params.clone()));
+        // Pure coning: the drawn cone and its label, and the analytic drift lines, follow a new
+        // cone or sample rate (the lines from where they stand: the drift goes on at the new rate).
+        let alpha = |p: &Params| p.table.vehicle.pure_coning().map_or(0.0, |c| c.half_angle_rad);
+        if let Some(gizmo) = self.cone.as_mut()
+            && old.as_ref().is_none_or(|p| alpha(p) != alpha(params))
+        {
+            gizmo.reshape(&self.rec, alpha(params), t_s)?;
+        }
+        if let Some(layout) = self.ins.as_mut() {
+            let algorithms = params.ins.as_ref().map(crate::ins::InsParams::algorithms).unwrap_or_default();
+            if let (Some(lines), Some(rates)) = (layout.coning_log.as_mut(), ins_view::coning_rates(params, &algorithms))
+                && rates != lines.rates
+            {
+                lines.change(t_s, rates);
+            }
+            let hidden: Vec<String> = layout.algorithms.iter().filter(|a| !params.recording.shows(a)).cloned().collect();
+            if hidden != layout.hidden {
+                layout.hidden = hidden;
+                self.log_shown_algorithms()?;
+            }
+        }
+        if retitle {
+            self.send_blueprint(params, self.custom.clone())?;
+        }
+        // Where the parameters changed, on every error plot (at 0: the plots' range is not known).
+        for axis in ERROR_AXES {
+            self.stream.mark_events(&error_path(self.error_unit, axis), "reloads", "config reloaded", &[t_s], 0.0)?;
+            if self.ins.as_ref().is_some_and(|l| l.errors) {
+                self.stream.mark_events(&format!("ins/attitude_error_arcsec/{axis}"), "reloads", "config reloaded", &[t_s], 0.0)?;
+            }
+        }
+        self.log_error_geometry(params, self.geometry_at(t_s))
+    }
+
+    /// Sends the buffered time-series rows to viewers watching live: a series whose rows all
+    /// repeat the last row it sent (a table error that is zero, a vehicle at rest) sends nothing
+    /// for up to `hold`, then its newest row only — the same line, drawn flat to the same end, with
+    /// a chunk every `hold` instead of every flush (a web viewer ingests a few dozen chunks a
+    /// second). Every row is sent when the stream also exports its tables.
+    pub fn flush_series_held(&mut self, hold: std::time::Duration) -> RecordingStreamResult<()> {
+        self.flush_series_with(Some(hold))
+    }
+
+}
