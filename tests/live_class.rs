@@ -185,7 +185,7 @@ fn the_cone_changed_twice_from_the_class_page_goes_on_and_its_labels_and_rates_f
 
     // The 3D label says the cone there is (1° until the first change, then 2°).
     let labels = point_labels(&rec, "world/cone/label").expect("labels");
-    let label_at = |t: f64| labels.iter().filter(|(s, _)| s.is_none_or(|s| s <= t)).next_back().map(|(_, l)| l.clone()).unwrap_or_default();
+    let label_at = |t: f64| labels.iter().rfind(|(s, _)| s.is_none_or(|s| s <= t)).map(|(_, l)| l.clone()).unwrap_or_default();
     assert!(label_at(t1 - 0.5).contains("1.0000° cone") && label_at(t1 + 0.5).contains("2.0000° cone"), "{labels:?}");
 
     // The INS heading error of every algorithm goes on without a jump: no row (0.1 s apart) moves by

@@ -528,6 +528,7 @@ impl Recorder {
     }
 
     fn flush_series_with(&mut self, hold: Option<std::time::Duration>) -> RecordingStreamResult<()> {
+        self.flush_dial()?;
         if self.series_t.is_empty() {
             return Ok(());
         }
@@ -604,15 +605,22 @@ impl Recorder {
                 self.rec.send_columns(ins_view::TRACE_AXES_PATH, self.stream.time_columns(&times), rerun::Arrows3D::update_fields().with_vectors(trace).columns(std::iter::repeat_n(6, times.len()))?)?;
                 sent += 1;
             }
-            let dial_t = std::mem::take(&mut layout.dial_t);
-            let needles = std::mem::take(&mut layout.dial);
-            if !dial_t.is_empty() {
-                let k = layout.algorithms.len();
-                self.rec.send_columns(ins_view::DIAL_NEEDLES_PATH, self.stream.time_columns(&dial_t), rerun::Arrows3D::update_fields().with_vectors(needles).columns(std::iter::repeat_n(k, dial_t.len()))?)?;
-                sent += 1;
-            }
         }
         self.throttle(sent);
+        Ok(())
+    }
+
+    /// Sends the drift dial's buffered frames (with the plots: the needles turn with the errors).
+    fn flush_dial(&mut self) -> RecordingStreamResult<()> {
+        let Some(layout) = self.ins.as_mut() else { return Ok(()) };
+        let dial_t = std::mem::take(&mut layout.dial_t);
+        let needles = std::mem::take(&mut layout.dial);
+        if dial_t.is_empty() {
+            return Ok(());
+        }
+        let k = layout.algorithms.len();
+        self.rec.send_columns(ins_view::DIAL_NEEDLES_PATH, self.stream.time_columns(&dial_t), rerun::Arrows3D::update_fields().with_vectors(needles).columns(std::iter::repeat_n(k, dial_t.len()))?)?;
+        self.throttle(1);
         Ok(())
     }
 

@@ -72,9 +72,10 @@ pub(crate) struct Series {
     pub(crate) held_until_s: Option<f64>,
 }
 
-/// Whether two rows hold the same values, bit for bit (a NaN row repeats a NaN row).
+/// Whether two rows hold the same values to a part in 10⁹ (a NaN row repeats a NaN row): a zero
+/// error whose rounding flickers at 1e-13″ is a repeated row to a plot.
 pub(crate) fn same_row(a: &[f64], b: &[f64]) -> bool {
-    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits() || (x - y).abs() <= 1e-9 * x.abs().max(y.abs()).max(1.0))
 }
 
 impl Series {

@@ -34,53 +34,76 @@ class Browser:
         tab = next(t for t in tabs if t.get("type") == "page")
         self.ws = websocket.create_connection(tab["webSocketDebuggerUrl"], timeout=60, suppress_origin=True)
         self.seq = 0
-        self.contexts = {}  # execution context id -> (origin, frame id, is default)
+        # Execution contexts: (session, context id) -> (origin, frame id, is default). A frame of
+        # another origin may run in a process of its own (an out-of-process iframe): its contexts
+        # come through a session attached to its target (`Target.setAutoAttach`, flattened).
+        self.contexts = {}
+        self.pending_sessions = []
         self.call("Runtime.enable")
         self.call("Page.enable")
+        self.call("Target.setAutoAttach", autoAttach=True, waitForDebuggerOnStart=False, flatten=True)
         if dark:
             self.call("Emulation.setEmulatedMedia", features=[{"name": "prefers-color-scheme", "value": "dark"}])
 
     def _event(self, m):
-        if m.get("method") == "Runtime.executionContextCreated":
+        session = m.get("sessionId")
+        method = m.get("method")
+        if method == "Runtime.executionContextCreated":
             c = m["params"]["context"]
             aux = c.get("auxData", {})
-            self.contexts[c["id"]] = (c.get("origin", ""), aux.get("frameId"), aux.get("isDefault", False))
-        elif m.get("method") == "Runtime.executionContextDestroyed":
-            self.contexts.pop(m["params"]["executionContextId"], None)
-        elif m.get("method") == "Runtime.executionContextsCleared":
-            self.contexts.clear()
+            self.contexts[(session, c["id"])] = (c.get("origin", ""), aux.get("frameId"), aux.get("isDefault", False))
+        elif method == "Runtime.executionContextDestroyed":
+            self.contexts.pop((session, m["params"]["executionContextId"]), None)
+        elif method == "Runtime.executionContextsCleared":
+            self.contexts = {k: v for k, v in self.contexts.items() if k[0] != session}
+        elif method == "Target.attachedToTarget":
+            self.pending_sessions.append(m["params"]["sessionId"])
+        elif method == "Target.detachedFromTarget":
+            gone = m["params"].get("sessionId")
+            self.contexts = {k: v for k, v in self.contexts.items() if k[0] != gone}
 
-    def call(self, method, **params):
+    def call(self, method, session=None, **params):
         self.seq += 1
         want = self.seq
-        self.ws.send(json.dumps({"id": want, "method": method, "params": params}))
+        msg = {"id": want, "method": method, "params": params}
+        if session:
+            msg["sessionId"] = session
+        self.ws.send(json.dumps(msg))
         while True:
             m = json.loads(self.ws.recv())
-            if m.get("id") == want:
-                return m
+            if m.get("id") == want and m.get("sessionId") == session:
+                break
             self._event(m)
+        # Frames attached meanwhile get their contexts reported (and run on).
+        while self.pending_sessions:
+            s = self.pending_sessions.pop()
+            self.call("Runtime.enable", session=s)
+            self.call("Runtime.runIfWaitingForDebugger", session=s)
+        return m
 
     def pump(self):
         """Reads the events that arrived (new frames' contexts)."""
         self.call("Runtime.evaluate", expression="0")
 
     def js(self, expr, context=None):
-        """The value of `expr` (awaited), in the page or in execution context `context`."""
+        """The value of `expr` (awaited), in the page or in `context` (from `context_of`)."""
         params = {"expression": expr, "awaitPromise": True, "returnByValue": True}
+        session = None
         if context is not None:
-            params["contextId"] = context
-        r = self.call("Runtime.evaluate", **params)
+            session, params["contextId"] = context
+        r = self.call("Runtime.evaluate", session=session, **params)
         res = r.get("result", {})
         if "exceptionDetails" in res:
             return None
         return res.get("result", {}).get("value")
 
     def context_of(self, origin):
-        """The default execution context of the frame whose origin is `origin` (None: not yet)."""
+        """The default execution context of the frame whose origin is `origin`, as (session, id)
+        (None: not yet)."""
         self.pump()
-        for cid, (o, _, default) in sorted(self.contexts.items(), reverse=True):
+        for key, (o, _, default) in sorted(self.contexts.items(), key=lambda kv: kv[0][1], reverse=True):
             if default and o.rstrip("/") == origin.rstrip("/"):
-                return cid
+                return key
         return None
 
     def find_viewer_handle(self, context):
@@ -88,15 +111,16 @@ class Browser:
         Rerun's index.html keeps it in a local variable (it sets `window._handle` only once `start()`
         resolves, which 0.36 does not do while it streams): the heap is asked for the objects whose
         prototype is `WebHandle.prototype` (`Runtime.queryObjects`). True when found."""
-        r = self.call("Runtime.evaluate", expression="wasm_bindgen.WebHandle.prototype", contextId=context)
+        session, cid = context
+        r = self.call("Runtime.evaluate", session=session, expression="wasm_bindgen.WebHandle.prototype", contextId=cid)
         proto = r.get("result", {}).get("result", {}).get("objectId")
         if not proto:
             return False
-        r = self.call("Runtime.queryObjects", prototypeObjectId=proto)
+        r = self.call("Runtime.queryObjects", session=session, prototypeObjectId=proto)
         arr = r.get("result", {}).get("objects", {}).get("objectId")
         if not arr:
             return False
-        r = self.call("Runtime.callFunctionOn", objectId=arr, returnByValue=True,
+        r = self.call("Runtime.callFunctionOn", session=session, objectId=arr, returnByValue=True,
                       functionDeclaration="function() { const h = this.find(x => x.__wbg_ptr); if (h) window.__rinscope_handle = h; return !!h; }")
         return bool(r.get("result", {}).get("result", {}).get("value"))
 

@@ -64,7 +64,8 @@ try:
     if n == 0:
         fail("no controls appeared on the page")
     src = js("document.getElementById('viewer').src")
-    if not src or "?url=rerun" not in src or "theme=dark" not in src:
+    # The session so far (the class page's /history.rrd) and the live stream, in the dark theme.
+    if not src or "url=rerun" not in src or "history.rrd" not in src or "theme=dark" not in src:
         fail(f"the viewer frame points to {src!r}")
     print(f"web: page loaded, {n} controls, viewer frame {src}")
     # 2. A teacher moves the inner swing slider to 450″ (the range input's value, then its change event,

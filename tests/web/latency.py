@@ -1,19 +1,22 @@
 """How far behind the session the Rerun web viewer is, read in the viewer itself.
 
 Opens PAGE in headless Chromium, finds the Rerun viewer's frame (origin VIEWER_ORIGIN; the page
-itself when it is the viewer), and once a second reads the viewer's own time cursor and the range of
-data it holds on `sim_time` (`window._handle`, set by Rerun's index.html) beside the session's
-simulated time (`GET CONTROLS`: the class page's `sim_t_s`; without it, the viewer is compared with
-END_T, a finished run's last instant). Optionally moves a slider every MOVE_EVERY seconds and times
-how long until the viewer shows data past the change.
+itself when it is the viewer), and reads the viewer's own time cursor on `sim_time` and the range of
+data it holds (through its `WebHandle`: `cdp.Browser.find_viewer_handle`) beside the session's
+simulated time: `GET CONTROLS` (the class page's `sim_t_s`), or, for a finished run, END_T. With
+MOVE_EVERY, a teacher moves a slider on the page every MOVE_EVERY seconds (alternately two values) and
+the time until the viewer shows data past the change is measured (polled every 0.1 s).
 
     latency.py --page URL --viewer-origin ORIGIN --cdp PORT --seconds N
-               [--controls URL] [--end-t T] [--move-every S] [--json OUT] [--screenshot OUT.png]
+               [--controls URL | --end-t T] [--move-every S --move-label LABEL --move-values A,B]
+               [--warmup S] [--max-lag S] [--max-move S] [--json OUT] [--screenshot OUT.png [--dark]]
 
-Prints one line per sample and a summary; with --json, writes the samples and the summary.
+Prints a line per second and a summary; exits 1 when the steady-state lag (after the viewer first
+shows data plus WARMUP) ever exceeds MAX_LAG, or a change took longer than MAX_MOVE to show.
 """
 import argparse
 import json
+import re
 import statistics
 import sys
 import time
@@ -28,11 +31,18 @@ ap.add_argument("--cdp", type=int, required=True)
 ap.add_argument("--seconds", type=float, required=True)
 ap.add_argument("--controls")
 ap.add_argument("--end-t", type=float)
+# A finished run plays from its start in the viewer (its time cursor is the user's): what it holds is
+# measured, its newest data against END_T.
+ap.add_argument("--newest", action="store_true")
 ap.add_argument("--move-every", type=float, default=0.0)
 ap.add_argument("--move-label", default="inner swing half-angle")
+ap.add_argument("--move-values", default="450,300")
+ap.add_argument("--warmup", type=float, default=10.0)
+ap.add_argument("--max-lag", type=float)
+ap.add_argument("--max-move", type=float)
 ap.add_argument("--json")
 ap.add_argument("--screenshot")
-ap.add_argument("--warmup", type=float, default=20.0)
+ap.add_argument("--dark", action="store_true")
 a = ap.parse_args()
 
 
@@ -41,60 +51,68 @@ def controls():
         return json.load(r)
 
 
-def to_s(t):
-    # The viewer reports a duration timeline in nanoseconds.
-    return None if t is None else t / 1e9
+def session_time():
+    if a.controls:
+        try:
+            return controls()["sim_t_s"]
+        except Exception:
+            return None
+    return a.end_t
 
 
-b = Browser(a.cdp)
+b = Browser(a.cdp, dark=a.dark)
 samples, moves = [], []
+ctx = None
+
+
+def viewer():
+    """What the viewer shows: (time cursor s, newest data s, frames painted) or None."""
+    global ctx
+    if ctx is None:
+        ctx = b.context_of(a.viewer_origin)
+    state = b.js(VIEWER_STATE, ctx) if ctx else None
+    if state is None and ctx is not None and b.find_viewer_handle(ctx):
+        state = b.js(VIEWER_STATE, ctx)
+    if state is None and ctx is not None:
+        ctx = None  # the frame was reloaded: find its new context
+    if not state or state.get("t") is None:
+        return None
+    rng = state.get("range")
+    newest = rng["max"] / 1e9 if isinstance(rng, dict) and rng.get("max") is not None else None
+    # The viewer reports a duration timeline in nanoseconds.
+    return state["t"] / 1e9, newest, state.get("frames")
+
+
+values = [float(v) for v in a.move_values.split(",")]
 try:
     b.navigate(a.page)
     t0 = time.monotonic()
-    ctx, first_data, next_move, move_k = None, None, None, 0
-    while time.monotonic() - t0 < a.seconds:
+    first_data, next_move = None, None
+    # SECONDS of watching from the viewer's first data (it takes about a minute to start here).
+    while (first_data is None and time.monotonic() - t0 < 240) or (first_data is not None and time.monotonic() - t0 < first_data + a.seconds):
         time.sleep(1.0)
         asked = time.monotonic()
-        if ctx is None:
-            ctx = b.context_of(a.viewer_origin)
-        state = b.js(VIEWER_STATE, ctx) if ctx else None
-        if state is None and ctx is not None and b.find_viewer_handle(ctx):
-            state = b.js(VIEWER_STATE, ctx)
-        if state is None and ctx is not None:
-            ctx = None  # the frame was reloaded: find its new context
-        # The session's time when the viewer's answer came (a viewer whose page is busy answers late:
-        # what it shows is compared with the session at that moment).
-        now = time.monotonic() - t0
-        answered_in = time.monotonic() - asked
-        session = None
-        if a.controls:
-            try:
-                session = controls()["sim_t_s"]
-            except Exception:
-                session = None
-        elif a.end_t is not None:
-            session = a.end_t
-        shown = to_s(state.get("t")) if state else None
-        rng = state.get("range") if state else None
-        newest = to_s(rng["max"]) if isinstance(rng, dict) and rng.get("max") is not None else None
-        frames = state.get("frames") if state else None
+        shown = viewer()
+        # The session's time when the viewer's answer came (a viewer whose page is busy answers
+        # late: what it shows is compared with the session at that moment).
+        now, answered_in = time.monotonic() - t0, time.monotonic() - asked
+        session = session_time()
+        t, newest, frames = shown if shown else (None, None, None)
+        if a.newest:
+            t = newest
+        lag = session - t if (session is not None and t is not None) else None
         fps = None
-        if frames is not None and samples and samples[-1].get("frames") is not None and now > samples[-1]["wall_s"]:
+        if frames is not None and samples and samples[-1]["frames"] is not None:
             fps = round((frames - samples[-1]["frames"]) / (now - samples[-1]["wall_s"]), 1)
-        lag = (session - shown) if (session is not None and shown is not None) else None
-        if shown is not None and first_data is None:
+        if t is not None and first_data is None:
             first_data = now
             next_move = now + a.warmup
-        samples.append({"wall_s": round(now, 2), "session_s": session, "viewer_t_s": shown, "viewer_newest_s": newest, "lag_s": lag, "viewer_answered_in_s": round(answered_in, 2), "frames": frames, "fps": fps})
-        print(f"wall {now:7.1f} s  session {session if session is None else round(session, 2)}  viewer {shown if shown is None else round(shown, 2)}  newest {newest if newest is None else round(newest, 2)}  lag {lag if lag is None else round(lag, 2)}  fps {fps}  (viewer answered in {answered_in:.2f} s)", flush=True)
-        # A slider moved from the page: how long until the viewer shows data past the change.
-        for m in moves:
-            if m.get("seen_after_s") is None and newest is not None and shown is not None and shown >= m["session_s"]:
-                m["seen_after_s"] = round(now - m["wall_s"], 2)
+        samples.append({"wall_s": round(now, 2), "session_s": session, "viewer_t_s": t, "viewer_newest_s": newest, "lag_s": lag, "fps": fps, "frames": frames, "viewer_answered_in_s": round(answered_in, 2)})
+        print(f"wall {now:6.1f} s  session {session if session is None else round(session, 2)}  viewer {t if t is None else round(t, 2)}  lag {lag if lag is None else round(lag, 2)}  fps {fps}  (answered in {answered_in:.2f} s)", flush=True)
+        # A teacher moves a slider on the page (its input and change events, as a mouse release).
         if a.move_every > 0 and a.controls and next_move is not None and now >= next_move:
             next_move = now + a.move_every
-            move_k += 1
-            value = 300 + 30 * (move_k % 10)
+            value = values[len(moves) % len(values)]
             expr = f"""(() => {{
                 const row = [...document.querySelectorAll('.control')].find(d => d.textContent.startsWith({json.dumps(a.move_label)}));
                 if (!row) return null;
@@ -102,19 +120,46 @@ try:
                 input.value = {value}; input.dispatchEvent(new Event('input')); input.dispatchEvent(new Event('change'));
                 return true;
             }})()"""
-            if b.js(expr):
-                s = controls()["sim_t_s"]
-                moves.append({"wall_s": now, "session_s": s, "value": value, "seen_after_s": None})
+            generation = controls()["generation"]
+            moved_at = time.monotonic()
+            if not b.js(expr):
+                print(f"latency: no control {a.move_label!r} on the page", flush=True)
+                sys.exit(1)
+            # The change applies in the session at its time then; it shows when the viewer shows
+            # data past it.
+            applied = None
+            while applied is None and time.monotonic() - moved_at < 5:
+                c = controls()
+                m = re.search(r"reloaded at t = ([0-9.]+) s", c.get("message", ""))
+                if c["generation"] > generation and m:
+                    applied, applied_wall = float(m.group(1)), time.monotonic()
+                else:
+                    time.sleep(0.02)
+            if applied is None:
+                print(f"latency: the change of {a.move_label} was not applied within 5 s", flush=True)
+                sys.exit(1)
+            seen = None
+            while time.monotonic() - moved_at < 30:
+                s = viewer()
+                if s and s[0] >= applied:
+                    seen = time.monotonic() - moved_at
+                    break
+                time.sleep(0.1)
+            moves.append({"wall_s": round(now, 2), "value": value, "applied_at_sim_s": applied, "applied_after_s": round(applied_wall - moved_at, 2), "seen_after_s": None if seen is None else round(seen, 2)})
+            print(f"wall {now:6.1f} s  moved {a.move_label} to {value}: applied at t = {applied} ({applied_wall - moved_at:.2f} s after the release), shown after {seen if seen is None else round(seen, 2)} s", flush=True)
     if a.screenshot:
         b.screenshot(a.screenshot)
 finally:
     b.close()
 
 steady = [s["lag_s"] for s in samples if s["lag_s"] is not None and first_data is not None and s["wall_s"] >= first_data + a.warmup]
-summary = {"samples": len(samples), "steady_samples": len(steady)}
+summary = {"samples": len(samples), "steady_samples": len(steady), "first_data_wall_s": first_data}
 if steady:
     q = sorted(steady)
-    summary.update({"lag_median_s": statistics.median(q), "lag_p95_s": q[min(len(q) - 1, int(0.95 * len(q)))], "lag_max_s": q[-1], "lag_last_s": samples[-1]["lag_s"]})
+    summary.update({"lag_median_s": round(statistics.median(q), 3), "lag_p95_s": round(q[min(len(q) - 1, int(0.95 * len(q)))], 3), "lag_max_s": round(q[-1], 3), "lag_last_s": samples[-1]["lag_s"]})
+fps = [s["fps"] for s in samples if s["fps"] is not None]
+if fps:
+    summary["viewer_fps_median"] = statistics.median(fps)
 if moves:
     seen = [m["seen_after_s"] for m in moves if m["seen_after_s"] is not None]
     summary.update({"moves": len(moves), "moves_seen": len(seen), "move_seen_max_s": max(seen) if seen else None})
@@ -122,3 +167,11 @@ print("summary:", json.dumps(summary), flush=True)
 if a.json:
     with open(a.json, "w") as f:
         json.dump({"samples": samples, "moves": moves, "summary": summary}, f, indent=1)
+failed = []
+if a.max_lag is not None and (not steady or max(steady) > a.max_lag):
+    failed.append(f"the viewer's lag reached {max(steady) if steady else 'no data'} s (at most {a.max_lag} s)")
+if a.max_move is not None and moves and (len(seen) < len(moves) or max(seen) > a.max_move):
+    failed.append(f"a change showed after {max(seen) if seen else None} s ({len(seen)} of {len(moves)} seen; at most {a.max_move} s)")
+if failed:
+    print("latency: FAILED:", "; ".join(failed), flush=True)
+    sys.exit(1)

@@ -219,6 +219,8 @@ pub fn sim_loop(mut sim: LiveSim, reloads: &Receiver<WatchEvent>, out: &Sender<R
 pub const SCENE_FLUSH: Duration = Duration::from_millis(250);
 /// Same for the plots, which a user reads rather than watches move.
 pub const SERIES_FLUSH: Duration = Duration::from_millis(500);
+/// How long after a reload the viewers get what the new parameters did (a few steps of it).
+const RELOAD_FLUSH: Duration = Duration::from_millis(60);
 /// A plot whose rows repeat its last one (a zero error, a vehicle at rest) sends its newest row
 /// to viewers this often, not at every flush ([`Recorder::flush_series_held`]).
 pub const SERIES_HOLD: Duration = Duration::from_secs(2);
@@ -255,15 +257,19 @@ pub struct Outputs {
 /// `file` only when its chunks are full, `history` when a late viewer asks for it.
 pub fn recorder_loop(mut viewer: Option<Recorder>, mut file: Option<Recorder>, mut history: Option<(Recorder, History)>, msgs: &Receiver<RecorderMsg>) -> anyhow::Result<()> {
     let (mut last_scene, mut last_series) = (Instant::now(), Instant::now());
+    // After a reload, the first moments of the new parameters go out at once (a teacher waits for
+    // them), not at the next tick.
+    let mut soon: Option<Instant> = None;
     loop {
-        let msg = match msgs.recv_timeout(SCENE_FLUSH / 2) {
+        let wait = soon.map_or(SCENE_FLUSH / 2, |at| at.saturating_duration_since(Instant::now()).min(SCENE_FLUSH / 2));
+        let msg = match msgs.recv_timeout(wait) {
             Ok(m) => Some(m),
             Err(crossbeam_channel::RecvTimeoutError::Timeout) => None,
             Err(crossbeam_channel::RecvTimeoutError::Disconnected) => break,
         };
-        if let Some(msg) = msg {
+        if let Some(msg) = &msg {
             for recorder in viewer.iter_mut().chain(file.iter_mut()).chain(history.iter_mut().map(|(r, _)| r)) {
-                match &msg {
+                match msg {
                     RecorderMsg::Series(rows) => rows.iter().try_for_each(|(r, ins)| recorder.push_row(r, ins.as_ref()))?,
                     RecorderMsg::Scene(rows) => rows.iter().try_for_each(|(r, ins)| recorder.push_scene_row(r, ins.as_ref()))?,
                     RecorderMsg::Signal(samples) => samples.iter().try_for_each(|s| recorder.push_signal(s))?,
@@ -272,12 +278,19 @@ pub fn recorder_loop(mut viewer: Option<Recorder>, mut file: Option<Recorder>, m
                 }
             }
         }
+        if matches!(msg, Some(RecorderMsg::Reconfigure { .. })) {
+            soon = Some(Instant::now() + RELOAD_FLUSH);
+        }
         if let Some(v) = viewer.as_mut() {
-            if last_scene.elapsed() >= SCENE_FLUSH {
+            let reloaded = soon.is_some_and(|at| Instant::now() >= at);
+            if reloaded {
+                soon = None;
+            }
+            if reloaded || last_scene.elapsed() >= SCENE_FLUSH {
                 v.flush_scene()?;
                 last_scene = Instant::now();
             }
-            if last_series.elapsed() >= SERIES_FLUSH {
+            if reloaded || last_series.elapsed() >= SERIES_FLUSH {
                 v.flush_signal()?;
                 v.flush_series_held(SERIES_HOLD)?;
                 last_series = Instant::now();

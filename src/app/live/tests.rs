@@ -142,10 +142,10 @@ fn coning_session(text: &str, changes: &[(f64, &str, &str)], until_s: f64) -> Ve
             sim.apply(scenario::parse(&current, "pure-coning").expect("edited")).expect("applied");
         }
         sim.step();
-        if let Some(v) = sim.ins_view(false) {
-            if out.last().is_none_or(|(t, _)| *t != v.t_s) {
-                out.push((v.t_s, v.errors.iter().map(|e| e.heading_rad).collect()));
-            }
+        if let Some(v) = sim.ins_view(false)
+            && out.last().is_none_or(|(t, _)| *t != v.t_s)
+        {
+            out.push((v.t_s, v.errors.iter().map(|e| e.heading_rad).collect()));
         }
     }
     out

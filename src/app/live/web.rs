@@ -338,7 +338,14 @@ impl Server {
         }
         let path = req.uri().path().to_owned();
         match (req.method(), path.as_str()) {
-            (&Method::GET, "/") => reply(StatusCode::OK, self.page(&host), "text/html; charset=utf-8"),
+            (&Method::GET, "/") => {
+                let mut page = reply(StatusCode::OK, self.page(&host), "text/html; charset=utf-8");
+                // The page in an agent cluster of its own origin: the browser may then run it apart
+                // from the viewer's frame (another origin on the same host), whose drawing without a
+                // GPU would otherwise hold up a slider's release by a frame (~0.4 s).
+                page.headers_mut().insert(header::HeaderName::from_static("origin-agent-cluster"), HeaderValue::from_static("?1"));
+                page
+            }
             (&Method::GET, "/controls") => {
                 let body = self.with_panel(|panel, st| controls_json(panel, st, &self.cfg.config_path));
                 reply(StatusCode::OK, body.to_string(), JSON)
