@@ -72,8 +72,8 @@ fn selfcal_log(args: &SelfcalArgs, dir: &Path) -> Result<(), Failure> {
     let (estimate, estimation_s) = sc::run_log(&log, &stop).map_err(|e| if stop.load(Ordering::SeqCst) { Failure::interrupted("nothing was estimated") } else { Failure::input(format!("selfcal --log: {e:#}")) })?;
     let seen = crate::ins::selfcal::observability(&estimate);
     let hours = estimate.history.last().map_or(0.0, |r| r.t_s) / 3600.0;
-    let head = format!("self-calibration of the log set {}: {hours:.2} h at {:.0} Hz; estimated in {estimation_s:.2} s (no truth: a log)\n\n", dir.display(), log.imu.rate_hz);
-    let table = sc::estimates_table(head, &estimate, None, &seen, &[], None);
+    let head = format!("self-calibration of the log set {}: {hours:.2} h at {:.0} Hz; estimated in {estimation_s:.2} s (no truth: a log)", dir.display(), log.imu.rate_hz);
+    let table = sc::estimates_table(format!("{head}\n\n"), &estimate, None, &seen, &[], None);
     out!("{table}");
     if let Some(path) = &args.json {
         let names = crate::ins::selfcal::param_names();
@@ -83,7 +83,7 @@ fn selfcal_log(args: &SelfcalArgs, dir: &Path) -> Result<(), Failure> {
         let sinks = open_sinks(args.sinks.request(PathBuf::from("recordings").join(format!("{}-selfcal.rrd", log.name)))?, &format!("{}-selfcal", log.name))?;
         let view = crate::record::selfcal::SelfcalView {
             title: format!("log set {}", log.name),
-            table: &table,
+            document: &sc::estimates_document(&head, &estimate, None, &seen, &[], None),
             history: &estimate.history,
             prior: &estimate.prior,
             truth: None,

@@ -87,7 +87,7 @@ impl Recorder {
                 let ins_view = |a: usize, axis: &str| {
                     let title = match (a, layout.algorithms.len()) {
                         (_, 1) => format!("INS {axis} error (arcsec)"),
-                        (0, _) => format!("INS {axis} (″) — {algorithm_key}"),
+                        (0, _) => format!("INS {axis} error (arcsec) — {algorithm_key}"),
                         _ => format!("INS {axis} error (arcsec), colours as above"),
                     };
                     framed(plot(title, &format!("ins/attitude_error_arcsec/{axis}")), ins_peak(a)).with_property("PlotLegend", &layout::no_legend())

@@ -136,12 +136,9 @@ impl Recorder {
             format!("{}/sensor_axes", self.paths.imu),
             &rerun::Arrows3D::from_vectors([[0.45, 0.0, 0.0], [0.0, 0.45, 0.0], [0.0, 0.0, 0.45]]).with_colors(colors::SENSOR.map(rgb)).with_radii([0.015]),
         )?;
-        // Labels beyond the arrow tips and off their lines (an arrow's own label sits at its
-        // middle, inside the box, where the three pile up; on the line past the tip it covered the
-        // arrowhead and, along a gimbal axis, sat in that axis's swing cone).
         rec.log_static(
             format!("{}/sensor_axes/labels", self.paths.imu),
-            &rerun::Points3D::new([[0.72, 0.0, -0.22], [0.0, 0.72, -0.22], [0.22, 0.0, 0.72]])
+            &rerun::Points3D::new(SENSOR_LABELS_AT)
                 .with_labels(["x_s", "y_s", "z_s"])
                 // Half-saturated tints of the arrows' colours (a label the colour of its arrow
                 // vanishes where it crosses it), legible on both themes (`palette::label`).
@@ -246,7 +243,8 @@ impl Recorder {
         let installation = p.table.truth.installation_rad.norm() * ARCSEC_PER_RAD;
         // 1.1 long: at 1.5 the wedge and its label ran off the top of the default view.
         let mut key: Vec<(String, [u8; 3])> = Vec::new();
-        key.extend(self.log_wedge(at, &format!("{}/installation", self.paths.vehicle), axes[0].axis, first_tilted, 1.1, installation, f.installation, "installation")?);
+        let wedge = |radii: (f64, f64), both_ends: bool| Wedge { radii, both_ends };
+        key.extend(self.log_wedge(at, &format!("{}/installation", self.paths.vehicle), axes[0].axis, first_tilted, wedge((0.0, 1.1), false), installation, f.installation, "installation")?);
         for (k, g) in axes.iter().enumerate() {
             let half = ring_radius(k, n) * 1.25;
             let color = colors::AXES[k];
@@ -270,40 +268,55 @@ impl Recorder {
                 self.clear(at, cone_path.as_str())?;
             }
             // Non-orthogonality: a wedge, in the previous rotor, between the normal to the previous
-            // axis and this axis.
+            // axis and this axis, at both ends of the axis beyond everything on it — its swing
+            // cone and the previous ring, which crosses it. From the centre (it was 0 to the cone's
+            // end) it lay inside the IMU's case and the cone, over the axis's own lines: on the
+            // dual-axis presets nothing of it showed from the default eye. 0.25 long: the vertical
+            // inner axis's lower end then stops above the deck (its upper end runs into the top of
+            // the view and the key, so one end alone would not do).
             if k > 0 {
                 let tilted = draw.mount[k] * g.axis;
                 let eta_arcsec = p.table.truth.axes[k].non_orthogonality_rad * ARCSEC_PER_RAD;
-                key.extend(self.log_wedge(at, &format!("{}/non_orthogonality", self.paths.gimbals[k - 1]), g.axis, tilted, half, eta_arcsec, f.non_orthogonality, &format!("η non-orthogonality of the {} axis", g.name))?);
+                let from = half.max(ring_radius(k - 1, n)) + 0.05;
+                // Short: the key's line must stop short of the upper wedge (the inner axis's, from
+                // the default eye, passes just left of the key's middle).
+                let what = format!("{} η", g.name);
+                key.extend(self.log_wedge(at, &format!("{}/non_orthogonality", self.paths.gimbals[k - 1]), g.axis, tilted, wedge((from, from + 0.25), true), eta_arcsec, f.non_orthogonality, &what)?);
             }
         }
         self.log_key(at, &key)
     }
 
-    /// A translucent wedge from `ideal` to `tilted` (both unit, same frame); its line of the key
-    /// (None when there is no wedge).
+    /// A translucent wedge from `ideal` to `tilted` (both unit, same frame) over `shape`'s radii;
+    /// its line of the key (None when there is no wedge).
     #[allow(clippy::too_many_arguments)]
-    pub(crate) fn log_wedge(&self, at: Option<f64>, path: &str, ideal: Vector3<f64>, tilted: Vector3<f64>, length: f64, true_arcsec: f64, x: f64, what: &str) -> RecordingStreamResult<Option<(String, [u8; 3])>> {
+    pub(crate) fn log_wedge(&self, at: Option<f64>, path: &str, ideal: Vector3<f64>, tilted: Vector3<f64>, shape: Wedge, true_arcsec: f64, x: f64, what: &str) -> RecordingStreamResult<Option<(String, [u8; 3])>> {
         if true_arcsec == 0.0 {
             self.clear(at, path)?;
             return Ok(None);
         }
-        let mut positions = vec![[0.0f32; 3]];
-        let steps = 16;
-        for i in 0..=steps {
-            let s = i as f64 / steps as f64;
-            positions.push(p3(((1.0 - s) * ideal + s * tilted).normalize() * length));
+        let (r0, r1) = shape.radii;
+        let steps = 16u32;
+        let (mut positions, mut triangles, mut edges) = (Vec::new(), Vec::new(), Vec::new());
+        for &sign in if shape.both_ends { &[1.0, -1.0][..] } else { &[1.0][..] } {
+            // An inner and an outer arc (the inner a point when r0 = 0), joined by quads.
+            let base = positions.len() as u32;
+            for i in 0..=steps {
+                let s = f64::from(i) / f64::from(steps);
+                let dir = sign * ((1.0 - s) * ideal + s * tilted).normalize();
+                positions.extend([p3(dir * r0), p3(dir * r1)]);
+            }
+            for i in 0..steps {
+                let (a, b) = (base + 2 * i, base + 2 * i + 2);
+                triangles.extend([[a, a + 1, b + 1], [a, b + 1, b]]);
+            }
+            edges.extend([[p3(sign * ideal * r0), p3(sign * ideal * r1)], [p3(sign * tilted * r0), p3(sign * tilted * r1)]]);
         }
-        let triangles: Vec<[u32; 3]> = (1..=steps as u32).map(|i| [0, i, i + 1]).collect();
         self.put(at, format!("{path}/wedge"), &rerun::Mesh3D::new(positions).with_triangle_indices(triangles).with_albedo_factor(albedo(WEDGE, 110)))?;
-        self.put(
-            at,
-            format!("{path}/edges"),
-            &rerun::LineStrips3D::new([[[0.0, 0.0, 0.0], p3(ideal * length)], [[0.0, 0.0, 0.0], p3(tilted * length)]])
-                .with_colors([rgb([255, 255, 255]), rgb([255, 200, 60])])
-                .with_radii([0.004]),
-        )?;
-        Ok(Some((format!("yellow wedge: {what} {} (drawn ×{x})", fmt_angle(true_arcsec / ARCSEC_PER_RAD)), WEDGE)))
+        let edge_colors: Vec<rerun::Color> = (0..edges.len()).map(|i| if i % 2 == 0 { rgb([255, 255, 255]) } else { rgb(WEDGE) }).collect();
+        self.put(at, format!("{path}/edges"), &rerun::LineStrips3D::new(edges).with_colors(edge_colors).with_radii([0.004]))?;
+        let wedges = if shape.both_ends { "wedges" } else { "wedge" };
+        Ok(Some((format!("yellow {wedges}: {what} = {} (drawn ×{x})", fmt_angle(true_arcsec / ARCSEC_PER_RAD)), WEDGE)))
     }
 
     /// The key of the error classes drawn: one line each, in its object's colour, in a fixed column
@@ -323,6 +336,31 @@ impl Recorder {
                 .with_radii([0.002]),
         )
     }
+}
+
+/// Where the sensor axes' labels stand in the IMU frame (m; the arrows are 0.45 long): beyond the
+/// tips and off their lines, each pushed its own way. (An arrow's own label sat at its middle,
+/// inside the box, where the three piled up; on the line past the tip it covered the arrowhead
+/// and, along a gimbal axis, sat in that axis's swing cone.) Labels turn with the IMU, so two of
+/// them line up with the eye at some attitude wherever they stand; these places were searched for
+/// in a pinhole model of the two default eyes (the table's and, with an INS, the one stepped back;
+/// 55° field of view, checked against screenshots to ~20 px) over the attitudes of
+/// jiang2017-dual-axis's continuous rotation and dual-axis-16-position's moves and dwells, a label
+/// taken as a 54×30 px box. From the table's eye no two labels meet during the continuous rotation
+/// (before, [0.72, 0, −0.22] and its turns: x_s and z_s for 11% of each turn, y_s and z_s for
+/// 3.5%, 3 s into the preset among them), at no dwell, at 1.4% of the moves' attitudes (2.8%);
+/// from the INS's eye at 0.7% (21%) and 4.9% (6.2%). A label is nearer another arrow's tip than
+/// its own 5% of the time (21%). Screenshots of jiang2017-dual-axis every 2 s of a turn show no two
+/// labels on each other.
+const SENSOR_LABELS_AT: [[f32; 3]; 3] = [[0.85, -0.2, -0.16], [0.26, 0.74, -0.06], [-0.31, -0.03, 0.65]];
+
+/// Where a wedge is drawn along its axis.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Wedge {
+    /// From and to this distance from the axis's centre (m in the scene).
+    pub(crate) radii: (f64, f64),
+    /// At both ends of the axis (else along `ideal` only).
+    pub(crate) both_ends: bool,
 }
 
 /// The entity of the error classes' key, where it stands (world, m) and its line spacing.

@@ -1,7 +1,8 @@
 //! The recording of `rinscope selfcal`: the IMU turning through the sequence (its true attitude,
 //! 1 Hz), each parameter's estimate minus the truth inside its ±3σ band (one view per parameter,
-//! in tabs), and the observability timeline: each group's σ_k/σ_0 on a log10 axis with the moves
-//! marked, so a reader sees which move makes which parameter observable.
+//! in tabs), the observability timeline: each group's σ_k/σ_0 on a log10 axis with the moves
+//! marked, so a reader sees which move makes which parameter observable, and what it buys: the
+//! same IMU free-inertial afterwards, one plot per motion.
 
 use nalgebra::UnitQuaternion;
 use rerun::blueprint::components::ContainerKind;
@@ -16,8 +17,8 @@ use crate::ins::selfcal::{param, HistoryRow, N_PARAMS};
 pub struct SelfcalView<'a> {
     /// Scenario name and the sequence's.
     pub title: String,
-    /// The result as the terminal prints it.
-    pub table: &'a str,
+    /// The result as a document (markdown), narrow enough for the viewer's text panel.
+    pub document: &'a str,
     /// The filter's history (1 Hz).
     pub history: &'a [HistoryRow],
     /// The prior 1σ, SI.
@@ -29,31 +30,70 @@ pub struct SelfcalView<'a> {
     /// The IMU's attitude C_s^n, 1 Hz.
     pub attitude: &'a [(f64, UnitQuaternion<f64>)],
     /// What it buys: free-inertial runs (at rest and modulated × none, estimated, true).
-    pub navigation: Vec<&'a crate::ins::trace::NavTrace>,
+    pub navigation: Vec<NavLine<'a>>,
 }
 
-const GROUPS: [(&str, &str); 4] = [("gyro bias", "gyro_bias"), ("gyro scale and misalignment", "gyro_gain"), ("accelerometer bias", "accel_bias"), ("accelerometer scale and misalignment", "accel_gain")];
-/// The lines of a group's plot, with the names its title gives them (a legend would cover the curves).
-const LINE_COLORS: [(&str, [u8; 3]); 9] = [
-    ("red", [230, 90, 90]),
-    ("green", [90, 200, 90]),
-    ("blue", [90, 140, 240]),
-    ("orange", [240, 160, 40]),
-    ("purple", [200, 90, 230]),
-    ("cyan", [60, 200, 200]),
-    ("yellow", [250, 200, 60]),
-    ("grey", [160, 160, 160]),
-    ("pink", [240, 120, 180]),
+/// One free-inertial run of what the calibration buys.
+pub struct NavLine<'a> {
+    /// "at rest", "16-position": one plot each.
+    pub motion: &'a str,
+    /// "none", "estimated", "true": one line each, in the same colour in every plot.
+    pub compensation: &'a str,
+    /// Its errors.
+    pub trace: &'a crate::ins::trace::NavTrace,
+}
+
+/// The groups of parameters, one plot each: the group's name ([`crate::ins::selfcal::Kind::group`]),
+/// the entity's, and the plot's title (short enough for a third of the plots' width at 1600×1000).
+const GROUPS: [(&str, &str, &str); 4] = [
+    ("gyro bias", "gyro_bias", "gyro bias: log10 σ/σ0"),
+    ("gyro scale and misalignment", "gyro_gain", "gyro Kg: log10 σ/σ0"),
+    ("accelerometer bias", "accel_bias", "accel bias: log10 σ/σ0"),
+    ("accelerometer scale and misalignment", "accel_gain", "accel Ka: log10 σ/σ0"),
 ];
+
+/// The axes a parameter's name ends in (`bg_y`, `Kg_yx`), in the order of their line colours in
+/// [`palette::colors::DISTINCT`]: an axis, or a diagonal of K (a scale factor), in that axis's
+/// colour, as the IMU's axes in 3D; the misalignments in colours of their own.
+const LINE_AXES: [&[&str]; 9] = [&["x", "xx"], &["y", "yy"], &["z", "zz"], &["xy"], &["xz"], &["yz"], &["yx"], &["zx"], &["zy"]];
+
+/// A parameter's line colour in its group's plot: its index in [`palette::colors::DISTINCT`].
+fn line_colour(name: &str) -> usize {
+    let axes = name.rsplit('_').next().unwrap_or_default();
+    LINE_AXES.iter().position(|names| names.contains(&axes)).unwrap_or(LINE_AXES.len() - 1)
+}
+
+/// The key of the groups' plots (their titles have no room for it, a legend would cover the lines).
+fn line_key() -> String {
+    let name = |k: usize| palette::colors::DISTINCT[k].0;
+    let axes = (0..3).map(|k| format!("{} {}", LINE_AXES[k][0], name(k))).collect::<Vec<_>>().join(", ");
+    let scale = (0..3).map(|k| format!("{} {}", LINE_AXES[k][1], name(k))).collect::<Vec<_>>().join(", ");
+    let misalignment = (3..9).map(|k| format!("{} {}", LINE_AXES[k][0], name(k))).collect::<Vec<_>>().join(", ");
+    format!("biases {axes} (as the IMU's axes); Kg, Ka: scale factors {scale}, misalignments {misalignment}")
+}
 
 /// Logs the self-calibration.
 pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
     let rec = stream.rec();
     rec.send_recording_name(format!("rinscope selfcal: {}", v.title))?;
+    let motions = motions(&v.navigation);
+    let navigation = if motions.is_empty() {
+        String::new()
+    } else {
+        let compensations = v.navigation.iter().filter(|l| l.motion == motions[0]).enumerate().map(|(i, l)| format!("{} {}", nav_colour(i).0, l.compensation));
+        format!(
+            "- right column: afterwards, the same IMU free-inertial from t = 0 ({}), the radial position error in log10 metres (1 = 10 m, 4 = 10 km); compensation {}\n",
+            motions.join(", "),
+            compensations.collect::<Vec<_>>().join(", ")
+        )
+    };
     let doc = format!(
-        "# Self-calibration: {}\n\n```\n{}```\n\nLeft: the IMU turning through the sequence. Right: each group's 1σ over its prior (log10: −2 is a hundredfold), \
-         the moves marked ▼; in the tabs, each estimate minus the truth with its ±3σ band. docs/selfcal.md explains the filter and the sequences.\n",
-        v.title, v.table
+        "# Self-calibration: {}\n\n**Plots**\n\n- top left: each parameter's 1σ over its prior σ0 in log10 (−2: a hundredfold), ▼ a move; {}\n{navigation}\
+         - tabs: each estimate{} inside its ±3σ band (grey)\n\ndocs/selfcal.md explains the filter and the sequences.\n\n{}",
+        v.title,
+        line_key(),
+        if v.truth.is_some() { " minus the truth" } else { "" },
+        v.document
     );
     rec.log_static("docs/selfcal", &rerun::TextDocument::from_markdown(doc))?;
     // The IMU: a case and its axes, turned by its true attitude.
@@ -68,31 +108,28 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
     )?;
     let times: Vec<f64> = v.attitude.iter().map(|a| a.0).collect();
     if !times.is_empty() {
-    rec.send_columns(
-        "world/imu",
-        stream.time_columns(&times),
-        rerun::Transform3D::update_fields().with_many_quaternion(v.attitude.iter().map(|a| to_rerun_quaternion(&a.1))).columns_of_unit_batches()?,
-    )?;
+        rec.send_columns(
+            "world/imu",
+            stream.time_columns(&times),
+            rerun::Transform3D::update_fields().with_many_quaternion(v.attitude.iter().map(|a| to_rerun_quaternion(&a.1))).columns_of_unit_batches()?,
+        )?;
     }
     let t: Vec<f64> = v.history.iter().map(|r| r.t_s).collect();
     // The sequence's plots show the sequence (the free-inertial runs after it share the timeline).
     let seq_axis = layout::time_axis_range(0.0, t.last().copied().unwrap_or(1.0));
     let mut tabs = Vec::new();
-    let mut timeline = Vec::new();
-    for (group, slug) in GROUPS {
+    let mut observability = Vec::new();
+    for (group, slug, title) in GROUPS {
         let members: Vec<usize> = (0..N_PARAMS).filter(|&k| param(k).0.group() == group).collect();
         let path = format!("selfcal/observability/{slug}/log10_sigma_ratio");
         let names: Vec<String> = members.iter().map(|&k| param(k).1).collect();
-        rec.log_static(path.as_str(), &rerun::SeriesLines::new().with_colors((0..members.len()).map(|i| rgb(LINE_COLORS[i % 9].1))).with_names(names.clone()))?;
+        let colors = names.iter().map(|n| rgb(palette::colors::DISTINCT[line_colour(n)].1));
+        rec.log_static(path.as_str(), &rerun::SeriesLines::new().with_colors(colors).with_names(names.clone()))?;
         let values: Vec<f64> = v.history.iter().flat_map(|r| members.iter().map(|&k| (r.sigma[k] / v.prior[k]).max(1e-12).log10()).collect::<Vec<_>>()).collect();
         stream.send_series(&path, &names, &t, values, members.len())?;
         stream.mark_events(&path, "moves", "moves", v.move_starts_s, 0.0)?;
-        let key = names.iter().enumerate().map(|(i, n)| format!("{} {n}", LINE_COLORS[i % 9].0)).collect::<Vec<_>>().join(" · ");
-        timeline.push(
-            Node::view("TimeSeries", format!("{group}: log10 σ/σ0 — {key} · ▼ moves"), path)
-                .with_property("TimeAxis", &seq_axis)
-                .with_property("PlotLegend", &layout::no_legend()),
-        );
+        // Keyed in the document (a legend would cover the lines, the title has no room).
+        observability.push(Node::view("TimeSeries", title, path).with_property("TimeAxis", &seq_axis).with_property("PlotLegend", &layout::no_legend()));
         for &k in &members {
             let (kind, name) = param(k);
             let (unit, per_si) = kind.unit();
@@ -117,27 +154,74 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
             );
         }
     }
-    if !v.navigation.is_empty() {
-        // On its own timeline (hours of navigation after the calibration, not the sequence's time).
-        let path = "selfcal/navigation/radial_position_error_log10_m";
-        let names: Vec<String> = v.navigation.iter().map(|t| t.label.clone()).collect();
-        let colors = [[230, 90, 90], [250, 200, 60], [90, 200, 90], [230, 150, 150], [250, 230, 150], [160, 230, 160]];
-        rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors.iter().take(names.len()).map(|c| rgb(*c))).with_names(names.clone()))?;
-        let n = v.navigation.iter().map(|t| t.samples.len()).min().unwrap_or(0);
-        let times: Vec<f64> = v.navigation[0].samples.iter().take(n).map(|s| s.t_s).collect();
-        let values: Vec<f64> = (0..n).flat_map(|i| v.navigation.iter().map(move |t| t.samples[i].position_m[2].max(1e-3).log10())).collect();
-        rec.send_columns(path, stream.time_columns(&times), rerun::Scalars::new(values).columns(std::iter::repeat_n(names.len(), n))?)?;
-        timeline.push(
-            Node::view("TimeSeries", "afterwards, free-inertial from t = 0: radial position error, log10 of metres (1 = 10 m, 4 = 10 km)", path)
-                .with_property("TimeAxis", &layout::whole_run_time_axis()),
-        );
+    let navigation = log_navigation(stream, &v.navigation, &motions)?;
+    // Gyro groups over accelerometer groups, a motion's navigation beside each row.
+    let mut navigation = navigation.into_iter();
+    let mut observability = observability.into_iter();
+    let rows: Vec<Node> = (0..2)
+        .map(|_| Node::container(ContainerKind::Horizontal, observability.by_ref().take(2).chain(navigation.next()).collect(), &[]))
+        .collect();
+    let mut grid = Node::container(ContainerKind::Vertical, rows, &[]);
+    // More motions than rows (none today): a row of their own.
+    let more: Vec<Node> = navigation.collect();
+    if !more.is_empty() {
+        grid = Node::container(ContainerKind::Vertical, vec![grid, Node::container(ContainerKind::Horizontal, more, &[])], &[2.0, 1.0]);
     }
     let left = Node::container(ContainerKind::Vertical, vec![Node::view("3D", "the IMU turning through the sequence (true attitude; the grid is level)", "world").with_property("EyeControls3D", &layout::eye([1.5, -1.7, 1.0], [0.0, 0.0, 0.0])), Node::view("TextDocument", "result", "docs/selfcal")], &[1.0, 1.2]);
     let right = Node::container(
         ContainerKind::Vertical,
-        vec![Node::container(ContainerKind::Grid, timeline, &[]), Node::container(ContainerKind::Tabs, tabs, &[])],
+        vec![grid, Node::container(ContainerKind::Tabs, tabs, &[])],
         &[1.2, 1.0],
     );
     let root = Node::container(ContainerKind::Horizontal, vec![left, right], &[1.0, 1.5]);
     layout::send(rec, APPLICATION_ID, &root, &layout::Playback { timeline: TIMELINE, speed: 60.0, follow: false })
+}
+
+/// The colour of a motion's `i`-th run (none, estimated, true: red, green, blue, as uncompensated,
+/// compensated and the closed form in a run's plots).
+fn nav_colour(i: usize) -> (&'static str, [u8; 3]) {
+    palette::colors::DISTINCT[i % 3]
+}
+
+/// The motions of the navigation runs, in order.
+fn motions<'a>(lines: &[NavLine<'a>]) -> Vec<&'a str> {
+    let mut out: Vec<&str> = Vec::new();
+    for l in lines {
+        if !out.contains(&l.motion) {
+            out.push(l.motion);
+        }
+    }
+    out
+}
+
+/// What the calibration buys: one plot per motion of its runs' radial position errors (log10 m),
+/// the compensations in the same colours in each, on one value range (so that the plots compare).
+/// On the sequence's timeline from t = 0, for the whole run (hours of navigation, not the sequence).
+fn log_navigation(stream: &Stream, lines: &[NavLine<'_>], motions: &[&str]) -> RecordingStreamResult<Vec<Node>> {
+    let log10_m = |m: f64| m.max(1e-3).log10();
+    // From the first hundredth of the run on (the lines' steep start from 0 m would set the range).
+    let end_s = lines.iter().filter_map(|l| l.trace.samples.last()).map(|s| s.t_s).fold(0.0, f64::max);
+    let (lo, hi) = lines.iter().flat_map(|l| &l.trace.samples).filter(|s| s.t_s >= 0.01 * end_s).map(|s| log10_m(s.position_m[2])).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| (lo.min(y), hi.max(y)));
+    let mut plots = Vec::new();
+    for motion in motions {
+        let runs: Vec<&NavLine<'_>> = lines.iter().filter(|l| l.motion == *motion).collect();
+        let path = format!("selfcal/navigation/{}/radial_position_error_log10_m", motion.replace([' ', '-'], "_"));
+        let names: Vec<String> = runs.iter().map(|l| l.compensation.to_owned()).collect();
+        let colors = (0..runs.len()).map(|i| rgb(nav_colour(i).1));
+        stream.rec().log_static(path.as_str(), &rerun::SeriesLines::new().with_colors(colors).with_names(names.clone()))?;
+        let n = runs.iter().map(|l| l.trace.samples.len()).min().unwrap_or(0);
+        let times: Vec<f64> = runs[0].trace.samples.iter().take(n).map(|s| s.t_s).collect();
+        let values: Vec<f64> = (0..n).flat_map(|i| runs.iter().map(move |l| log10_m(l.trace.samples[i].position_m[2]))).collect();
+        stream.rec().send_columns(path.as_str(), stream.time_columns(&times), rerun::Scalars::new(values).columns(std::iter::repeat_n(names.len(), n))?)?;
+        let mut plot = Node::view("TimeSeries", format!("{motion}: log10 error (m)"), path)
+            .with_property("TimeAxis", &layout::whole_run_time_axis())
+            // Below the lines once they have left 0 m: the legend covers none of them.
+            .with_property("PlotLegend", &layout::legend_at(layout::LegendCorner::RightBottom));
+        if lo.is_finite() {
+            // A whole decade of room under the lowest value, for the legend.
+            plot = plot.with_property("ScalarAxis", &layout::scalar_range(lo.floor() - 1.0, hi.ceil()));
+        }
+        plots.push(plot);
+    }
+    Ok(plots)
 }
