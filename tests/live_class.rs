@@ -238,7 +238,7 @@ fn a_stalled_client_holds_up_neither_the_page_nor_a_signal() {
     signal(&s.child, "-INT");
     let asked = Instant::now();
     assert_eq!(s.wait(Duration::from_secs(10)), 130, "{}", s.log());
-    assert!(asked.elapsed() < Duration::from_millis(1500), "SIGINT took {:?} to end the session", asked.elapsed());
+    assert!(asked.elapsed() < Duration::from_secs(1), "SIGINT took {:?} to end the session", asked.elapsed());
     rinscope::record::sink::verify_recording(&rec).expect("a complete recording");
     drop(stalls);
     std::fs::remove_dir_all(&dir).ok();
