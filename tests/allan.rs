@@ -3,24 +3,12 @@
 //! with a table description, and a strapdown one without, written by the test, with `--export`),
 //! and the new scenario keys refused clearly when misused.
 
+mod common;
+use common::{rinscope, scratch, stderr};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use serde_json::Value;
-
-fn rinscope() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_rinscope"))
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("rinscope-allan-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
 
 const PRESET: &str = include_str!("../assets/scenarios/static-imu-10h.toml");
 

@@ -11,22 +11,14 @@
 #[path = "io/common.rs"]
 mod common;
 
+mod common;
+use common::{rinscope, scratch};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use serde_json::Value;
 
 use common::nbs14_1000;
-
-fn rinscope() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_rinscope"))
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("rinscope-series-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
-}
 
 fn text(o: &Output) -> String {
     format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))

@@ -2,22 +2,10 @@
 //! naming key, value and unit, leaving no file behind; a good run writes a complete recording and
 //! a summary whose numbers are consistent with the physics.
 
+mod common;
+use common::{rinscope, scratch, stderr};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn rinscope() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_rinscope"))
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("rinscope-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
 
 const PRESET: &str = include_str!("../assets/scenarios/jiang2017-dual-axis.toml");
 

@@ -21,11 +21,13 @@
 //! ```
 //!
 //! (`RINSCOPE_DAMAGE_SEED` picks another seed; `RINSCOPE_DAMAGE_KEEP=1` keeps the cases that break
-//! a promise; `RINSCOPE_DAMAGE_BIN=PATH` runs another build, e.g. a copy of the binary before a
+//! a promise; `RINSCOPE_TEST_BIN=PATH` runs another build, e.g. a copy of the binary before a
 //! fix.) Both print the outcomes per damage class; docs/reliability.md has the table.
 
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+mod common;
+use common::rinscope;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs::File;
 use std::io::Write;
@@ -37,11 +39,6 @@ use rinscope::io::{Col, ColumnReader, ReadOptions, TableWriter};
 
 /// The longest a command may take on a 20 s log set (they take 0.1 s; the machine may be busy).
 const TIME_BOUND: Duration = Duration::from_secs(60);
-
-fn rinscope() -> Command {
-    // RINSCOPE_DAMAGE_BIN: another build to measure (a copy of the binary before a fix).
-    Command::new(std::env::var_os("RINSCOPE_DAMAGE_BIN").unwrap_or_else(|| env!("CARGO_BIN_EXE_rinscope").into()))
-}
 
 /// xorshift64*: a tiny deterministic generator, so that a case reproduces from its seed.
 struct Rng(u64);

@@ -10,19 +10,10 @@
 #[path = "io/common.rs"]
 mod common;
 
+mod common;
+use common::{rinscope, scratch};
 use std::path::{Path, PathBuf};
 use std::process::Command;
-
-fn rinscope() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_rinscope"))
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("rinscope-figures-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
-}
 
 
 /// SP 1065 p. 108: OADEV at τ = 1, 10, 100 s.

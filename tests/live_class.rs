@@ -2,6 +2,8 @@
 //! driven from the class page (the cone changed twice, read back from the saved session), a
 //! stalled client that must not hold up a signal, and the exit codes of a session ended by one.
 
+mod common;
+use common::{rinscope, scratch};
 use std::io::{Read, Write};
 use std::net::{TcpListener, TcpStream};
 use std::path::{Path, PathBuf};
@@ -10,20 +12,6 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use rinscope::record::read::{events, plots, point_labels};
-
-fn rinscope() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_rinscope"));
-    // No test may open a window, whatever the machine it runs on has.
-    c.env_remove("DISPLAY").env_remove("WAYLAND_DISPLAY");
-    c
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("rinscope-live-class-{}-{name}", std::process::id()));
-    std::fs::remove_dir_all(&dir).ok();
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
-}
 
 /// Three consecutive free ports on 127.0.0.1 (the page, the viewer, its stream), never the same
 /// for two tests of this process (they run at once).

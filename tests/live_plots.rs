@@ -3,16 +3,12 @@
 //! exist (the INS plots were NaN in every live session) and lie inside the value range the
 //! layout gives it (a fixed range hid series; the viewer kept ±1 for plots created before data).
 
+mod common;
+use common::scratch;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use rinscope::record::read::{plot_frames, PlotFrame};
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("rinscope-live-plots-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
-}
 
 fn check(rec: &Path, what: &str) -> Vec<PlotFrame> {
     let frames = plot_frames(rec).expect("readable recording");

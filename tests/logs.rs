@@ -4,29 +4,12 @@
 //! The moving car's increments are computed here from the WGS84 navigation equations (written
 //! out in this file, not taken from rinscope), so the replay is checked against an independent model.
 
+mod common;
+use common::{rinscope, scratch, stderr, stdout};
 use std::f64::consts::PI;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn rinscope() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_rinscope"))
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("rinscope-logs-{}-{name}", std::process::id()));
-    std::fs::remove_dir_all(&dir).ok();
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
 
 fn ok(o: &Output) {
     assert!(o.status.success(), "exit {:?}: {}{}", o.status.code(), stderr(o), stdout(o));

@@ -1,18 +1,10 @@
 //! A Monte Carlo cut into shards on several processes (as a cluster's array job runs it) and merged
 //! gives the statistics of the unsharded run, bit for bit but for wall time and threads.
 
+mod common;
+use common::{rinscope, scratch};
 use std::path::PathBuf;
 use std::process::Command;
-
-fn rinscope() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_rinscope"))
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("rinscope-mc-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
-}
 
 /// The JSON without the fields that measure the machine, not the result.
 fn without_wall_clock(path: &std::path::Path) -> serde_json::Value {

@@ -3,23 +3,10 @@
 //! readable tables, a strapdown log (no table) records and exports the INS alone, and every kind of
 //! bad input is one clear message, exit code 2, nothing written.
 
+mod common;
+use common::{rinscope, scratch, stderr};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn rinscope() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_rinscope"))
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("rinscope-replay-{}-{name}", std::process::id()));
-    std::fs::remove_dir_all(&dir).ok();
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
 
 fn ok(o: &Output) {
     assert!(o.status.success(), "exit {:?}: {}", o.status.code(), stderr(o));

@@ -3,30 +3,14 @@
 //! missing or broken viewer, a frozen viewer, a FIFO, a closed pipe, an over-long run) and checks
 //! the outcome a user relies on: the exit code, one clear message, no `.partial`, a good file kept.
 
+mod common;
+use common::{rinscope, scratch, stderr};
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use rinscope::record::sink::verify_recording;
-
-fn rinscope() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_rinscope"));
-    // No test may open a window, whatever the machine it runs on has.
-    c.env_remove("DISPLAY").env_remove("WAYLAND_DISPLAY");
-    c
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("rinscope-trust-{}-{name}", std::process::id()));
-    std::fs::remove_dir_all(&dir).ok();
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
 
 fn partials(dir: &Path) -> Vec<PathBuf> {
     std::fs::read_dir(dir).expect("dir").flatten().map(|e| e.path()).filter(|p| p.to_string_lossy().ends_with(".partial")).collect()

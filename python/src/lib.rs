@@ -18,7 +18,8 @@ use rinscope::app::allan::AllanRequest;
 use rinscope::calib::MonteCarloConfig;
 
 use rinscope::record::export::Table;
-use rinscope::record::sink::{self, OpenSinks, SinkRequest};
+use rinscope::app::outputs::RecordingRequest;
+use rinscope::record::sink::{self, SinkRequest};
 use rinscope::record::APPLICATION_ID;
 use rinscope::scenario::{self, logset, presets, Params};
 
@@ -41,6 +42,19 @@ impl From<Failure> for PyErr {
             Failure::Output(m) => PyOSError::new_err(m),
             Failure::Run(m) => PyRuntimeError::new_err(m),
             Failure::Interrupted(m) => PyKeyboardInterrupt::new_err(m),
+        }
+    }
+}
+
+/// A command owner's failure (`rinscope::app`), as the exception its kind says.
+impl From<rinscope::app::failure::Failure> for Failure {
+    fn from(f: rinscope::app::failure::Failure) -> Self {
+        use rinscope::app::failure::FailureKind;
+        match f.kind {
+            FailureKind::Input => Self::Input(f.message),
+            FailureKind::Output => Self::Output(f.message),
+            FailureKind::Run => Self::Run(f.message),
+            FailureKind::Interrupted => Self::Interrupted(f.message),
         }
     }
 }
@@ -87,10 +101,9 @@ fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce(&Arc<AtomicBool>) ->
     })
 }
 
-/// The sinks of a call: the recording file if `save`, and the tables in memory.
-fn open_sinks(save: Option<PathBuf>, recording_id: &str, stop: &Arc<AtomicBool>) -> Result<OpenSinks, Failure> {
-    let request = SinkRequest { save, stop_on_failure: Some(Arc::clone(stop)), tables_in_memory: true, ..Default::default() };
-    Ok(sink::open(&request, APPLICATION_ID, recording_id)?)
+/// Where a call's recording goes: the file if `save`, and the tables in memory.
+fn recording(save: Option<PathBuf>, stop: &Arc<AtomicBool>) -> RecordingRequest {
+    RecordingRequest { sinks: SinkRequest { save, stop_on_failure: Some(Arc::clone(stop)), tables_in_memory: true, ..Default::default() }, save_by_default: false }
 }
 
 /// One table as an Arrow IPC stream: float64 columns named as `--export` names them, the entity in
@@ -129,25 +142,6 @@ fn output<S: Serialize>(summary: S, saved: sink::Saved) -> Result<Output, Failur
     let json = serde_json::to_string(&summary).map_err(|e| Failure::Run(e.to_string()))?;
     let tables = saved.tables.into_iter().map(ipc).collect::<Result<_, _>>()?;
     Ok((json, tables))
-}
-
-/// Finishes the sinks and the call's output; `fill` adds the recording's path and size to the summary.
-fn finish<S: Serialize>(sinks: OpenSinks, mut summary: S, fill: impl FnOnce(&mut S, &sink::Saved)) -> Result<Output, Failure> {
-    let saved = sinks.finish()?;
-    fill(&mut summary, &saved);
-    output(summary, saved)
-}
-
-/// `sinks` once `logged` (the logging into them) succeeded; on a failure they are abandoned (the
-/// partial recording removed).
-fn logged<E: std::fmt::Display>(logged: Result<(), E>, sinks: OpenSinks) -> Result<OpenSinks, Failure> {
-    match logged {
-        Ok(()) => Ok(sinks),
-        Err(e) => {
-            sinks.abandon();
-            Err(Failure::Run(format!("rerun: {e}")))
-        }
-    }
 }
 
 /// The presets: (name, title) pairs, in the order `rinscope scenarios` lists them.
@@ -197,18 +191,10 @@ fn set_duration(params: &mut Params, duration_s: Option<f64>) -> Result<(), Fail
 
 /// The library's run of `params` into the sinks of a call (the recording if `save`, the tables in
 /// memory), finished: what `run` converts, and what `_time_run` times.
-fn run_to_sinks(params: &Params, save: Option<PathBuf>, stop: &Arc<AtomicBool>) -> Result<(rinscope::app::run::RunSummary, sink::Saved), Failure> {
-    let sinks = open_sinks(save, &format!("{}-seed{}", params.meta.name, params.meta.seed), stop)?;
-    let mut summary = match rinscope::app::run::run_recorded(params, &sinks, stop, false) {
-        Ok(s) => s,
-        Err(e) => {
-            sinks.abandon();
-            return Err(Failure::Run(format!("{e:#}")));
-        }
-    };
-    let saved = sinks.finish()?;
-    (summary.recording_path, summary.recording_bytes) = saved.recording_fields();
-    Ok((summary, saved))
+fn run_to_sinks(params: Params, save: Option<PathBuf>, stop: &Arc<AtomicBool>) -> Result<(rinscope::app::run::RunSummary, sink::Saved), Failure> {
+    use rinscope::app::run::{execute, RunRequest};
+    let report = execute(&RunRequest { params, recording: recording(save, stop), summary_json: None, progress: false }, stop)?;
+    Ok((report.summary, report.saved))
 }
 
 /// The reference of the overhead benchmark (python/benchmarks/overhead.py): `repeats` runs of a
@@ -223,7 +209,7 @@ fn _time_run(py: Python<'_>, toml: &str, duration_s: Option<f64>, repeats: usize
                 let started = std::time::Instant::now();
                 let mut params = parse(toml, "the scenario")?;
                 set_duration(&mut params, duration_s)?;
-                let (_, saved) = run_to_sinks(&params, None, &stop)?;
+                let (_, saved) = run_to_sinks(params, None, &stop)?;
                 std::hint::black_box(saved.tables.len());
                 Ok(started.elapsed().as_secs_f64())
             })
@@ -239,8 +225,8 @@ fn _time_run(py: Python<'_>, toml: &str, duration_s: Option<f64>, repeats: usize
 fn run(py: Python<'_>, toml: &str, duration_s: Option<f64>, save: Option<PathBuf>) -> PyResult<PyOutput> {
     let mut params = parse(toml, "the scenario")?;
     set_duration(&mut params, duration_s)?;
-    let out = interruptible(py, |stop| -> Result<Output, Failure> {
-        let (summary, saved) = run_to_sinks(&params, save, stop)?;
+    let out = interruptible(py, move |stop| -> Result<Output, Failure> {
+        let (summary, saved) = run_to_sinks(params, save, stop)?;
         output(summary, saved)
     })??;
     Ok(to_python(py, out))
@@ -251,24 +237,12 @@ fn run(py: Python<'_>, toml: &str, duration_s: Option<f64>, save: Option<PathBuf
 #[pyfunction]
 #[pyo3(signature = (dir, save=None, compensation=None))]
 fn replay(py: Python<'_>, dir: PathBuf, save: Option<PathBuf>, compensation: Option<&str>) -> PyResult<PyOutput> {
+    use rinscope::app::replay::{execute, ReplayRequest};
     let log = logset::load(&dir).map_err(|e| Failure::Input(e.to_string()))?;
-    let compensation = match compensation {
-        None => log.table.compensation.clone(),
-        Some(text) => logset::compensation_from_calibration(&log.raw_table, text, "compensation").map_err(|e| Failure::Input(e.to_string()))?,
-    };
-    let out = interruptible(py, |stop| -> Result<Output, Failure> {
-        let sinks = open_sinks(save, &format!("{}-replay", log.name), stop)?;
-        let summary = match rinscope::app::replay::replay_recorded(&log, &compensation, &sinks, stop, None) {
-            Ok(s) => s,
-            Err(e) => {
-                sinks.abandon();
-                return Err(match e {
-                    rinscope::app::playback::PlaybackError::Record(_) => Failure::Run(e.to_string()),
-                    _ => Failure::Input(e.to_string()),
-                });
-            }
-        };
-        finish(sinks, summary, |s, saved| (s.recording_path, s.recording_bytes) = saved.recording_fields())
+    let compensation = compensation.map(|text| (text.to_owned(), "compensation".to_owned()));
+    let out = interruptible(py, move |stop| -> Result<Output, Failure> {
+        let report = execute(&ReplayRequest { log, compensation, recording: recording(save, stop), summary_json: None }, stop, None)?;
+        output(report.summary, report.saved)
     })??;
     Ok(to_python(py, out))
 }
@@ -278,37 +252,16 @@ fn replay(py: Python<'_>, dir: PathBuf, save: Option<PathBuf>, compensation: Opt
 #[pyfunction]
 #[pyo3(signature = (toml=None, log_dir=None, save=None))]
 fn calibrate(py: Python<'_>, toml: Option<&str>, log_dir: Option<PathBuf>, save: Option<PathBuf>) -> PyResult<PyOutput> {
-    use rinscope::app::calibrate::{calibrate_log, calibrate_scenario, estimated_compensation, record_outcome, CalibrationOutput};
-    let calib = |e: rinscope::calib::CalibError| Failure::Input(format!("calibrate: {e}"));
-    let out = match (toml, log_dir) {
-        (Some(toml), None) => {
-            let params = parse(toml, "the scenario")?;
-            interruptible(py, |stop| -> Result<Output, Failure> {
-                let outcome = calibrate_scenario(&params, true, stop).map_err(calib)?;
-                let sinks = open_sinks(save, &format!("{}-calibration-seed{}", params.meta.name, params.meta.seed), stop)?;
-                let sinks = logged(record_outcome(sinks.stream(), &params, &outcome, stop), sinks)?;
-                let compensation = estimated_compensation(&params.table.chain, &outcome.cal, &params.calibration_known);
-                let json = serde_json::to_value(CalibrationOutput { report: &outcome.report, estimated_compensation: compensation }).map_err(|e| Failure::Run(e.to_string()))?;
-                finish(sinks, json, |_, _| ())
-            })??
-        }
-        (None, Some(dir)) => {
-            let log = logset::load(&dir).map_err(|e| Failure::Input(e.to_string()))?;
-            if log.table.strapdown {
-                return Err(Failure::Input(format!("calibrate: {} has no table description with [turntable] (log.table): there is no table to calibrate", dir.display())).into());
-            }
-            interruptible(py, |stop| -> Result<Output, Failure> {
-                let (cal, report, data, traces) = calibrate_log(&log, true, stop).map_err(|e| Failure::Input(format!("calibrate: {e}")))?;
-                let params = log.recording_params(data.samples.last_t_s().max(1.0)).map_err(|e| Failure::Input(e.to_string()))?;
-                let sinks = open_sinks(save, &format!("{}-calibration", log.name), stop)?;
-                let sinks = logged(rinscope::record::calibration::log(sinks.stream(), &params, &cal, &report, &traces).and_then(|mut r| r.finish()), sinks)?;
-                let compensation = estimated_compensation(&log.table.chain, &cal, &log.table.compensation);
-                let json = serde_json::to_value(CalibrationOutput { report: &report, estimated_compensation: compensation }).map_err(|e| Failure::Run(e.to_string()))?;
-                finish(sinks, json, |_, _| ())
-            })??
-        }
+    use rinscope::app::calibrate::{execute, CalibrateInput, CalibrateRequest};
+    let input = match (toml, log_dir) {
+        (Some(toml), None) => CalibrateInput::Scenario(Box::new(parse(toml, "the scenario")?)),
+        (None, Some(dir)) => CalibrateInput::Log(Box::new(logset::load(&dir).map_err(|e| Failure::Input(e.to_string()))?)),
         _ => return Err(PyValueError::new_err("calibrate: give a scenario or log_dir (one of them)")),
     };
+    let out = interruptible(py, move |stop| -> Result<Output, Failure> {
+        let report = execute(&CalibrateRequest { input, recording: Some(recording(save, stop)), json: None }, stop)?;
+        output(report.document, report.saved.unwrap_or_default())
+    })??;
     Ok(to_python(py, out))
 }
 
@@ -359,7 +312,8 @@ fn allan(
         let tables = tables.finish().map_err(|e| Failure::Run(e.to_string()))?.tables;
         if let Some(path) = save {
             let sinks = sink::open(&SinkRequest { save: Some(path), stop_on_failure: Some(Arc::clone(stop)), ..Default::default() }, APPLICATION_ID, "python-allan")?;
-            logged(rinscope::record::allan::log(&sinks.stream(), &result, description.as_deref().unwrap_or("Arrays analysed from Python.")), sinks)?.finish()?;
+            rinscope::app::outputs::logged(rinscope::record::allan::log(&sinks.stream(), &result, description.as_deref().unwrap_or("Arrays analysed from Python.")))?;
+            sinks.finish()?;
         }
         Ok((result.json().to_string(), tables.into_iter().map(ipc).collect::<Result<_, _>>()?))
     })??;
@@ -399,24 +353,20 @@ fn montecarlo(py: Python<'_>, toml: &str, runs: Option<usize>, eta_measured_sigm
 #[pyfunction]
 #[pyo3(signature = (toml, sequence="dual-axis-29", monte_carlo=None, navigate_hours=24.0, save=None))]
 fn selfcal(py: Python<'_>, toml: &str, sequence: &str, monte_carlo: Option<usize>, navigate_hours: f64, save: Option<PathBuf>) -> PyResult<PyOutput> {
-    use rinscope::app::selfcal::{self as sc, SequenceChoice};
+    use rinscope::app::selfcal::{self as sc, execute, SelfcalInput, SelfcalRequest, SequenceChoice};
     let params = parse(toml, "the scenario")?;
     sc::check_navigate_hours(navigate_hours).map_err(|e| PyValueError::new_err(format!("navigate_hours {e}")))?;
     if let Some(n) = monte_carlo.filter(|n| !sc::MONTE_CARLO_RUNS.contains(&(*n as u64))) {
         let (lo, hi) = (sc::MONTE_CARLO_RUNS.start(), sc::MONTE_CARLO_RUNS.end());
         return Err(PyValueError::new_err(format!("monte_carlo {n}: must be {lo} ..= {hi} runs (or None), as --monte-carlo")));
     }
-    let choice = SequenceChoice::parse(sequence).map_err(|e| PyValueError::new_err(format!("sequence {e}")))?;
-    let setup = sc::setup(&params, choice).map_err(|e| PyValueError::new_err(format!("{e:#}")))?;
-    let out = interruptible(py, |stop| -> Result<Output, Failure> {
-        let failed = |e: anyhow::Error| if stop.load(Ordering::SeqCst) { Failure::Interrupted("selfcal: stopped; nothing was estimated".into()) } else { Failure::Run(format!("selfcal: {e:#}")) };
-        let plan = sc::plan(&setup, params.meta.seed, stop).map_err(failed)?;
-        let report = sc::calibrate(&params, setup, plan, monte_carlo, navigate_hours, stop).map_err(failed)?;
-        let sinks = open_sinks(save, &format!("{}-selfcal-seed{}", params.meta.name, params.meta.seed), stop)?;
-        let sinks = logged(rinscope::record::selfcal::log(&sinks.stream(), &report.view(&params.meta.name)), sinks)?;
-        let mut json = report.json();
-        json["table"] = serde_json::Value::String(report.table.clone());
-        finish(sinks, json, |_, _| ())
+    let sequence = SequenceChoice::parse(sequence).map_err(|e| PyValueError::new_err(format!("sequence {e}")))?;
+    let input = SelfcalInput::Scenario { params: Box::new(params), sequence, monte_carlo, navigate_hours, plan_only: false };
+    let out = interruptible(py, move |stop| -> Result<Output, Failure> {
+        let report = execute(&SelfcalRequest { input, recording: Some(recording(save, stop)), json: None }, stop)?;
+        let mut json = report.document;
+        json["table"] = serde_json::Value::String(report.text);
+        output(json, report.saved.unwrap_or_default())
     })??;
     Ok(to_python(py, out))
 }

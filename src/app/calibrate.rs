@@ -10,7 +10,12 @@ use crate::ins::pipeline::InsRun;
 use crate::scenario::logset::LogSet;
 use crate::model::gimbal::TableErrors;
 use crate::scenario::Params;
+use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
+
+use crate::app::failure::Failure;
+use crate::app::outputs::{check_output, logged, write_json, RecordingName, RecordingRequest};
+use crate::record::sink::Saved;
 
 use crate::app::run::record_run;
 use crate::sim::{encoder_readings, DemodState};
@@ -325,4 +330,95 @@ pub struct CalibrationOutput<'a> {
 #[must_use]
 pub fn estimated_compensation(chain: &crate::model::gimbal::Chain, cal: &Calibration, known: &TableErrors) -> crate::scenario::raw::RawCompensation {
     crate::scenario::compensation_keys(chain, &cal.set.errors(&cal.nls.theta, known))
+}
+
+/// What `calibrate` calibrates: a scenario's simulated static test or a log set's recorded one.
+pub enum CalibrateInput {
+    /// A scenario (simulated twice: the test and an independent validation run).
+    Scenario(Box<Params>),
+    /// A log set with a table description.
+    Log(Box<LogSet>),
+}
+
+/// `rinscope calibrate` (and Python's `calibrate`): what to calibrate and where its outputs go.
+pub struct CalibrateRequest {
+    /// The test.
+    pub input: CalibrateInput,
+    /// The recording's sinks; `None`: no recording.
+    pub recording: Option<RecordingRequest>,
+    /// `--json`: the report and the compensation.
+    pub json: Option<PathBuf>,
+}
+
+/// What `calibrate` reports.
+pub struct CalibrateReport {
+    /// The estimates, their 1σ and the compensation before/after, as a user reads them.
+    pub text: String,
+    /// The `--json` document.
+    pub document: serde_json::Value,
+    /// The recording and tables kept.
+    pub saved: Option<Saved>,
+    /// A signal ended the recording's table motion early (the estimates are complete).
+    pub interrupted: bool,
+}
+
+/// `calibrate`'s one owner: the outputs checked, the calibration, its document and recording.
+///
+/// # Errors
+/// Bad input, a calibration the data cannot support, an output that cannot be written, or a stop
+/// before the estimates were complete.
+pub fn execute(req: &CalibrateRequest, stop: &AtomicBool) -> Result<CalibrateReport, Failure> {
+    check_output("--json", req.json.as_deref())?;
+    let started = std::time::Instant::now();
+    let (name, seed) = match &req.input {
+        CalibrateInput::Scenario(p) => (&p.meta.name, Some(p.meta.seed)),
+        CalibrateInput::Log(log) => {
+            if log.table.strapdown {
+                return Err(Failure::input(format!("calibrate --log: {} has no table description with [turntable] (log.table): there is no table to calibrate", log.dir.display())));
+            }
+            (&log.name, None)
+        }
+    };
+    // Dropped unfinished (any error below), the sinks are abandoned.
+    let sinks = req.recording.as_ref().map(|r| r.open(RecordingName { name, kind: Some("calibration"), seed })).transpose()?;
+    let (text, output, saved) = match &req.input {
+        CalibrateInput::Scenario(params) => {
+            let outcome = calibrate_scenario(params, sinks.is_some(), stop).map_err(|e| Failure::calibration("calibrate", e, "calibrate did not finish; nothing was estimated and no recording was made"))?;
+            let text = format!("{}({:.2} s wall: two {:.0}-s runs simulated, filter and least squares)\n", outcome.report.text(), started.elapsed().as_secs_f64(), params.duration_s);
+            let compensation = estimated_compensation(&params.table.chain, &outcome.cal, &params.calibration_known);
+            let output = serde_json::to_value(CalibrationOutput { report: &outcome.report, estimated_compensation: compensation }).map_err(|e| Failure::run(e.to_string()))?;
+            let saved = match sinks {
+                Some(s) => {
+                    logged(record_outcome(s.stream(), params, &outcome, stop))?;
+                    Some(s.finish()?)
+                }
+                None => None,
+            };
+            (text, output, saved)
+        }
+        CalibrateInput::Log(log) => {
+            let interrupted = "calibrate --log did not finish; nothing was estimated";
+            let (cal, report, data, traces) = calibrate_log(log, sinks.is_some(), stop).map_err(|e| match e {
+                LogCalibrationError::Interrupted => Failure::interrupted(interrupted),
+                LogCalibrationError::Calibration(c) => Failure::calibration("calibrate --log", c, interrupted),
+                other => Failure::input(format!("calibrate --log: {other}")),
+            })?;
+            let text = format!("{}({:.2} s wall: {} measurements of {}, filter and least squares; before/after on the same data)\n", report.text(), started.elapsed().as_secs_f64(), data.samples.len(), log.dir.display());
+            let compensation = estimated_compensation(&log.table.chain, &cal, &log.table.compensation);
+            let output = serde_json::to_value(CalibrationOutput { report: &report, estimated_compensation: compensation }).map_err(|e| Failure::run(e.to_string()))?;
+            let saved = match sinks {
+                Some(s) => {
+                    let params = log.recording_params(data.samples.last_t_s().max(1.0))?;
+                    logged(crate::record::calibration::log(s.stream(), &params, &cal, &report, &traces).and_then(|mut r| r.finish()))?;
+                    Some(s.finish()?)
+                }
+                None => None,
+            };
+            (text, output, saved)
+        }
+    };
+    if let Some(path) = &req.json {
+        write_json("--json", path, &output)?;
+    }
+    Ok(CalibrateReport { text, document: output, saved, interrupted: stop.load(std::sync::atomic::Ordering::SeqCst) })
 }

@@ -4,7 +4,10 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
+use crate::app::failure::Failure;
+use crate::app::outputs::{logged, RecordingName, RecordingRequest};
 use crate::ins::trace::{NavSample, NavTrace};
+use crate::record::sink::Saved;
 use crate::math::units::ARCSEC_PER_RAD;
 use crate::scenario::{presets, Params};
 
@@ -80,4 +83,36 @@ mod tests {
         assert!(sixteen.peak_heading_arcsec() < none.peak_heading_arcsec() / 20.0);
         assert!(cont.peak_heading_arcsec() > none.peak_heading_arcsec() / 3.0, "the azimuth gyro is not modulated by azimuth rotation");
     }
+}
+
+/// What `modulation` reports.
+pub struct ModulationReport {
+    /// The three variants side by side (with what a stop cut short said first).
+    pub table: String,
+    /// The recording kept.
+    pub saved: Saved,
+    /// Stopped early: the table and the recording cover the simulated part only.
+    pub interrupted: bool,
+}
+
+/// `modulation`'s one owner: `hours` simulated three times in parallel, one recording.
+///
+/// # Errors
+/// `hours` out of range, a sink that cannot be opened or written.
+pub fn execute(hours: f64, recording: &RecordingRequest, stop: &AtomicBool) -> Result<ModulationReport, Failure> {
+    if !(hours.is_finite() && hours > 0.0 && hours <= 24.0 * 30.0) {
+        return Err(Failure::input(format!("--hours {hours}: must be > 0 and at most 720 h")));
+    }
+    let sinks = recording.open(RecordingName { name: "rotation-modulation", kind: None, seed: None })?;
+    let started = std::time::Instant::now();
+    errln!("rinscope: simulating {hours} h three times in parallel (no rotation, continuous azimuth, 16-position)...");
+    let traces = simulate_variants(hours, stop)?;
+    let interrupted = stop.load(Ordering::SeqCst);
+    let mut text = table(&traces, started.elapsed().as_secs_f64());
+    if interrupted {
+        let reached = traces.iter().filter_map(|t| t.samples.last()).map(|s| s.t_s / 3600.0).fold(f64::INFINITY, f64::min);
+        text = format!("INTERRUPTED after {reached:.2} of {hours} h: the numbers below are over that part only, not the run's\n{text}");
+    }
+    logged(crate::record::modulation::log(&sinks.stream(), &traces, &text))?;
+    Ok(ModulationReport { table: text, saved: sinks.finish()?, interrupted })
 }

@@ -10,6 +10,8 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use super::failure::Failure;
+use super::outputs::{check_output, kept, write_json, RecordingName, RecordingRequest};
 use super::playback::{AlignmentReport, Gap, Playback, PlaybackError};
 use super::run::{NavSummary, RmsPeak};
 use crate::ins::pipeline::InsView;
@@ -392,4 +394,48 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
         r.finish().map_err(rerun)?;
     }
     Ok(summary)
+}
+
+/// `rinscope replay` (and Python's `replay`).
+pub struct ReplayRequest {
+    /// The log set.
+    pub log: LogSet,
+    /// A calibration's estimates to compensate with (`calibrate --json`'s text and where it came
+    /// from) instead of the table description's own compensation.
+    pub compensation: Option<(String, String)>,
+    /// The recording's sinks.
+    pub recording: RecordingRequest,
+    /// `--summary-json`.
+    pub summary_json: Option<std::path::PathBuf>,
+}
+
+/// What `replay` reports.
+pub struct ReplayReport {
+    /// The summary, as `--summary-json` writes it.
+    pub summary: ReplaySummary,
+    /// The recording, tables and figures kept.
+    pub saved: crate::record::sink::Saved,
+}
+
+/// `replay`'s one owner: the outputs checked, the log replayed into its recording, the summary.
+///
+/// # Errors
+/// Bad data or compensation, a sink or output that cannot be opened or written.
+pub fn execute(req: &ReplayRequest, stop: &AtomicBool, bar: Option<&indicatif::ProgressBar>) -> Result<ReplayReport, Failure> {
+    let log = &req.log;
+    check_output("--summary-json", req.summary_json.as_deref())?;
+    let compensation = match &req.compensation {
+        None => log.table.compensation.clone(),
+        Some((text, origin)) => crate::scenario::logset::compensation_from_calibration(&log.raw_table, text, origin)?,
+    };
+    log.recording_params(1.0)?;
+    let sinks = req.recording.open(RecordingName { name: &log.name, kind: Some("replay"), seed: None })?;
+    let mut summary = replay_recorded(log, &compensation, &sinks, stop, bar)?;
+    let saved = sinks.finish()?;
+    (summary.recording_path, summary.recording_bytes) = saved.recording_fields();
+    kept(&saved)?;
+    if let Some(path) = &req.summary_json {
+        write_json("--summary-json", path, &summary)?;
+    }
+    Ok(ReplayReport { summary, saved })
 }

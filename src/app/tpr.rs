@@ -4,7 +4,10 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
+use crate::app::failure::Failure;
+use crate::app::outputs::{check_output, logged, write_json, RecordingName, RecordingRequest};
 use crate::ins::pipeline::InsRun;
+use crate::record::sink::Saved;
 use crate::ins::reset::{azimuth_error_at_second_fix, azimuth_error_level_corrected, level_errors_from_velocity, ResetSample, SweepRow, TprResult, BRANCHES};
 use crate::math::units::ARCSEC_PER_RAD;
 use crate::model::earth::{normal_gravity, Earth};
@@ -260,4 +263,57 @@ mod tests {
         let e = compare_resets(&p, 600.0, &AtomicBool::new(false)).expect_err("one fix");
         assert!(e.to_string().contains("two fixes"), "{e}");
     }
+}
+
+/// `rinscope tpr`: the scenario, where its outputs go, and how many seeds to sweep after it.
+pub struct TprRequest {
+    /// A scenario with an INS, navigation and two position fixes.
+    pub params: Params,
+    /// The recording's sinks.
+    pub recording: RecordingRequest,
+    /// `--json`: the comparison and the sampled traces.
+    pub json: Option<std::path::PathBuf>,
+    /// `--seeds N`: also this many seeds in parallel, summarised.
+    pub seeds: Option<u64>,
+}
+
+/// What `tpr` reports.
+pub struct TprReport {
+    /// The comparison as a user reads it.
+    pub text: String,
+    /// The recording kept.
+    pub saved: Saved,
+    /// The seed sweep's table and its wall time, s.
+    pub sweep: Option<(String, f64)>,
+    /// Stopped early: the recording holds what was simulated until then.
+    pub interrupted: bool,
+}
+
+/// `tpr`'s one owner: the outputs checked, the comparison, its recording and document, the sweep.
+///
+/// # Errors
+/// A scenario without what the comparison needs, an output that cannot be written.
+pub fn execute(req: &TprRequest, stop: &AtomicBool) -> Result<TprReport, Failure> {
+    let params = &req.params;
+    check_output("--json", req.json.as_deref())?;
+    check(params).map_err(|e| Failure::input(format!("tpr: {e}")))?;
+    let sinks = req.recording.open(RecordingName { name: &params.meta.name, kind: None, seed: Some(params.meta.seed) })?;
+    errln!("rinscope: navigating {:.1} h (forking at the second fix)...", params.duration_s / 3600.0);
+    let result = compare_resets(params, 60.0, stop).map_err(|e| Failure::input(format!("tpr: {e}")))?;
+    let text = result.text();
+    logged(crate::record::tpr::log(&sinks.stream(), params, &result, &text))?;
+    let saved = sinks.finish()?;
+    if let Some(path) = &req.json {
+        write_json("--json", path, &result)?;
+    }
+    let mut sweep_table = None;
+    if let (Some(n), true) = (req.seeds, result.complete) {
+        errln!("rinscope: {n} seeds from {} in parallel...", params.meta.seed);
+        let started = std::time::Instant::now();
+        let rows = sweep(params, n, stop).map_err(|e| Failure::input(format!("tpr: {e}")))?;
+        if !stop.load(Ordering::SeqCst) {
+            sweep_table = Some((crate::ins::reset::sweep_text(&rows), started.elapsed().as_secs_f64()));
+        }
+    }
+    Ok(TprReport { text, saved, sweep: sweep_table, interrupted: !result.complete || stop.load(Ordering::SeqCst) })
 }

@@ -2,19 +2,15 @@
 //! `app`, prints what a user reads and maps failures to exit codes.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::Ordering;
 
 use super::{CalibrateArgs, Failure, LiveArgs, ModulationArgs, MonteCarloAction, MonteCarloArgs, RunArgs, ScenarioSource, TprArgs};
-use crate::app::calibrate::{calibrate_scenario, estimated_compensation, monte_carlo_runs, monte_carlo_setup, record_outcome, CalibrationOutput};
+use crate::app::calibrate::{monte_carlo_runs, monte_carlo_setup};
+use crate::app::outputs::{check_output, kept, read_small_file, write_json};
+use crate::app::terminate::stop_flag;
+use crate::app::{live, modulation, reproduce};
 use crate::calib::montecarlo::{self, Shard, ShardFile};
 use crate::calib::MonteCarloConfig;
-use crate::app::run::run_recorded;
-use crate::app::terminate::stop_flag;
-use crate::app::{live, modulation, reproduce, tpr};
-use crate::ins::reset::sweep_text;
-use crate::io::files::write_atomically;
-use crate::record::sink::{self, SinkRequest};
-use crate::record::APPLICATION_ID;
+use crate::record::sink;
 use crate::scenario::{self, presets, Params};
 
 fn load(args: &RunArgs) -> Result<Params, Failure> {
@@ -32,27 +28,12 @@ pub(super) fn duration_flag(d: f64) -> Result<f64, Failure> {
 
 /// `rinscope run`.
 pub(super) fn run(args: &RunArgs) -> Result<(), Failure> {
-    let params = load(args)?;
-    // The summary file is checked before anything runs, so a typo costs nothing.
-    check_output_dir("--summary-json", args.summary_json.as_deref())?;
-    let sinks = open_sinks(args.sinks.request(default_recording(&params.meta.name))?, &format!("{}-seed{}", params.meta.name, params.meta.seed))?;
-    let stop = stop_flag();
-    let mut summary = match run_recorded(&params, &sinks, &stop, true) {
-        Ok(s) => s,
-        Err(e) => {
-            sinks.abandon();
-            return Err(e.into());
-        }
-    };
-    let saved = sinks.finish()?;
-    (summary.recording_path, summary.recording_bytes) = saved.recording_fields();
-    summary.peak_rss_mb = crate::app::bench::peak_rss_bytes() as f64 / 1e6;
+    use crate::app::run::{execute, RunRequest};
+    let request = RunRequest { params: load(args)?, recording: args.sinks.recording()?, summary_json: args.summary_json.clone(), progress: true };
+    let report = execute(&request, &stop_flag())?;
+    let summary = &report.summary;
     out!("{}", summary.table());
-    print_exported(&saved);
-    kept(&saved)?;
-    if let Some(path) = &args.summary_json {
-        write_json("--summary-json", path, &summary)?;
-    }
+    print_exported(&report.saved);
     if let Some(p) = &summary.recording_path {
         outln!("open it with:  rerun {p}     (viewer: {})", sink::VIEWER_INSTALL_HINT);
     }
@@ -64,134 +45,20 @@ pub(super) fn run(args: &RunArgs) -> Result<(), Failure> {
 
 /// `rinscope live`.
 pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
-    use std::io::IsTerminal;
-    // --export: the session's series as tables, written when it ends (with the saved file's
-    // stream if there is one, else with the viewer's).
-    let export = args.sinks.export_request()?;
-    let path = match (&args.config, &args.scenario) {
-        (Some(p), _) => p.clone(),
-        (None, name) => {
-            let name = name.as_deref().unwrap_or(presets::DEFAULT_SCENARIO);
-            presets::load(name)?; // a clear error for an unknown name
-            let (path, created) = live::ensure_preset_copy(name).map_err(|e| Failure::input(format!("{e:#}")))?;
-            let sliders = if args.no_panel { "" } else { ", or move the sliders" };
-            errln!("rinscope live: {} {} — edit it{sliders}", if created { "wrote" } else { "using your edited" }, path.display());
-            path
-        }
-    };
-    let params = scenario::load_file(&path)?;
-    if let Some(s) = args.speed
-        && !(s.is_finite() && s > 0.0 && s <= 10_000.0)
-    {
-        return Err(Failure::input(format!("--speed {s}: must be > 0 and <= 10000 (x real time)")));
-    }
     if let Some(d) = args.duration_s {
         duration_flag(d)?;
     }
-    let viewer_given = args.sinks.viewer_asked();
-    if args.sinks.figures.is_some() && args.sinks.save.is_none() {
-        return Err(Failure::input("live --figures DIR draws the session's plots from its saved file when it ends: add --save FILE"));
-    }
-    if args.no_viewer && args.sinks.save.is_none() {
-        return Err(Failure::input("--no-viewer needs --save FILE (otherwise nothing would be kept)"));
-    }
-    // Two streams: small chunks for viewers, full-size chunks for the saved file (see live::Outputs).
-    let viewer_request = SinkRequest {
-        spawn: args.sinks.spawn || (!viewer_given && !args.no_viewer),
-        connect: args.sinks.connect.clone(),
-        serve: args.sinks.serve,
-        bind: args.sinks.bind,
-        // The class page takes --serve-web's port; the viewer it embeds the next one.
-        serve_web: match args.sinks.serve_web {
-            Some(p) => Some(p.checked_add(1).filter(|p| p.checked_add(1).is_some()).ok_or_else(|| Failure::input(format!("--serve-web {p}: the class page needs this port and the next two")))?),
-            None => None,
-        },
-        // The class page serves the session so far to late viewers; the stream then keeps none.
-        serve_web_history: args.sinks.serve_web,
-        stop_on_failure: Some(stop_flag()),
-        export: if args.sinks.save.is_none() { export.clone() } else { None },
-        ..Default::default()
+    let request = live::LiveRequest {
+        config: args.config.clone(),
+        scenario: args.scenario.clone(),
+        sinks: args.sinks.recording()?.sinks,
+        speed: args.speed,
+        duration_s: args.duration_s,
+        no_viewer: args.no_viewer,
+        panel: !args.no_panel,
     };
-    let recording_id = format!("{}-seed{}-live", params.meta.name, params.meta.seed);
-    // `--serve-web`: the session kept compact in memory for the class page's late viewers.
-    let (history, history_requests) = match args.sinks.serve_web {
-        Some(_) => {
-            let (stream, store) = sink::open_history(APPLICATION_ID, &recording_id)?;
-            let (tx, requests) = crossbeam_channel::unbounded();
-            (Some(live::History { stream, store, requests }), Some(tx))
-        }
-        None => (None, None),
-    };
-    let viewer_sinks = if viewer_request.spawn || viewer_request.connect.is_some() || viewer_request.serve.is_some() || viewer_request.serve_web.is_some() {
-        let implicit = !viewer_given;
-        Some(sink::open(&viewer_request, APPLICATION_ID, &recording_id).map_err(|e| {
-            let mut f = Failure::from(e);
-            if implicit {
-                f.message.push_str("\n(live opens a viewer unless told otherwise: `rinscope live --no-viewer --save session.rrd` runs without one, `--serve` streams to a viewer elsewhere)");
-            }
-            f
-        })?)
-    } else {
-        None
-    };
-    let file_sinks = match &args.sinks.save {
-        Some(p) => Some(sink::open(&SinkRequest { save: Some(p.clone()), stop_on_failure: Some(stop_flag()), export, figures: args.sinks.figures.clone(), ..Default::default() }, APPLICATION_ID, &recording_id)?),
-        None => None,
-    };
-    for d in viewer_sinks.iter().chain(file_sinks.iter()).flat_map(|s| &s.description) {
-        errln!("rinscope live: {d}");
-    }
-    let panel = !args.no_panel && std::io::stdout().is_terminal() && std::io::stdin().is_terminal();
-    let stop = stop_flag();
-    if !panel {
-        errln!("rinscope live: running; edit {} to change parameters, Ctrl-C to stop", path.display());
-    }
-    let status = live::new_status(&params, args.speed.unwrap_or(params.live_speed));
-    // `--serve-web`: the class page, the viewer beside the sliders, on the port asked for.
-    // Its viewer is the web viewer opened above (the next port), the viewer's stream the one after.
-    let class_page = match (args.sinks.serve_web, viewer_sinks.as_ref().and_then(sink::OpenSinks::web_page)) {
-        (Some(port), Some(_)) => {
-            let ip = args.sinks.bind.unwrap_or(std::net::IpAddr::V4(std::net::Ipv4Addr::LOCALHOST));
-            let token = if ip.is_loopback() { None } else { Some(live::web::random_token().map_err(|e| Failure::run(format!("no random token for the class page: {e}")))?) };
-            let cfg = live::web::PageConfig { addr: std::net::SocketAddr::new(ip, port), host: sink::address::local_host(ip), config_path: path.clone(), token: token.clone(), history: history_requests.clone() };
-            let page = live::web::start(cfg, status.clone(), format!("{} — {}", params.meta.name, params.meta.title)).map_err(|e| Failure::input(format!("--serve-web: {e:#}")))?;
-            errln!("rinscope live: the class page (viewer and sliders): {}", page.url);
-            // Every address: 127.0.0.1 above names each reader's own machine; others open this one's.
-            let network_url = if ip.is_unspecified() { sink::address::network_host(ip).map(|h| page.url_at(&h)) } else { None };
-            match &network_url {
-                Some(url) => errln!("rinscope live: from other machines: {url}"),
-                None if ip.is_unspecified() => errln!("rinscope live: from other machines: that URL with this machine's address in place of {} (it has no route out and no name to print)", sink::address::local_host(ip)),
-                None => {}
-            }
-            if token.is_some() {
-                errln!("rinscope live: shared beyond this machine: anyone who reaches the page can watch; changing a parameter needs the token in that URL (give it only to whom may)");
-            }
-            Some((page, network_url))
-        }
-        _ => None,
-    };
-    // The panel's title shows the URL the class opens.
-    let page_url = class_page.as_ref().map(|(p, network)| network.clone().unwrap_or_else(|| p.url.clone()));
-    let options = live::LiveOptions { config_path: path, speed: args.speed, duration_s: args.duration_s, panel, log_to_stderr: true, page_url };
-    let outputs = live::Outputs { viewer: viewer_sinks.as_ref().map(sink::OpenSinks::stream), file: file_sinks.as_ref().map(sink::OpenSinks::stream), history };
-    let result = live::run_session_with_status(&options, params, outputs, &stop, &status);
-    // A signal that ended the session (not one that ends the wait of a viewer left open after it).
-    let interrupted = crate::app::terminate::stop_reason().is_some();
-    drop(class_page);
-    // Whatever happened, complete the saved file: it holds everything simulated so far.
-    let mut exported = Vec::new();
-    if let Some(Ok(done)) = viewer_sinks.map(sink::OpenSinks::finish) {
-        exported.extend(done.exported);
-    }
-    let saved = match file_sinks {
-        Some(f) => {
-            let done = f.finish()?;
-            exported.extend(done.exported);
-            done.recording
-        }
-        None => None,
-    };
-    let summary = result?;
+    let report = live::execute(&request, &stop_flag())?;
+    let summary = &report.summary;
     outln!(
         "live session: {:.1} s simulated ({} steps), {} reloads applied, save -> applied p95 {:.1} ms",
         summary.sim_t_s,
@@ -199,12 +66,12 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
         summary.latencies_ms.len(),
         live::p95(&summary.latencies_ms)
     );
-    if let Some((p, bytes)) = saved {
-        outln!("recording: {} ({:.2} MB) — open with `rerun {}`, list its events with `rinscope events {}`", p.display(), bytes as f64 / 1e6, p.display(), p.display());
+    if let Some((p, bytes)) = &report.recording {
+        outln!("recording: {} ({:.2} MB) — open with `rerun {}`, list its events with `rinscope events {}`", p.display(), *bytes as f64 / 1e6, p.display(), p.display());
     }
-    print_tables(&exported);
+    print_tables(&report.exported);
     // Ended by a signal (not by `q` or its length): 128 + the signal, as every command.
-    if interrupted {
+    if report.interrupted {
         return Err(Failure::interrupted("the session's recording is complete up to that moment"));
     }
     Ok(())
@@ -212,66 +79,13 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
 
 /// `rinscope modulation`.
 pub(super) fn modulation(args: &ModulationArgs) -> Result<(), Failure> {
-    let hours = args.hours;
-    if !(hours.is_finite() && hours > 0.0 && hours <= 24.0 * 30.0) {
-        return Err(Failure::input(format!("--hours {hours}: must be > 0 and at most 720 h")));
-    }
-    let sinks = open_sinks(args.sinks.request(default_recording("rotation-modulation"))?, "rotation-modulation")?;
-    let stop = stop_flag();
-    let started = std::time::Instant::now();
-    errln!("rinscope: simulating {hours} h three times in parallel (no rotation, continuous azimuth, 16-position)...");
-    let traces = match modulation::simulate_variants(hours, &stop) {
-        Ok(t) => t,
-        Err(e) => {
-            sinks.abandon();
-            return Err(e.into());
-        }
-    };
-    let interrupted = stop.load(Ordering::SeqCst);
-    let mut table = modulation::table(&traces, started.elapsed().as_secs_f64());
-    if interrupted {
-        let reached = traces.iter().filter_map(|t| t.samples.last()).map(|s| s.t_s / 3600.0).fold(f64::INFINITY, f64::min);
-        table = format!("INTERRUPTED after {reached:.2} of {hours} h: the numbers below are over that part only, not the run's\n{table}");
-    }
-    if let Err(e) = crate::record::modulation::log(&sinks.stream(), &traces, &table) {
-        sinks.abandon();
-        return Err(Failure::run(format!("rerun: {e}")));
-    }
-    let saved = sinks.finish()?;
-    out!("{table}");
-    print_saved(&saved)?;
-    if interrupted {
+    let report = modulation::execute(args.hours, &args.sinks.recording()?, &stop_flag())?;
+    out!("{}", report.table);
+    print_saved(&report.saved)?;
+    if report.interrupted {
         return Err(Failure::interrupted("the table and the recording cover the simulated part only"));
     }
     Ok(())
-}
-
-/// Checks an output file's path before anything runs (see [`crate::io::files::check_output_path`]).
-pub(super) fn check_output_dir(flag: &str, path: Option<&std::path::Path>) -> Result<(), Failure> {
-    match path {
-        Some(p) => crate::io::files::check_output_path(p).map_err(|e| Failure::input(format!("{flag} {e}"))),
-        None => Ok(()),
-    }
-}
-
-/// The file a command saves to when no sink is asked for.
-pub(super) fn default_recording(name: &str) -> PathBuf {
-    PathBuf::from("recordings").join(format!("{name}.rrd"))
-}
-
-/// Opens the sinks a command asked for.
-pub(super) fn open_sinks(request: SinkRequest, recording_id: &str) -> Result<sink::OpenSinks, Failure> {
-    let sinks = sink::open(&request, APPLICATION_ID, recording_id)?;
-    for d in &sinks.description {
-        errln!("rinscope: {d}");
-    }
-    Ok(sinks)
-}
-
-/// Writes `value` as pretty JSON to the file given with `flag`, atomically.
-pub(super) fn write_json(flag: &str, path: &std::path::Path, value: &impl serde::Serialize) -> Result<(), Failure> {
-    let json = serde_json::to_string_pretty(value).map_err(|e| Failure::run(e.to_string()))?;
-    write_atomically(path, json.as_bytes()).map_err(|e| Failure::output(flag, &e))
 }
 
 /// The line that tells where a saved recording is and how to open it; an error if the only
@@ -282,14 +96,6 @@ pub(super) fn print_saved(saved: &sink::Saved) -> Result<(), Failure> {
     }
     print_exported(saved);
     kept(saved)
-}
-
-/// An error if a viewer failed and no file kept the data.
-pub(super) fn kept(saved: &sink::Saved) -> Result<(), Failure> {
-    if saved.recording.is_none() && !saved.viewer_problems.is_empty() {
-        return Err(Failure::run(format!("nothing kept this run's data: {} (add --save FILE)", saved.viewer_problems.join("; "))));
-    }
-    Ok(())
 }
 
 /// The lines that tell where the export tables and the figures are.
@@ -314,43 +120,18 @@ pub(super) fn print_tables(written: &[std::path::PathBuf]) {
 
 /// `rinscope calibrate`.
 pub(super) fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
-    if let Some(dir) = &args.log {
-        return super::logs::calibrate_log(args, dir);
-    }
-    let params = args.source.load("jiang2017-calibration")?;
-    check_output_dir("--json", args.json.as_deref())?;
-    let sinks = if args.no_recording {
-        None
-    } else {
-        let request = args.sinks.request(default_recording(&format!("{}-calibration", params.meta.name)))?;
-        Some(open_sinks(request, &format!("{}-calibration-seed{}", params.meta.name, params.meta.seed))?)
+    use crate::app::calibrate::{execute, CalibrateInput, CalibrateRequest};
+    let input = match &args.log {
+        Some(dir) => CalibrateInput::Log(Box::new(crate::scenario::logset::load(dir)?)),
+        None => CalibrateInput::Scenario(Box::new(args.source.load("jiang2017-calibration")?)),
     };
-    let started = std::time::Instant::now();
-    let stop = stop_flag();
-    let outcome = match calibrate_scenario(&params, sinks.is_some(), &stop) {
-        Ok(o) => o,
-        Err(e) => {
-            if let Some(s) = sinks {
-                s.abandon();
-            }
-            return Err(Failure::calibration("calibrate", e, "calibrate did not finish; nothing was estimated and no recording was made"));
-        }
-    };
-    let wall = started.elapsed().as_secs_f64();
-    out!("{}", outcome.report.text());
-    outln!("({wall:.2} s wall: two {:.0}-s runs simulated, filter and least squares)", params.duration_s);
-    if let Some(path) = &args.json {
-        let compensation = estimated_compensation(&params.table.chain, &outcome.cal, &params.calibration_known);
-        write_json("--json", path, &CalibrationOutput { report: &outcome.report, estimated_compensation: compensation })?;
+    let recording = if args.no_recording { None } else { Some(args.sinks.recording()?) };
+    let report = execute(&CalibrateRequest { input, recording, json: args.json.clone() }, &stop_flag())?;
+    out!("{}", report.text);
+    if let Some(saved) = &report.saved {
+        print_saved(saved)?;
     }
-    if let Some(sinks) = sinks {
-        if let Err(e) = record_outcome(sinks.stream(), &params, &outcome, &stop) {
-            sinks.abandon();
-            return Err(Failure::run(format!("rerun: {e}")));
-        }
-        print_saved(&sinks.finish()?)?;
-    }
-    if stop.load(Ordering::SeqCst) {
+    if report.interrupted {
         return Err(Failure::interrupted("the estimates above are complete; the recording's table motion stops where it was cut short"));
     }
     Ok(())
@@ -371,7 +152,7 @@ pub(super) fn montecarlo(args: &MonteCarloArgs) -> Result<(), Failure> {
         return montecarlo_merge(files, source, *eta_measured_sigma_arcsec, json.as_deref());
     }
     let params = monte_carlo_params(&args.source, args.eta_measured_sigma_arcsec)?;
-    check_output_dir("--json", args.json.as_deref())?;
+    check_output("--json", args.json.as_deref())?;
     let runs = MonteCarloConfig::check_runs(args.runs.unwrap_or(params.calibration.montecarlo.runs as usize)).map_err(|e| Failure::input(format!("--runs {e}")))?;
     let shard = match &args.shard {
         Some(text) => Shard::parse(text).map_err(|e| Failure::input(format!("--shard {e}")))?,
@@ -411,7 +192,7 @@ pub(super) fn montecarlo(args: &MonteCarloArgs) -> Result<(), Failure> {
 /// `rinscope montecarlo merge`.
 fn montecarlo_merge(files: &[PathBuf], source: &ScenarioSource, eta_measured_sigma_arcsec: Option<f64>, json: Option<&Path>) -> Result<(), Failure> {
     let params = monte_carlo_params(source, eta_measured_sigma_arcsec)?;
-    check_output_dir("--json", json)?;
+    check_output("--json", json)?;
     let mut shards = Vec::new();
     for f in files {
         let text = read_small_file(f, "shard file")?;
@@ -435,59 +216,20 @@ fn montecarlo_merge(files: &[PathBuf], source: &ScenarioSource, eta_measured_sig
     Ok(())
 }
 
-/// Reads a text file of at most 1 GB (opened by the rule for every input: a FIFO or a device is
-/// refused at once).
-pub(super) fn read_small_file(path: &Path, what: &str) -> Result<String, Failure> {
-    use std::io::Read as _;
-    let fail = |e: std::io::Error| Failure::input(format!("{what} {}: {e}", path.display()));
-    let file = crate::io::files::open_input(path).map_err(fail)?;
-    let len = file.metadata().map_err(fail)?.len();
-    if len > 1 << 30 {
-        return Err(Failure::input(format!("{what} {}: {len} bytes, more than the 1 GB such a file can be", path.display())));
-    }
-    let mut text = String::new();
-    file.take((1 << 30) + 1).read_to_string(&mut text).map_err(fail)?;
-    Ok(text)
-}
-
 /// `rinscope tpr`.
 pub(super) fn tpr(args: &TprArgs) -> Result<(), Failure> {
+    use crate::app::tpr::{execute, TprRequest};
     let params = args.source.load("zheng2016-tpr")?;
-    check_output_dir("--json", args.json.as_deref())?;
-    tpr::check(&params).map_err(|e| Failure::input(format!("tpr: {e}")))?;
-    let sinks = open_sinks(args.sinks.request(default_recording(&params.meta.name))?, &format!("{}-seed{}", params.meta.name, params.meta.seed))?;
-    let stop = stop_flag();
-    errln!("rinscope: navigating {:.1} h (forking at the second fix)...", params.duration_s / 3600.0);
-    let result = match tpr::compare_resets(&params, 60.0, &stop) {
-        Ok(r) => r,
-        Err(e) => {
-            sinks.abandon();
-            return Err(Failure::input(format!("tpr: {e}")));
-        }
-    };
-    let text = result.text();
-    if let Err(e) = crate::record::tpr::log(&sinks.stream(), &params, &result, &text) {
-        sinks.abandon();
-        return Err(Failure::run(format!("rerun: {e}")));
+    let request = TprRequest { params, recording: args.sinks.recording()?, json: args.json.clone(), seeds: args.seeds };
+    let report = execute(&request, &stop_flag())?;
+    out!("{}", report.text);
+    print_saved(&report.saved)?;
+    if let Some((table, wall_s)) = &report.sweep {
+        out!("{table}");
+        outln!("  {} runs of {:.1} h in {wall_s:.1} s", args.seeds.unwrap_or(0), request.params.duration_s / 3600.0);
     }
-    let saved = sinks.finish()?;
-    out!("{text}");
-    if let Some(path) = &args.json {
-        write_json("--json", path, &result)?;
-    }
-    print_saved(&saved)?;
-    if !result.complete {
+    if report.interrupted {
         return Err(Failure::interrupted("the recording holds what was simulated until then"));
-    }
-    if let Some(n) = args.seeds {
-        errln!("rinscope: {n} seeds from {} in parallel...", params.meta.seed);
-        let started = std::time::Instant::now();
-        let rows = tpr::sweep(&params, n, &stop).map_err(|e| Failure::input(format!("tpr: {e}")))?;
-        if stop.load(Ordering::SeqCst) {
-            return Err(Failure::interrupted("the seed sweep did not finish"));
-        }
-        out!("{}", sweep_text(&rows));
-        outln!("  {n} runs of {:.1} h in {:.1} s", params.duration_s / 3600.0, started.elapsed().as_secs_f64());
     }
     Ok(())
 }
@@ -539,7 +281,7 @@ pub(super) fn reproduce(markdown: Option<&Path>) -> Result<(), Failure> {
     let table = reproduce::run_all()?;
     out!("{}", table.text());
     if let Some(path) = markdown {
-        write_atomically(path, table.markdown().as_bytes()).map_err(|e| Failure::output("--markdown", &e))?;
+        crate::io::files::write_atomically(path, table.markdown().as_bytes()).map_err(|e| Failure::output("--markdown", &e))?;
     }
     if table.all_agree() {
         Ok(())
@@ -550,7 +292,7 @@ pub(super) fn reproduce(markdown: Option<&Path>) -> Result<(), Failure> {
 
 /// `bench`.
 pub(super) fn bench(steps: u64, json: Option<&std::path::Path>, only: &[String]) -> Result<(), Failure> {
-    check_output_dir("--json", json)?;
+    check_output("--json", json)?;
     let stop = stop_flag();
     let figures = match crate::app::bench::run_benchmarks(steps, only, &stop) {
         Ok(f) => f,
@@ -566,7 +308,7 @@ pub(super) fn bench(steps: u64, json: Option<&std::path::Path>, only: &[String])
 /// `bench --peer allantools`.
 pub(super) fn bench_allantools(python: &std::path::Path, rounds: usize, samples: u64, json: Option<&std::path::Path>) -> Result<(), Failure> {
     use crate::app::bench::allantools;
-    check_output_dir("--json", json)?;
+    check_output("--json", json)?;
     let stop = stop_flag();
     let reports = match allantools::compare(python, samples, rounds, &stop) {
         Ok(r) => r,
@@ -583,7 +325,7 @@ pub(super) fn bench_allantools(python: &std::path::Path, rounds: usize, samples:
 /// `bench --peer pyins`.
 pub(super) fn bench_peer(python: PathBuf, rounds: usize, samples: u64, json: Option<&std::path::Path>) -> Result<(), Failure> {
     use crate::app::bench::peer;
-    check_output_dir("--json", json)?;
+    check_output("--json", json)?;
     let stop = stop_flag();
     let reports = match peer::compare(&peer::PeerOptions { python, rounds, samples }, &stop) {
         Ok(r) => r,

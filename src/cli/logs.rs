@@ -1,24 +1,15 @@
-//! The commands on recorded data: `export-log`, `replay` and `calibrate --log`.
+//! The commands on recorded data: `export-log` and `replay` (`calibrate --log` is `calibrate`'s).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use super::commands::{check_output_dir, open_sinks, print_saved, read_small_file, write_json};
-use super::{CalibrateArgs, ExportLogArgs, Failure, ReplayArgs};
-use crate::app::calibrate::{self as calibration, estimated_compensation, CalibrationOutput, LogCalibrationError};
+use super::commands::print_saved;
+use super::{ExportLogArgs, Failure, ReplayArgs};
 use crate::app::export_log::{export_log as write_log_set, LogFormat};
-use crate::app::replay::replay_recorded;
+use crate::app::outputs::read_small_file;
+use crate::app::replay::{execute, ReplayRequest};
 use crate::app::terminate::stop_flag;
 use crate::scenario::logset::{self, RawImuFile, RawInitial, RawLogInfo, RawManifest, RawReference, RawTable};
 use crate::scenario::presets;
-
-impl From<crate::app::playback::PlaybackError> for Failure {
-    fn from(e: crate::app::playback::PlaybackError) -> Self {
-        match e {
-            crate::app::playback::PlaybackError::Record(_) => Self::run(format!("replay: {e}")),
-            _ => Self::input(format!("replay: {e}")),
-        }
-    }
-}
 
 /// `rinscope export-log`.
 pub(super) fn export_log(args: &ExportLogArgs) -> Result<(), Failure> {
@@ -133,78 +124,26 @@ fn load_log(args: &ReplayArgs) -> Result<logset::LogSet, Failure> {
 /// `rinscope replay`.
 pub(super) fn replay(args: &ReplayArgs) -> Result<(), Failure> {
     let log = load_log(args)?;
-    check_output_dir("--summary-json", args.summary_json.as_deref())?;
     let compensation = match &args.compensation {
-        None => log.table.compensation.clone(),
-        Some(path) => {
-            let text = read_small_file(path, "--compensation")?;
-            logset::compensation_from_calibration(&log.raw_table, &text, &path.display().to_string())?
-        }
+        None => None,
+        Some(path) => Some((read_small_file(path, "--compensation")?, path.display().to_string())),
     };
-    log.recording_params(1.0)?;
-    let default_save = PathBuf::from("recordings").join(format!("{}-replay.rrd", log.name));
-    let sinks = open_sinks(args.sinks.request(default_save)?, &format!("{}-replay", log.name))?;
-    let stop = stop_flag();
+    let request = ReplayRequest { log, compensation, recording: args.sinks.recording()?, summary_json: args.summary_json.clone() };
     let bar = std::io::IsTerminal::is_terminal(&std::io::stderr()).then(|| {
         let bar = indicatif::ProgressBar::new_spinner();
         bar.enable_steady_tick(std::time::Duration::from_millis(200));
         bar.set_message("opening the log");
         bar
     });
-    let result = replay_recorded(&log, &compensation, &sinks, &stop, bar.as_ref());
+    let report = execute(&request, &stop_flag(), bar.as_ref());
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
-    let mut summary = match result {
-        Ok(s) => s,
-        Err(e) => {
-            sinks.abandon();
-            return Err(e.into());
-        }
-    };
-    let saved = sinks.finish()?;
-    (summary.recording_path, summary.recording_bytes) = saved.recording_fields();
-    out!("{}", summary.text());
-    if let Some(path) = &args.summary_json {
-        write_json("--summary-json", path, &summary)?;
-    }
-    print_saved(&saved)?;
-    if summary.interrupted {
+    let report = report?;
+    out!("{}", report.summary.text());
+    print_saved(&report.saved)?;
+    if report.summary.interrupted {
         return Err(Failure::interrupted("the recording is complete up to that moment"));
-    }
-    Ok(())
-}
-
-/// `rinscope calibrate --log DIR`.
-pub(super) fn calibrate_log(args: &CalibrateArgs, dir: &Path) -> Result<(), Failure> {
-    let log = logset::load(dir)?;
-    if log.table.strapdown {
-        return Err(Failure::input(format!("calibrate --log: {} has no table description with [turntable] (log.table): there is no table to calibrate", dir.display())));
-    }
-    check_output_dir("--json", args.json.as_deref())?;
-    let stop = stop_flag();
-    let started = std::time::Instant::now();
-    let (cal, report, data, traces) = calibration::calibrate_log(&log, !args.no_recording, &stop).map_err(|e| match e {
-        LogCalibrationError::Interrupted => Failure::interrupted("calibrate --log did not finish; nothing was estimated"),
-        LogCalibrationError::Calibration(c) => Failure::calibration("calibrate --log", c, "calibrate --log did not finish; nothing was estimated"),
-        other => Failure::input(format!("calibrate --log: {other}")),
-    })?;
-    out!("{}", report.text());
-    outln!("({:.2} s wall: {} measurements of {}, filter and least squares; before/after on the same data)", started.elapsed().as_secs_f64(), data.samples.len(), dir.display());
-    if let Some(path) = &args.json {
-        let compensation = estimated_compensation(&log.table.chain, &cal, &log.table.compensation);
-        write_json("--json", path, &CalibrationOutput { report: &report, estimated_compensation: compensation })?;
-    }
-    if !args.no_recording {
-        let params = log.recording_params(data.samples.last_t_s().max(1.0))?;
-        let default_save = PathBuf::from("recordings").join(format!("{}-calibration.rrd", log.name));
-        let sinks = open_sinks(args.sinks.request(default_save)?, &format!("{}-calibration", log.name))?;
-        let logged = crate::record::calibration::log(sinks.stream(), &params, &cal, &report, &traces).and_then(|mut r| r.finish());
-        if let Err(e) = logged {
-            sinks.abandon();
-            return Err(Failure::run(format!("rerun: {e}")));
-        }
-        print_saved(&sinks.finish()?)?;
     }
     Ok(())
 }

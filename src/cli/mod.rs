@@ -34,7 +34,9 @@ use std::process::ExitCode;
 use clap::{Args, Parser, Subcommand};
 
 use crate::record::export::ExportFormat;
-use crate::record::sink::{self, SinkError, SinkRequest};
+pub(crate) use crate::app::failure::Failure;
+use crate::app::outputs::RecordingRequest;
+use crate::record::sink::{self, SinkRequest};
 use crate::scenario::{self, presets, ConfigError, Params};
 
 #[derive(Parser)]
@@ -181,15 +183,15 @@ impl SinkArgs {
         }
     }
 
-    /// The request, with `default_save` when no viewer was asked for.
-    fn request(&self, default_save: PathBuf) -> Result<SinkRequest, Failure> {
-        let save = self.save.clone().or_else(|| (!self.viewer_asked() || self.figures.is_some()).then_some(default_save));
+    /// Where the command's recording goes: saved under `recordings/` by default when no viewer
+    /// was asked for (or `--figures`, which draws from the saved file).
+    fn recording(&self) -> Result<RecordingRequest, Failure> {
         let export = self.export_request()?;
         if self.bind.is_some() && self.serve.is_none() && self.serve_web.is_none() {
             return Err(Failure::input("--bind ADDR goes with --serve or --serve-web"));
         }
-        Ok(SinkRequest {
-            save,
+        let sinks = SinkRequest {
+            save: self.save.clone(),
             spawn: self.spawn,
             connect: self.connect.clone(),
             serve: self.serve,
@@ -200,7 +202,8 @@ impl SinkArgs {
             figures: self.figures.clone(),
             stop_on_failure: Some(crate::app::terminate::stop_flag()),
             tables_in_memory: false,
-        })
+        };
+        Ok(RecordingRequest { sinks, save_by_default: !self.viewer_asked() || self.figures.is_some() })
     }
 }
 
@@ -522,74 +525,6 @@ struct SelfcalArgs {
     /// Write the result (estimates, 1σ, truth, observability, Monte Carlo) as JSON.
     #[arg(long)]
     json: Option<PathBuf>,
-}
-
-/// A failure with the exit code it deserves (the policy in the module docs): every command maps
-/// its errors through these constructors, never through a code of its own.
-struct Failure {
-    code: u8,
-    message: String,
-}
-
-impl Failure {
-    /// Bad input (exit 2): arguments, configuration, a log set's files or data.
-    fn input(message: impl Into<String>) -> Self {
-        Self { code: 2, message: message.into() }
-    }
-
-    /// The run failed though its input was good (exit 1): an output, a viewer, a disagreement.
-    fn run(message: impl Into<String>) -> Self {
-        Self { code: 1, message: message.into() }
-    }
-
-    /// Stopped before the end by a signal (exit 128 + the signal: 130, 143, 129).
-    fn interrupted(message: impl Into<String>) -> Self {
-        let by = crate::app::terminate::stop_reason().unwrap_or("a stop request");
-        Self { code: crate::app::terminate::interrupted_exit_code(), message: format!("interrupted by {by}: {}", message.into()) }
-    }
-
-    /// An output file `flag` names that could not be written: exit 1 when writing failed (disk
-    /// full, permission), 2 when the path itself cannot be used (a directory, a symlinked partial,
-    /// an input of the run, another run writing it).
-    fn output(flag: &str, e: &crate::io::files::OutputError) -> Self {
-        let message = format!("{flag} {e}");
-        match e {
-            crate::io::files::OutputError::Io { .. } => Self::run(message),
-            _ => Self::input(message),
-        }
-    }
-
-    /// A calibration that did not end (`calibrate`, `calibrate --log`, `montecarlo`): cut short by a
-    /// signal, or refused because of its input — a table without axes, data the estimators cannot
-    /// use (singular normal equations), a log set's unreadable or bad data.
-    fn calibration(command: &str, e: crate::calib::CalibError, interrupted: &str) -> Self {
-        match e {
-            crate::calib::CalibError::Interrupted => Self::interrupted(interrupted),
-            e => Self::input(format!("{command}: {e}")),
-        }
-    }
-}
-
-impl From<ConfigError> for Failure {
-    fn from(e: ConfigError) -> Self {
-        Self::input(format!("config error: {e}"))
-    }
-}
-
-impl From<SinkError> for Failure {
-    fn from(e: SinkError) -> Self {
-        let code = match e {
-            SinkError::Rerun(_) | SinkError::Spawn(_) | SinkError::Write(_) | SinkError::ExportWrite(_) | SinkError::FiguresWrite(_) => 1,
-            _ => 2,
-        };
-        Self { code, message: e.to_string() }
-    }
-}
-
-impl From<anyhow::Error> for Failure {
-    fn from(e: anyhow::Error) -> Self {
-        Self::run(format!("{e:#}"))
-    }
 }
 
 /// Parses the command line, runs the command, maps its outcome to an exit code.

@@ -14,7 +14,7 @@ cd "$work"
 norm() {  # norm NAME FILE: the document without what differs between runs of the same input
   python3 - "$2" "$out/$1.json" <<'EOF'
 import json, re, sys
-VARIES = re.compile(r"(wall|rss|elapsed|recording_path|recording_bytes|threads|_per_s$|speed|cpu)", re.I)
+VARIES = re.compile(r"(wall|rss|elapsed|recording_path|recording_bytes|threads|per_s$|per_second|speed|cpu|^analysis_s$|^gather_s$|^estimation_s$)", re.I)
 def clean(v):
     if isinstance(v, dict):
         return {k: clean(x) for k, x in v.items() if not VARIES.search(k)}

@@ -6,6 +6,7 @@
 
 pub mod edit;
 pub mod panel;
+mod command;
 mod session;
 pub mod watch;
 pub mod web;
@@ -22,6 +23,7 @@ use crate::record::{LiveOutput, Recorder, Stream};
 use crate::scenario::{Params, RawConfig};
 use crate::ins::pipeline::InsView;
 use crate::sim::StepOutput;
+pub use command::{execute, LiveReport, LiveRequest};
 pub use session::{describe_changes, LiveSim};
 use watch::WatchEvent;
 

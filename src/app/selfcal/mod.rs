@@ -4,6 +4,9 @@
 //! the sequence can see) is computed before, on the sequence's noise-free motion; a Monte Carlo
 //! over random IMUs checks the reported 1σ against the spread.
 
+mod command;
+pub use command::{execute, SelfcalInput, SelfcalReport, SelfcalRequest};
+
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{anyhow, bail, Result};

@@ -2,6 +2,9 @@
 //! from a scenario's `[imu]`, or read from a log set — and analysed the IEEE way (`ins::allan`,
 //! docs/allan.md). Memory: 8 bytes per sample and channel (10 h at 200 Hz: 346 MB).
 
+mod command;
+pub use command::{execute, AllanCommand, AllanReport, AllanSource};
+
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 

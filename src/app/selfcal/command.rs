@@ -1,0 +1,126 @@
+//! `selfcal`'s one owner: what the command line and Python both ask for, the outputs checked up
+//! front, the estimate, its document and its recording.
+
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use super::{calibrate, check_navigate_hours, estimates_document, estimates_table, plan, run_log, setup, SequenceChoice, JSON_UNITS};
+use crate::app::failure::Failure;
+use crate::app::outputs::{check_output, logged, write_json, RecordingName, RecordingRequest};
+use crate::record::selfcal::SelfcalView;
+use crate::record::sink::Saved;
+use crate::scenario::logset::LogSet;
+use crate::scenario::Params;
+
+/// What `selfcal` calibrates.
+pub enum SelfcalInput {
+    /// A scenario's IMU on its gimbals, simulated.
+    Scenario {
+        /// The scenario.
+        params: Box<Params>,
+        /// The sequence.
+        sequence: SequenceChoice,
+        /// Also this many random IMUs.
+        monte_carlo: Option<usize>,
+        /// The free-inertial comparison's length, h (0: none).
+        navigate_hours: f64,
+        /// Only the plan (what the sequence can see).
+        plan_only: bool,
+    },
+    /// A log set of a sequence run on a real table.
+    Log(Box<LogSet>),
+}
+
+/// `rinscope selfcal` (and Python's `selfcal`).
+pub struct SelfcalRequest {
+    /// What to calibrate.
+    pub input: SelfcalInput,
+    /// The recording's sinks; `None`: no recording.
+    pub recording: Option<RecordingRequest>,
+    /// `--json`.
+    pub json: Option<PathBuf>,
+}
+
+/// What `selfcal` reports.
+pub struct SelfcalReport {
+    /// The result as a user reads it (empty for a plan).
+    pub text: String,
+    /// The `--json` document.
+    pub document: serde_json::Value,
+    /// The recording kept.
+    pub saved: Option<Saved>,
+}
+
+/// `selfcal`'s one owner.
+///
+/// # Errors
+/// Bad input, an output that cannot be written, a stop before anything was estimated.
+pub fn execute(req: &SelfcalRequest, stop: &AtomicBool) -> Result<SelfcalReport, Failure> {
+    check_output("--json", req.json.as_deref())?;
+    let interrupted = |command: &str, e: anyhow::Error| if stop.load(Ordering::SeqCst) { Failure::interrupted("nothing was estimated") } else { Failure::run(format!("{command}: {e:#}")) };
+    let (text, document, view_of) = match &req.input {
+        SelfcalInput::Scenario { params, sequence, monte_carlo, navigate_hours, plan_only } => {
+            check_navigate_hours(*navigate_hours).map_err(|e| Failure::input(format!("--navigate-hours {e}")))?;
+            let setup = setup(params, *sequence).map_err(|e| Failure::input(format!("{e:#}")))?;
+            let plan = plan(&setup, params.meta.seed, stop).map_err(|e| interrupted("selfcal", e))?;
+            if *plan_only || !plan.unobservable.is_empty() || !plan.weak.is_empty() {
+                let list = |v: &Vec<String>| if v.is_empty() { "none".to_owned() } else { v.join(", ") };
+                errln!("rinscope selfcal: plan for {}: not observable: {}; weakly observable: {}", setup.sequence, list(&plan.unobservable), list(&plan.weak));
+                for a in &plan.aliased {
+                    errln!("rinscope selfcal: aliased: {a}");
+                }
+            }
+            if *plan_only {
+                let document = serde_json::json!({ "sequence": setup.sequence, "observability": plan });
+                if let Some(path) = &req.json {
+                    write_json("--json", path, &document)?;
+                }
+                return Ok(SelfcalReport { text: String::new(), document, saved: None });
+            }
+            let sinks = req.recording.as_ref().map(|r| r.open(RecordingName { name: &params.meta.name, kind: Some("selfcal"), seed: Some(params.meta.seed) })).transpose()?;
+            // The IMU's calibration, the Monte Carlo and the free-inertial comparison; on a
+            // failure the sinks are dropped unfinished (abandoned).
+            let report = calibrate(params, setup, plan, *monte_carlo, *navigate_hours, stop).map_err(|e| interrupted("selfcal", e))?;
+            let saved = match sinks {
+                Some(s) => {
+                    logged(crate::record::selfcal::log(&s.stream(), &report.view(&params.meta.name)))?;
+                    Some(s.finish()?)
+                }
+                None => None,
+            };
+            (report.table.clone(), report.json(), saved)
+        }
+        SelfcalInput::Log(log) => {
+            let sinks = req.recording.as_ref().map(|r| r.open(RecordingName { name: &log.name, kind: Some("selfcal"), seed: None })).transpose()?;
+            let (estimate, estimation_s) = run_log(log, stop).map_err(|e| if stop.load(Ordering::SeqCst) { Failure::interrupted("nothing was estimated") } else { Failure::input(format!("selfcal --log: {e:#}")) })?;
+            let seen = crate::ins::selfcal::observability(&estimate);
+            let hours = estimate.history.last().map_or(0.0, |r| r.t_s) / 3600.0;
+            let head = format!("self-calibration of the log set {}: {hours:.2} h at {:.0} Hz; estimated in {estimation_s:.2} s (no truth: a log)", log.dir.display(), log.imu.rate_hz);
+            let text = estimates_table(format!("{head}\n\n"), &estimate, None, &seen, &[], None);
+            let names = crate::ins::selfcal::param_names();
+            let document = serde_json::json!({ "log": log.dir.display().to_string(), "parameters": names, "units": JSON_UNITS, "estimate": estimate.params, "sigma": estimate.sigma, "estimation_s": estimation_s, "observability": seen });
+            let saved = match sinks {
+                Some(s) => {
+                    let view = SelfcalView {
+                        title: format!("log set {}", log.name),
+                        document: &estimates_document(&head, &estimate, None, &seen, &[], None),
+                        history: &estimate.history,
+                        prior: &estimate.prior,
+                        truth: None,
+                        move_starts_s: &[],
+                        attitude: &[],
+                        navigation: Vec::new(),
+                    };
+                    logged(crate::record::selfcal::log(&s.stream(), &view))?;
+                    Some(s.finish()?)
+                }
+                None => None,
+            };
+            (text, document, saved)
+        }
+    };
+    if let Some(path) = &req.json {
+        write_json("--json", path, &document)?;
+    }
+    Ok(SelfcalReport { text, document, saved: view_of })
+}
