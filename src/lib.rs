@@ -3,16 +3,23 @@
 //! Layers, lowest first; a module imports only the layers above it in this list (enforced by
 //! `tests/layers.rs`), and only `record` imports Rerun:
 //!
-//! 0. [`math`], [`io`] — frames and typed rotations, units, attitude, noise, statistics, the
-//!    sampling rule; atomic output files and the one rule for opening inputs (`io::files`).
-//! 1. [`model`] — the gimbal chain with its exact errors, rotation schemes, vehicle motion, Earth.
-//! 2. [`sim`] — the turntable step: truth, encoders, three demodulations (pure).
-//! 3. [`ins`], [`calib`] — the INS in the loop (IMU truth, sensors, algorithms, navigation,
-//!    resets) and the calibration estimators; each takes the parameter struct it owns.
-//! 4. [`scenario`] — the only code that knows the TOML: raw structs, validation, presets.
-//! 5. [`record`] — the only door to Rerun: entity tree, series, layout, sinks; it never steps a model.
-//! 6. [`app`] — the commands' orchestration: threads, channels, progress, files.
-//! 7. [`cli`] — clap, the sink flags declared once, exit codes.
+//! 0. [`math`] — frames and typed rotations, units and the physical constants (each defined
+//!    once), attitude, noise, statistics, the sampling rule.
+//! 1. [`io`] — the file formats read and written, atomic output files and the one rule for
+//!    opening inputs (`io::files`), the plausibility of a log's numbers.
+//! 2. [`model`] — the gimbal chain with its exact errors, rotation schemes, vehicle motion, Earth.
+//! 3. [`sim`] — the turntable step: truth, encoders, three demodulations (pure).
+//! 4. [`ins`], [`calib`] — the INS in the loop (IMU truth, sensors, algorithms, navigation,
+//!    resets, self-calibration) and the table's calibration estimators; each takes the parameter
+//!    struct it owns.
+//! 5. [`scenario`] — the only code that knows the TOML: raw structs, validation, presets, log sets.
+//! 6. [`record`] — the only door to Rerun: entity tree, series, layout, sinks; it never steps a model.
+//! 7. [`app`] — one owner per command: each command is one function taking a request and a stop
+//!    flag and returning a report (`app::run::execute`, `app::calibrate::execute`, ...), with one
+//!    termination policy (`app::failure`) and one way to open, check and write outputs
+//!    (`app::outputs`); threads, channels and progress live here.
+//! 8. [`cli`] — clap: arguments into requests, reports into text, failures into exit codes
+//!    (`python/` does the same for Python).
 
 /// `print!` for what a command outputs: stdout may be a pipe whose reader has gone
 /// (`rinscope scenarios | head -5`); see [`app::terminate::write_stdout`].

@@ -5,8 +5,7 @@
 
 mod common;
 use common::{rinscope, scratch, stderr};
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
 
 use serde_json::Value;
 

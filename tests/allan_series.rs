@@ -9,16 +9,16 @@
 // The io tests' own writers (hand-written .npy, the parquet crate's ArrowWriter); test helpers unwrap.
 #[allow(dead_code, clippy::unwrap_used)]
 #[path = "io/common.rs"]
-mod common;
+mod writers;
 
 mod common;
 use common::{rinscope, scratch};
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
+use std::process::Output;
 
 use serde_json::Value;
 
-use common::nbs14_1000;
+use writers::nbs14_1000;
 
 fn text(o: &Output) -> String {
     format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
@@ -100,7 +100,7 @@ fn the_same_set_as_a_phase_record_in_npy_with_a_time_column_gives_the_same_curve
         x += y * 1e9;
         rows.push(vec![x, (k + 1) as f64 * 1000.0]);
     }
-    common::write_npy(&npy, &rows, "<f8");
+    writers::write_npy(&npy, &rows, "<f8");
     let (j, _) = analyse(&dir, &["--series", npy.to_str().expect("utf-8"), "--column", "0:phase:ns", "--time-column", "1:ms", "--estimator", "all", "--taus", "decade"]);
     assert_eq!(j["samples"].as_u64(), Some(1000), "1001 phase points are 1000 intervals");
     // Summing in ns then scaling back costs a few ulps of the phase: 1e-9 would still be exact
@@ -113,7 +113,7 @@ fn the_9_point_set_is_analysed_as_far_as_each_estimator_is_defined() {
     // Nine samples: no 16-sample minimum. The published τ = 1 and 2 values (SP 1065 Table 31).
     let dir = scratch("nbs9");
     let pq = dir.join("nbs9.parquet");
-    common::write_parquet(&pq, &["f"], &NBS14_9.iter().map(|v| vec![*v]).collect::<Vec<_>>(), None, 4);
+    writers::write_parquet(&pq, &["f"], &NBS14_9.iter().map(|v| vec![*v]).collect::<Vec<_>>(), None, 4);
     let (j, out) = analyse(&dir, &["--series", pq.to_str().expect("utf-8"), "--column", "f:frequency", "--rate-hz", "1", "--estimator", "all", "--taus", "all"]);
     let published = [("adev", 91.22945, 115.8082), ("oadev", 91.22945, 85.95287), ("mdev", 91.22945, 74.78849), ("tdev", 52.67135, 86.35831), ("hdev", 70.80608, 116.7980), ("ohdev", 70.80607, 85.61487), ("totdev", 91.22945, 93.90379)];
     for (est, d1, d2) in published {

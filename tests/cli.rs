@@ -5,7 +5,6 @@
 mod common;
 use common::{rinscope, scratch, stderr};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 const PRESET: &str = include_str!("../assets/scenarios/jiang2017-dual-axis.toml");
 

@@ -8,12 +8,11 @@
 // The io tests' helpers (the NBS14 set); test helpers unwrap.
 #[allow(dead_code, clippy::unwrap_used)]
 #[path = "io/common.rs"]
-mod common;
+mod writers;
 
 mod common;
 use common::{rinscope, scratch};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 
 /// SP 1065 p. 108: OADEV at τ = 1, 10, 100 s.
@@ -38,7 +37,7 @@ fn circles(svg: &str) -> Vec<(f64, f64)> {
 fn allan_figures_have_logarithmic_axes_that_place_the_published_values() {
     let dir = scratch("allan");
     let csv = dir.join("nbs14.csv");
-    let body: String = common::nbs14_1000().iter().map(|y| format!("{y}\n")).collect();
+    let body: String = writers::nbs14_1000().iter().map(|y| format!("{y}\n")).collect();
     std::fs::write(&csv, format!("y\n{body}")).expect("csv");
     let figs = dir.join("figs");
     let o = rinscope()

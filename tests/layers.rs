@@ -9,15 +9,15 @@ use std::path::{Path, PathBuf};
 /// Layers, lowest first; modules of one rank are peers and may not import each other.
 const LAYERS: &[(&str, u32)] = &[
     ("math", 0),
-    ("io", 0),
-    ("model", 1),
-    ("sim", 2),
-    ("ins", 3),
-    ("calib", 3),
-    ("scenario", 4),
-    ("record", 5),
-    ("app", 6),
-    ("cli", 7),
+    ("io", 1),
+    ("model", 2),
+    ("sim", 3),
+    ("ins", 4),
+    ("calib", 4),
+    ("scenario", 5),
+    ("record", 6),
+    ("app", 7),
+    ("cli", 8),
 ];
 
 /// A source file longer than this is a god file in the making: split it by responsibility.
@@ -27,15 +27,79 @@ fn rank(module: &str) -> Option<u32> {
     LAYERS.iter().find(|(m, _)| *m == module).map(|(_, r)| *r)
 }
 
-/// The shipped part of a file: everything before its first `#[cfg(test)]`.
-fn shipped(text: &str) -> &str {
-    text.find("#[cfg(test)]").map_or(text, |i| &text[..i])
+/// The shipped part of a file: the file without each `#[cfg(test)]` item (a `mod tests;` line,
+/// a `use`, or a braced block up to its matching brace). Code after a test module still counts.
+fn shipped(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(i) = rest.find("#[cfg(test)]") {
+        out.push_str(&rest[..i]);
+        let item = &rest[i + "#[cfg(test)]".len()..];
+        // The item ends at the first `;` before any `{`, else at the brace matching the first `{`.
+        let (semi, brace) = (item.find(';'), item.find('{'));
+        let end = match (semi, brace) {
+            (Some(s), Some(b)) if s < b => s + 1,
+            (Some(s), None) => s + 1,
+            (_, Some(b)) => {
+                let mut depth = 0usize;
+                let mut end = item.len();
+                for (k, c) in item[b..].char_indices() {
+                    match c {
+                        '{' => depth += 1,
+                        '}' => {
+                            depth -= 1;
+                            if depth == 0 {
+                                end = b + k + 1;
+                                break;
+                            }
+                        }
+                        _ => {}
+                    }
+                }
+                end
+            }
+            (None, None) => item.len(),
+        };
+        // Keep the line count: the item's lines become empty lines.
+        out.push_str(&"\n".repeat(item[..end].matches('\n').count()));
+        rest = &item[end..];
+    }
+    out.push_str(rest);
+    out
+}
+
+/// The top-level modules a `crate::` path names, from the text right after `crate::`: one ident,
+/// or each first segment of a group `{a::x, b::{y, z}}` (which may span lines).
+fn crate_targets(after: &str) -> Vec<String> {
+    let ident = |t: &str| t.chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect::<String>();
+    let Some(group) = after.strip_prefix('{') else { return vec![ident(after)] };
+    let mut targets = Vec::new();
+    let (mut depth, mut start) = (1usize, 0usize);
+    for (k, c) in group.char_indices() {
+        match c {
+            '{' => depth += 1,
+            '}' | ',' if depth == 1 => {
+                let t = ident(group[start..k].trim_start());
+                if !t.is_empty() {
+                    targets.push(t);
+                }
+                start = k + 1;
+                if c == '}' {
+                    break;
+                }
+            }
+            '}' => depth -= 1,
+            _ => {}
+        }
+    }
+    targets
 }
 
 /// The violations in one file of top-level module `module` (None: the crate root or the binary).
 fn violations(file: &str, module: Option<&str>, text: &str) -> Vec<String> {
     let mut out = Vec::new();
     let code = shipped(text);
+    let code = code.as_str();
     let lines = text.lines().count();
     if lines > MAX_LINES {
         out.push(format!("{file}: {lines} lines (at most {MAX_LINES}); split it by responsibility"));
@@ -56,15 +120,15 @@ fn violations(file: &str, module: Option<&str>, text: &str) -> Vec<String> {
         out.push(format!("{file}: top-level module `{module}` has no layer in tests/layers.rs"));
         return out;
     };
-    for (n, line) in code.lines().enumerate() {
-        let l = line.trim_start();
-        if l.starts_with("//") {
-            continue;
-        }
-        let mut rest = l;
-        while let Some(i) = rest.find("crate::") {
-            rest = &rest[i + "crate::".len()..];
-            let target: String = rest.chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
+    // Comments out, line numbers kept; a group may span lines, so the text is searched whole.
+    let uncommented: String = code.lines().map(|l| if l.trim_start().starts_with("//") { "" } else { l }).collect::<Vec<_>>().join("\n");
+    let mut from = 0;
+    while let Some(i) = uncommented[from..].find("crate::") {
+        let at = from + i;
+        from = at + "crate::".len();
+        let n = uncommented[..at].matches('\n').count();
+        let l = uncommented.lines().nth(n).unwrap_or("").trim_start();
+        for target in crate_targets(&uncommented[from..]) {
             if target == module || target.is_empty() {
                 continue;
             }
@@ -124,6 +188,12 @@ fn the_checker_sees_what_it_must_refuse() {
     assert_eq!(violations("app/x.rs", Some("app"), "let s: rerun::RecordingStream;\n").len(), 1);
     assert_eq!(violations("record/x.rs", Some("record"), "use rerun::Color;\n").len(), 0);
     assert_eq!(violations("sim/x.rs", Some("sim"), "// crate::app is above\n#[cfg(test)]\nuse crate::scenario::presets;\n").len(), 0);
+    // Grouped imports, on one line or several, name each module they import.
+    assert_eq!(violations("model/x.rs", Some("model"), "use crate::{math::units, sim::Model};\n").len(), 1, "grouped");
+    assert_eq!(violations("model/x.rs", Some("model"), "use crate::{\n    math::{units, frames},\n    app::run,\n    record::Recorder,\n};\n").len(), 2, "grouped over lines");
+    // Code after a test module is shipped code.
+    assert_eq!(violations("sim/x.rs", Some("sim"), "#[cfg(test)]\nmod tests;\nuse crate::app::run;\n").len(), 1, "after mod tests;");
+    assert_eq!(violations("sim/x.rs", Some("sim"), "#[cfg(test)]\nmod tests {\n    use crate::app::run;\n    fn f() { if true { } }\n}\nuse crate::record::Recorder;\n").len(), 1, "after a test block");
     let long = "let x = 1;\n".repeat(MAX_LINES + 1);
     assert_eq!(violations("math/x.rs", Some("math"), &long).len(), 1);
 }

@@ -5,7 +5,7 @@
 
 mod common;
 use common::scratch;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 use rinscope::record::read::{plot_frames, PlotFrame};

@@ -8,8 +8,8 @@ mod common;
 use common::{rinscope, scratch, stderr, stdout};
 use std::f64::consts::PI;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
+use std::process::Output;
 
 fn ok(o: &Output) {
     assert!(o.status.success(), "exit {:?}: {}{}", o.status.code(), stderr(o), stdout(o));

@@ -3,8 +3,6 @@
 
 mod common;
 use common::{rinscope, scratch};
-use std::path::PathBuf;
-use std::process::Command;
 
 /// The JSON without the fields that measure the machine, not the result.
 fn without_wall_clock(path: &std::path::Path) -> serde_json::Value {

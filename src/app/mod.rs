@@ -1,4 +1,4 @@
-//! Layer 6, the commands' orchestration: a recorded run (simulation thread → channel → recorder),
+//! Layer 7, one owner per command (each `execute(request, stop) -> report`): a recorded run (simulation thread → channel → recorder),
 //! live mode, calibration and its Monte Carlo, the position-reset comparison, rotation modulation,
 //! the paper reproductions and the benchmarks. Threads, channels, progress bars and files live
 //! here, above the pure layers and the recorder.

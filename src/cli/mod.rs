@@ -1,4 +1,4 @@
-//! Layer 7, the command line: clap's view of every command, the sink flags declared once and
+//! Layer 8, the command line: clap's view of every command, the sink flags declared once and
 //! flattened into each command that records, exit codes. `main` parses and dispatches; the
 //! commands' work is in [`commands`] and the layers below.
 //!

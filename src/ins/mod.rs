@@ -1,4 +1,4 @@
-//! Layer 3, the INS in the loop: IMU increments from the exact truth, sensor errors (constant ones,
+//! Layer 4, the INS in the loop: IMU increments from the exact truth, sensor errors (constant ones,
 //! white noise and the IEEE 952/1293 stochastic terms), dither and its FIR, coning-compensated
 //! attitude algorithms, strapdown navigation, position resets.
 

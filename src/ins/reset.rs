@@ -1,4 +1,4 @@
-//! Layer 2: position resets of a navigating INS at rest — the Twice Position-fix Reset estimator of
+//! Layer 4 (ins): position resets of a navigating INS at rest — the Twice Position-fix Reset estimator of
 //! Zheng et al. 2016 (§4, eq. 15-25) in rinscope's signs, its level-corrected extension, and the result of
 //! comparing them with the conventional reset (docs/tpr.md).
 //!

@@ -1,4 +1,4 @@
-//! Layer 0, files: tabular logs in and out — streaming column readers for CSV, NumPy .npy, Parquet,
+//! Layer 1, files (above `math`, whose units and constants it uses): tabular logs in and out — streaming column readers for CSV, NumPy .npy, Parquet,
 //! MCAP (ROS 2 `sensor_msgs/msg/Imu`) and PSINS SIMU `.imu` text ([`read_psins_header`]), IMU
 //! layouts with checked units and frames, atomic table writers — and outputs that a reader never
 //! sees half-written ([`files`]).

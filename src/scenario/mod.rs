@@ -1,4 +1,4 @@
-//! Layer 4, the scenario: the only code that knows the TOML. The file is parsed strictly
+//! Layer 5, the scenario: the only code that knows the TOML. The file is parsed strictly
 //! ([`raw`]), validated once and converted once into SI [`Params`] made of the lower layers' own
 //! parameter structs ([`validate`], [`instruments`]); [`presets`] embeds the shipped scenarios.
 //!

@@ -1,4 +1,4 @@
-//! Layer 2, the turntable step: truth, encoders, and the body attitude error of three
+//! Layer 3, the turntable step: truth, encoders, and the body attitude error of three
 //! demodulations.
 //!
 //! Pure: `step(&Model, &mut DemodState, t)` knows nothing of Rerun, files or threads.

@@ -16,6 +16,10 @@ use crate::scenario::{self, Params};
 /// produces two events microseconds apart, and the empty file between them must not be reported.
 pub const DEBOUNCE: Duration = Duration::from_millis(15);
 
+/// How long an empty file waits for the write that follows its truncation before it is reported:
+/// on a loaded machine the two halves of a save can be further apart than [`DEBOUNCE`].
+const EMPTY_GRACE: Duration = Duration::from_secs(1);
+
 /// What a save produced.
 #[derive(Debug)]
 pub enum WatchEvent {
@@ -68,15 +72,28 @@ pub fn watch(path: &Path, initial_text: String, tx: Sender<WatchEvent>) -> notif
     Ok(Watcher { _notify: w, _debounce: debounce })
 }
 
+/// Whether another event arrives within [`EMPTY_GRACE`] (the write after a truncation).
+fn pending_write(pokes: &Receiver<Instant>) -> bool {
+    pokes.recv_timeout(EMPTY_GRACE).is_ok()
+}
+
 fn debounce_loop(path: &Path, initial_text: String, pokes: &Receiver<Instant>, tx: &Sender<WatchEvent>) {
     let origin = path.display().to_string();
     let mut last_text = Some(initial_text);
     let mut deleted = false;
     // An unreadable path (a directory, a FIFO, no permission) is reported once, not on every event.
     let mut last_error: Option<String> = None;
+    // A save whose first read found the file empty (its write still to come).
+    let mut pending: Option<Instant> = None;
     loop {
         // Wait for a save (or the watcher to go away).
-        let Ok(seen_at) = pokes.recv() else { return };
+        let seen_at = match pending.take() {
+            Some(t) => t,
+            None => match pokes.recv() {
+                Ok(t) => t,
+                Err(_) => return,
+            },
+        };
         // Then for quiet.
         loop {
             match pokes.recv_timeout(DEBOUNCE) {
@@ -105,6 +122,10 @@ fn debounce_loop(path: &Path, initial_text: String, pokes: &Receiver<Instant>, t
                 last_error = Some(message.clone());
                 last_text = None;
                 WatchEvent::Invalid { message, seen_at }
+            }
+            Ok(text) if text.is_empty() && pending_write(pokes) => {
+                pending = Some(seen_at);
+                continue;
             }
             Ok(text) => {
                 last_error = None;

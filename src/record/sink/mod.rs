@@ -115,7 +115,8 @@ pub struct SinkRequest {
     pub figures: Option<PathBuf>,
 }
 
-/// An open recording and the file it will become.
+/// An open recording and the file it will become. Dropped without [`OpenSinks::finish`] (a failed
+/// run returning early), it is abandoned: every sink closed and the partial file removed.
 pub struct OpenSinks {
     /// The stream to log into.
     rec: RecordingStream,
@@ -397,14 +398,6 @@ impl OpenSinks {
         }
         drop(rec);
         Ok(Saved { recording, exported, tables, viewer_problems, figures })
-    }
-
-    /// Closes every sink and deletes the partial file (the run failed).
-    pub fn abandon(self) {
-        let Self { rec, file, .. } = self;
-        drop(rec);
-        // Dropping the file unfinished removes its partial.
-        drop(file);
     }
 
     /// The path the recording will be saved to, if any.
