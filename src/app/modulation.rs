@@ -65,25 +65,6 @@ pub fn table(traces: &[NavTrace], wall_s: f64) -> String {
     s
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn rotation_averages_constant_biases_out() {
-        // The principle (Zheng et al. 2016 §1, Levinson & Majure 1987): with constant biases, turning the IMU
-        // modulates their effect. Over 6 h: the 16-position sequence keeps the position error two
-        // orders of magnitude below the static INS; azimuth rotation alone leaves the vertical gyro's
-        // bias, so its heading error stays of the static order.
-        let traces = simulate_variants(6.0, &AtomicBool::new(false)).expect("runs");
-        let (none, cont, sixteen) = (&traces[0], &traces[1], &traces[2]);
-        assert!(none.peak_radial_m() > 1000.0, "static INS: {} m", none.peak_radial_m());
-        assert!(sixteen.peak_radial_m() < none.peak_radial_m() / 50.0, "16-position {} m vs static {} m", sixteen.peak_radial_m(), none.peak_radial_m());
-        assert!(cont.peak_radial_m() < none.peak_radial_m(), "continuous {} m", cont.peak_radial_m());
-        assert!(sixteen.peak_heading_arcsec() < none.peak_heading_arcsec() / 20.0);
-        assert!(cont.peak_heading_arcsec() > none.peak_heading_arcsec() / 3.0, "the azimuth gyro is not modulated by azimuth rotation");
-    }
-}
 
 /// What `modulation` reports.
 pub struct ModulationReport {
@@ -115,4 +96,24 @@ pub fn execute(hours: f64, recording: &RecordingRequest, stop: &AtomicBool) -> R
     }
     logged(crate::record::modulation::log(&sinks.stream(), &traces, &text))?;
     Ok(ModulationReport { table: text, saved: sinks.finish()?, interrupted })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rotation_averages_constant_biases_out() {
+        // The principle (Zheng et al. 2016 §1, Levinson & Majure 1987): with constant biases, turning the IMU
+        // modulates their effect. Over 6 h: the 16-position sequence keeps the position error two
+        // orders of magnitude below the static INS; azimuth rotation alone leaves the vertical gyro's
+        // bias, so its heading error stays of the static order.
+        let traces = simulate_variants(6.0, &AtomicBool::new(false)).expect("runs");
+        let (none, cont, sixteen) = (&traces[0], &traces[1], &traces[2]);
+        assert!(none.peak_radial_m() > 1000.0, "static INS: {} m", none.peak_radial_m());
+        assert!(sixteen.peak_radial_m() < none.peak_radial_m() / 50.0, "16-position {} m vs static {} m", sixteen.peak_radial_m(), none.peak_radial_m());
+        assert!(cont.peak_radial_m() < none.peak_radial_m(), "continuous {} m", cont.peak_radial_m());
+        assert!(sixteen.peak_heading_arcsec() < none.peak_heading_arcsec() / 20.0);
+        assert!(cont.peak_heading_arcsec() > none.peak_heading_arcsec() / 3.0, "the azimuth gyro is not modulated by azimuth rotation");
+    }
 }

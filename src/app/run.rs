@@ -481,6 +481,47 @@ impl Producer<'_> {
     }
 }
 
+
+/// `rinscope run` (and Python's `run`): the scenario and where its outputs go.
+pub struct RunRequest {
+    /// The scenario.
+    pub params: Params,
+    /// The recording's sinks.
+    pub recording: RecordingRequest,
+    /// `--summary-json`.
+    pub summary_json: Option<std::path::PathBuf>,
+    /// A progress bar on a terminal's stderr.
+    pub progress: bool,
+}
+
+/// What `run` reports: the summary (its recording's path and size filled in) and what was kept.
+pub struct RunReport {
+    /// The summary, as `--summary-json` writes it.
+    pub summary: RunSummary,
+    /// The recording, tables and figures kept.
+    pub saved: crate::record::sink::Saved,
+}
+
+/// `run`'s one owner: the outputs checked, the simulation streamed to its sinks, the summary.
+///
+/// # Errors
+/// A sink or output that cannot be opened or written; nothing kept the data.
+pub fn execute(req: &RunRequest, stop: &AtomicBool) -> Result<RunReport, Failure> {
+    let params = &req.params;
+    // The summary file is checked before anything runs, so a typo costs nothing.
+    check_output("--summary-json", req.summary_json.as_deref())?;
+    let sinks = req.recording.open(RecordingName { name: &params.meta.name, kind: None, seed: Some(params.meta.seed) })?;
+    let mut summary = run_recorded(params, &sinks, stop, req.progress)?;
+    let saved = sinks.finish()?;
+    (summary.recording_path, summary.recording_bytes) = saved.recording_fields();
+    summary.peak_rss_mb = crate::app::bench::peak_rss_bytes() as f64 / 1e6;
+    kept(&saved)?;
+    if let Some(path) = &req.summary_json {
+        write_json("--summary-json", path, &summary)?;
+    }
+    Ok(RunReport { summary, saved })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -540,44 +581,4 @@ mod tests {
         }
         Ok(())
     }
-}
-
-/// `rinscope run` (and Python's `run`): the scenario and where its outputs go.
-pub struct RunRequest {
-    /// The scenario.
-    pub params: Params,
-    /// The recording's sinks.
-    pub recording: RecordingRequest,
-    /// `--summary-json`.
-    pub summary_json: Option<std::path::PathBuf>,
-    /// A progress bar on a terminal's stderr.
-    pub progress: bool,
-}
-
-/// What `run` reports: the summary (its recording's path and size filled in) and what was kept.
-pub struct RunReport {
-    /// The summary, as `--summary-json` writes it.
-    pub summary: RunSummary,
-    /// The recording, tables and figures kept.
-    pub saved: crate::record::sink::Saved,
-}
-
-/// `run`'s one owner: the outputs checked, the simulation streamed to its sinks, the summary.
-///
-/// # Errors
-/// A sink or output that cannot be opened or written; nothing kept the data.
-pub fn execute(req: &RunRequest, stop: &AtomicBool) -> Result<RunReport, Failure> {
-    let params = &req.params;
-    // The summary file is checked before anything runs, so a typo costs nothing.
-    check_output("--summary-json", req.summary_json.as_deref())?;
-    let sinks = req.recording.open(RecordingName { name: &params.meta.name, kind: None, seed: Some(params.meta.seed) })?;
-    let mut summary = run_recorded(params, &sinks, stop, req.progress)?;
-    let saved = sinks.finish()?;
-    (summary.recording_path, summary.recording_bytes) = saved.recording_fields();
-    summary.peak_rss_mb = crate::app::bench::peak_rss_bytes() as f64 / 1e6;
-    kept(&saved)?;
-    if let Some(path) = &req.summary_json {
-        write_json("--summary-json", path, &summary)?;
-    }
-    Ok(RunReport { summary, saved })
 }

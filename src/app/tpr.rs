@@ -211,59 +211,6 @@ pub fn sweep(params: &Params, seeds: u64, stop: &AtomicBool) -> Result<Vec<Sweep
     rows
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::scenario::presets;
-
-    /// The preset with its text edited: `preset = "none"` removes every sensor error.
-    fn preset_with(edits: &[(&str, &str)]) -> Params {
-        let mut text = presets::text("zheng2016-tpr").expect("preset").to_owned();
-        for (from, to) in edits {
-            assert!(text.contains(from), "{from}");
-            text = text.replacen(from, to, 1);
-        }
-        crate::scenario::parse(&text, "test").expect("valid")
-    }
-
-    #[test]
-    fn without_stochastic_errors_tpr_removes_the_azimuth_error() {
-        // Zheng et al. 2016 §4.3 without sensor noise (initial heading error 1′ only), at 25 Hz to keep the
-        // test short. The paper's estimator assumes zero level errors (its assumption a); velocity
-        // damping leaves ~1″ of tilt, so its estimate is within 15 % of the true heading error, not
-        // exact. With the level errors read from the velocity the same equations leave no residual
-        // azimuth error at the fix (within 2 % of it; docs/tpr.md). Conventional keeps all of it.
-        let p = preset_with(&[("preset = \"zheng2016\"", "preset = \"none\""), ("step_hz = 100.0", "step_hz = 25.0")]);
-        let r = compare_resets(&p, 600.0, &AtomicBool::new(false)).expect("runs");
-        let at_fix = r.heading_at_second_fix_arcsec;
-        assert!(at_fix.abs() > 3.0, "a deterministic azimuth error to correct: {at_fix}″");
-        let rel = |estimate: f64| (estimate - at_fix).abs() / at_fix.abs();
-        assert!(rel(r.tpr_heading_estimate_arcsec) < 0.15, "TPR estimate {}″ vs {at_fix}″", r.tpr_heading_estimate_arcsec);
-        assert!(rel(r.level_heading_estimate_arcsec) < 0.02, "TPR + level estimate {}″ vs {at_fix}″", r.level_heading_estimate_arcsec);
-        let first_after = r.samples.iter().find(|s| s.t_s > r.fixes_s[1]).expect("samples after the fix");
-        let [conventional, tpr, level] = first_after.heading_arcsec;
-        assert!((conventional - at_fix).abs() < 0.1, "conventional keeps it: {conventional}″");
-        assert!(tpr.abs() < 0.15 * at_fix.abs(), "TPR's residual {tpr}″");
-        assert!(level.abs() < 0.02 * at_fix.abs(), "TPR + level's residual {level}″");
-        let [conv, tpr, level] = r.peak_radial_after_m();
-        assert!(tpr < 0.3 * conv && level < 0.3 * conv, "radial: conventional {conv} m, TPR {tpr} m, TPR + level {level} m");
-        // The level errors read from the velocity against the INS's own tilts (the simulated truth,
-        // not the velocity equation inverted): docs/tpr.md reports agreement to 0.01″.
-        for (fix, (read, truth)) in r.level_errors_arcsec.iter().zip(&r.true_level_errors_arcsec).enumerate() {
-            for axis in 0..2 {
-                assert!(truth[axis].abs() > 0.1, "fix {fix}: a tilt to read ({truth:?}″)");
-                assert!((read[axis] - truth[axis]).abs() < 0.03, "fix {fix}, axis {axis}: read {read:?}″, true {truth:?}″");
-            }
-        }
-    }
-
-    #[test]
-    fn a_scenario_without_two_fixes_is_refused() {
-        let p = preset_with(&[("at_h = [17.0, 21.0]", "at_h = [17.0]")]);
-        let e = compare_resets(&p, 600.0, &AtomicBool::new(false)).expect_err("one fix");
-        assert!(e.to_string().contains("two fixes"), "{e}");
-    }
-}
 
 /// `rinscope tpr`: the scenario, where its outputs go, and how many seeds to sweep after it.
 pub struct TprRequest {
@@ -316,4 +263,58 @@ pub fn execute(req: &TprRequest, stop: &AtomicBool) -> Result<TprReport, Failure
         }
     }
     Ok(TprReport { text, saved, sweep: sweep_table, interrupted: !result.complete || stop.load(Ordering::SeqCst) })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::presets;
+
+    /// The preset with its text edited: `preset = "none"` removes every sensor error.
+    fn preset_with(edits: &[(&str, &str)]) -> Params {
+        let mut text = presets::text("zheng2016-tpr").expect("preset").to_owned();
+        for (from, to) in edits {
+            assert!(text.contains(from), "{from}");
+            text = text.replacen(from, to, 1);
+        }
+        crate::scenario::parse(&text, "test").expect("valid")
+    }
+
+    #[test]
+    fn without_stochastic_errors_tpr_removes_the_azimuth_error() {
+        // Zheng et al. 2016 §4.3 without sensor noise (initial heading error 1′ only), at 25 Hz to keep the
+        // test short. The paper's estimator assumes zero level errors (its assumption a); velocity
+        // damping leaves ~1″ of tilt, so its estimate is within 15 % of the true heading error, not
+        // exact. With the level errors read from the velocity the same equations leave no residual
+        // azimuth error at the fix (within 2 % of it; docs/tpr.md). Conventional keeps all of it.
+        let p = preset_with(&[("preset = \"zheng2016\"", "preset = \"none\""), ("step_hz = 100.0", "step_hz = 25.0")]);
+        let r = compare_resets(&p, 600.0, &AtomicBool::new(false)).expect("runs");
+        let at_fix = r.heading_at_second_fix_arcsec;
+        assert!(at_fix.abs() > 3.0, "a deterministic azimuth error to correct: {at_fix}″");
+        let rel = |estimate: f64| (estimate - at_fix).abs() / at_fix.abs();
+        assert!(rel(r.tpr_heading_estimate_arcsec) < 0.15, "TPR estimate {}″ vs {at_fix}″", r.tpr_heading_estimate_arcsec);
+        assert!(rel(r.level_heading_estimate_arcsec) < 0.02, "TPR + level estimate {}″ vs {at_fix}″", r.level_heading_estimate_arcsec);
+        let first_after = r.samples.iter().find(|s| s.t_s > r.fixes_s[1]).expect("samples after the fix");
+        let [conventional, tpr, level] = first_after.heading_arcsec;
+        assert!((conventional - at_fix).abs() < 0.1, "conventional keeps it: {conventional}″");
+        assert!(tpr.abs() < 0.15 * at_fix.abs(), "TPR's residual {tpr}″");
+        assert!(level.abs() < 0.02 * at_fix.abs(), "TPR + level's residual {level}″");
+        let [conv, tpr, level] = r.peak_radial_after_m();
+        assert!(tpr < 0.3 * conv && level < 0.3 * conv, "radial: conventional {conv} m, TPR {tpr} m, TPR + level {level} m");
+        // The level errors read from the velocity against the INS's own tilts (the simulated truth,
+        // not the velocity equation inverted): docs/tpr.md reports agreement to 0.01″.
+        for (fix, (read, truth)) in r.level_errors_arcsec.iter().zip(&r.true_level_errors_arcsec).enumerate() {
+            for axis in 0..2 {
+                assert!(truth[axis].abs() > 0.1, "fix {fix}: a tilt to read ({truth:?}″)");
+                assert!((read[axis] - truth[axis]).abs() < 0.03, "fix {fix}, axis {axis}: read {read:?}″, true {truth:?}″");
+            }
+        }
+    }
+
+    #[test]
+    fn a_scenario_without_two_fixes_is_refused() {
+        let p = preset_with(&[("at_h = [17.0, 21.0]", "at_h = [17.0]")]);
+        let e = compare_resets(&p, 600.0, &AtomicBool::new(false)).expect_err("one fix");
+        assert!(e.to_string().contains("two fixes"), "{e}");
+    }
 }
