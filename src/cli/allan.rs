@@ -118,7 +118,7 @@ pub(super) fn allan(args: &AllanArgs) -> Result<(), Failure> {
         }
         Source::Series(file, columns, sampling) => {
             errln!("rinscope: reading {} ...", file.display());
-            allan::series(file, columns, sampling, &request)
+            allan::series(file, columns, sampling, &request, &stop)
         }
         Source::Scenario(p) => {
             errln!("rinscope: simulating {:.2} h of {} at {} Hz, then the Allan analysis of 6 channels ...", p.duration_s / 3600.0, p.meta.name, p.step_hz);
