@@ -33,6 +33,8 @@ use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
 
+use crate::io::files::{check_output, OutputKind};
+use crate::io::validity::{self, check_number, Range};
 use crate::record::export::ExportFormat;
 use crate::record::sink::{self, SinkError, SinkRequest};
 use crate::scenario::{self, presets, ConfigError, Params};
@@ -98,7 +100,7 @@ enum Command {
     /// Measure speed and recording size.
     Bench {
         /// Steps of each pure-simulation repetition.
-        #[arg(long, default_value_t = 2_000_000)]
+        #[arg(long, default_value_t = 2_000_000, allow_negative_numbers = true, value_parser = |t: &str| count(t, 1, 1_000_000_000, "steps"))]
         steps: u64,
         /// Instead: measure against a peer, whole processes alternated on the same input (`pyins`:
         /// `rinscope replay` vs python-ins 1.0.1; `allantools`: `rinscope allan --series` vs
@@ -109,10 +111,10 @@ enum Command {
         #[arg(long, default_value = "python3")]
         python: PathBuf,
         /// --peer: alternated rounds per stream.
-        #[arg(long, default_value_t = 5)]
+        #[arg(long, default_value_t = 5, allow_negative_numbers = true, value_parser = |t: &str| count(t, 1, 1000, "rounds").map(|n| n as usize))]
         rounds: usize,
         /// --peer: samples per stream (pyins: at 2 kHz; allantools: the series' length).
-        #[arg(long, default_value_t = 2_000_000)]
+        #[arg(long, default_value_t = 2_000_000, allow_negative_numbers = true, value_parser = |t: &str| count(t, 2, 1_000_000_000, "samples"))]
         samples: u64,
         /// Also write every figure as JSON (with --peer: every round's numbers), to compare a change
         /// against the last run.
@@ -123,6 +125,73 @@ enum Command {
         #[arg(long, value_delimiter = ',', value_parser = crate::app::bench::SECTIONS)]
         only: Vec<String>,
     },
+}
+
+// The one number rule at the parser (issue 31): every numeric option is parsed by [`number`] or
+// [`count`], which hold it to its physical range with the samples' rule
+// ([`validity::check_number`]) and accept a negative number as a value (`--duration-s -10` is
+// answered "-10 s is out of range ...", not "unexpected argument '-1'"). clap exits 2 with
+// `invalid value '-10' for '--duration-s <DURATION_S>': ...`, naming the option. The ranges, and
+// why:
+
+/// A simulated duration, s: > 0 and at most 30 days (`scenario::MAX_DURATION_S`, the bound of
+/// `simulation.duration_s`).
+const DURATION_S: Range = Range::positive(scenario::MAX_DURATION_S, "s", "a simulated duration");
+/// `modulation --hours`: the same 30 days, in hours.
+const HOURS: Range = Range::positive(scenario::MAX_DURATION_S / 3600.0, "h", "a simulated duration");
+/// `selfcal --navigate-hours`: 0 (skip) to 30 days, in hours (`app::selfcal::check_navigate_hours`).
+const NAVIGATE_HOURS: Range = Range::closed(0.0, 720.0, "h", "a navigation time");
+/// `live --speed`: simulated seconds per wall-clock second, > 0 and at most 10 000 (the command's
+/// own bound: faster, a step's drawing no longer keeps up).
+const SPEED: Range = Range::positive(10_000.0, "× real time", "a speed");
+/// `--ci-sigma`: > 0 and at most 3 normal sigmas (99.7 %; `app::allan::options`' bound: wider
+/// intervals say nothing more of a curve).
+const CI_SIGMA: Range = Range::positive(3.0, "σ", "a confidence half-width");
+/// `replay --align-s`: > 0 and at most a day (a manifest's `initial.alignment_s`).
+const ALIGN_S: Range = Range::positive(86_400.0, "s", "an alignment time");
+/// One of `--attitude-deg` / `--reference-attitude-deg`: within ±360° (each angle's own bound,
+/// pitch ±90°, roll ±180°, is the manifest's check, which these options feed).
+const ANGLE_DEG: Range = Range::symmetric(360.0, "deg", "an attitude angle");
+/// One of `--position LAT LON HEIGHT`: within ±100 000 (the widest of the three, the height in m;
+/// each one's own bound is the manifest's check, which this option feeds).
+const POSITION_PART: Range = Range::symmetric(100_000.0, "", "a latitude (deg), longitude (deg) or height (m)");
+/// `--eta-measured-sigma-arcsec`: > 0 and at most 3600″ (`calib`'s bound: a 1° measurement tells
+/// the filter nothing).
+const ETA_SIGMA_ARCSEC: Range = Range::positive(3600.0, "arcsec", "a measurement's 1σ");
+
+/// Parses `text` as a number in `range` (the one number rule).
+fn number(text: &str, range: &Range) -> Result<f64, String> {
+    let v: f64 = text.trim().parse().map_err(|_| format!("{} is not a number", cut(text)))?;
+    check_number(v, range)
+}
+
+/// `--duration-s`.
+fn duration_s(text: &str) -> Result<f64, String> {
+    number(text, &DURATION_S)
+}
+
+/// Parses `text` as a whole number in `min..=max` (`unit` names what it counts).
+fn count(text: &str, min: u64, max: u64, unit: &str) -> Result<u64, String> {
+    let t = text.trim();
+    let refuse = || format!("{}: must be a whole number of {unit}, {min} ..= {max}", cut(t));
+    match t.parse::<i128>() {
+        Ok(n) if n >= i128::from(min) && n <= i128::from(max) => u64::try_from(n).map_err(|_| refuse()),
+        _ => Err(refuse()),
+    }
+}
+
+/// A TCP port, 1 ..= 65535.
+fn port(text: &str) -> Result<u16, String> {
+    count(text, 1, 65_535, "port").map(|n| n as u16)
+}
+
+/// A user's text cut for a message (40 characters).
+fn cut(text: &str) -> String {
+    let mut out: String = text.chars().take(40).collect();
+    if text.chars().count() > 40 {
+        out.push('…');
+    }
+    out
 }
 
 /// Where a recording goes, as Rerun's tools spell it; several at once are allowed. With none, a
@@ -139,13 +208,13 @@ struct SinkArgs {
     #[arg(long, num_args = 0..=1, default_missing_value = sink::DEFAULT_CONNECT_URL)]
     connect: Option<String>,
     /// Serve the stream over gRPC on this port (default 9876) for native or web viewers.
-    #[arg(long, num_args = 0..=1, default_missing_value = "9876")]
+    #[arg(long, num_args = 0..=1, default_missing_value = "9876", allow_negative_numbers = true, value_parser = port)]
     serve: Option<u16>,
     /// Serve the viewer itself for a browser on this HTTP port (default 9090), with the stream on
     /// the next port: open the printed URL, nothing to install. After a run the page stays until
     /// Ctrl-C. `live`: a class page on this port, the viewer beside the parameters' sliders (the
     /// viewer on the next port, the stream on the one after); it ends with the session.
-    #[arg(long, num_args = 0..=1, default_missing_value = "9090", value_name = "PORT")]
+    #[arg(long, num_args = 0..=1, default_missing_value = "9090", value_name = "PORT", allow_negative_numbers = true, value_parser = port)]
     serve_web: Option<u16>,
     /// --serve / --serve-web: the address to listen on (default 127.0.0.1, this machine only;
     /// 0.0.0.0 shares the session with the whole network: anyone can watch; live's class page
@@ -173,16 +242,29 @@ impl SinkArgs {
         self.spawn || self.connect.is_some() || self.serve.is_some() || self.serve_web.is_some()
     }
 
-    /// `--export DIR` and its format, if asked for.
+    /// `--export DIR` and its format, if asked for; the folder checked up front by the one output
+    /// rule ([`check_output`]).
     fn export_request(&self) -> Result<Option<(PathBuf, ExportFormat)>, Failure> {
         match &self.export {
             None => Ok(None),
-            Some(dir) => Ok(Some((dir.clone(), ExportFormat::parse(&self.export_format).map_err(|e| Failure::input(format!("--export-format {e}")))?))),
+            Some(dir) => {
+                let format = ExportFormat::parse(&self.export_format).map_err(|e| Failure::input(format!("--export-format {e}")))?;
+                check_output("--export", dir, OutputKind::Folder).map_err(|e| Failure::input(e.to_string()))?;
+                Ok(Some((dir.clone(), format)))
+            }
         }
     }
 
-    /// The request, with `default_save` when no viewer was asked for.
+    /// The request, with `default_save` when no viewer was asked for. `--save`, `--export` and
+    /// `--figures` are checked up front by the one output rule ([`check_output`]), before any
+    /// work: every command that records gets it here.
     fn request(&self, default_save: PathBuf) -> Result<SinkRequest, Failure> {
+        if let Some(path) = &self.save {
+            check_output("--save", path, OutputKind::File).map_err(|e| Failure::input(e.to_string()))?;
+        }
+        if let Some(dir) = &self.figures {
+            check_output("--figures", dir, OutputKind::Folder).map_err(|e| Failure::input(e.to_string()))?;
+        }
         let save = self.save.clone().or_else(|| (!self.viewer_asked() || self.figures.is_some()).then_some(default_save));
         let export = self.export_request()?;
         if self.bind.is_some() && self.serve.is_none() && self.serve_web.is_none() {
@@ -235,7 +317,7 @@ struct RunArgs {
     #[arg(long)]
     summary_json: Option<PathBuf>,
     /// Override the scenario's simulated duration, s.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = duration_s)]
     duration_s: Option<f64>,
 }
 
@@ -250,10 +332,10 @@ struct LiveArgs {
     #[command(flatten)]
     sinks: SinkArgs,
     /// Simulated seconds per wall-clock second (default: the file's [live] speed, else 1).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = |t: &str| number(t, &SPEED))]
     speed: Option<f64>,
     /// Stop after this much simulated time, s (default: run until you quit).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = duration_s)]
     duration_s: Option<f64>,
     /// No viewer: only --save (for headless sessions and tests).
     #[arg(long, conflicts_with_all = ["spawn", "connect", "serve"])]
@@ -266,7 +348,7 @@ struct LiveArgs {
 #[derive(Args)]
 struct ModulationArgs {
     /// Simulated hours.
-    #[arg(long, default_value_t = 24.0)]
+    #[arg(long, default_value_t = 24.0, allow_negative_numbers = true, value_parser = |t: &str| number(t, &HOURS))]
     hours: f64,
     #[command(flatten)]
     sinks: SinkArgs,
@@ -336,7 +418,7 @@ struct ReplayArgs {
     #[arg(long, requires = "imu")]
     imu_frame: Option<String>,
     /// --imu: the sample rate, Hz (default: a PSINS header's, else what the time stamps say).
-    #[arg(long, requires = "imu")]
+    #[arg(long, requires = "imu", allow_negative_numbers = true, value_parser = |t: &str| number(t, &validity::IMU_RATE_HZ))]
     rate_hz: Option<f64>,
     /// --imu: the table description (the [site], [turntable], [imu], ... sections of a scenario);
     /// without one the IMU is strapdown (its axes are the body's).
@@ -347,27 +429,27 @@ struct ReplayArgs {
     encoders: Option<PathBuf>,
     /// The body attitude at the start [pitch, roll, heading], deg: the INS starts from it instead
     /// of aligning (a moving start, or a known attitude).
-    #[arg(long, num_args = 3, value_names = ["PITCH", "ROLL", "HEADING"], allow_negative_numbers = true)]
+    #[arg(long, num_args = 3, value_names = ["PITCH", "ROLL", "HEADING"], allow_negative_numbers = true, value_parser = |t: &str| number(t, &ANGLE_DEG))]
     attitude_deg: Option<Vec<f64>>,
     /// A constant reference attitude of the body [pitch, roll, heading], deg, to measure the errors
     /// against (a vehicle at rest whose attitude is known); also the start, unless --attitude-deg.
-    #[arg(long, num_args = 3, value_names = ["PITCH", "ROLL", "HEADING"], allow_negative_numbers = true)]
+    #[arg(long, num_args = 3, value_names = ["PITCH", "ROLL", "HEADING"], allow_negative_numbers = true, value_parser = |t: &str| number(t, &ANGLE_DEG))]
     reference_attitude_deg: Option<Vec<f64>>,
     /// The velocity at the start [East, North, Up], m/s (a moving start; needs --attitude-deg).
-    #[arg(long, num_args = 3, value_names = ["EAST", "NORTH", "UP"], allow_negative_numbers = true)]
+    #[arg(long, num_args = 3, value_names = ["EAST", "NORTH", "UP"], allow_negative_numbers = true, value_parser = |t: &str| number(t, &validity::VELOCITY_MPS))]
     velocity_enu_mps: Option<Vec<f64>>,
     /// The position at the start [latitude deg, longitude deg, height m] (the site).
-    #[arg(long, num_args = 3, value_names = ["LAT_DEG", "LON_DEG", "HEIGHT_M"], allow_negative_numbers = true)]
+    #[arg(long, num_args = 3, value_names = ["LAT_DEG", "LON_DEG", "HEIGHT_M"], allow_negative_numbers = true, value_parser = |t: &str| number(t, &POSITION_PART))]
     position: Option<Vec<f64>>,
     /// Replay from this time on the IMU file's clock (as written in its time column), s.
-    #[arg(long, value_name = "T_S", allow_negative_numbers = true)]
+    #[arg(long, value_name = "T_S", allow_negative_numbers = true, value_parser = |t: &str| number(t, &validity::CLOCK_S))]
     from: Option<f64>,
     /// Replay up to this time on the IMU file's clock, s.
-    #[arg(long, value_name = "T_S", allow_negative_numbers = true)]
+    #[arg(long, value_name = "T_S", allow_negative_numbers = true, value_parser = |t: &str| number(t, &validity::CLOCK_S))]
     to: Option<f64>,
     /// Align over the first this many seconds, declared at rest (default: the rest the data show,
     /// at most 300 s).
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = |t: &str| number(t, &ALIGN_S))]
     align_s: Option<f64>,
 }
 
@@ -387,7 +469,7 @@ struct AllanArgs {
     #[arg(long, value_name = "COLUMN:KIND[:UNIT]", requires = "series")]
     column: Vec<String>,
     /// With --series: the sample rate, Hz (or --time-column).
-    #[arg(long, value_name = "HZ", requires = "series", conflicts_with = "time_column")]
+    #[arg(long, value_name = "HZ", requires = "series", conflicts_with = "time_column", allow_negative_numbers = true, value_parser = |t: &str| number(t, &validity::SERIES_RATE_HZ))]
     rate_hz: Option<f64>,
     /// With --series: the column of sample times, COLUMN[:UNIT] (unit s, ms, us, ns; default s);
     /// the samples must be evenly spaced (to 1 %).
@@ -411,16 +493,16 @@ struct AllanArgs {
     #[arg(long)]
     json: Option<PathBuf>,
     /// Override the scenario's simulated duration, s.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = duration_s)]
     duration_s: Option<f64>,
     /// Cluster times per decade (the same as --taus N).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = |t: &str| count(t, 1, 1000, "cluster times per decade").map(|n| n as u32))]
     per_decade: Option<u32>,
     /// Sum this many samples into one before the analysis (a long, fast log in less memory).
-    #[arg(long, default_value_t = 1, value_name = "N")]
+    #[arg(long, default_value_t = 1, value_name = "N", allow_negative_numbers = true, value_parser = |t: &str| count(t, 1, 1_000_000, "samples").map(|n| n as usize))]
     decimate: usize,
     /// Half-width of the confidence intervals, normal sigmas (1: 68.3 %).
-    #[arg(long, default_value_t = 1.0, value_name = "Z")]
+    #[arg(long, default_value_t = 1.0, value_name = "Z", allow_negative_numbers = true, value_parser = |t: &str| number(t, &CI_SIGMA))]
     ci_sigma: f64,
     /// A simulation: analyse the sensor errors alone (output − truth), e.g. of a scenario whose
     /// table turns (zheng2016-tpr); default: what the IMU outputs, as a static test logs it.
@@ -440,10 +522,10 @@ struct MonteCarloArgs {
     #[command(flatten)]
     source: ScenarioSource,
     /// Number of runs (default: [calibration.montecarlo] runs).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = |t: &str| count(t, 1, 1_000_000, "runs").map(|n| n as usize))]
     runs: Option<usize>,
     /// Give the filter an independent measurement of η with this 1σ, arcsec.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = |t: &str| number(t, &ETA_SIGMA_ARCSEC))]
     eta_measured_sigma_arcsec: Option<f64>,
     /// Run only the runs i with i mod M == K (K/M, K from 0), seeded as in the whole run; --json
     /// then writes the shard file that `montecarlo merge` combines (cluster array jobs).
@@ -466,7 +548,7 @@ enum MonteCarloAction {
         #[command(flatten)]
         source: ScenarioSource,
         /// The η measurement the shards were given, arcsec.
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true, value_parser = |t: &str| number(t, &ETA_SIGMA_ARCSEC))]
         eta_measured_sigma_arcsec: Option<f64>,
         /// Write the merged statistics as JSON.
         #[arg(long)]
@@ -486,7 +568,7 @@ struct TprArgs {
     json: Option<PathBuf>,
     /// Also run this many seeds (the scenario's and the following ones) in parallel and print the
     /// distribution: one realisation of the random walk says little.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=10_000))]
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(1..=10_000))]
     seeds: Option<u64>,
 }
 
@@ -505,14 +587,14 @@ struct SelfcalArgs {
     sequence: String,
     /// Also calibrate this many random IMUs (seeds after the scenario's, on every core) and
     /// compare each parameter's reported 1σ with the spread of its errors.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(crate::app::selfcal::MONTE_CARLO_RUNS))]
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(crate::app::selfcal::MONTE_CARLO_RUNS))]
     monte_carlo: Option<u64>,
     /// Only the plan: what the sequence can see, from its noise-free motion (no IMU drawn).
     #[arg(long)]
     plan: bool,
     /// What it buys: the same IMU navigates this many hours free-inertial, at rest and under the
     /// 16-position modulation, with no, estimated and true compensation (0: skip).
-    #[arg(long, default_value_t = 24.0, value_name = "HOURS")]
+    #[arg(long, default_value_t = 24.0, value_name = "HOURS", allow_negative_numbers = true, value_parser = |t: &str| number(t, &NAVIGATE_HOURS))]
     navigate_hours: f64,
     #[command(flatten)]
     sinks: SinkArgs,
@@ -578,7 +660,8 @@ impl From<ConfigError> for Failure {
 
 impl From<SinkError> for Failure {
     fn from(e: SinkError) -> Self {
-        let code = match e {
+        let code = match &e {
+            SinkError::Interrupted(m) => return Self::interrupted(m.clone()),
             SinkError::Rerun(_) | SinkError::Spawn(_) | SinkError::Write(_) | SinkError::ExportWrite(_) | SinkError::FiguresWrite(_) => 1,
             _ => 2,
         };
@@ -636,5 +719,66 @@ where
             errln!("rinscope: {}", f.message);
             f.code
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory as _;
+
+    /// Every option of every (sub)command, with its command line's words.
+    fn walk(cmd: &clap::Command, path: &mut Vec<String>, out: &mut Vec<(Vec<String>, clap::Arg)>) {
+        for a in cmd.get_arguments() {
+            out.push((path.clone(), a.clone()));
+        }
+        for sub in cmd.get_subcommands() {
+            path.push(sub.get_name().to_owned());
+            walk(sub, path, out);
+            path.pop();
+        }
+    }
+
+    #[test]
+    fn every_numeric_option_takes_a_negative_number_to_its_range_check() {
+        // Issue 31: `run --duration-s -10` said "unexpected argument '-1'".
+        use std::any::TypeId;
+        let numeric = [TypeId::of::<f64>(), TypeId::of::<u64>(), TypeId::of::<usize>(), TypeId::of::<u32>(), TypeId::of::<u16>()];
+        let mut all = Vec::new();
+        walk(&Cli::command(), &mut Vec::new(), &mut all);
+        let mut checked = 0;
+        for (path, arg) in all {
+            let Some(long) = arg.get_long() else { continue };
+            if !numeric.iter().any(|t| arg.get_value_parser().type_id() == *t) {
+                continue;
+            }
+            assert!(arg.is_allow_negative_numbers_set(), "{path:?} --{long}: allow_negative_numbers");
+            let values = arg.get_num_args().map_or(1, |r| r.min_values().max(1));
+            let mut line = vec!["rinscope".to_owned()];
+            line.extend(path.iter().cloned());
+            line.push(format!("--{long}"));
+            line.extend(std::iter::repeat_n("-1e300".to_owned(), values));
+            let e = match Cli::try_parse_from(&line) {
+                Ok(_) => panic!("{line:?}: -1e300 accepted"),
+                Err(e) => e,
+            };
+            assert_eq!(e.kind(), clap::error::ErrorKind::ValueValidation, "{line:?}: {e}");
+            let text = e.to_string();
+            assert!(text.contains(&format!("--{long}")) && text.contains("-1e300") && text.len() < 400, "{line:?}: {text}");
+            checked += 1;
+        }
+        assert!(checked >= 25, "{checked} numeric options seen");
+    }
+
+    #[test]
+    fn a_number_is_held_to_its_range_and_said_short() {
+        assert_eq!(number("1e-3", &DURATION_S), Ok(1e-3));
+        let e = number("1e308", &validity::IMU_RATE_HZ).expect_err("1e308 Hz");
+        assert!(e.starts_with("1e308 Hz") && e.len() < 120, "{e}");
+        assert!(number(&"9".repeat(400), &DURATION_S).expect_err("long").len() < 120);
+        assert!(number("abc", &DURATION_S).expect_err("text").contains("not a number"));
+        assert_eq!(count("7", 1, 10, "runs"), Ok(7));
+        assert!(count("-7", 1, 10, "runs").expect_err("negative").starts_with("-7: must be a whole number of runs, 1 ..= 10"));
+        assert!(count("0", 1, 10, "runs").is_err() && count("1.5", 1, 10, "runs").is_err());
     }
 }
