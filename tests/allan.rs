@@ -139,7 +139,7 @@ fn bad_requests_and_misused_keys_are_refused_by_name() {
     refused(&["allan"], Some(ramp), &["imu.gyro.rate_ramp_deg_per_h2", "deg/h²"]);
     refused(&["allan", "--scenario", "jiang2017-dual-axis"], None, &["needs an [imu] section"]);
     refused(&["allan", "--scenario", "static-imu-10h", "--export", "x", "--export-format", "xls"], None, &["--export-format"]);
-    refused(&["allan", "--scenario", "static-imu-10h", "--decimate", "0"], None, &["--decimate 0"]);
+    refused(&["allan", "--scenario", "static-imu-10h", "--decimate", "0"], None, &["--decimate", "0: must be a whole number of samples, 1 ..= 1000000"]);
 }
 
 /// The columns of a csv table and its rows.

@@ -31,7 +31,7 @@ fn refused(dir: &Path, cfg: &Path, expected: &[&str]) {
 fn a_typo_in_a_key_is_refused_with_its_line() {
     let dir = scratch("typo");
     let cfg = with_edit(&dir, "swing_half_angle_arcsec = 300.0", "swing_half_angl_arcsec = 300.0");
-    refused(&dir, &cfg, &["unknown field `swing_half_angl_arcsec`", "swing_half_angle_arcsec"]);
+    refused(&dir, &cfg, &["unknown key `swing_half_angl_arcsec`; did you mean `swing_half_angle_arcsec`?", "valid keys here"]);
 }
 
 #[test]

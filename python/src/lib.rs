@@ -62,6 +62,7 @@ impl From<rinscope::app::failure::Failure> for Failure {
 impl From<sink::SinkError> for Failure {
     fn from(e: sink::SinkError) -> Self {
         match e {
+            sink::SinkError::Interrupted(m) => Self::Interrupted(m),
             sink::SinkError::Write(_) | sink::SinkError::File(_) | sink::SinkError::ExportWrite(_) => Self::Output(e.to_string()),
             sink::SinkError::Rerun(_) | sink::SinkError::FiguresWrite(_) => Self::Run(e.to_string()),
             _ => Self::Input(e.to_string()),

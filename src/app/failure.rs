@@ -86,6 +86,7 @@ impl From<SinkError> for Failure {
     fn from(e: SinkError) -> Self {
         let message = e.to_string();
         match e {
+            SinkError::Interrupted(m) => Self::interrupted(m),
             SinkError::Write(_) | SinkError::ExportWrite(_) | SinkError::FiguresWrite(_) => Self { code: 1, kind: FailureKind::Output, message },
             SinkError::File(_) => Self { code: 2, kind: FailureKind::Output, message },
             SinkError::Rerun(_) | SinkError::Spawn(_) => Self::run(message),

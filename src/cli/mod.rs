@@ -26,6 +26,7 @@
 mod allan;
 mod commands;
 mod logs;
+mod numbers;
 mod selfcal;
 
 use std::path::PathBuf;
@@ -33,6 +34,9 @@ use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
 
+use crate::io::files::{check_output, OutputKind};
+use crate::io::validity;
+use numbers::{count, duration_s, number, port, ALIGN_S, ANGLE_DEG, CI_SIGMA, ETA_SIGMA_ARCSEC, HOURS, NAVIGATE_HOURS, POSITION_PART, SPEED};
 use crate::record::export::ExportFormat;
 pub(crate) use crate::app::failure::Failure;
 use crate::app::outputs::RecordingRequest;
@@ -100,7 +104,7 @@ enum Command {
     /// Measure speed and recording size.
     Bench {
         /// Steps of each pure-simulation repetition.
-        #[arg(long, default_value_t = 2_000_000)]
+        #[arg(long, default_value_t = 2_000_000, allow_negative_numbers = true, value_parser = |t: &str| count(t, 1, 1_000_000_000, "steps"))]
         steps: u64,
         /// Instead: measure against a peer, whole processes alternated on the same input (`pyins`:
         /// `rinscope replay` vs python-ins 1.0.1; `allantools`: `rinscope allan --series` vs
@@ -111,10 +115,10 @@ enum Command {
         #[arg(long, default_value = "python3")]
         python: PathBuf,
         /// --peer: alternated rounds per stream.
-        #[arg(long, default_value_t = 5)]
+        #[arg(long, default_value_t = 5, allow_negative_numbers = true, value_parser = |t: &str| count(t, 1, 1000, "rounds").map(|n| n as usize))]
         rounds: usize,
         /// --peer: samples per stream (pyins: at 2 kHz; allantools: the series' length).
-        #[arg(long, default_value_t = 2_000_000)]
+        #[arg(long, default_value_t = 2_000_000, allow_negative_numbers = true, value_parser = |t: &str| count(t, 2, 1_000_000_000, "samples"))]
         samples: u64,
         /// Also write every figure as JSON (with --peer: every round's numbers), to compare a change
         /// against the last run.
@@ -141,13 +145,13 @@ struct SinkArgs {
     #[arg(long, num_args = 0..=1, default_missing_value = sink::DEFAULT_CONNECT_URL)]
     connect: Option<String>,
     /// Serve the stream over gRPC on this port (default 9876) for native or web viewers.
-    #[arg(long, num_args = 0..=1, default_missing_value = "9876")]
+    #[arg(long, num_args = 0..=1, default_missing_value = "9876", allow_negative_numbers = true, value_parser = port)]
     serve: Option<u16>,
     /// Serve the viewer itself for a browser on this HTTP port (default 9090), with the stream on
     /// the next port: open the printed URL, nothing to install. After a run the page stays until
     /// Ctrl-C. `live`: a class page on this port, the viewer beside the parameters' sliders (the
     /// viewer on the next port, the stream on the one after); it ends with the session.
-    #[arg(long, num_args = 0..=1, default_missing_value = "9090", value_name = "PORT")]
+    #[arg(long, num_args = 0..=1, default_missing_value = "9090", value_name = "PORT", allow_negative_numbers = true, value_parser = port)]
     serve_web: Option<u16>,
     /// --serve / --serve-web: the address to listen on (default 127.0.0.1, this machine only;
     /// 0.0.0.0 shares the session with the whole network: anyone can watch; live's class page
@@ -175,17 +179,30 @@ impl SinkArgs {
         self.spawn || self.connect.is_some() || self.serve.is_some() || self.serve_web.is_some()
     }
 
-    /// `--export DIR` and its format, if asked for.
+    /// `--export DIR` and its format, if asked for; the folder checked up front by the one output
+    /// rule ([`check_output`]).
     fn export_request(&self) -> Result<Option<(PathBuf, ExportFormat)>, Failure> {
         match &self.export {
             None => Ok(None),
-            Some(dir) => Ok(Some((dir.clone(), ExportFormat::parse(&self.export_format).map_err(|e| Failure::input(format!("--export-format {e}")))?))),
+            Some(dir) => {
+                let format = ExportFormat::parse(&self.export_format).map_err(|e| Failure::input(format!("--export-format {e}")))?;
+                check_output("--export", dir, OutputKind::Folder).map_err(|e| Failure::input(e.to_string()))?;
+                Ok(Some((dir.clone(), format)))
+            }
         }
     }
 
     /// Where the command's recording goes: saved under `recordings/` by default when no viewer
-    /// was asked for (or `--figures`, which draws from the saved file).
+    /// was asked for (or `--figures`, which draws from the saved file). `--save`, `--export` and
+    /// `--figures` are checked up front by the one output rule ([`check_output`]), before any
+    /// work: every command that records gets it here.
     fn recording(&self) -> Result<RecordingRequest, Failure> {
+        if let Some(path) = &self.save {
+            check_output("--save", path, OutputKind::File).map_err(|e| Failure::input(e.to_string()))?;
+        }
+        if let Some(dir) = &self.figures {
+            check_output("--figures", dir, OutputKind::Folder).map_err(|e| Failure::input(e.to_string()))?;
+        }
         let export = self.export_request()?;
         if self.bind.is_some() && self.serve.is_none() && self.serve_web.is_none() {
             return Err(Failure::input("--bind ADDR goes with --serve or --serve-web"));
@@ -238,7 +255,7 @@ struct RunArgs {
     #[arg(long)]
     summary_json: Option<PathBuf>,
     /// Override the scenario's simulated duration, s.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = duration_s)]
     duration_s: Option<f64>,
 }
 
@@ -253,10 +270,10 @@ struct LiveArgs {
     #[command(flatten)]
     sinks: SinkArgs,
     /// Simulated seconds per wall-clock second (default: the file's [live] speed, else 1).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = |t: &str| number(t, &SPEED))]
     speed: Option<f64>,
     /// Stop after this much simulated time, s (default: run until you quit).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = duration_s)]
     duration_s: Option<f64>,
     /// No viewer: only --save (for headless sessions and tests).
     #[arg(long, conflicts_with_all = ["spawn", "connect", "serve"])]
@@ -269,7 +286,7 @@ struct LiveArgs {
 #[derive(Args)]
 struct ModulationArgs {
     /// Simulated hours.
-    #[arg(long, default_value_t = 24.0)]
+    #[arg(long, default_value_t = 24.0, allow_negative_numbers = true, value_parser = |t: &str| number(t, &HOURS))]
     hours: f64,
     #[command(flatten)]
     sinks: SinkArgs,
@@ -339,7 +356,7 @@ struct ReplayArgs {
     #[arg(long, requires = "imu")]
     imu_frame: Option<String>,
     /// --imu: the sample rate, Hz (default: a PSINS header's, else what the time stamps say).
-    #[arg(long, requires = "imu")]
+    #[arg(long, requires = "imu", allow_negative_numbers = true, value_parser = |t: &str| number(t, &validity::IMU_RATE_HZ))]
     rate_hz: Option<f64>,
     /// --imu: the table description (the [site], [turntable], [imu], ... sections of a scenario);
     /// without one the IMU is strapdown (its axes are the body's).
@@ -350,27 +367,27 @@ struct ReplayArgs {
     encoders: Option<PathBuf>,
     /// The body attitude at the start [pitch, roll, heading], deg: the INS starts from it instead
     /// of aligning (a moving start, or a known attitude).
-    #[arg(long, num_args = 3, value_names = ["PITCH", "ROLL", "HEADING"], allow_negative_numbers = true)]
+    #[arg(long, num_args = 3, value_names = ["PITCH", "ROLL", "HEADING"], allow_negative_numbers = true, value_parser = |t: &str| number(t, &ANGLE_DEG))]
     attitude_deg: Option<Vec<f64>>,
     /// A constant reference attitude of the body [pitch, roll, heading], deg, to measure the errors
     /// against (a vehicle at rest whose attitude is known); also the start, unless --attitude-deg.
-    #[arg(long, num_args = 3, value_names = ["PITCH", "ROLL", "HEADING"], allow_negative_numbers = true)]
+    #[arg(long, num_args = 3, value_names = ["PITCH", "ROLL", "HEADING"], allow_negative_numbers = true, value_parser = |t: &str| number(t, &ANGLE_DEG))]
     reference_attitude_deg: Option<Vec<f64>>,
     /// The velocity at the start [East, North, Up], m/s (a moving start; needs --attitude-deg).
-    #[arg(long, num_args = 3, value_names = ["EAST", "NORTH", "UP"], allow_negative_numbers = true)]
+    #[arg(long, num_args = 3, value_names = ["EAST", "NORTH", "UP"], allow_negative_numbers = true, value_parser = |t: &str| number(t, &validity::VELOCITY_MPS))]
     velocity_enu_mps: Option<Vec<f64>>,
     /// The position at the start [latitude deg, longitude deg, height m] (the site).
-    #[arg(long, num_args = 3, value_names = ["LAT_DEG", "LON_DEG", "HEIGHT_M"], allow_negative_numbers = true)]
+    #[arg(long, num_args = 3, value_names = ["LAT_DEG", "LON_DEG", "HEIGHT_M"], allow_negative_numbers = true, value_parser = |t: &str| number(t, &POSITION_PART))]
     position: Option<Vec<f64>>,
     /// Replay from this time on the IMU file's clock (as written in its time column), s.
-    #[arg(long, value_name = "T_S", allow_negative_numbers = true)]
+    #[arg(long, value_name = "T_S", allow_negative_numbers = true, value_parser = |t: &str| number(t, &validity::CLOCK_S))]
     from: Option<f64>,
     /// Replay up to this time on the IMU file's clock, s.
-    #[arg(long, value_name = "T_S", allow_negative_numbers = true)]
+    #[arg(long, value_name = "T_S", allow_negative_numbers = true, value_parser = |t: &str| number(t, &validity::CLOCK_S))]
     to: Option<f64>,
     /// Align over the first this many seconds, declared at rest (default: the rest the data show,
     /// at most 300 s).
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true, value_parser = |t: &str| number(t, &ALIGN_S))]
     align_s: Option<f64>,
 }
 
@@ -390,7 +407,7 @@ struct AllanArgs {
     #[arg(long, value_name = "COLUMN:KIND[:UNIT]", requires = "series")]
     column: Vec<String>,
     /// With --series: the sample rate, Hz (or --time-column).
-    #[arg(long, value_name = "HZ", requires = "series", conflicts_with = "time_column")]
+    #[arg(long, value_name = "HZ", requires = "series", conflicts_with = "time_column", allow_negative_numbers = true, value_parser = |t: &str| number(t, &validity::SERIES_RATE_HZ))]
     rate_hz: Option<f64>,
     /// With --series: the column of sample times, COLUMN[:UNIT] (unit s, ms, us, ns; default s);
     /// the samples must be evenly spaced (to 1 %).
@@ -414,16 +431,16 @@ struct AllanArgs {
     #[arg(long)]
     json: Option<PathBuf>,
     /// Override the scenario's simulated duration, s.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = duration_s)]
     duration_s: Option<f64>,
     /// Cluster times per decade (the same as --taus N).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = |t: &str| count(t, 1, 1000, "cluster times per decade").map(|n| n as u32))]
     per_decade: Option<u32>,
     /// Sum this many samples into one before the analysis (a long, fast log in less memory).
-    #[arg(long, default_value_t = 1, value_name = "N")]
+    #[arg(long, default_value_t = 1, value_name = "N", allow_negative_numbers = true, value_parser = |t: &str| count(t, 1, 1_000_000, "samples").map(|n| n as usize))]
     decimate: usize,
     /// Half-width of the confidence intervals, normal sigmas (1: 68.3 %).
-    #[arg(long, default_value_t = 1.0, value_name = "Z")]
+    #[arg(long, default_value_t = 1.0, value_name = "Z", allow_negative_numbers = true, value_parser = |t: &str| number(t, &CI_SIGMA))]
     ci_sigma: f64,
     /// A simulation: analyse the sensor errors alone (output − truth), e.g. of a scenario whose
     /// table turns (zheng2016-tpr); default: what the IMU outputs, as a static test logs it.
@@ -443,10 +460,10 @@ struct MonteCarloArgs {
     #[command(flatten)]
     source: ScenarioSource,
     /// Number of runs (default: [calibration.montecarlo] runs).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = |t: &str| count(t, 1, 1_000_000, "runs").map(|n| n as usize))]
     runs: Option<usize>,
     /// Give the filter an independent measurement of η with this 1σ, arcsec.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = |t: &str| number(t, &ETA_SIGMA_ARCSEC))]
     eta_measured_sigma_arcsec: Option<f64>,
     /// Run only the runs i with i mod M == K (K/M, K from 0), seeded as in the whole run; --json
     /// then writes the shard file that `montecarlo merge` combines (cluster array jobs).
@@ -469,7 +486,7 @@ enum MonteCarloAction {
         #[command(flatten)]
         source: ScenarioSource,
         /// The η measurement the shards were given, arcsec.
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true, value_parser = |t: &str| number(t, &ETA_SIGMA_ARCSEC))]
         eta_measured_sigma_arcsec: Option<f64>,
         /// Write the merged statistics as JSON.
         #[arg(long)]
@@ -489,7 +506,7 @@ struct TprArgs {
     json: Option<PathBuf>,
     /// Also run this many seeds (the scenario's and the following ones) in parallel and print the
     /// distribution: one realisation of the random walk says little.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=10_000))]
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(1..=10_000))]
     seeds: Option<u64>,
 }
 
@@ -508,14 +525,14 @@ struct SelfcalArgs {
     sequence: String,
     /// Also calibrate this many random IMUs (seeds after the scenario's, on every core) and
     /// compare each parameter's reported 1σ with the spread of its errors.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(crate::app::selfcal::MONTE_CARLO_RUNS))]
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(crate::app::selfcal::MONTE_CARLO_RUNS))]
     monte_carlo: Option<u64>,
     /// Only the plan: what the sequence can see, from its noise-free motion (no IMU drawn).
     #[arg(long)]
     plan: bool,
     /// What it buys: the same IMU navigates this many hours free-inertial, at rest and under the
     /// 16-position modulation, with no, estimated and true compensation (0: skip).
-    #[arg(long, default_value_t = 24.0, value_name = "HOURS")]
+    #[arg(long, default_value_t = 24.0, value_name = "HOURS", allow_negative_numbers = true, value_parser = |t: &str| number(t, &NAVIGATE_HOURS))]
     navigate_hours: f64,
     #[command(flatten)]
     sinks: SinkArgs,
@@ -573,3 +590,4 @@ where
         }
     }
 }
+

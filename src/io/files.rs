@@ -59,6 +59,22 @@ pub enum OutputError {
         /// What it is ("a FIFO", "a device", ...).
         kind: &'static str,
     },
+    /// A folder was asked for (`--export DIR`, `--figures DIR`) and the path is a file.
+    #[error("{}: is a file; give a folder (a new one, or one of yours to add files to)", .0.display())]
+    NotAFolder(PathBuf),
+    /// The path is a symlink: an output is never written through one (its target could be anything).
+    #[error("{}: is a symlink; give the real path (an output is never written through a symlink)", .0.display())]
+    Symlink(PathBuf),
+    /// The folder an output would go in cannot be written (a test file could not be created).
+    #[error("{}: the folder {} cannot be written ({source}); choose another place", .path.display(), .dir.display())]
+    ReadOnly {
+        /// The output path.
+        path: PathBuf,
+        /// The folder tried.
+        dir: PathBuf,
+        /// The OS error of the test file.
+        source: std::io::Error,
+    },
     /// The output would replace a file this run reads.
     #[error("{}: is an input of this run; choose another name for the output", .0.display())]
     IsInput(PathBuf),
@@ -144,12 +160,111 @@ fn is_input(path: &Path, dir: &Path) -> bool {
 }
 
 /// Checks that `path` can name an output file, before anything runs: not a directory (nor a name
-/// ending in `/`), in a directory that exists, not a file this run reads ([`note_input`]).
+/// ending in `/`), in a directory that exists and can be written, not a symlink, not a FIFO or a
+/// device, not a file this run reads ([`note_input`]). The same as
+/// `check_output(_, path, OutputKind::File)`.
 ///
 /// # Errors
 /// See [`OutputError`].
 pub fn check_output_path(path: &Path) -> Result<(), OutputError> {
-    check_path(path, false)
+    check_output_kind(path, OutputKind::File)
+}
+
+/// What an output option names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OutputKind {
+    /// A file, replaced atomically when complete (`--save`, `--json`, `--summary-json`).
+    File,
+    /// A folder files are written into (`--export DIR`, `--figures DIR`), new or existing.
+    Folder,
+}
+
+/// An output option's path refused before any work, naming the option.
+#[derive(Debug, thiserror::Error)]
+#[error("{flag} {error}")]
+pub struct OutputRefused {
+    /// The option (`--json`, `--export`, ...).
+    pub flag: String,
+    /// Why.
+    #[source]
+    pub error: OutputError,
+}
+
+/// The one output rule: checks the path an output option `flag` names, before any work, the same
+/// way for every option. Refused: a FIFO, a socket or a device; a symlink; a folder where a file
+/// is wanted ([`OutputKind::File`]) or a file where a folder is wanted ([`OutputKind::Folder`]);
+/// a parent folder that does not exist (no option creates missing folders: a typo in a folder's
+/// name is not a new tree); a folder that cannot be written (tested by creating and removing a
+/// file); a file this run reads.
+///
+/// # Errors
+/// [`OutputRefused`]: the flag and the [`OutputError`].
+pub fn check_output(flag: &str, path: &Path, kind: OutputKind) -> Result<(), OutputRefused> {
+    check_output_kind(path, kind).map_err(|error| OutputRefused { flag: flag.to_owned(), error })
+}
+
+fn check_output_kind(path: &Path, kind: OutputKind) -> Result<(), OutputError> {
+    let meta = std::fs::symlink_metadata(path).ok();
+    if meta.as_ref().is_some_and(|m| m.file_type().is_symlink()) {
+        return Err(OutputError::Symlink(path.to_path_buf()));
+    }
+    if let Some(kind) = meta.as_ref().and_then(|m| special_kind(&m.file_type())) {
+        return Err(OutputError::NotRegular { path: path.to_path_buf(), kind });
+    }
+    match kind {
+        OutputKind::File => {
+            check_path(path, false)?;
+            writable(path, parent_of(path))
+        }
+        OutputKind::Folder => match meta {
+            Some(m) if m.is_dir() => writable(path, path),
+            Some(_) => Err(OutputError::NotAFolder(path.to_path_buf())),
+            None => {
+                let dir = parent_of(path);
+                if !dir.is_dir() {
+                    return Err(OutputError::NoDirectory { path: path.to_path_buf(), dir: dir.to_path_buf() });
+                }
+                writable(path, dir)
+            }
+        },
+    }
+}
+
+/// The folder `path` is in (`.` for a bare name).
+fn parent_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    }
+}
+
+/// Whether a file can be created in `dir` (for the output `path`): one is created and removed
+/// (permissions alone do not tell: a read-only mount, an ACL, root).
+fn writable(path: &Path, dir: &Path) -> Result<(), OutputError> {
+    static PROBES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let n = PROBES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let probe = dir.join(format!(".rinscope-write-test-{}-{n}", std::process::id()));
+    match OpenOptions::new().write(true).create_new(true).custom_flags(libc::O_NOFOLLOW | libc::O_CLOEXEC).open(&probe) {
+        Ok(_) => {
+            std::fs::remove_file(&probe).ok();
+            Ok(())
+        }
+        Err(source) => Err(OutputError::ReadOnly { path: path.to_path_buf(), dir: dir.to_path_buf(), source }),
+    }
+}
+
+/// Makes the output folder `dir` an option named, checked by [`check_output`] up front: its
+/// parent must exist (no option creates a tree); an existing folder is used as it is.
+///
+/// # Errors
+/// [`OutputRefused`] as [`check_output`], or the OS error of the creation.
+pub fn create_output_dir(flag: &str, dir: &Path) -> Result<(), OutputRefused> {
+    check_output(flag, dir, OutputKind::Folder)?;
+    match std::fs::create_dir(dir) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && dir.is_dir() => Ok(()),
+        Err(source) => Err(OutputRefused { flag: flag.to_owned(), error: OutputError::Io { path: dir.to_path_buf(), action: "create the folder", source } }),
+    }
 }
 
 fn check_path(path: &Path, may_replace_input: bool) -> Result<(), OutputError> {
@@ -466,6 +581,53 @@ mod tests {
         assert!(matches!(check_output_path(Path::new("new/")), Err(OutputError::IsDirectory(_))));
         assert!(matches!(check_output_path(&d.join("missing/x.json")), Err(OutputError::NoDirectory { .. })));
         assert!(check_output_path(&d.join("x.json")).is_ok());
+    }
+
+    /// A folder no one may write to: a 0o555 folder, or /sys for root (who writes anywhere else).
+    fn read_only_dir(d: &Path) -> PathBuf {
+        use std::os::unix::fs::PermissionsExt as _;
+        let ro = d.join("ro");
+        std::fs::create_dir_all(&ro).expect("ro");
+        std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o555)).expect("chmod");
+        if std::fs::write(ro.join("probe"), "").is_ok() { PathBuf::from("/sys") } else { ro }
+    }
+
+    #[test]
+    fn one_output_rule_for_files_and_folders() {
+        // Issue 31: --export or --figures onto a FIFO or a file said only "File exists (os error
+        // 17)"; --json into a read-only folder was refused only after the whole run.
+        let d = scratch("rule");
+        let fifo = d.join("fifo");
+        assert!(std::process::Command::new("mkfifo").arg(&fifo).status().is_ok_and(|s| s.success()));
+        let file = d.join("file.txt");
+        std::fs::write(&file, "x").expect("file");
+        let link = d.join("link");
+        std::os::unix::fs::symlink(&file, &link).expect("symlink");
+        let ro = read_only_dir(&d);
+        use OutputKind::{File as F, Folder as D};
+        for (flag, path, kind, says) in [
+            ("--export", fifo.clone(), D, "is a FIFO"),
+            ("--figures", file.clone(), D, "is a file; give a folder"),
+            ("--figures", link.clone(), D, "is a symlink"),
+            ("--json", link.clone(), F, "is a symlink"),
+            ("--json", fifo.clone(), F, "is a FIFO"),
+            ("--summary-json", d.clone(), F, "is a directory"),
+            ("--save", Path::new("/dev/null").to_path_buf(), F, "is a device"),
+            ("--export", d.join("missing/sub"), D, "does not exist"),
+            ("--json", d.join("missing/x.json"), F, "does not exist"),
+            ("--json", ro.join("x.json"), F, "cannot be written"),
+            ("--export", ro.join("new"), D, "cannot be written"),
+        ] {
+            let e = check_output(flag, &path, kind).expect_err(says).to_string();
+            assert!(e.starts_with(flag) && e.contains(says), "{flag} {}: {e}", path.display());
+        }
+        assert!(check_output("--export", &d.join("new"), D).is_ok() && !d.join("new").exists(), "a new folder in a writable one; nothing left");
+        assert!(check_output("--export", &d, D).is_ok());
+        assert!(check_output("--json", &d.join("x.json"), F).is_ok());
+        assert_eq!(std::fs::read_dir(&d).expect("dir").count(), 4, "no probe left behind");
+        create_output_dir("--figures", &d.join("figs")).expect("made");
+        create_output_dir("--figures", &d.join("figs")).expect("an existing folder is used");
+        assert!(create_output_dir("--figures", &d.join("a/b")).is_err(), "no tree is created");
     }
 
     #[test]

@@ -257,11 +257,40 @@ fn read_header(path: &Path, lines: &mut LineReader) -> Result<PsinsHeader> {
 }
 
 /// Why header row `r`'s field `k` cannot be `value` (a finite number), if it cannot.
+///
+/// Every field passes the one number rule ([`crate::io::validity::check_number`]) with its
+/// physical range: an attitude, a velocity, a position, a time base and scale factors that a
+/// header can hold (`pitch = 1e300` was read, and printed back with 300 digits).
 fn header_problem(r: usize, k: usize, value: f64) -> Option<String> {
+    use crate::io::validity::{self as v, Range};
+    /// A sampling interval, ms: 10 µs (100 kHz) to 1 s (1 Hz), the IMU rates a manifest accepts.
+    const INTERVAL_MS: Range = Range::closed(0.01, 1000.0, "ms", "a sampling interval");
+    /// t0, s: a time on the file's clock.
+    const T0_S: Range = v::CLOCK_S;
+    /// A gyro count, arcsec: a nonzero scale up to 1e6″ (278° per count; imufile.m's are ~1e-3″).
+    const GYRO_SCALE: Range = Range::symmetric(1e6, "arcsec", "a gyro scale factor");
+    /// An accelerometer count, µg·s: a nonzero scale up to 1e6 µg·s (1 g·s per count).
+    const ACCEL_SCALE: Range = Range::symmetric(1e6, "µg·s", "an accelerometer scale factor");
+    let range = match (r, k) {
+        (0, 0) => Some(v::PITCH_DEG),
+        (0, 1) => Some(v::ROLL_DEG),
+        (0, 2) => Some(v::HEADING_DEG),
+        (0, 3..6) => Some(v::VELOCITY_MPS),
+        (1, 0) => Some(v::LATITUDE_DEG),
+        (1, 1) => Some(v::LONGITUDE_DEG),
+        (1, 2) => Some(v::HEIGHT_M),
+        (1, 3) => Some(T0_S),
+        (1, 4) => Some(INTERVAL_MS),
+        (2, 0..3) => Some(GYRO_SCALE),
+        (2, 3..6) => Some(ACCEL_SCALE),
+        _ => None,
+    };
+    if let Some(range) = range
+        && let Err(e) = v::check_number(value, &range)
+    {
+        return Some(e);
+    }
     match (r, k) {
-        (1, 0) if value.abs() > 90.0 => Some("is not a latitude: it must be within ±90°".into()),
-        (1, 1) if value.abs() > 360.0 => Some("is not a longitude: it must be within ±360°".into()),
-        (1, 4) if value <= 0.0 => Some("is not a sampling interval: it must be > 0 ms".into()),
         (1, 5) if !(G_MIN_MPS2..=G_MAX_MPS2).contains(&value) => Some(format!(
             "is not the g that scales the accelerometer counts: it must be within {G_MIN_MPS2}..{G_MAX_MPS2} m/s² (imufile.m writes PSINS's glv.g0, 9.780327)"
         )),

@@ -11,6 +11,7 @@
 //! | `frequency` | a fractional frequency y | `1`, `ppm`, `ppb`, `ppt` | y·τ0 (s) |
 
 use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::io::error::{Location, LogError};
 use crate::io::table::{Col, ColumnReader, ReadOptions};
@@ -152,6 +153,9 @@ pub struct Series {
     pub tau0_s: f64,
     /// Rows read.
     pub rows: usize,
+    /// The reading was stopped (the stop flag of [`read_series_until`]) before the file's end:
+    /// the series is the rows read until then.
+    pub interrupted: bool,
 }
 
 /// Why a series cannot be read.
@@ -163,7 +167,18 @@ pub enum SeriesError {
     /// The series as a whole (too short, a rate out of range, a time column that does not advance).
     #[error("{0}")]
     Series(String),
+    /// Stopped (a signal) before two rows were read.
+    #[error("{}: stopped after {rows} row(s), too few to analyse", .path.display())]
+    Interrupted {
+        /// The file.
+        path: std::path::PathBuf,
+        /// Rows read.
+        rows: usize,
+    },
 }
+
+/// Rows read between two looks at the stop flag: one batch (64k rows, a few ms of reading).
+const STOP_CHECK_ROWS: usize = 65_536;
 
 /// Largest relative spread of the time column's steps accepted as even sampling.
 const EVEN_TOLERANCE: f64 = 0.01;
@@ -174,7 +189,24 @@ const EVEN_TOLERANCE: f64 = 0.01;
 /// The file or a column cannot be read (the error names the column, row and value), a time column
 /// that does not advance evenly (the row), fewer than two rows, a rate out of range.
 pub fn read_series(path: &Path, columns: &[SeriesColumn], sampling: &Sampling) -> Result<Series, SeriesError> {
+    read_series_until(path, columns, sampling, &AtomicBool::new(false))
+}
+
+/// [`read_series`], looking at `stop` every [`STOP_CHECK_ROWS`] rows: once it is set, the rows read
+/// so far are the series, marked [`Series::interrupted`] (a signal ends the reading of a 20 M-row
+/// file within milliseconds, not after it).
+///
+/// # Errors
+/// As [`read_series`]; [`SeriesError::Interrupted`] when stopped before two rows.
+pub fn read_series_until(path: &Path, columns: &[SeriesColumn], sampling: &Sampling, stop: &AtomicBool) -> Result<Series, SeriesError> {
     let bad = |what: String| SeriesError::Series(format!("{}: {what}", path.display()));
+    // A declared rate is checked before the file is read (the one number rule: a rate of 1e-308
+    // Hz gave infinite increments and NaN deviations).
+    let declared_tau0_s = match sampling {
+        Sampling::RateHz(hz) => Some(tau0_of_rate(*hz, "--rate-hz").map_err(bad)?),
+        Sampling::TimeColumn(..) => None,
+    };
+    let mut interrupted = false;
     let mut cols: Vec<Col> = columns.iter().map(|c| c.col.clone()).collect();
     if let Sampling::TimeColumn(t, _) = sampling {
         cols.push(t.clone());
@@ -183,11 +215,15 @@ pub fn read_series(path: &Path, columns: &[SeriesColumn], sampling: &Sampling) -
     let names: Vec<String> = reader.columns()[..columns.len()].to_vec();
     let mut values: Vec<Vec<f64>> = vec![Vec::new(); columns.len()];
     let width = cols.len();
-    let mut batch = Vec::with_capacity(width * 65_536);
+    let mut batch = Vec::with_capacity(width * STOP_CHECK_ROWS);
     let (mut t_first, mut t_prev, mut steps) = (None::<f64>, 0.0, Vec::new());
     loop {
+        if stop.load(Ordering::Relaxed) {
+            interrupted = true;
+            break;
+        }
         batch.clear();
-        if reader.next_batch(&mut batch, 65_536)? == 0 {
+        if reader.next_batch(&mut batch, STOP_CHECK_ROWS)? == 0 {
             break;
         }
         for row in batch.chunks_exact(width) {
@@ -205,30 +241,33 @@ pub fn read_series(path: &Path, columns: &[SeriesColumn], sampling: &Sampling) -
         }
     }
     let rows = values.first().map_or(0, Vec::len);
+    if rows < 2 && interrupted {
+        return Err(SeriesError::Interrupted { path: path.to_owned(), rows });
+    }
     if rows < 2 {
         return Err(bad(format!("{rows} row(s): a series needs at least two samples")));
     }
-    let tau0_s = match sampling {
-        Sampling::RateHz(hz) => tau0_of_rate(*hz, "--rate-hz").map_err(bad)?,
-        Sampling::TimeColumn(..) => match even_step(&steps) {
+    let tau0_s = match (declared_tau0_s, sampling) {
+        (Some(tau0_s), _) => tau0_s,
+        (None, Sampling::RateHz(hz)) => tau0_of_rate(*hz, "--rate-hz").map_err(bad)?,
+        (None, Sampling::TimeColumn(..)) => match even_step(&steps) {
             Ok(()) => (t_prev - t_first.unwrap_or(0.0)) / (rows - 1) as f64,
-            Err(Uneven::Stalled(median)) => return Err(bad(format!("the time column does not advance (median step {median} s)"))),
+            Err(Uneven::Stalled(median)) => return Err(bad(format!("the time column does not advance (median step {} s)", crate::io::short_number(median)))),
             Err(Uneven::Step { k, step, median }) => {
                 // Step k ends at data row k + 2 (1-based).
                 let at = Location { row: k as u64 + 2, line: None };
                 let time_col = &reader.columns()[columns.len()];
-                return Err(SeriesError::Log(LogError::BadValue { file: path.to_owned(), at, column: time_col.clone(), value: format!("step {step} s"), problem: uneven_problem(median) }));
+                return Err(SeriesError::Log(LogError::BadValue { file: path.to_owned(), at, column: time_col.clone(), value: format!("step {} s", crate::io::short_number(step)), problem: uneven_problem(median) }));
             }
         },
     };
-    Ok(Series { names, columns: columns.to_vec(), increments: increments(columns, values, tau0_s), tau0_s, rows })
+    Ok(Series { names, columns: columns.to_vec(), increments: increments(columns, values, tau0_s), tau0_s, rows, interrupted })
 }
 
-/// The sample interval of a rate given as `name`, s.
+/// The sample interval of a rate given as `name`, s (the one number rule,
+/// [`crate::io::validity::SERIES_RATE_HZ`]).
 fn tau0_of_rate(hz: f64, name: &str) -> Result<f64, String> {
-    if !(hz.is_finite() && hz > 0.0 && hz <= 1e9) {
-        return Err(format!("{name} {hz}: must be > 0 and at most 1e9 Hz"));
-    }
+    let hz = crate::io::validity::check_number(hz, &crate::io::validity::SERIES_RATE_HZ).map_err(|e| format!("{name} {e}"))?;
     Ok(1.0 / hz)
 }
 
@@ -256,7 +295,8 @@ fn even_step(steps: &[f64]) -> Result<(), Uneven> {
 
 fn uneven_problem(median: f64) -> String {
     format!(
-        "where the series steps {median} s: the Allan-type estimators need evenly spaced samples (a gap, or a jitter over {} %); cut the file at the gap or resample it",
+        "where the series steps {} s: the Allan-type estimators need evenly spaced samples (a gap, or a jitter over {} %); cut the file at the gap or resample it",
+        crate::io::short_number(median),
         EVEN_TOLERANCE * 100.0
     )
 }
@@ -316,18 +356,56 @@ pub fn series_in_memory(columns: &[SeriesColumn], values: Vec<Vec<f64>>, rate_hz
             let steps: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
             match even_step(&steps) {
                 Ok(()) => (t[rows - 1] - t[0]) / (rows - 1) as f64,
-                Err(Uneven::Stalled(median)) => return Err(SeriesError::Series(format!("time_s does not advance (median step {median} s)"))),
+                Err(Uneven::Stalled(median)) => return Err(SeriesError::Series(format!("time_s does not advance (median step {} s)", crate::io::short_number(median)))),
                 Err(Uneven::Step { k, step, median }) => return Err(SeriesError::Series(format!("time_s, from sample {k} to {}: step {step} s {}", k + 1, uneven_problem(median)))),
             }
         }
         _ => return Err(SeriesError::Series("give the sampling: rate_hz or time_s (not both)".into())),
     };
-    Ok(Series { names, columns: columns.to_vec(), increments: increments(columns, values, tau0_s), tau0_s, rows })
+    Ok(Series { names, columns: columns.to_vec(), increments: increments(columns, values, tau0_s), tau0_s, rows, interrupted: false })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn scratch_csv(name: &str, rows: usize) -> std::path::PathBuf {
+        let d = std::env::temp_dir().join(format!("rinscope-series-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&d).expect("scratch");
+        let path = d.join("s.csv");
+        let mut text = String::from("x\n");
+        for k in 0..rows {
+            text.push_str(&format!("{}\n", (k % 7) as f64 * 0.1));
+        }
+        std::fs::write(&path, text).expect("csv");
+        path
+    }
+
+    #[test]
+    fn an_absurd_rate_is_refused_before_reading_and_said_short() {
+        // Issue 31: --rate-hz 1e-308 gave a 1e308 s interval, infinite increments and NaN deviations.
+        let path = scratch_csv("rate", 10);
+        let col = [SeriesColumn::parse("x:rate:deg/s").expect("spec")];
+        for hz in [1e-308, 1e308, -10.0, f64::NAN] {
+            let e = read_series(&path, &col, &Sampling::RateHz(hz)).expect_err("refused").to_string();
+            assert!(e.contains("--rate-hz") && e.contains("Hz") && e.len() < 200, "{hz}: {e}");
+        }
+        assert!(read_series(&path, &col, &Sampling::RateHz(1e-308)).expect_err("1e-308").to_string().contains("1e-308 Hz"));
+        let s = read_series(&path, &col, &Sampling::RateHz(100.0)).expect("a good rate");
+        assert!(!s.interrupted && s.rows == 10 && s.increments[0].iter().all(|x| x.is_finite()));
+    }
+
+    #[test]
+    fn a_stop_ends_the_reading_at_the_next_batch() {
+        // Issue 31: allan --series read a whole 20 M-row file after SIGTERM.
+        let path = scratch_csv("stop", 3 * STOP_CHECK_ROWS);
+        let col = [SeriesColumn::parse("x:rate:deg/s").expect("spec")];
+        let stop = AtomicBool::new(true);
+        let e = read_series_until(&path, &col, &Sampling::RateHz(100.0), &stop).expect_err("stopped before any row");
+        assert!(matches!(e, SeriesError::Interrupted { rows: 0, .. }), "{e}");
+        let whole = read_series_until(&path, &col, &Sampling::RateHz(100.0), &AtomicBool::new(false)).expect("whole");
+        assert_eq!((whole.rows, whole.interrupted), (3 * STOP_CHECK_ROWS, false));
+    }
 
     #[test]
     fn a_column_spec_names_its_column_kind_and_unit() {

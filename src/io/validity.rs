@@ -89,9 +89,128 @@ pub fn check_span(file: &Path, at: Location, column: &str, cell: f64, t_s: f64) 
     Err(bad_value(file, at, column, cell, format!("is {} s from the IMU's first stamp: not a time on the same clock (a log spans at most 1e9 s); a damaged file?", short_number(t_s))))
 }
 
+/// The physical range of one number a user gives — an option on the command line, a field of a
+/// file's header, a key of a manifest — checked by [`check_number`], the same rule as a log's
+/// samples: finite and inside what the quantity can physically be, or refused with a short message
+/// naming the value and its unit (never a 300-digit echo, never a NaN or an infinity that travels).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Range {
+    /// The smallest value allowed (see `min_inclusive`).
+    pub min: f64,
+    /// `min` itself is allowed; else only values above it (a rate, a duration: `> 0`).
+    pub min_inclusive: bool,
+    /// The largest value allowed.
+    pub max: f64,
+    /// The unit the value is given in, as the message shows it (`Hz`, `s`, `deg`).
+    pub unit: &'static str,
+    /// What the value is, for the message (`a sample rate`).
+    pub what: &'static str,
+}
+
+impl Range {
+    /// `min <= v <= max`.
+    #[must_use]
+    pub const fn closed(min: f64, max: f64, unit: &'static str, what: &'static str) -> Self {
+        Self { min, min_inclusive: true, max, unit, what }
+    }
+
+    /// `0 < v <= max`.
+    #[must_use]
+    pub const fn positive(max: f64, unit: &'static str, what: &'static str) -> Self {
+        Self { min: 0.0, min_inclusive: false, max, unit, what }
+    }
+
+    /// `-max <= v <= max`.
+    #[must_use]
+    pub const fn symmetric(max: f64, unit: &'static str, what: &'static str) -> Self {
+        Self { min: -max, min_inclusive: true, max, unit, what }
+    }
+
+    /// Whether `v` is inside (a NaN never is).
+    #[must_use]
+    pub fn contains(&self, v: f64) -> bool {
+        let above = if self.min_inclusive { v >= self.min } else { v > self.min };
+        above && v <= self.max
+    }
+
+    /// The range in words: `> 0 and at most 1e9 Hz`.
+    #[must_use]
+    pub fn text(&self) -> String {
+        let unit = self.unit;
+        let sep = if unit.is_empty() { "" } else { " " };
+        if self.min_inclusive && self.min == -self.max {
+            format!("within ±{}{sep}{unit}", short_number(self.max))
+        } else {
+            let low = if self.min_inclusive { "at least" } else { ">" };
+            format!("{low} {}{sep}{unit} and at most {}{sep}{unit}", short_number(self.min), short_number(self.max))
+        }
+    }
+}
+
+/// The rule of [`Range`]: `value` if finite and inside `range`.
+///
+/// # Errors
+/// The message, short, naming the value and its unit, what it should be and the range (the
+/// caller adds the option's or the field's name): `1e-308 Hz is not a sample rate: it must be at
+/// least 1e-6 Hz and at most 1e9 Hz`.
+pub fn check_number(value: f64, range: &Range) -> Result<f64, String> {
+    if value.is_finite() && range.contains(value) {
+        return Ok(value);
+    }
+    let sep = if range.unit.is_empty() { "" } else { " " };
+    let (v, unit, what) = (short_number(value), range.unit, range.what);
+    if value.is_finite() {
+        Err(format!("{v}{sep}{unit} is out of range for {what}: it must be {}", range.text()))
+    } else {
+        Err(format!("{v}{sep}{unit} is not a finite number ({what} must be {})", range.text()))
+    }
+}
+
+/// The sample rate of any series (`allan --series --rate-hz`), Hz. Up to 1 GHz (the fastest time
+/// interval counters; the bound the reader always had); down to one sample per 11.6 days (1e-6
+/// Hz): the interval 1/rate multiplies every rate sample, and below that an interval turns a
+/// finite sample into an infinity (1e-308 Hz gave a 1e308 s interval and NaN deviations).
+pub const SERIES_RATE_HZ: Range = Range::closed(1e-6, 1e9, "Hz", "a sample rate");
+
+/// The sample rate of an IMU, Hz (`replay --rate-hz`, a manifest's `imu.rate_hz`): 1 Hz to 100
+/// kHz, the manifest's bound (navigation IMUs log at 100 Hz to 2 kHz; none at 100 kHz).
+pub const IMU_RATE_HZ: Range = Range::closed(1.0, 100_000.0, "Hz", "an IMU's sample rate");
+
+/// A pitch, deg: ±90 (the attitude's definition).
+pub const PITCH_DEG: Range = Range::symmetric(90.0, "deg", "a pitch");
+/// A roll, deg: ±180.
+pub const ROLL_DEG: Range = Range::symmetric(180.0, "deg", "a roll");
+/// A heading or yaw, deg: ±360 (either convention, 0..360 or ±180).
+pub const HEADING_DEG: Range = Range::symmetric(360.0, "deg", "a heading");
+/// A latitude, deg: ±90.
+pub const LATITUDE_DEG: Range = Range::symmetric(90.0, "deg", "a latitude");
+/// A longitude, deg: ±360 (either convention).
+pub const LONGITUDE_DEG: Range = Range::symmetric(360.0, "deg", "a longitude");
+/// A height, m: from below the deepest trench (−12 km) to 100 km (the Kármán line; the manifest's
+/// bound: the gravity model is not meant for orbits).
+pub const HEIGHT_M: Range = Range::closed(-12_000.0, 100_000.0, "m", "a height");
+/// A velocity component, m/s: ±3 km/s (the manifest's bound: beyond a rifle bullet's speed,
+/// and no navigation grade vehicle flies faster in the atmosphere).
+pub const VELOCITY_MPS: Range = Range::symmetric(3_000.0, "m/s", "a velocity");
+/// A time on a file's clock, s: ±1e10 s (Unix time reaches 1e10 s in the year 2286; a larger
+/// value is a unit other than seconds).
+pub const CLOCK_S: Range = Range::symmetric(1e10, "s", "a time on the file's clock");
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn one_number_rule_refuses_the_absurd_in_a_short_message() {
+        assert_eq!(check_number(100.0, &IMU_RATE_HZ), Ok(100.0));
+        for v in [1e-308, 1e308, 1e300, -10.0, 0.0, f64::NAN, f64::INFINITY] {
+            let e = check_number(v, &SERIES_RATE_HZ).expect_err("refused");
+            assert!(e.len() < 120 && e.contains("Hz") && e.contains("1e9"), "{v}: {e}");
+        }
+        assert!(check_number(1e-308, &SERIES_RATE_HZ).expect_err("1e-308").starts_with("1e-308 Hz"));
+        assert!(check_number(1e300, &PITCH_DEG).expect_err("1e300").starts_with("1e300 deg is out of range for a pitch: it must be within ±90 deg"));
+        assert!(check_number(-90.0, &PITCH_DEG).is_ok() && check_number(0.0, &Range::positive(1.0, "s", "a duration")).is_err());
+    }
 
     #[test]
     fn bounds_refuse_the_absurd_and_say_it_short() {

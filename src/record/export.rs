@@ -134,9 +134,14 @@ pub fn column_base(name: &str) -> String {
 }
 
 impl Exporter {
-    /// Tables into `dir` (created if needed).
-    pub fn new(dir: &Path, format: ExportFormat) -> std::io::Result<Self> {
-        std::fs::create_dir_all(dir)?;
+    /// Tables into `dir`, created if missing; its parent must exist, as for every output folder
+    /// ([`crate::io::files::create_output_dir`]: a FIFO, a file, a symlink or a read-only folder is
+    /// refused with what it is, not "File exists").
+    ///
+    /// # Errors
+    /// Why the folder cannot be used.
+    pub fn new(dir: &Path, format: ExportFormat) -> Result<Self, crate::io::files::OutputError> {
+        crate::io::files::create_output_dir("--export", dir).map_err(|e| e.error)?;
         Ok(Self { target: Target::Files { dir: dir.to_path_buf(), format }, tables: BTreeMap::new(), failed: None, file_clock_s: None })
     }
 

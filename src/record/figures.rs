@@ -8,6 +8,7 @@
 //! contrast (WCAG's for graphics); no other change.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::prelude::*;
@@ -32,19 +33,32 @@ pub struct Written {
     pub plots: usize,
     /// Why the PNGs lack text, if they do (no system font).
     pub warning: Option<String>,
+    /// The stop flag was set before every plot was drawn: `files` are the figures finished
+    /// before it (each whole; the one being drawn was not written).
+    pub interrupted: bool,
 }
 
-/// Draws every time-series plot of the recording at `rrd` into `dir` (created if missing) as
-/// `NN-<origin>.svg` and `.png`, each file written atomically.
+/// Draws every time-series plot of the recording at `rrd` into `dir` (created if missing; its
+/// parent must exist, as for every output folder: [`crate::io::files::create_output_dir`]) as
+/// `NN-<origin>.svg` and `.png`, each file written atomically. `stop` is looked at before each
+/// plot (one takes a few hundred ms): once set, the drawing ends with the figures finished so far
+/// and [`Written::interrupted`].
 ///
 /// # Errors
 /// An unreadable recording, a plot that cannot be drawn, a file that cannot be written.
-pub fn write(rrd: &Path, dir: &Path) -> anyhow::Result<Written> {
+pub fn write(rrd: &Path, dir: &Path, stop: &AtomicBool) -> anyhow::Result<Written> {
+    if stop.load(Ordering::SeqCst) {
+        return Ok(Written { interrupted: true, ..Written::default() });
+    }
     let plots = super::read::plots(rrd)?;
-    std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("{}: cannot create the folder: {e}", dir.display()))?;
+    crate::io::files::create_output_dir("--figures", dir).map_err(|e| anyhow::anyhow!("{}", e.error))?;
     let (fonts, warning) = fonts();
     let mut out = Written { warning, ..Written::default() };
     for (i, plot) in plots.iter().filter(|p| p.series.iter().any(|s| s.y.iter().any(|v| v.is_finite()))).enumerate() {
+        if stop.load(Ordering::SeqCst) {
+            out.interrupted = true;
+            break;
+        }
         let stem = format!("{:02}-{}", i + 1, slug(&plot.origin));
         let svg = svg(plot)?;
         let svg_path = dir.join(format!("{stem}.svg"));

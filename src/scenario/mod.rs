@@ -16,7 +16,7 @@ pub fn check_duration(duration_s: f64) -> Result<f64, String> {
     if duration_s.is_finite() && duration_s > 0.0 && duration_s <= MAX_DURATION_S {
         Ok(duration_s)
     } else {
-        Err(format!("{duration_s} s: must be > 0 and at most {MAX_DURATION_S} s (30 days), as simulation.duration_s"))
+        Err(format!("{} s: must be > 0 and at most {MAX_DURATION_S} s (30 days), as simulation.duration_s", crate::io::short_number(duration_s)))
     }
 }
 
@@ -285,12 +285,18 @@ pub fn from_raw(raw: RawConfig, origin: &str) -> Result<Params, ConfigError> {
 
 /// The toml crate's message, which quotes the offending line: each quoted line cut to 160
 /// characters and the whole to 40 lines (a 200 kB line of nested brackets is not echoed back).
+///
+/// A misspelt key (serde's "unknown field `x`, expected one of `a`, `b`, ...") or value ("unknown
+/// variant") is said with the closest valid one(s) and the whole list of the section's keys,
+/// never cut ([`did_you_mean`]).
 pub fn parse_message(e: &toml::de::Error) -> String {
     const LINE: usize = 160;
     let text = e.to_string();
     let mut out: Vec<String> = Vec::new();
     for line in text.trim_end().lines().take(40) {
-        if line.chars().count() > LINE {
+        if let Some(said) = did_you_mean(line) {
+            out.push(said);
+        } else if line.chars().count() > LINE {
             let cut: String = line.chars().take(LINE).collect();
             out.push(format!("{cut}… ({} characters)", line.chars().count()));
         } else {
@@ -298,6 +304,31 @@ pub fn parse_message(e: &toml::de::Error) -> String {
         }
     }
     out.join("\n")
+}
+
+/// serde's message for an unknown key or value (`unknown field `swing_half_angle_arcsex`,
+/// expected one of `name`, `swing_half_angle_arcsec`, ...`) said for a person: the closest valid
+/// name(s) by edit distance, and every valid name of the section (None for any other line).
+#[must_use]
+pub fn did_you_mean(line: &str) -> Option<String> {
+    let (what, rest) = [("field", "key"), ("variant", "value")].iter().find_map(|(serde_word, ours)| line.strip_prefix(&format!("unknown {serde_word} `")).map(|r| (*ours, r)))?;
+    let (given, rest) = rest.split_once('`')?;
+    let rest = rest.strip_prefix(", ")?;
+    let valid: Vec<&str> = if rest.starts_with("there are no") {
+        Vec::new()
+    } else {
+        let list = rest.strip_prefix("expected one of ").or_else(|| rest.strip_prefix("expected "))?;
+        list.split('`').skip(1).step_by(2).collect()
+    };
+    if valid.is_empty() {
+        return Some(format!("unknown {what} `{given}`: this section takes none"));
+    }
+    // The closest by edit distance, if close enough to be a slip (a third of the name, at least 2).
+    let distance = |v: &str| strsim::damerau_levenshtein(&given.to_lowercase(), &v.to_lowercase());
+    let best = valid.iter().map(|v| distance(v)).min().unwrap_or(usize::MAX);
+    let near: Vec<String> = valid.iter().filter(|v| distance(v) == best && best <= (given.chars().count() / 3).max(2)).map(|v| format!("`{v}`")).collect();
+    let hint = if near.is_empty() { String::new() } else { format!("; did you mean {}?", near.join(" or ")) };
+    Some(format!("unknown {what} `{given}`{hint}\nvalid {what}s here ({}): {}", valid.len(), valid.join(", ")))
 }
 
 /// Every leaf of a resolved config as `dotted.key -> value text` (arrays of tables indexed `[i]`),
@@ -359,5 +390,27 @@ pub fn compensation_keys(chain: &crate::model::gimbal::Chain, errors: &crate::mo
         imu_mount_y_arcsec: arcsec(errors.imu_mount_rad.y),
         imu_mount_z_arcsec: arcsec(errors.imu_mount_rad.z),
         axis,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn a_misspelt_key_gets_the_closest_and_the_whole_list() {
+        // Issue 31: the list of valid keys was cut, with no "did you mean".
+        let keys: Vec<String> = (0..40).map(|i| format!("`key_number_{i:02}_with_a_long_name`")).collect();
+        let line = format!("unknown field `key_number_07_with_a_lng_name`, expected one of {}", keys.join(", "));
+        let said = super::did_you_mean(&line).expect("recognised");
+        assert!(said.contains("did you mean `key_number_07_with_a_long_name`?"), "{said}");
+        assert!(said.contains("key_number_39_with_a_long_name") && said.contains("(40)"), "the whole list: {said}");
+        let said = super::did_you_mean("unknown field `duraton_s`, expected `duration_s` or `step_hz`").expect("two");
+        assert!(said.contains("did you mean `duration_s`?") && said.contains("duration_s, step_hz"), "{said}");
+        let said = super::did_you_mean("unknown field `zzzzzzzz`, expected `duration_s`").expect("one");
+        assert!(!said.contains("did you mean") && said.contains("duration_s"), "{said}");
+        assert!(super::did_you_mean("unknown variant `sin`, expected one of `sine`, `square`").expect("variant").contains("did you mean `sine`?"));
+        assert!(super::did_you_mean("invalid type: string, expected f64").is_none());
+        // Through the parser, as a user meets it: the whole list, never cut.
+        let e = super::parse("[simulation]\nduraton_s = 3\n", "t.toml").expect_err("typo").to_string();
+        assert!(e.contains("did you mean `duration_s`?"), "{e}");
     }
 }

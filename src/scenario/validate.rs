@@ -33,7 +33,7 @@ impl Checker<'_> {
     pub(super) fn range(&self, key: &str, value: f64, unit: &'static str, lo: f64, hi: f64, hint: &str) -> Result<f64, ConfigError> {
         self.finite(key, value, unit)?;
         if value < lo || value > hi {
-            let mut range = format!("allowed {lo} ..= {hi} {unit}");
+            let mut range = format!("allowed {} ..= {} {unit}", crate::io::short_number(lo), crate::io::short_number(hi));
             if !hint.is_empty() {
                 range.push_str(" (");
                 range.push_str(hint);
@@ -53,7 +53,7 @@ impl Checker<'_> {
                 key: key.to_owned(),
                 value,
                 unit,
-                range: format!("must be > 0 and <= {hi} {unit}"),
+                range: format!("must be > 0 and <= {} {unit}", crate::io::short_number(hi)),
             });
         }
         Ok(value)

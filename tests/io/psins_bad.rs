@@ -120,11 +120,17 @@ fn header_values() {
     let dir = scratch("psins_bad_header_values");
     let lines = valid_lines(false);
     for (name, line, k, value, expected) in [
-        ("ts0.imu", 16, 4, "0.00000000", ["sampling-interval(ms) (header row 2, field 5)", "must be > 0 ms"]),
-        ("ts_neg.imu", 16, 4, "-10.00000000", ["sampling-interval(ms)", "must be > 0 ms"]),
+        ("ts0.imu", 16, 4, "0.00000000", ["sampling-interval(ms) (header row 2, field 5)", "at least 0.01 ms"]),
+        ("ts_neg.imu", 16, 4, "-10.00000000", ["sampling-interval(ms)", "at least 0.01 ms"]),
+        // Issue 31: every header number passes the samples' rule, said short (no 300 digits).
+        ("pitch.imu", 15, 0, "1e300", ["pitch0(deg) (header row 1, field 1)", "1e300 deg is out of range for a pitch: it must be within ±90 deg"]),
+        ("ve.imu", 15, 3, "1e300", ["VE0(m/s) (header row 1, field 4)", "1e300 m/s is out of range for a velocity"]),
+        ("h.imu", 16, 2, "-1e300", ["height0(m)", "-1e300 m is out of range for a height"]),
+        ("t0.imu", 16, 3, "1e300", ["t0(s)", "a time on the file's clock"]),
+        ("gf_big.imu", 17, 0, "1e300", ["gf_x", "1e300 arcsec is out of range"]),
         ("g.imu", 16, 5, "9.600000", ["g(m/s^2) (header row 2, field 6)", "9.7..9.9"]),
         ("g_mps2.imu", 16, 5, "98.066500", ["g(m/s^2)", "9.7..9.9"]),
-        ("lat.imu", 16, 0, "134.24604800", ["latitude0(deg) (header row 2, field 1)", "±90°"]),
+        ("lat.imu", 16, 0, "134.24604800", ["latitude0(deg) (header row 2, field 1)", "±90 deg"]),
         ("gf.imu", 17, 1, "0.000000", ["gf_y (header row 3, field 2)", "zero scale factor"]),
         ("nan.imu", 15, 2, "NaN", ["yaw0(deg) (header row 1, field 3)", "NaN"]),
         ("word.imu", 17, 3, "one", ["af_x (header row 3, field 4)", "not a number"]),
@@ -134,6 +140,7 @@ fn header_values() {
         // NaN is named bare ("the value is NaN"), the others quoted.
         let quoted = if value == "NaN" { value.to_owned() } else { format!("{value:?}") };
         let e = error(&path, &[&line_text, &quoted, expected[0], expected[1]]);
+        assert!(e.to_string().len() < 400, "short: {e}");
         assert!(matches!(&e, LogError::BadValue { at: Location { row: 0, .. }, .. } | LogError::NonFinite { .. } | LogError::NonNumeric { .. }), "{e:?}");
         let header_error = read_psins_header(&path).unwrap_err().to_string();
         assert_eq!(header_error, e.to_string());

@@ -85,7 +85,7 @@ pub fn execute(req: &AllanCommand, stop: &AtomicBool, progress: &dyn Fn(u64)) ->
         }
         AllanSource::Series(file, columns, sampling, _) => {
             errln!("rinscope: reading {} ...", file.display());
-            series(file, columns, sampling, &req.analysis)
+            series(file, columns, sampling, &req.analysis, stop)
         }
         AllanSource::Scenario(p) => {
             errln!("rinscope: simulating {:.2} h of {} at {} Hz, then the Allan analysis of 6 channels ...", p.duration_s / 3600.0, p.meta.name, p.step_hz);

@@ -12,7 +12,7 @@ use nalgebra::Vector3;
 
 use super::playback::{ImuItem, ImuSamples, PlaybackError};
 use crate::ins::allan::{analyze_channel, analyze_imu, ChannelError, ImuAllan, Sensor, Truth};
-use crate::io::series::{read_series, Sampling, SeriesColumn};
+use crate::io::series::{read_series_until, Sampling, SeriesColumn};
 use crate::io::units::Quantity;
 use crate::ins::InsParams;
 use crate::math::allan::estimators::Estimator;
@@ -173,7 +173,7 @@ pub fn options(req: &AllanRequest) -> Result<AllanOptions, AllanRunError> {
         return Err(AllanRunError::Config(format!("--decimate {}: must be 1 ..= 1000000 samples", req.decimate)));
     }
     if !(req.ci_sigma > 0.0 && req.ci_sigma <= 3.0) {
-        return Err(AllanRunError::Config(format!("--ci-sigma {}: must be > 0 and <= 3 (normal sigmas)", req.ci_sigma)));
+        return Err(AllanRunError::Config(format!("--ci-sigma {}: must be > 0 and <= 3 (normal sigmas)", crate::io::short_number(req.ci_sigma))));
     }
     if req.spacing == TauSpacing::PerDecade(0) {
         return Err(AllanRunError::Config("--taus 0: give at least 1 cluster time per decade (or octave, decade, all)".into()));
@@ -358,10 +358,15 @@ fn finish(g: Gather, source: String, seed: Option<u64>, rate_hz: f64, truth: Opt
 ///
 /// # Errors
 /// The file, a column, the sampling, a request out of range, a channel with too few samples.
-pub fn series(path: &std::path::Path, columns: &[SeriesColumn], sampling: &Sampling, req: &AllanRequest) -> Result<ImuAllan, AllanRunError> {
+/// `stop` ends the reading at its next batch of rows: the analysis is then of the rows read, and
+/// says so (`interrupted`).
+pub fn series(path: &std::path::Path, columns: &[SeriesColumn], sampling: &Sampling, req: &AllanRequest, stop: &AtomicBool) -> Result<ImuAllan, AllanRunError> {
     options(req)?;
     let started = Instant::now();
-    let data = read_series(path, columns, sampling).map_err(|e| AllanRunError::Config(e.to_string()))?;
+    let data = read_series_until(path, columns, sampling, stop).map_err(|e| match e {
+        crate::io::series::SeriesError::Interrupted { rows, .. } => AllanRunError::Interrupted(rows),
+        e => AllanRunError::Config(e.to_string()),
+    })?;
     let source = format!("series {}", path.display());
     analyze_series(data, &source, req, started.elapsed().as_secs_f64())
 }
@@ -376,6 +381,9 @@ pub fn analyze_series(data: crate::io::series::Series, source: &str, req: &Allan
     opts.min_clusters = 2;
     let started = Instant::now();
     let mut notes = Vec::new();
+    if data.interrupted {
+        notes.push(format!("stopped after {} rows: the analysis is of the series read until then", data.rows));
+    }
     let mut channels = Vec::new();
     for ((spec, name), increments) in data.columns.iter().zip(&data.names).zip(&data.increments) {
         let sensor = match spec.increment_quantity() {
@@ -410,7 +418,7 @@ pub fn analyze_series(data: crate::io::series::Series, source: &str, req: &Allan
         ci_sigma: req.ci_sigma,
         channels,
         notes,
-        interrupted: false,
+        interrupted: data.interrupted,
         gather_s,
         analysis_s: started.elapsed().as_secs_f64(),
     })

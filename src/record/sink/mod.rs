@@ -81,6 +81,9 @@ pub enum SinkError {
     /// The figures could not be drawn or written (the recording is kept).
     #[error("--figures: {0} (the recording itself was saved)")]
     FiguresWrite(String),
+    /// A signal stopped a phase after the run (drawing the figures): what is done is kept.
+    #[error("{0}")]
+    Interrupted(String),
     /// Any other Rerun SDK error.
     #[error("rerun: {0}")]
     Rerun(String),
@@ -278,7 +281,7 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
     let export = match &req.export {
         None if !req.tables_in_memory => None,
         Some((dir, format)) => {
-            let e = Exporter::new(dir, *format).map_err(|e| SinkError::Export(format!("{}: {e}", dir.display())))?;
+            let e = Exporter::new(dir, *format).map_err(|e| SinkError::Export(e.to_string()))?;
             description.push(format!("exporting every time series as {format:?} tables to {}", dir.display()));
             Some(Arc::new(Mutex::new(e)))
         }
@@ -371,6 +374,11 @@ impl OpenSinks {
     /// table failed.
     pub fn finish(self) -> Result<Saved, SinkError> {
         let Self { rec, file, export, viewer_problems, web, stop, figures, .. } = self;
+        // A stop set during the run ended the run (what was simulated is saved); one that comes
+        // in a phase after it (the figures) ends that phase and is reported here.
+        let never = std::sync::atomic::AtomicBool::new(false);
+        let stop_flag: &std::sync::atomic::AtomicBool = stop.as_deref().unwrap_or(&never);
+        let stopped_before = stop_flag.load(std::sync::atomic::Ordering::SeqCst);
         // Viewers that stall are detached by their own timeouts; the file's writer is waited for
         // by `RrdFile::finish`, so a flush timeout here loses nothing.
         rec.flush_with_timeout(Duration::from_secs(10)).ok();
@@ -384,9 +392,20 @@ impl OpenSinks {
         };
         let viewer_problems = viewer_problems.lock().unwrap_or_else(std::sync::PoisonError::into_inner).clone();
         let figures = match (&figures, &recording) {
-            (Some(dir), Some((path, _))) => Some(crate::record::figures::write(path, dir).map_err(|e| SinkError::FiguresWrite(format!("{e:#}")))?),
+            (Some(dir), Some((path, _))) => Some(crate::record::figures::write(path, dir, stop_flag).map_err(|e| SinkError::FiguresWrite(format!("{e:#}")))?),
             _ => None,
         };
+        if let (Some(w), Some((path, _))) = (&figures, &recording)
+            && w.interrupted
+            && !stopped_before
+        {
+            return Err(SinkError::Interrupted(format!(
+                "--figures: drawing stopped after {} of the figures ({} files, each whole); the recording {} was saved",
+                w.plots,
+                w.files.len(),
+                path.display()
+            )));
+        }
         // A browser may still be reading: the page and the stream (held by `rec`) serve until the
         // stop flag (Ctrl-C) is set.
         if let (Some(w), Some(stop)) = (web, stop.filter(|s| !s.load(std::sync::atomic::Ordering::SeqCst))) {

@@ -277,14 +277,16 @@ fn validate_manifest_for(dir: &Path, raw: &RawManifest, origin: &str, raw_table:
         accel_bias_mps2: i.accel_bias_ug.map(|b| c.positive("initial.accel_bias_ug", b, "µg", 1e6)).transpose()?.map(|b| b * crate::math::units::MPS2_PER_UG),
         rest_threshold_mps2: i.rest_threshold_mps2.map_or(Ok(crate::ins::align::REST_THRESHOLD_MPS2), |t| c.positive("initial.rest_threshold_mps2", t, "m/s²", 10.0))?,
     };
+    // Times on the file's clock: finite and within ±1e10 s (the one number rule's CLOCK_S).
+    let clock = crate::io::validity::CLOCK_S;
     let span_s = (
-        raw.log.from_s.map(|t| c.finite("log.from_s", t, "s")).transpose()?,
-        raw.log.to_s.map(|t| c.finite("log.to_s", t, "s")).transpose()?,
+        raw.log.from_s.map(|t| c.range("log.from_s", t, "s", clock.min, clock.max, "")).transpose()?,
+        raw.log.to_s.map(|t| c.range("log.to_s", t, "s", clock.min, clock.max, "")).transpose()?,
     );
     if let (Some(a), Some(b)) = span_s
         && b <= a
     {
-        return Err(c.invalid("log.to_s", format!("{b} s is not after log.from_s = {a} s")));
+        return Err(c.invalid("log.to_s", format!("{} s is not after log.from_s = {} s", crate::io::short_number(b), crate::io::short_number(a))));
     }
     let encoders = match &raw.encoders {
         None => None,
@@ -313,7 +315,7 @@ fn validate_manifest_for(dir: &Path, raw: &RawManifest, origin: &str, raw_table:
             }
             let norm = q.iter().map(|x| x * x).sum::<f64>().sqrt();
             if (norm - 1.0).abs() > 1e-6 {
-                return Err(c.invalid("initial.imu_quaternion_wxyz", format!("norm {norm}: a rotation quaternion has norm 1")));
+                return Err(c.invalid("initial.imu_quaternion_wxyz", format!("norm {}: a rotation quaternion has norm 1", crate::io::short_number(norm))));
             }
             Initial::ImuQuaternion(q)
         }
