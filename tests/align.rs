@@ -6,7 +6,10 @@
 
 use rinscope::ins::align::{self, AlignConfig, Increment};
 use rinscope::math::rotvec;
-use rinscope::math::units::{MPS2_PER_UG, MPS_PER_SQRT_S_PER_UG_PER_SQRT_HZ, RAD_PER_DEG, RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H, RAD_PER_S_PER_DEG_PER_H};
+use rinscope::math::units::{
+    MPS_PER_SQRT_S_PER_UG_PER_SQRT_HZ, MPS2_PER_UG, RAD_PER_DEG, RAD_PER_S_PER_DEG_PER_H,
+    RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H,
+};
 
 /// A navigation-grade IMU (issue 23's: gyro bias 0.01 °/h, ARW 0.001 °/√h; accelerometer bias 50 µg,
 /// white noise 10 µg/√Hz), 100 Hz, at 34° N, heading varied with the seed.
@@ -56,8 +59,18 @@ fn align_once(seed: u64, rocking: bool, indexing: bool, seconds: f64) -> ([f64; 
     }
     // The rocking is there (its rate peaks near 0.08° · 2π · 1.3 Hz = 0.65 °/s), the quiet IMU reads
     // only the Earth's rate and noise; an indexing table turns at 10 °/s.
-    let expected = if indexing { 9.0 } else if rocking { 0.5 } else { 0.0 };
-    assert!(peak_rate.to_degrees() >= expected && (indexing || rocking || peak_rate.to_degrees() < 0.05), "peak rate {} °/s", peak_rate.to_degrees());
+    let expected = if indexing {
+        9.0
+    } else if rocking {
+        0.5
+    } else {
+        0.0
+    };
+    assert!(
+        peak_rate.to_degrees() >= expected && (indexing || rocking || peak_rate.to_degrees() < 0.05),
+        "peak rate {} °/s",
+        peak_rate.to_degrees()
+    );
     let truth = ins.true_n_from_s(t_end);
     let cfg = AlignConfig {
         latitude_rad: 34.0 * RAD_PER_DEG,
@@ -121,7 +134,12 @@ fn heading_lies_within_its_reported_2_sigma_over_50_seeds_at_rest_and_rocked() {
         check(if rocking { "rocked" } else { "at rest" }, &t);
         // Gyrocompassing's limit: heading 1σ → ε_E / (Ω cos L) = 0.01 °/h / (15.04 °/h · 0.829) = 2.75′.
         let limit_rad = 0.01 / (15.041 * 34.0_f64.to_radians().cos());
-        assert!((t.sigma_mean[2] - limit_rad).abs() < 0.25 * limit_rad, "heading 1σ {}′ vs the limit {}′", t.sigma_mean[2] / RAD_PER_DEG * 60.0, limit_rad / RAD_PER_DEG * 60.0);
+        assert!(
+            (t.sigma_mean[2] - limit_rad).abs() < 0.25 * limit_rad,
+            "heading 1σ {}′ vs the limit {}′",
+            t.sigma_mean[2] / RAD_PER_DEG * 60.0,
+            limit_rad / RAD_PER_DEG * 60.0
+        );
     }
 }
 
@@ -131,8 +149,16 @@ fn an_indexing_table_beats_the_gyrocompassing_limit_and_stays_honest() {
     let t = tally(&runs);
     // ε_E / (Ω cos L), rad (a ratio of two rates).
     let limit = 0.01 / (15.041 * 34.0_f64.to_radians().cos());
-    println!("indexing: mean heading 1σ {:.3}′ vs the fixed IMU's limit {:.3}′", t.sigma_mean[2] / RAD_PER_DEG * 60.0, limit / RAD_PER_DEG * 60.0);
+    println!(
+        "indexing: mean heading 1σ {:.3}′ vs the fixed IMU's limit {:.3}′",
+        t.sigma_mean[2] / RAD_PER_DEG * 60.0,
+        limit / RAD_PER_DEG * 60.0
+    );
     assert!(t.sigma_mean[2] < 0.5 * limit, "the turning IMU separates the east gyro bias");
     let rms_z = (t.sum_z2[2] / t.n as f64).sqrt();
-    assert!(t.within_2sigma[2] >= 17 && (0.5..=1.6).contains(&rms_z), "indexing: {}/20 within 2σ, RMS z {rms_z:.2}", t.within_2sigma[2]);
+    assert!(
+        t.within_2sigma[2] >= 17 && (0.5..=1.6).contains(&rms_z),
+        "indexing: {}/20 within 2σ, RMS z {rms_z:.2}",
+        t.within_2sigma[2]
+    );
 }

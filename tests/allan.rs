@@ -34,13 +34,22 @@ fn the_10h_preset_gives_back_n_b_and_k_on_every_axis() {
     // far wider). Q and R are not configured and must not be found.
     let dir = scratch("preset");
     let (out, rec) = (dir.join("adev.json"), dir.join("allan.rrd"));
-    let o = rinscope().args(["allan", "--scenario", "static-imu-10h", "--json"]).arg(&out).arg("--save").arg(&rec).output().expect("run");
+    let o = rinscope()
+        .args(["allan", "--scenario", "static-imu-10h", "--json"])
+        .arg(&out)
+        .arg("--save")
+        .arg(&rec)
+        .output()
+        .expect("run");
     assert!(o.status.success(), "{}", stderr(&o));
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(text.contains("angle random walk") && text.contains("acceleration random walk"), "{text}");
     let j = json(&out);
     assert_eq!(j["samples"].as_u64(), Some(7_200_000));
-    for (sensor, keys) in [("gyro", ["n_deg_per_sqrt_h", "b_deg_per_h", "k_deg_per_h_per_sqrt_h", "q_arcsec", "r_deg_per_h2"]), ("accel", ["n_ug_per_sqrt_hz", "b_ug", "k_ug_per_sqrt_h", "q_mps", "r_ug_per_h"])] {
+    for (sensor, keys) in [
+        ("gyro", ["n_deg_per_sqrt_h", "b_deg_per_h", "k_deg_per_h_per_sqrt_h", "q_arcsec", "r_deg_per_h2"]),
+        ("accel", ["n_ug_per_sqrt_hz", "b_ug", "k_ug_per_sqrt_h", "q_mps", "r_ug_per_h"]),
+    ] {
         let channels = j[sensor].as_array().expect("channels");
         assert_eq!(channels.len(), 3);
         for ch in channels {
@@ -48,7 +57,10 @@ fn the_10h_preset_gives_back_n_b_and_k_on_every_axis() {
             for (key, band) in [(keys[0], 0.10), (keys[1], 0.25), (keys[2], 0.10)] {
                 let (value, found) = fitted(ch, key);
                 let truth = configured(ch, key);
-                assert!(found && (value / truth - 1.0).abs() < band, "{sensor} {axis} {key}: {value} vs {truth} (band {band})");
+                assert!(
+                    found && (value / truth - 1.0).abs() < band,
+                    "{sensor} {axis} {key}: {value} vs {truth} (band {band})"
+                );
             }
             for key in &keys[3..] {
                 assert!(!fitted(ch, key).1, "{sensor} {axis}: {key} found but not configured");
@@ -97,10 +109,15 @@ fn a_log_set_is_analysed_from_its_files() {
     let cut: Vec<&str> = lines[..80_001].iter().chain(&lines[80_101..]).copied().collect();
     std::fs::write(&imu, cut.join("\n") + "\n").expect("write");
     let manifest = std::fs::read_to_string(log.join("log.toml")).expect("manifest");
-    std::fs::write(log.join("log.toml"), manifest.replacen("gap_policy = \"refuse\"", "gap_policy = \"split\"", 1)).expect("write");
+    std::fs::write(log.join("log.toml"), manifest.replacen("gap_policy = \"refuse\"", "gap_policy = \"split\"", 1))
+        .expect("write");
     let o = rinscope().arg("allan").arg(&log).arg("--json").arg(&out).arg("--no-recording").output().expect("allan");
     assert!(o.status.success(), "{}", stderr(&o));
-    assert!(String::from_utf8_lossy(&o.stdout).contains("1 gap(s): the longest stretch"), "{}", String::from_utf8_lossy(&o.stdout));
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains("1 gap(s): the longest stretch"),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
     let j = json(&out);
     assert_eq!(j["samples"].as_u64(), Some(159_902), "{}", j["notes"]);
     std::fs::remove_dir_all(&dir).ok();
@@ -131,15 +148,29 @@ fn bad_requests_and_misused_keys_are_refused_by_name() {
     // bias; now it is IEEE's B, and the old spelling is pointed to the new one.
     let gm = ("bias_instability_deg_per_h = 2.0", "bias_instability_deg_per_h = 2.0\ncorrelation_time_s = 100.0");
     refused(&["allan"], Some(gm), &["imu.gyro.bias_instability_deg_per_h", "markov_sigma_deg_per_h"]);
-    let both = ("arw_deg_per_sqrt_h = 0.02", "arw_deg_per_sqrt_h = 0.02\nquantization_arcsec = 0.1\npulse_weight_arcsec = 0.3");
+    let both = (
+        "arw_deg_per_sqrt_h = 0.02",
+        "arw_deg_per_sqrt_h = 0.02\nquantization_arcsec = 0.1\npulse_weight_arcsec = 0.3",
+    );
     refused(&["allan"], Some(both), &["imu.gyro.pulse_weight_arcsec", "not both"]);
-    let range = ("bias_instability_range_s = [0.1, 10000.0]     # where", "bias_instability_range_s = [100.0, 10.0]     # where");
+    let range = (
+        "bias_instability_range_s = [0.1, 10000.0]     # where",
+        "bias_instability_range_s = [100.0, 10.0]     # where",
+    );
     refused(&["allan"], Some(range), &["imu.gyro.bias_instability_range_s", "[100, 10] s"]);
     let ramp = ("# rate_ramp_deg_per_h2 = 0.0", "rate_ramp_deg_per_h2 = 1e9");
     refused(&["allan"], Some(ramp), &["imu.gyro.rate_ramp_deg_per_h2", "deg/h²"]);
     refused(&["allan", "--scenario", "jiang2017-dual-axis"], None, &["needs an [imu] section"]);
-    refused(&["allan", "--scenario", "static-imu-10h", "--export", "x", "--export-format", "xls"], None, &["--export-format"]);
-    refused(&["allan", "--scenario", "static-imu-10h", "--decimate", "0"], None, &["--decimate", "0: must be a whole number of samples, 1 ..= 1000000"]);
+    refused(
+        &["allan", "--scenario", "static-imu-10h", "--export", "x", "--export-format", "xls"],
+        None,
+        &["--export-format"],
+    );
+    refused(
+        &["allan", "--scenario", "static-imu-10h", "--decimate", "0"],
+        None,
+        &["--decimate", "0: must be a whole number of samples, 1 ..= 1000000"],
+    );
 }
 
 /// The columns of a csv table and its rows.
@@ -179,24 +210,52 @@ fn a_strapdown_log_set_is_analysed_and_exported() {
     for k in 0..n {
         let g: Vec<f64> = (0..3).map(|_| gyro_n * tau0.sqrt() * normal()).collect();
         let a: Vec<f64> = (0..3).map(|_| accel_n * tau0.sqrt() * normal()).collect();
-        csv.push_str(&format!("{},{},{},{},{},{},{}\n", k as f64 * tau0, g[0], g[1], g[2], a[0], a[1], 9.80665 * tau0 + a[2]));
+        csv.push_str(&format!(
+            "{},{},{},{},{},{},{}\n",
+            k as f64 * tau0,
+            g[0],
+            g[1],
+            g[2],
+            a[0],
+            a[1],
+            9.80665 * tau0 + a[2]
+        ));
     }
     std::fs::write(log.join("imu.csv"), csv).expect("imu.csv");
     std::fs::write(log.join("log.toml"), "[log]\nname = \"strapdown-bench\"\n[imu]\nfile = \"imu.csv\"\nlayout = \"rinscope\"\nkind = \"increments\"\nrate_hz = 200.0\n").expect("log.toml");
     let (out, tables) = (dir.join("adev.json"), dir.join("tables"));
-    let o = rinscope().arg("allan").arg(&log).arg("--json").arg(&out).args(["--no-recording", "--export-format", "csv", "--export"]).arg(&tables).output().expect("allan");
+    let o = rinscope()
+        .arg("allan")
+        .arg(&log)
+        .arg("--json")
+        .arg(&out)
+        .args(["--no-recording", "--export-format", "csv", "--export"])
+        .arg(&tables)
+        .output()
+        .expect("allan");
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(String::from_utf8_lossy(&o.stdout).contains("exported 8 tables"), "{}", String::from_utf8_lossy(&o.stdout));
     let j = json(&out);
-    for (sensor, key, unit, truth) in [("gyro", "n_deg_per_sqrt_h", "deg_per_h", 0.05), ("accel", "n_ug_per_sqrt_hz", "ug", 40.0)] {
+    for (sensor, key, unit, truth) in
+        [("gyro", "n_deg_per_sqrt_h", "deg_per_h", 0.05), ("accel", "n_ug_per_sqrt_hz", "ug", 40.0)]
+    {
         for (axis, ch) in ["x", "y", "z"].iter().zip(j[sensor].as_array().expect("channels")) {
             let (value, found) = fitted(ch, key);
             assert!(found && (value / truth - 1.0).abs() < 0.05, "{sensor} {axis} {key}: {value} vs {truth}");
             // The curve table: the JSON's curve, τ increasing, the ADEV inside its bounds.
             let (header, rows) = csv_table(&tables.join(format!("allan__{sensor}_{axis}.csv")));
-            let columns = ["tau_s".to_owned(), format!("adev_{unit}"), format!("adev_lower_{unit}"), format!("adev_upper_{unit}"), format!("fit_adev_{unit}"), "edf".into(), "second_differences_count".into()];
+            let columns = [
+                "tau_s".to_owned(),
+                format!("adev_{unit}"),
+                format!("adev_lower_{unit}"),
+                format!("adev_upper_{unit}"),
+                format!("fit_adev_{unit}"),
+                "edf".into(),
+                "second_differences_count".into(),
+            ];
             assert_eq!(header, columns, "no configured noise without a table description");
-            let taus: Vec<f64> = ch["tau_s"].as_array().expect("taus").iter().map(|v| v.as_f64().expect("tau")).collect();
+            let taus: Vec<f64> =
+                ch["tau_s"].as_array().expect("taus").iter().map(|v| v.as_f64().expect("tau")).collect();
             assert_eq!(rows.len(), taus.len());
             for (r, tau) in rows.iter().zip(&taus) {
                 assert_eq!(r[0], *tau, "the same τ as --json (csv round-trips f64 exactly)");
@@ -206,9 +265,17 @@ fn a_strapdown_log_set_is_analysed_and_exported() {
         // The fit table: one row per axis, the JSON's values and 1σ.
         let (header, rows) = csv_table(&tables.join(format!("allan__{sensor}_fit.csv")));
         assert_eq!(header[0], "axis");
-        let (kv, ks, kf) = (header.iter().position(|c| c == key).expect("value column"), header.iter().position(|c| *c == key.replacen('_', "_sigma_", 1)).expect("sigma column"), header.iter().position(|c| c == "n_found").expect("found column"));
+        let (kv, ks, kf) = (
+            header.iter().position(|c| c == key).expect("value column"),
+            header.iter().position(|c| *c == key.replacen('_', "_sigma_", 1)).expect("sigma column"),
+            header.iter().position(|c| c == "n_found").expect("found column"),
+        );
         for (row, ch) in rows.iter().zip(j[sensor].as_array().expect("channels")) {
-            assert_eq!((row[kv], row[ks], row[kf]), (ch["fitted"][key]["value"].as_f64().expect("v"), ch["fitted"][key]["sigma"].as_f64().expect("s"), 1.0), "{sensor} {row:?}");
+            assert_eq!(
+                (row[kv], row[ks], row[kf]),
+                (ch["fitted"][key]["value"].as_f64().expect("v"), ch["fitted"][key]["sigma"].as_f64().expect("s"), 1.0),
+                "{sensor} {row:?}"
+            );
         }
         assert_eq!(rows.iter().map(|r| r[0]).collect::<Vec<_>>(), [0.0, 1.0, 2.0]);
     }
@@ -233,11 +300,22 @@ fn a_rocked_parked_imu_is_warned_about_and_no_false_term_is_claimed() {
     )
     .expect("config");
     let out = dir.join("adev.json");
-    let o = rinscope().args(["allan", "--config"]).arg(&cfg).args(["--json"]).arg(&out).arg("--save").arg(dir.join("a.rrd")).output().expect("run");
+    let o = rinscope()
+        .args(["allan", "--config"])
+        .arg(&cfg)
+        .args(["--json"])
+        .arg(&out)
+        .arg("--save")
+        .arg(dir.join("a.rrd"))
+        .output()
+        .expect("run");
     assert!(o.status.success(), "{}", stderr(&o));
     let j = json(&out);
     let text = String::from_utf8_lossy(&o.stdout);
-    for (sensor, keys) in [("gyro", ["b_deg_per_h", "k_deg_per_h_per_sqrt_h", "r_deg_per_h2", "q_arcsec"]), ("accel", ["b_ug", "k_ug_per_sqrt_h", "r_ug_per_h", "q_mps"])] {
+    for (sensor, keys) in [
+        ("gyro", ["b_deg_per_h", "k_deg_per_h_per_sqrt_h", "r_deg_per_h2", "q_arcsec"]),
+        ("accel", ["b_ug", "k_ug_per_sqrt_h", "r_ug_per_h", "q_mps"]),
+    ] {
         for ch in j[sensor].as_array().expect("channels") {
             let axis = ch["axis"].as_str().unwrap_or("?");
             for key in keys {

@@ -31,7 +31,11 @@ fn refused(dir: &Path, cfg: &Path, expected: &[&str]) {
 fn a_typo_in_a_key_is_refused_with_its_line() {
     let dir = scratch("typo");
     let cfg = with_edit(&dir, "swing_half_angle_arcsec = 300.0", "swing_half_angl_arcsec = 300.0");
-    refused(&dir, &cfg, &["unknown key `swing_half_angl_arcsec`; did you mean `swing_half_angle_arcsec`?", "valid keys here"]);
+    refused(
+        &dir,
+        &cfg,
+        &["unknown key `swing_half_angl_arcsec`; did you mean `swing_half_angle_arcsec`?", "valid keys here"],
+    );
 }
 
 #[test]
@@ -137,7 +141,12 @@ fn scenarios_lists_every_preset() {
     let o = rinscope().arg("scenarios").output().expect("run");
     assert!(o.status.success());
     let text = String::from_utf8_lossy(&o.stdout);
-    for name in ["jiang2017-dual-axis (default)", "rotary-table-2016-installation", "rotary-table-2016-wobble", "rotary-table-2016-angular"] {
+    for name in [
+        "jiang2017-dual-axis (default)",
+        "rotary-table-2016-installation",
+        "rotary-table-2016-wobble",
+        "rotary-table-2016-angular",
+    ] {
         assert!(text.contains(name), "{text}");
     }
 }

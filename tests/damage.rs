@@ -81,9 +81,23 @@ impl Cmd {
     fn command(self, log: &Path, out: &Path) -> Command {
         let mut c = rinscope();
         match self {
-            Self::Replay => c.arg("replay").arg(log).arg("--save").arg(out.join("r.rrd")).arg("--summary-json").arg(out.join("r.json")),
-            Self::Calibrate => c.args(["calibrate", "--log"]).arg(log).arg("--save").arg(out.join("c.rrd")).arg("--json").arg(out.join("c.json")),
-            Self::Allan => c.arg("allan").arg(log).arg("--save").arg(out.join("a.rrd")).arg("--json").arg(out.join("a.json")),
+            Self::Replay => c
+                .arg("replay")
+                .arg(log)
+                .arg("--save")
+                .arg(out.join("r.rrd"))
+                .arg("--summary-json")
+                .arg(out.join("r.json")),
+            Self::Calibrate => c
+                .args(["calibrate", "--log"])
+                .arg(log)
+                .arg("--save")
+                .arg(out.join("c.rrd"))
+                .arg("--json")
+                .arg(out.join("c.json")),
+            Self::Allan => {
+                c.arg("allan").arg(log).arg("--save").arg(out.join("a.rrd")).arg("--json").arg(out.join("a.json"))
+            }
         };
         c
     }
@@ -173,7 +187,11 @@ fn load_table(path: &Path) -> Table {
     let options = ReadOptions { allow_non_finite: true, ..ReadOptions::default() };
     let probe = ColumnReader::open(path, &[], &options).expect("probe");
     let n = probe.all_columns().len();
-    let names = if path.extension().is_some_and(|e| e == "npy") { (0..n).map(|i| format!("c{i}")).collect() } else { probe.all_columns().to_vec() };
+    let names = if path.extension().is_some_and(|e| e == "npy") {
+        (0..n).map(|i| format!("c{i}")).collect()
+    } else {
+        probe.all_columns().to_vec()
+    };
     let cols: Vec<Col> = (0..n).map(Col::Index).collect();
     let mut r = ColumnReader::open(path, &cols, &options).expect("open");
     let mut row = vec![0.0; n];
@@ -227,7 +245,12 @@ fn store_mcap(path: &Path, t: &Table) {
     let channel = w.add_channel(schema, "/imu", "cdr", &BTreeMap::new()).expect("channel");
     for (k, r) in t.rows.iter().enumerate() {
         let ns = r[0] as i64;
-        let header = mcap::records::MessageHeader { channel_id: channel, sequence: k as u32, log_time: ns.max(0) as u64, publish_time: ns.max(0) as u64 };
+        let header = mcap::records::MessageHeader {
+            channel_id: channel,
+            sequence: k as u32,
+            log_time: ns.max(0) as u64,
+            publish_time: ns.max(0) as u64,
+        };
         w.write_to_known_channel(&header, &cdr_imu(ns, [r[1], r[2], r[3]], [r[4], r[5], r[6]])).expect("message");
     }
     w.finish().expect("finish");
@@ -268,7 +291,10 @@ fn null_paths(v: &serde_json::Value, path: &str, out: &mut BTreeSet<String>) {
 /// The scenario of the table log sets: Jiang et al. 2017's static calibration test, 20 s instead of 200.
 fn short_calibration_scenario(dir: &Path) -> PathBuf {
     let preset = read_text(&Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenarios/jiang2017-calibration.toml"));
-    let text: Vec<String> = preset.lines().map(|l| if l.starts_with("duration_s =") { "duration_s = 20.0".to_owned() } else { l.to_owned() }).collect();
+    let text: Vec<String> = preset
+        .lines()
+        .map(|l| if l.starts_with("duration_s =") { "duration_s = 20.0".to_owned() } else { l.to_owned() })
+        .collect();
     let path = dir.join("short-calibration.toml");
     write(&path, text.join("\n") + "\n");
     path
@@ -321,7 +347,11 @@ fn bases(root: &Path) -> Vec<Base> {
     let dt = 0.005;
     let rates = Table {
         names: ["t_ns", "gx", "gy", "gz", "ax", "ay", "az"].map(String::from).to_vec(),
-        rows: imu.rows.iter().map(|r| std::iter::once(ns(r[0])).chain(r[1..].iter().map(|x| x / dt)).collect()).collect(),
+        rows: imu
+            .rows
+            .iter()
+            .map(|r| std::iter::once(ns(r[0])).chain(r[1..].iter().map(|x| x / dt)).collect())
+            .collect(),
     };
     store_mcap(&dir.join("imu.mcap"), &rates);
     for f in ["encoders.csv", "reference.csv"] {
@@ -336,11 +366,25 @@ fn bases(root: &Path) -> Vec<Base> {
         write(&dir.join(f), body.join("\n") + "\n");
     }
     write(&dir.join("table.toml"), read_text(&csv.join("table.toml")));
-    let manifest = read_text(&csv.join("log.toml")).replace("file = \"imu.csv\"", "file = \"imu.mcap\"").replace("layout = \"rinscope\"", "layout = \"ros2\"").replace("kind = \"increments\"", "kind = \"rates\"");
+    let manifest = read_text(&csv.join("log.toml"))
+        .replace("file = \"imu.csv\"", "file = \"imu.mcap\"")
+        .replace("layout = \"rinscope\"", "layout = \"ros2\"")
+        .replace("kind = \"increments\"", "kind = \"rates\"");
     write(&dir.join("log.toml"), manifest);
     let mut tables = BTreeMap::new();
     tables.insert("imu.mcap".to_owned(), rates);
-    out.push(Base { name: "mcap", dir, fmt: Fmt::Mcap, imu: "imu.mcap".into(), encoders: Some("encoders.csv".into()), reference: Some("reference.csv".into()), has_table: true, commands: table_commands, tables, allowed_nulls: BTreeMap::new() });
+    out.push(Base {
+        name: "mcap",
+        dir,
+        fmt: Fmt::Mcap,
+        imu: "imu.mcap".into(),
+        encoders: Some("encoders.csv".into()),
+        reference: Some("reference.csv".into()),
+        has_table: true,
+        commands: table_commands,
+        tables,
+        allowed_nulls: BTreeMap::new(),
+    });
     // A strapdown IMU at rest, aligned on its first 10 s (no table, no encoders).
     let sd_scenario = root.join("strapdown.toml");
     write(
@@ -387,7 +431,13 @@ fn bases(root: &Path) -> Vec<Base> {
         std::fs::create_dir_all(&outdir).expect("out");
         for &cmd in &b.commands {
             let o = cmd.command(&b.dir, &outdir).output().expect("run");
-            assert!(o.status.success(), "{} on the undamaged {} set: {}", cmd.name(), b.name, String::from_utf8_lossy(&o.stderr));
+            assert!(
+                o.status.success(),
+                "{} on the undamaged {} set: {}",
+                cmd.name(),
+                b.name,
+                String::from_utf8_lossy(&o.stderr)
+            );
             let v: serde_json::Value = serde_json::from_str(&read_text(&cmd.json(&outdir))).expect("json");
             let mut nulls = BTreeSet::new();
             null_paths(&v, "", &mut nulls);
@@ -407,7 +457,8 @@ struct Damage {
     must_refuse: bool,
 }
 
-const ABSURD: [&str; 12] = ["NaN", "inf", "-inf", "1e300", "-1e300", "1e30", "-1.5e30", "0", "-0", "1e-300", "5e-324", "12345.678"];
+const ABSURD: [&str; 12] =
+    ["NaN", "inf", "-inf", "1e300", "-1e300", "1e30", "-1.5e30", "0", "-0", "1e-300", "5e-324", "12345.678"];
 
 fn is_absurd(v: &str) -> bool {
     v.parse::<f64>().is_ok_and(|x| !x.is_finite() || x.abs() >= 1e30)
@@ -422,7 +473,19 @@ fn junk(rng: &mut Rng, n: usize) -> Vec<u8> {
 
 /// Damages the log set copied into `log` (a copy of `base.dir`).
 fn damage(rng: &mut Rng, base: &Base, log: &Path) -> Damage {
-    const CLASSES: [&str; 11] = ["flip", "truncate", "cut-last-field", "garbage", "columns", "absurd", "scale", "rows", "split-gaps", "manifest", "table-toml"];
+    const CLASSES: [&str; 11] = [
+        "flip",
+        "truncate",
+        "cut-last-field",
+        "garbage",
+        "columns",
+        "absurd",
+        "scale",
+        "rows",
+        "split-gaps",
+        "manifest",
+        "table-toml",
+    ];
     let class = *rng.pick(&CLASSES);
     let mut target = *rng.pick(&[Target::Imu, Target::Imu, Target::Encoders, Target::Reference]);
     if base.file(target).is_none() {
@@ -459,12 +522,18 @@ fn damage(rng: &mut Rng, base: &Base, log: &Path) -> Damage {
                     bytes.pop();
                 }
                 let line_start = bytes.iter().rposition(|b| *b == b'\n').map_or(0, |p| p + 1);
-                let field_start = bytes[line_start..].iter().rposition(|b| *b == b',').map_or(line_start, |p| line_start + p + 1);
+                let field_start =
+                    bytes[line_start..].iter().rposition(|b| *b == b',').map_or(line_start, |p| line_start + p + 1);
                 let len = bytes.len() - field_start;
                 let keep = if len >= 2 { 1 + rng.below(len - 1) } else { 0 };
                 bytes.truncate(field_start + keep);
                 write(&path, bytes);
-                d(format!("{name}: last line cut inside its last field ({keep} of {len} characters kept, no line end)"), true)
+                d(
+                    format!(
+                        "{name}: last line cut inside its last field ({keep} of {len} characters kept, no line end)"
+                    ),
+                    true,
+                )
             } else {
                 let n = 1 + rng.below(16);
                 bytes.truncate(bytes.len() - n);
@@ -501,11 +570,13 @@ fn damage(rng: &mut Rng, base: &Base, log: &Path) -> Damage {
         "columns" | "absurd" | "scale" | "rows" => table_damage(rng, base, log, class, target, &name),
         "split-gaps" => {
             // Gaps carried across (gap_policy = "split"): a stretch of the IMU file deleted.
-            let manifest = read_text(&log.join("log.toml")).replace("gap_policy = \"refuse\"\ngap_factor", "gap_policy = \"split\"\ngap_factor");
+            let manifest = read_text(&log.join("log.toml"))
+                .replace("gap_policy = \"refuse\"\ngap_factor", "gap_policy = \"split\"\ngap_factor");
             write(&log.join("log.toml"), manifest);
             let mut damage = table_damage(rng, base, log, "rows", Target::Imu, &base.imu);
             damage.class = "split-gaps";
-            damage.must_refuse = damage.what.contains("repeated") || damage.what.contains("swapped") || damage.what.contains("reversed");
+            damage.must_refuse =
+                damage.what.contains("repeated") || damage.what.contains("swapped") || damage.what.contains("reversed");
             damage
         }
         "manifest" => manifest_damage(rng, base, log),
@@ -566,7 +637,8 @@ fn table_damage(rng: &mut Rng, base: &Base, log: &Path, class: &'static str, tar
             // A column (or a whole triad) in another unit than its name says: in bounds or not.
             let factor = *rng.pick(&[-1.0, 10.0, 1000.0, 1e4, 1e-3, 57.295_779_513_082_32, 9.806_65, 200.0]);
             let first = if mcap { 1 + rng.below(6) } else { rng.below(width) };
-            let columns: Vec<usize> = if rng.below(2) == 0 { vec![first] } else { (first..width.min(first + 3)).collect() };
+            let columns: Vec<usize> =
+                if rng.below(2) == 0 { vec![first] } else { (first..width.min(first + 3)).collect() };
             for r in &mut rows {
                 for &c in &columns {
                     if let Ok(x) = r[c].parse::<f64>() {
@@ -629,12 +701,17 @@ fn table_damage(rng: &mut Rng, base: &Base, log: &Path, class: &'static str, tar
         }
         write(&path, text);
     } else {
-        let names = if header.iter().all(|h| h.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_')) && header.iter().collect::<BTreeSet<_>>().len() == header.len() {
+        let names = if header.iter().all(|h| h.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_'))
+            && header.iter().collect::<BTreeSet<_>>().len() == header.len()
+        {
             header
         } else {
             (0..header.len()).map(|i| format!("c{i}")).collect()
         };
-        let t = Table { names, rows: rows.iter().map(|r| r.iter().map(|x| x.parse::<f64>().unwrap_or(f64::NAN)).collect()).collect() };
+        let t = Table {
+            names,
+            rows: rows.iter().map(|r| r.iter().map(|x| x.parse::<f64>().unwrap_or(f64::NAN)).collect()).collect(),
+        };
         std::fs::remove_file(&path).ok();
         if mcap { store_mcap(&path, &t) } else { store_table(&path, &t) }
     }
@@ -680,14 +757,27 @@ fn manifest_damage(rng: &mut Rng, base: &Base, log: &Path) -> Damage {
         }
         1 => {
             let r = *rng.pick(&["199.0", "202.5"]);
-            (set_imu(&text, "rate_hz", r), format!("imu.rate_hz = {r} (within 2 % of the stamps)"), false, Target::Manifest)
+            (
+                set_imu(&text, "rate_hz", r),
+                format!("imu.rate_hz = {r} (within 2 % of the stamps)"),
+                false,
+                Target::Manifest,
+            )
         }
         2 => {
             let u = *rng.pick(&["\"ms\"", "\"us\"", "\"ns\""]);
             (set_imu(&text, "time", u), format!("imu.time = {u}"), true, Target::Manifest)
         }
         3 => {
-            let l = *rng.pick(&["\"rinscope\"", "\"psins\"", "\"psins-imu\"", "\"kf-gins\"", "\"kalibr\"", "\"npy7\"", "\"ros2\""]);
+            let l = *rng.pick(&[
+                "\"rinscope\"",
+                "\"psins\"",
+                "\"psins-imu\"",
+                "\"kf-gins\"",
+                "\"kalibr\"",
+                "\"npy7\"",
+                "\"ros2\"",
+            ]);
             (set_imu(&text, "layout", l), format!("imu.layout = {l}"), false, Target::Manifest)
         }
         4 => {
@@ -695,17 +785,28 @@ fn manifest_damage(rng: &mut Rng, base: &Base, log: &Path) -> Damage {
             (set_imu(&text, "topic", t), format!("imu.topic = {t}"), true, Target::Manifest)
         }
         5 => {
-            let f = *rng.pick(&["[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]", "\"xyz\"", "[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 2.0]]", "\"rfd\""]);
+            let f = *rng.pick(&[
+                "[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]",
+                "\"xyz\"",
+                "[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 2.0]]",
+                "\"rfd\"",
+            ]);
             (set_imu(&text, "frame", f), format!("imu.frame = {f}"), true, Target::Manifest)
         }
         6 if base.encoders.is_some() => (
-            text.replace(&format!("file = \"{}\"", base.encoders.as_deref().unwrap_or_default()), &format!("file = \"imu.{imu_ext}\"")),
+            text.replace(
+                &format!("file = \"{}\"", base.encoders.as_deref().unwrap_or_default()),
+                &format!("file = \"imu.{imu_ext}\""),
+            ),
             "encoders.file names the IMU file".into(),
             true,
             Target::Encoders,
         ),
         6 | 7 => (
-            text.replace(&format!("file = \"{}\"", base.reference.as_deref().unwrap_or_default()), &format!("file = \"imu.{imu_ext}\"")),
+            text.replace(
+                &format!("file = \"{}\"", base.reference.as_deref().unwrap_or_default()),
+                &format!("file = \"imu.{imu_ext}\""),
+            ),
             "reference.file names the IMU file".into(),
             true,
             Target::Reference,
@@ -718,14 +819,24 @@ fn manifest_damage(rng: &mut Rng, base: &Base, log: &Path) -> Damage {
             let r = *rng.pick(&["1e300", "-200.0", "nan", "0.0"]);
             (set_imu(&text, "rate_hz", r), format!("imu.rate_hz = {r}"), true, Target::Manifest)
         }
-        10 => (set_imu(&text, "file", "\"missing.csv\""), "imu.file names a file that does not exist".into(), true, Target::Manifest),
+        10 => (
+            set_imu(&text, "file", "\"missing.csv\""),
+            "imu.file names a file that does not exist".into(),
+            true,
+            Target::Manifest,
+        ),
         11 => (set_imu(&text, "rate_hzz", "200.0"), "an unknown key imu.rate_hzz".into(), true, Target::Manifest),
         _ => {
             let l = *rng.pick(&["latch_delay_ms = 1e300", "latch_delay_ms = 5e3"]);
             if base.encoders.is_some() {
                 (in_section(&text, "encoders", l), format!("encoders.{l}"), true, Target::Manifest)
             } else {
-                (in_section(&text, "initial", "alignment_s = 1e300").replace("alignment_s = 10.0\n", ""), "initial.alignment_s = 1e300".into(), true, Target::Manifest)
+                (
+                    in_section(&text, "initial", "alignment_s = 1e300").replace("alignment_s = 10.0\n", ""),
+                    "initial.alignment_s = 1e300".into(),
+                    true,
+                    Target::Manifest,
+                )
             }
         }
     };
@@ -738,7 +849,12 @@ fn table_toml_damage(rng: &mut Rng, base: &Base, log: &Path) -> Damage {
     let path = log.join("table.toml");
     if !base.has_table {
         write(&path, "[site]\nlatitude_deg = 1e300\n");
-        return Damage { class: "table-toml", what: "a table.toml with latitude_deg = 1e300".into(), target: Target::Table, must_refuse: true };
+        return Damage {
+            class: "table-toml",
+            what: "a table.toml with latitude_deg = 1e300".into(),
+            target: Target::Table,
+            must_refuse: true,
+        };
     }
     let text = read_text(&path);
     let (edited, what, refuse) = match rng.below(4) {
@@ -759,7 +875,11 @@ fn table_toml_damage(rng: &mut Rng, base: &Base, log: &Path) -> Damage {
             let nested = format!("{text}\nnested = {}1{}\n", "[".repeat(depth), "]".repeat(depth));
             (nested.into_bytes(), format!("a {depth}-deep nested array appended"), true)
         }
-        _ => (text.replace("name = \"outer\"", "name = \"outerx\"").into_bytes(), "the outer axis renamed (the encoder file has no such column)".into(), true),
+        _ => (
+            text.replace("name = \"outer\"", "name = \"outerx\"").into_bytes(),
+            "the outer axis renamed (the encoder file has no such column)".into(),
+            true,
+        ),
     };
     write(&path, edited);
     // The axis rename is read by the commands that read the encoders.
@@ -815,7 +935,9 @@ fn check(cmd: Cmd, base: &Base, damage: &Damage, r: &Run, out: &Path) -> Vec<(&'
     if r.stderr.contains("panicked") || r.stderr.contains("RUST_BACKTRACE") {
         broken.push(("panic", "panic".into()));
     }
-    let left: Vec<String> = std::fs::read_dir(out).map(|d| d.flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect()).unwrap_or_default();
+    let left: Vec<String> = std::fs::read_dir(out)
+        .map(|d| d.flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect())
+        .unwrap_or_default();
     match r.code {
         Some(0) => {
             if damage.must_refuse && cmd.reads(damage.target) {
@@ -825,7 +947,10 @@ fn check(cmd: Cmd, base: &Base, damage: &Damage, r: &Run, out: &Path) -> Vec<(&'
             if ["NaN", "inf", "-inf", "NaN-", "Infinity"].iter().any(|w| words.contains(w)) {
                 broken.push(("non-finite results", "NaN or inf in the printed results".into()));
             }
-            match std::fs::read_to_string(cmd.json(out)).ok().and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok()) {
+            match std::fs::read_to_string(cmd.json(out))
+                .ok()
+                .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+            {
                 None => broken.push(("no output", "exit 0 without its JSON".into())),
                 Some(v) => {
                     let mut nulls = BTreeSet::new();
@@ -859,7 +984,8 @@ fn check(cmd: Cmd, base: &Base, damage: &Damage, r: &Run, out: &Path) -> Vec<(&'
                     break;
                 }
             }
-            let io = ["No such file", "cannot open", "cannot read", "Permission denied"].iter().any(|w| message.contains(w));
+            let io =
+                ["No such file", "cannot open", "cannot read", "Permission denied"].iter().any(|w| message.contains(w));
             if code == 1 && !io {
                 broken.push(("exit 1 for bad data", "exit 1 (a failure while running) for bad input".into()));
             }
@@ -950,7 +1076,10 @@ fn campaign(tag: &str, seed: u64, cases: usize) -> (String, Vec<String>) {
     report.push_str("class            cases  runs  exit 0  exit 2  exit 1  other  broken\n");
     let mut total = Tally::default();
     for (class, t) in &tally {
-        report.push_str(&format!("{class:<16} {:>5} {:>5} {:>7} {:>7} {:>7} {:>6} {:>7}\n", t.cases, t.runs, t.exit0, t.exit2, t.exit1, t.other, t.broken));
+        report.push_str(&format!(
+            "{class:<16} {:>5} {:>5} {:>7} {:>7} {:>7} {:>6} {:>7}\n",
+            t.cases, t.runs, t.exit0, t.exit2, t.exit1, t.other, t.broken
+        ));
         total.cases += t.cases;
         total.runs += t.runs;
         total.exit0 += t.exit0;
@@ -959,7 +1088,10 @@ fn campaign(tag: &str, seed: u64, cases: usize) -> (String, Vec<String>) {
         total.other += t.other;
         total.broken += t.broken;
     }
-    report.push_str(&format!("{:<16} {:>5} {:>5} {:>7} {:>7} {:>7} {:>6} {:>7}\n", "all", total.cases, total.runs, total.exit0, total.exit2, total.exit1, total.other, total.broken));
+    report.push_str(&format!(
+        "{:<16} {:>5} {:>5} {:>7} {:>7} {:>7} {:>6} {:>7}\n",
+        "all", total.cases, total.runs, total.exit0, total.exit2, total.exit1, total.other, total.broken
+    ));
     if !promises.is_empty() {
         report.push_str("runs breaking each promise: ");
         report.push_str(&promises.iter().map(|(p, n)| format!("{p} {n}")).collect::<Vec<_>>().join(", "));

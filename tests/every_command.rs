@@ -24,13 +24,70 @@ struct Case {
 }
 
 const CASES: &[Case] = &[
-    Case { name: "run-simulating", args: &["run", "--duration-s", "2000000", "--save", "{dir}/r.rrd", "--summary-json", "{dir}/r.json"], document: Some("r.json"), says_interrupted: true, begun: None, after: Duration::from_millis(1500) },
-    Case { name: "run-drawing", args: &["run", "--scenario", "rotation-modulation-16-position", "--save", "{dir}/r.rrd", "--figures", "{dir}/fig"], document: None, says_interrupted: false, begun: Some("fig/01"), after: Duration::ZERO },
-    Case { name: "allan-simulating", args: &["allan", "--duration-s", "2000000", "--no-recording", "--json", "{dir}/a.json"], document: Some("a.json"), says_interrupted: true, begun: None, after: Duration::from_millis(1500) },
-    Case { name: "modulation", args: &["modulation", "--hours", "720", "--save", "{dir}/m.rrd"], document: None, says_interrupted: false, begun: None, after: Duration::from_millis(1500) },
-    Case { name: "selfcal-navigating", args: &["selfcal", "--navigate-hours", "720", "--save", "{dir}/s.rrd", "--json", "{dir}/s.json"], document: Some("s.json"), says_interrupted: false, begun: None, after: Duration::from_millis(2500) },
-    Case { name: "montecarlo", args: &["montecarlo", "--runs", "100000", "--json", "{dir}/mc.json"], document: Some("mc.json"), says_interrupted: false, begun: None, after: Duration::from_millis(1500) },
-    Case { name: "tpr-sweeping", args: &["tpr", "--seeds", "500", "--save", "{dir}/t.rrd", "--json", "{dir}/t.json"], document: Some("t.json"), says_interrupted: false, begun: Some("t.json"), after: Duration::from_millis(300) },
+    Case {
+        name: "run-simulating",
+        args: &["run", "--duration-s", "2000000", "--save", "{dir}/r.rrd", "--summary-json", "{dir}/r.json"],
+        document: Some("r.json"),
+        says_interrupted: true,
+        begun: None,
+        after: Duration::from_millis(1500),
+    },
+    Case {
+        name: "run-drawing",
+        args: &[
+            "run",
+            "--scenario",
+            "rotation-modulation-16-position",
+            "--save",
+            "{dir}/r.rrd",
+            "--figures",
+            "{dir}/fig",
+        ],
+        document: None,
+        says_interrupted: false,
+        begun: Some("fig/01"),
+        after: Duration::ZERO,
+    },
+    Case {
+        name: "allan-simulating",
+        args: &["allan", "--duration-s", "2000000", "--decimate", "100", "--no-recording", "--json", "{dir}/a.json"],
+        document: Some("a.json"),
+        says_interrupted: true,
+        begun: None,
+        after: Duration::from_millis(1500),
+    },
+    Case {
+        name: "modulation",
+        args: &["modulation", "--hours", "720", "--save", "{dir}/m.rrd"],
+        document: None,
+        says_interrupted: false,
+        begun: None,
+        after: Duration::from_millis(1500),
+    },
+    Case {
+        name: "selfcal-navigating",
+        args: &["selfcal", "--navigate-hours", "720", "--save", "{dir}/s.rrd", "--json", "{dir}/s.json"],
+        document: Some("s.json"),
+        says_interrupted: false,
+        begun: None,
+        after: Duration::from_millis(2500),
+    },
+    Case {
+        name: "montecarlo",
+        args: &["montecarlo", "--runs", "100000", "--json", "{dir}/mc.json"],
+        document: Some("mc.json"),
+        says_interrupted: false,
+        begun: None,
+        after: Duration::from_millis(1500),
+    },
+    Case {
+        name: "tpr-sweeping",
+        args: &["tpr", "--seeds", "500", "--save", "{dir}/t.rrd", "--json", "{dir}/t.json"],
+        document: Some("t.json"),
+        says_interrupted: false,
+        begun: Some("t.json"),
+        after: Duration::from_millis(300),
+    },
 ];
 
 fn partials(dir: &Path) -> Vec<String> {
@@ -55,7 +112,9 @@ fn exists_with_prefix(dir: &Path, prefix: &str) -> bool {
         Some((f, s)) => (dir.join(f), s),
         None => (dir.to_path_buf(), prefix),
     };
-    std::fs::read_dir(folder).into_iter().flatten().flatten().any(|e| e.file_name().to_string_lossy().starts_with(stem) && !e.file_name().to_string_lossy().contains(".partial"))
+    std::fs::read_dir(folder).into_iter().flatten().flatten().any(|e| {
+        e.file_name().to_string_lossy().starts_with(stem) && !e.file_name().to_string_lossy().contains(".partial")
+    })
 }
 
 #[test]
@@ -65,20 +124,40 @@ fn every_command_stopped_in_any_phase_exits_128_plus_the_signal_and_says_so() {
         for (signal, code) in [(libc_signal::SIGINT, 130), (libc_signal::SIGTERM, 143)] {
             let dir = scratch(&format!("{}-{signal}", case.name));
             let args: Vec<String> = case.args.iter().map(|a| a.replace("{dir}", &dir.display().to_string())).collect();
-            let mut child = rinscope().args(&args).current_dir(&dir).stdout(Stdio::null()).stderr(Stdio::piped()).spawn().expect("spawns");
+            let mut child = rinscope()
+                .args(&args)
+                .current_dir(&dir)
+                .stdout(Stdio::null())
+                .stderr(Stdio::piped())
+                .spawn()
+                .expect("spawns");
             let started = Instant::now();
             if let Some(prefix) = case.begun {
-                while !exists_with_prefix(&dir, prefix) && started.elapsed() < Duration::from_secs(120) && child.try_wait().expect("wait").is_none() {
+                while !exists_with_prefix(&dir, prefix)
+                    && started.elapsed() < Duration::from_secs(120)
+                    && child.try_wait().expect("wait").is_none()
+                {
                     std::thread::sleep(Duration::from_millis(20));
                 }
             }
             std::thread::sleep(case.after);
             if child.try_wait().expect("wait").is_some() {
-                failures.push(format!("{} ({signal}): ended before the signal ({:.1} s): the case is too short to test", case.name, started.elapsed().as_secs_f64()));
+                failures.push(format!(
+                    "{} ({signal}): ended before the signal ({:.1} s): the case is too short to test",
+                    case.name,
+                    started.elapsed().as_secs_f64()
+                ));
                 continue;
             }
             let signalled = Instant::now();
-            assert!(std::process::Command::new("kill").arg(format!("-{signal}")).arg(child.id().to_string()).status().expect("kill").success());
+            assert!(
+                std::process::Command::new("kill")
+                    .arg(format!("-{signal}"))
+                    .arg(child.id().to_string())
+                    .status()
+                    .expect("kill")
+                    .success()
+            );
             let out = loop {
                 if child.try_wait().expect("wait").is_some() || signalled.elapsed() > Duration::from_secs(20) {
                     child.kill().ok();
@@ -118,7 +197,12 @@ fn every_command_stopped_in_any_phase_exits_128_plus_the_signal_and_says_so() {
                 }
             }
             if !wrong.is_empty() {
-                failures.push(format!("{} ({signal}): {}\n  stderr: {}", case.name, wrong.join("; "), err.lines().rev().take(3).collect::<Vec<_>>().join(" | ")));
+                failures.push(format!(
+                    "{} ({signal}): {}\n  stderr: {}",
+                    case.name,
+                    wrong.join("; "),
+                    err.lines().rev().take(3).collect::<Vec<_>>().join(" | ")
+                ));
             }
             std::fs::remove_dir_all(&dir).ok();
         }

@@ -14,12 +14,15 @@ mod common;
 use common::{rinscope, scratch};
 use std::path::{Path, PathBuf};
 
-
 /// SP 1065 p. 108: OADEV at τ = 1, 10, 100 s.
 const OADEV: [f64; 3] = [2.922319e-01, 9.159953e-02, 3.241343e-02];
 
 fn files(dir: &Path, ext: &str) -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(dir).expect("figures dir").map(|e| e.expect("entry").path()).filter(|p| p.extension().is_some_and(|e| e == ext)).collect();
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .expect("figures dir")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == ext))
+        .collect();
     v.sort();
     v
 }
@@ -50,7 +53,11 @@ fn allan_figures_have_logarithmic_axes_that_place_the_published_values() {
         .output()
         .expect("run");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    assert!(String::from_utf8_lossy(&o.stdout).contains("figures: 1 plots drawn"), "{}", String::from_utf8_lossy(&o.stdout));
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains("figures: 1 plots drawn"),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
     let svgs = files(&figs, "svg");
     assert_eq!(svgs.len(), 1);
     let svg = std::fs::read_to_string(&svgs[0]).expect("svg");
@@ -86,9 +93,16 @@ fn a_run_draws_every_plot_of_its_layout_and_a_bad_folder_costs_nothing() {
     let dir = scratch("run");
     let rec = dir.join("r.rrd");
     let figs = dir.join("figs");
-    let o = rinscope().args(["run", "--duration-s", "20", "--save"]).arg(&rec).arg("--figures").arg(&figs).output().expect("run");
+    let o = rinscope()
+        .args(["run", "--duration-s", "20", "--save"])
+        .arg(&rec)
+        .arg("--figures")
+        .arg(&figs)
+        .output()
+        .expect("run");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let with_data = rinscope::record::read::plot_frames(&rec).expect("readable").iter().filter(|f| f.finite > 0).count();
+    let with_data =
+        rinscope::record::read::plot_frames(&rec).expect("readable").iter().filter(|f| f.finite > 0).count();
     assert!(with_data >= 4);
     assert_eq!(files(&figs, "svg").len(), with_data, "one figure per plot with data");
     assert_eq!(files(&figs, "png").len(), with_data);
@@ -96,7 +110,13 @@ fn a_run_draws_every_plot_of_its_layout_and_a_bad_folder_costs_nothing() {
     let blocker = dir.join("file");
     std::fs::write(&blocker, "x").expect("file");
     let rec2 = dir.join("r2.rrd");
-    let o = rinscope().args(["run", "--duration-s", "20", "--save"]).arg(&rec2).arg("--figures").arg(&blocker).output().expect("run");
+    let o = rinscope()
+        .args(["run", "--duration-s", "20", "--save"])
+        .arg(&rec2)
+        .arg("--figures")
+        .arg(&blocker)
+        .output()
+        .expect("run");
     assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--figures"), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(!rec2.exists(), "nothing saved for a refused run");

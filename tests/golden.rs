@@ -28,12 +28,18 @@ fn every_command_writes_the_same_documents_as_before() {
     for want in &expected {
         let name = want.file_name().unwrap();
         let got = out.join(name);
-        let (want_text, got_text) = (std::fs::read_to_string(want).unwrap(), std::fs::read_to_string(&got).unwrap_or_default());
+        let (want_text, got_text) =
+            (std::fs::read_to_string(want).unwrap(), std::fs::read_to_string(&got).unwrap_or_default());
         if want_text != got_text {
             let first = want_text.lines().zip(got_text.lines()).enumerate().find(|(_, (a, b))| a != b);
             differ.push(match first {
                 Some((i, (a, b))) => format!("{}: line {}: was {a:?}, now {b:?}", name.to_string_lossy(), i + 1),
-                None => format!("{}: {} lines, now {}", name.to_string_lossy(), want_text.lines().count(), got_text.lines().count()),
+                None => format!(
+                    "{}: {} lines, now {}",
+                    name.to_string_lossy(),
+                    want_text.lines().count(),
+                    got_text.lines().count()
+                ),
             });
         }
     }

@@ -36,9 +36,29 @@ fn numbers_on_the_command_line_are_held_to_their_range_and_said_short() {
     let s = series(&d, 100);
     let s = s.to_str().expect("utf-8");
     // `--rate-hz 1e-308` exited 0 with inf/NaN; 1e308 and --ci-sigma 1e300 printed 300 digits.
-    refused(&["allan", "--series", s, "--column", "x:rate:deg/s", "--rate-hz", "1e-308", "--no-recording"], &["--rate-hz", "1e-308 Hz"]);
-    refused(&["allan", "--series", s, "--column", "x:rate:deg/s", "--rate-hz", "1e308", "--no-recording"], &["--rate-hz", "1e308 Hz"]);
-    refused(&["allan", "--series", s, "--column", "x:rate:deg/s", "--rate-hz", "10", "--ci-sigma", "1e300", "--no-recording"], &["--ci-sigma", "1e300"]);
+    refused(
+        &["allan", "--series", s, "--column", "x:rate:deg/s", "--rate-hz", "1e-308", "--no-recording"],
+        &["--rate-hz", "1e-308 Hz"],
+    );
+    refused(
+        &["allan", "--series", s, "--column", "x:rate:deg/s", "--rate-hz", "1e308", "--no-recording"],
+        &["--rate-hz", "1e308 Hz"],
+    );
+    refused(
+        &[
+            "allan",
+            "--series",
+            s,
+            "--column",
+            "x:rate:deg/s",
+            "--rate-hz",
+            "10",
+            "--ci-sigma",
+            "1e300",
+            "--no-recording",
+        ],
+        &["--ci-sigma", "1e300"],
+    );
     // `run --duration-s -10` said "unexpected argument '-1'".
     refused(&["run", "--duration-s", "-10"], &["--duration-s", "-10 s"]);
     refused(&["live", "--no-viewer", "--duration-s", "-1e300"], &["--duration-s", "-1e300 s"]);
@@ -49,7 +69,10 @@ fn numbers_on_the_command_line_are_held_to_their_range_and_said_short() {
     refused(&["montecarlo", "--runs", "-1"], &["--runs", "-1"]);
     refused(&["selfcal", "--navigate-hours", "nan"], &["--navigate-hours", "NaN h"]);
     // A good rate still analyses.
-    let o = rinscope().args(["allan", "--series", s, "--column", "x:rate:deg/s", "--rate-hz", "100", "--no-recording"]).output().expect("runs");
+    let o = rinscope()
+        .args(["allan", "--series", s, "--column", "x:rate:deg/s", "--rate-hz", "100", "--no-recording"])
+        .output()
+        .expect("runs");
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
 }
 
@@ -64,7 +87,13 @@ fn every_output_option_is_checked_before_any_work() {
     let missing = d.join("missing/fig");
     let missing = missing.to_str().expect("utf-8");
     // Said only "File exists (os error 17)" before, after the whole run.
-    for (flag, path, says) in [("--export", fifo, "is a FIFO"), ("--figures", fifo, "is a FIFO"), ("--export", file, "is a file; give a folder"), ("--figures", file, "is a file"), ("--figures", missing, "does not exist")] {
+    for (flag, path, says) in [
+        ("--export", fifo, "is a FIFO"),
+        ("--figures", fifo, "is a FIFO"),
+        ("--export", file, "is a file; give a folder"),
+        ("--figures", file, "is a file"),
+        ("--figures", missing, "does not exist"),
+    ] {
         let started = Instant::now();
         refused(&["run", "--duration-s", "3600", flag, path], &[flag, says]);
         assert!(started.elapsed() < Duration::from_secs(5), "{flag} refused before the run");
@@ -76,7 +105,9 @@ fn every_output_option_is_checked_before_any_work() {
 fn wait_for(dir: &Path, prefix: &str, limit: Duration) -> bool {
     let started = Instant::now();
     while started.elapsed() < limit {
-        if std::fs::read_dir(dir).is_ok_and(|r| r.flatten().any(|e| e.file_name().to_string_lossy().starts_with(prefix))) {
+        if std::fs::read_dir(dir)
+            .is_ok_and(|r| r.flatten().any(|e| e.file_name().to_string_lossy().starts_with(prefix)))
+        {
             return true;
         }
         std::thread::sleep(Duration::from_millis(5));
@@ -106,7 +137,8 @@ fn sigterm_while_figures_are_drawn_stops_the_drawing() {
     assert_eq!(o.status.code(), Some(143), "{}", stderr(&o));
     assert!(waited < Duration::from_secs(2), "stopped in {waited:?}");
     assert!(stderr(&o).contains("interrupted") && stderr(&o).contains("--figures"), "{}", stderr(&o));
-    let names: Vec<String> = std::fs::read_dir(&fig).expect("fig").flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
+    let names: Vec<String> =
+        std::fs::read_dir(&fig).expect("fig").flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
     assert!(names.iter().all(|n| !n.ends_with(".partial")), "no partial: {names:?}");
     assert!(d.join("r.rrd").exists(), "the recording is kept");
 }

@@ -121,7 +121,8 @@ fn violations(file: &str, module: Option<&str>, text: &str) -> Vec<String> {
         return out;
     };
     // Comments out, line numbers kept; a group may span lines, so the text is searched whole.
-    let uncommented: String = code.lines().map(|l| if l.trim_start().starts_with("//") { "" } else { l }).collect::<Vec<_>>().join("\n");
+    let uncommented: String =
+        code.lines().map(|l| if l.trim_start().starts_with("//") { "" } else { l }).collect::<Vec<_>>().join("\n");
     let mut from = 0;
     while let Some(i) = uncommented[from..].find("crate::") {
         let at = from + i;
@@ -134,7 +135,9 @@ fn violations(file: &str, module: Option<&str>, text: &str) -> Vec<String> {
             }
             match rank(&target) {
                 Some(r) if r < own => {}
-                Some(r) => out.push(format!("{file}:{}: `{module}` (layer {own}) imports `{target}` (layer {r}): {l}", n + 1)),
+                Some(r) => {
+                    out.push(format!("{file}:{}: `{module}` (layer {own}) imports `{target}` (layer {r}): {l}", n + 1))
+                }
                 None => out.push(format!("{file}:{}: unknown module `{target}`", n + 1)),
             }
         }
@@ -187,12 +190,29 @@ fn the_checker_sees_what_it_must_refuse() {
     assert_eq!(violations("app/x.rs", Some("app"), "use crate::record::Recorder;\nuse crate::math::units;\n").len(), 0);
     assert_eq!(violations("app/x.rs", Some("app"), "let s: rerun::RecordingStream;\n").len(), 1);
     assert_eq!(violations("record/x.rs", Some("record"), "use rerun::Color;\n").len(), 0);
-    assert_eq!(violations("sim/x.rs", Some("sim"), "// crate::app is above\n#[cfg(test)]\nuse crate::scenario::presets;\n").len(), 0);
+    assert_eq!(
+        violations("sim/x.rs", Some("sim"), "// crate::app is above\n#[cfg(test)]\nuse crate::scenario::presets;\n")
+            .len(),
+        0
+    );
     // Grouped imports, on one line or several, name each module they import.
     assert_eq!(violations("model/x.rs", Some("model"), "use crate::{math::units, sim::Model};\n").len(), 1, "grouped");
-    assert_eq!(violations("model/x.rs", Some("model"), "use crate::{\n    math::{units, frames},\n    app::run,\n    record::Recorder,\n};\n").len(), 2, "grouped over lines");
+    assert_eq!(
+        violations(
+            "model/x.rs",
+            Some("model"),
+            "use crate::{\n    math::{units, frames},\n    app::run,\n    record::Recorder,\n};\n"
+        )
+        .len(),
+        2,
+        "grouped over lines"
+    );
     // Code after a test module is shipped code.
-    assert_eq!(violations("sim/x.rs", Some("sim"), "#[cfg(test)]\nmod tests;\nuse crate::app::run;\n").len(), 1, "after mod tests;");
+    assert_eq!(
+        violations("sim/x.rs", Some("sim"), "#[cfg(test)]\nmod tests;\nuse crate::app::run;\n").len(),
+        1,
+        "after mod tests;"
+    );
     assert_eq!(violations("sim/x.rs", Some("sim"), "#[cfg(test)]\nmod tests {\n    use crate::app::run;\n    fn f() { if true { } }\n}\nuse crate::record::Recorder;\n").len(), 1, "after a test block");
     let long = "let x = 1;\n".repeat(MAX_LINES + 1);
     assert_eq!(violations("math/x.rs", Some("math"), &long).len(), 1);

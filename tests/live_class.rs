@@ -101,13 +101,23 @@ impl Session {
     /// The number of the control labelled `label`.
     fn control(&self, label: &str) -> u64 {
         let c = self.controls();
-        c["controls"].as_array().expect("controls").iter().find(|x| x["label"] == label).and_then(|x| x["id"].as_u64()).unwrap_or_else(|| panic!("no control {label}: {c}"))
+        c["controls"]
+            .as_array()
+            .expect("controls")
+            .iter()
+            .find(|x| x["label"] == label)
+            .and_then(|x| x["id"].as_u64())
+            .unwrap_or_else(|| panic!("no control {label}: {c}"))
     }
 
     fn wait_for_sim_time(&self, t_s: f64) {
         let started = Instant::now();
         while self.controls()["sim_t_s"].as_f64().unwrap_or(0.0) < t_s {
-            assert!(started.elapsed() < Duration::from_secs(60), "the session did not reach t = {t_s} s: {}", self.log());
+            assert!(
+                started.elapsed() < Duration::from_secs(60),
+                "the session did not reach t = {t_s} s: {}",
+                self.log()
+            );
             std::thread::sleep(Duration::from_millis(50));
         }
     }
@@ -147,10 +157,13 @@ fn signal(child: &Child, sig: &str) {
 fn the_cone_changed_twice_from_the_class_page_goes_on_and_its_labels_and_rates_follow() {
     // Pure coning at 4× real time: at t ≥ 8 s the page sets the half-angle 1° → 2°, at t ≥ 20 s the
     // frequency 5 → 10 Hz; the session ends at 32 s and its saved recording is read back.
-    use rinscope::ins::coning::{coning_drift_rate, Algorithm};
+    use rinscope::ins::coning::{Algorithm, coning_drift_rate};
     let dir = scratch("coning");
     let rec = dir.join("coning.rrd");
-    let mut s = Session::start(&dir, &["--scenario", "pure-coning", "--speed", "4", "--duration-s", "32", "--save", rec.to_str().expect("utf-8")]);
+    let mut s = Session::start(
+        &dir,
+        &["--scenario", "pure-coning", "--speed", "4", "--duration-s", "32", "--save", rec.to_str().expect("utf-8")],
+    );
     s.wait_for_sim_time(8.0);
     s.set("cone half-angle", 2.0);
     s.wait_for_sim_time(20.0);
@@ -167,13 +180,19 @@ fn the_cone_changed_twice_from_the_class_page_goes_on_and_its_labels_and_rates_f
 
     // The reloads, in words.
     let ev = events(&rec).expect("events");
-    let at = |what: &str| ev.iter().find(|e| e.text.contains(what)).and_then(|e| e.t_s).unwrap_or_else(|| panic!("no event {what}: {ev:?}"));
+    let at = |what: &str| {
+        ev.iter()
+            .find(|e| e.text.contains(what))
+            .and_then(|e| e.t_s)
+            .unwrap_or_else(|| panic!("no event {what}: {ev:?}"))
+    };
     let (t1, t2) = (at("cone half-angle 1° → 2°"), at("cone frequency 5 Hz → 10 Hz"));
     assert!((8.0..12.0).contains(&t1) && (20.0..24.0).contains(&t2), "{t1} {t2}");
 
     // The 3D label says the cone there is (1° until the first change, then 2°).
     let labels = point_labels(&rec, "world/cone/label").expect("labels");
-    let label_at = |t: f64| labels.iter().rfind(|(s, _)| s.is_none_or(|s| s <= t)).map(|(_, l)| l.clone()).unwrap_or_default();
+    let label_at =
+        |t: f64| labels.iter().rfind(|(s, _)| s.is_none_or(|s| s <= t)).map(|(_, l)| l.clone()).unwrap_or_default();
     assert!(label_at(t1 - 0.5).contains("1.0000° cone") && label_at(t1 + 0.5).contains("2.0000° cone"), "{labels:?}");
 
     // The INS heading error of every algorithm goes on without a jump: no row (0.1 s apart) moves by
@@ -183,20 +202,34 @@ fn the_cone_changed_twice_from_the_class_page_goes_on_and_its_labels_and_rates_f
     let heading = all.iter().find(|p| p.origin == "ins/attitude_error_arcsec/heading").expect("INS heading plot");
     let per_s = coning_drift_rate(Algorithm::SingleSample, 2f64.to_radians(), 10.0, 0.01).abs() * 206_264.806;
     for line in heading.series.iter().filter(|l| l.line) {
-        let worst = line.t.windows(2).zip(line.y.windows(2)).filter(|(_, y)| y[0].is_finite() && y[1].is_finite()).map(|(t, y)| (y[1] - y[0]).abs() / (3.0 * (t[1] - t[0]) * per_s)).fold(0.0, f64::max);
+        let worst = line
+            .t
+            .windows(2)
+            .zip(line.y.windows(2))
+            .filter(|(_, y)| y[0].is_finite() && y[1].is_finite())
+            .map(|(t, y)| (y[1] - y[0]).abs() / (3.0 * (t[1] - t[0]) * per_s))
+            .fold(0.0, f64::max);
         assert!(worst < 1.0, "{}: a jump of {worst:.2} × the bound", line.name);
     }
 
     // The analytic drift lines take each new rate from where they stand: their slope between the
     // changes is the analytic rate of the cone then (log10 of arcsec on the plot).
     let log_plot = all.iter().find(|p| p.origin == "ins/coning_drift_log10_arcsec").expect("coning plot");
-    let analytic = log_plot.series.iter().find(|l| l.name == "single-sample: analytic coning drift").expect("analytic line");
-    let value = |t: f64| analytic.t.iter().zip(&analytic.y).find(|(s, _)| **s >= t).map(|(s, y)| (*s, 10f64.powf(*y))).expect("row");
-    for (from, to, deg, hz) in [(2.0, t1 - 0.5, 1.0_f64, 5.0), (t1 + 0.5, t2 - 0.5, 2.0, 5.0), (t2 + 0.5, 31.0, 2.0, 10.0)] {
+    let analytic =
+        log_plot.series.iter().find(|l| l.name == "single-sample: analytic coning drift").expect("analytic line");
+    let value = |t: f64| {
+        analytic.t.iter().zip(&analytic.y).find(|(s, _)| **s >= t).map(|(s, y)| (*s, 10f64.powf(*y))).expect("row")
+    };
+    for (from, to, deg, hz) in
+        [(2.0, t1 - 0.5, 1.0_f64, 5.0), (t1 + 0.5, t2 - 0.5, 2.0, 5.0), (t2 + 0.5, 31.0, 2.0, 10.0)]
+    {
         let ((ta, a), (tb, b)) = (value(from), value(to));
         let expected = coning_drift_rate(Algorithm::SingleSample, deg.to_radians(), hz, 0.01).abs() * 206_264.806;
         let slope = (b - a) / (tb - ta);
-        assert!((slope - expected).abs() < 1e-6 * expected, "{deg}° at {hz} Hz: the analytic line grows at {slope}″/s, the rate is {expected}″/s");
+        assert!(
+            (slope - expected).abs() < 1e-6 * expected,
+            "{deg}° at {hz} Hz: the analytic line grows at {slope}″/s, the rate is {expected}″/s"
+        );
     }
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -12,7 +12,12 @@ struct Tmux {
 
 impl Tmux {
     fn run(&self, args: &[&str]) -> std::process::Output {
-        Command::new("tmux").arg("-L").arg(&self.socket).args(args).output().expect("tmux runs (install it: apt-get install tmux)")
+        Command::new("tmux")
+            .arg("-L")
+            .arg(&self.socket)
+            .args(args)
+            .output()
+            .expect("tmux runs (install it: apt-get install tmux)")
     }
 
     fn screen(&self) -> String {
@@ -63,10 +68,14 @@ fn sliders_and_an_editor_drive_the_same_reload_path_and_the_recording_keeps_it()
     std::fs::write(&cfg, include_str!("../assets/scenarios/jiang2017-dual-axis.toml")).expect("config");
     let rrd = dir.join("session.rrd");
     let bin = env!("CARGO_BIN_EXE_rinscope");
-    let command = format!("cd {} && {bin} live --config session.toml --no-viewer --save session.rrd --speed 5", dir.display());
+    let command =
+        format!("cd {} && {bin} live --config session.toml --no-viewer --save session.rrd --speed 5", dir.display());
 
     let tmux = Tmux { socket: format!("rinscope-e2e-{}", std::process::id()) };
-    assert!(tmux.run(&["new-session", "-d", "-x", "150", "-y", "48", "-s", "e2e", &command]).status.success(), "tmux starts");
+    assert!(
+        tmux.run(&["new-session", "-d", "-x", "150", "-y", "48", "-s", "e2e", &command]).status.success(),
+        "tmux starts"
+    );
     tmux.wait_for("parameters (write the config file)");
     tmux.wait_for("q quit"); // the help line is discoverable
 
@@ -80,7 +89,10 @@ fn sliders_and_an_editor_drive_the_same_reload_path_and_the_recording_keeps_it()
     tmux.wait_for("inner swing half-angle 300″ → 450″");
     // The slider was written into the file with its comment kept.
     let text = std::fs::read_to_string(&cfg).expect("read");
-    assert!(text.contains("swing_half_angle_arcsec = 630.0 # swing-cone half-angle α2"), "the slider kept the comment:\n{text}");
+    assert!(
+        text.contains("swing_half_angle_arcsec = 630.0 # swing-cone half-angle α2"),
+        "the slider kept the comment:\n{text}"
+    );
 
     // 3. A bad value is reported and the session keeps running on the last good parameters.
     replace_in(&cfg, "non_orthogonality_arcsec = 20.0", "non_orthogonality_arcsec = 1e9");
@@ -100,7 +112,10 @@ fn sliders_and_an_editor_drive_the_same_reload_path_and_the_recording_keeps_it()
     let out = Command::new(bin).arg("events").arg(&rrd).output().expect("events");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let events = String::from_utf8_lossy(&out.stdout);
-    assert!(events.contains("outer swing half-angle 600″ → 610″") || events.contains("outer swing half-angle 600″ → 630″"), "{events}");
+    assert!(
+        events.contains("outer swing half-angle 600″ → 610″") || events.contains("outer swing half-angle 600″ → 630″"),
+        "{events}"
+    );
     assert!(events.contains("inner swing half-angle 300″ → 450″"), "{events}");
     assert!(events.contains("config error") && events.contains("non_orthogonality_arcsec"), "{events}");
     assert!(events.contains("live session ended"), "{events}");

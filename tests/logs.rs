@@ -39,7 +39,10 @@ fn radii(lat: f64) -> (f64, f64) {
 /// samples (t, Δθ, Δv) at `hz` for `seconds` and the final (latitude rad, v_N m/s). With the body
 /// frame equal to ENU at every instant, ω_ib^b = ω_ie^n + ω_en^n and f^b = v̇ + (2ω_ie + ω_en) × v − g,
 /// integrated with 20 midpoint sub-steps per sample.
-fn drive_north(lat0: f64, h: f64, v0: f64, accel: impl Fn(f64) -> f64, hz: f64, seconds: f64) -> (Vec<(f64, [f64; 3], [f64; 3])>, f64, f64) {
+/// Samples (t, Δθ, Δv), the final latitude and speed.
+type Drive = (Vec<(f64, [f64; 3], [f64; 3])>, f64, f64);
+
+fn drive_north(lat0: f64, h: f64, v0: f64, accel: impl Fn(f64) -> f64, hz: f64, seconds: f64) -> Drive {
     let dt = 1.0 / hz;
     let sub = 20;
     let ds = dt / sub as f64;
@@ -74,7 +77,18 @@ fn drive_north(lat0: f64, h: f64, v0: f64, accel: impl Fn(f64) -> f64, hz: f64, 
 fn write_imu_csv(path: &Path, t0: f64, samples: &[(f64, [f64; 3], [f64; 3])]) {
     let mut s = String::from("t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n");
     for (t, g, f) in samples {
-        writeln!(s, "{:.6},{:.15e},{:.15e},{:.15e},{:.15e},{:.15e},{:.15e}", t0 + t, g[0], g[1], g[2], f[0], f[1], f[2]).expect("write");
+        writeln!(
+            s,
+            "{:.6},{:.15e},{:.15e},{:.15e},{:.15e},{:.15e},{:.15e}",
+            t0 + t,
+            g[0],
+            g[1],
+            g[2],
+            f[0],
+            f[1],
+            f[2]
+        )
+        .expect("write");
     }
     std::fs::write(path, s).expect("imu csv");
 }
@@ -103,9 +117,19 @@ fn a_car_already_moving_is_navigated_from_the_start_it_is_given_and_refused_with
     )
     .expect("manifest");
     // Without a start: the IMU alone cannot align a car in motion; the message says so (not "units").
-    let o = rinscope().arg("replay").arg(&dir).args(["--position", "34", "108.9", "380", "--save"]).arg(dir.join("x.rrd")).output().expect("replay");
+    let o = rinscope()
+        .arg("replay")
+        .arg(&dir)
+        .args(["--position", "34", "108.9", "380", "--save"])
+        .arg(dir.join("x.rrd"))
+        .output()
+        .expect("replay");
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(stderr(&o).contains("not at rest at the start") && stderr(&o).contains("--velocity-enu-mps"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("not at rest at the start") && stderr(&o).contains("--velocity-enu-mps"),
+        "{}",
+        stderr(&o)
+    );
     assert!(!stderr(&o).contains("degrees declared as radians"), "{}", stderr(&o));
     assert!(!dir.join("x.rrd").exists());
     // With its attitude, velocity and position: navigated, compared from the reference's start.
@@ -113,7 +137,21 @@ fn a_car_already_moving_is_navigated_from_the_start_it_is_given_and_refused_with
     let o = rinscope()
         .arg("replay")
         .arg(&dir)
-        .args(["--attitude-deg", "0", "0", "0", "--velocity-enu-mps", "0", "12", "0", "--position", "34", "108.9", "380", "--save"])
+        .args([
+            "--attitude-deg",
+            "0",
+            "0",
+            "0",
+            "--velocity-enu-mps",
+            "0",
+            "12",
+            "0",
+            "--position",
+            "34",
+            "108.9",
+            "380",
+            "--save",
+        ])
         .arg(dir.join("car.rrd"))
         .arg("--summary-json")
         .arg(&summary)
@@ -122,7 +160,12 @@ fn a_car_already_moving_is_navigated_from_the_start_it_is_given_and_refused_with
     ok(&o);
     let s = json(&summary);
     let notes = s["notes"].as_array().expect("notes");
-    assert!(notes.iter().any(|n| n.as_str().is_some_and(|n| n.contains("starts at 5001.000000 s") && n.contains("comparison starts there"))), "{notes:?}");
+    assert!(
+        notes.iter().any(|n| n
+            .as_str()
+            .is_some_and(|n| n.contains("starts at 5001.000000 s") && n.contains("comparison starts there"))),
+        "{notes:?}"
+    );
     assert!((s["t0_file_clock_s"].as_f64().expect("t0") - 5000.0).abs() < 0.1, "{}", s["t0_file_clock_s"]);
     let f = &s["final_state"];
     // Ideal sensors: what is left is the navigation's numerical error over 2 minutes, a fraction of
@@ -133,7 +176,8 @@ fn a_car_already_moving_is_navigated_from_the_start_it_is_given_and_refused_with
     assert!(north_err_m.abs() < 0.5, "north position error {north_err_m} m");
     assert!(v_err.abs() < 0.01, "north velocity error {v_err} m/s");
     assert!((f["longitude_deg"].as_f64().expect("lon") - LON0_DEG).abs() * 111e3 * 0.83 < 0.5, "east drift");
-    let heading_peak = s["ins_attitude_error_arcsec"]["two-sample-p1"]["heading"]["peak_arcsec"].as_f64().unwrap_or(f64::NAN);
+    let heading_peak =
+        s["ins_attitude_error_arcsec"]["two-sample-p1"]["heading"]["peak_arcsec"].as_f64().unwrap_or(f64::NAN);
     assert!(heading_peak < 1.0, "heading error against the level reference {heading_peak}″: {s}");
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -143,10 +187,18 @@ fn a_declared_rate_the_stamps_contradict_is_refused_naming_both() {
     let dir = scratch("rate");
     let (samples, _, _) = drive_north(LAT0_DEG.to_radians(), H0, 0.0, |_| 0.0, 100.0, 20.0);
     write_imu_csv(&dir.join("imu.csv"), 0.0, &samples);
-    std::fs::write(dir.join("log.toml"), "[log]\nname = \"r\"\n[imu]\nfile = \"imu.csv\"\nrate_hz = 20.0\n[initial]\nposition = [34.0, 108.9, 380.0]\n").expect("manifest");
+    std::fs::write(
+        dir.join("log.toml"),
+        "[log]\nname = \"r\"\n[imu]\nfile = \"imu.csv\"\nrate_hz = 20.0\n[initial]\nposition = [34.0, 108.9, 380.0]\n",
+    )
+    .expect("manifest");
     let o = rinscope().arg("replay").arg(&dir).args(["--save"]).arg(dir.join("x.rrd")).output().expect("replay");
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(stderr(&o).contains("`imu.rate_hz`: 20 Hz is declared") && stderr(&o).contains("100.0000 Hz"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("`imu.rate_hz`: 20 Hz is declared") && stderr(&o).contains("100.0000 Hz"),
+        "{}",
+        stderr(&o)
+    );
     assert!(!dir.join("x.rrd").exists());
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -158,9 +210,21 @@ fn a_parked_strapdown_imu_is_aligned_on_its_own_data_and_trimmed_on_its_clock() 
     let dir = scratch("parked");
     let (samples, _, _) = drive_north(LAT0_DEG.to_radians(), H0, 0.0, |_| 0.0, 100.0, 150.0);
     write_imu_csv(&dir.join("imu.csv"), 100.0, &samples);
-    std::fs::write(dir.join("log.toml"), "[log]\nname = \"parked\"\n[imu]\nfile = \"imu.csv\"\n[initial]\nposition = [34.0, 108.9, 380.0]\n").expect("manifest");
+    std::fs::write(
+        dir.join("log.toml"),
+        "[log]\nname = \"parked\"\n[imu]\nfile = \"imu.csv\"\n[initial]\nposition = [34.0, 108.9, 380.0]\n",
+    )
+    .expect("manifest");
     let summary = dir.join("s.json");
-    let o = rinscope().arg("replay").arg(&dir).args(["--from", "110", "--to", "240", "--save"]).arg(dir.join("p.rrd")).arg("--summary-json").arg(&summary).output().expect("replay");
+    let o = rinscope()
+        .arg("replay")
+        .arg(&dir)
+        .args(["--from", "110", "--to", "240", "--save"])
+        .arg(dir.join("p.rrd"))
+        .arg("--summary-json")
+        .arg(&summary)
+        .output()
+        .expect("replay");
     ok(&o);
     let s = json(&summary);
     let a = &s["alignment"];
@@ -186,7 +250,8 @@ mod psins_writer;
 /// A PSINS SIMU file (as `imufile.m` writes it) of `samples` (t, Δθ, Δv) with header `avp0` =
 /// [pitch, roll, yaw (deg; PSINS's yaw is counter-clockwise), VE, VN, VU, lat, lon (deg), h, t0].
 fn write_psins(path: &Path, samples: &[(f64, [f64; 3], [f64; 3])], avp0: [f64; 10], ts: f64) {
-    let imu: Vec<[f64; 7]> = samples.iter().map(|(t, g, f)| [g[0], g[1], g[2], f[0], f[1], f[2], avp0[9] + t]).collect();
+    let imu: Vec<[f64; 7]> =
+        samples.iter().map(|(t, g, f)| [g[0], g[1], g[2], f[0], f[1], f[2], avp0[9] + t]).collect();
     // A ring-laser gyro's 0.01″ pulses and 1 µg·s accelerometer pulses (PSINS's own defaults are 0.1″, 125 µg·s).
     let input = psins_writer::SimuInput { imu, avp0, ts, scales: [0.01, 0.01, 0.01, 1.0, 1.0, 1.0] };
     std::fs::write(path, psins_writer::imufile_text(&input)).expect("psins file");
@@ -194,9 +259,19 @@ fn write_psins(path: &Path, samples: &[(f64, [f64; 3], [f64; 3])], avp0: [f64; 1
 
 /// An IMU fixed on the Earth at `lat` with body attitude (pitch, roll, heading clockwise), exact:
 /// ω^b = C_n^b ω_ie^n, f^b = C_n^b (0, 0, g), C_b^n = Rz(−heading) Rx(pitch) Ry(roll) (ENU, RFU).
-fn parked(lat: f64, h: f64, pitch: f64, roll: f64, heading: f64, hz: f64, seconds: f64) -> Vec<(f64, [f64; 3], [f64; 3])> {
+fn parked(
+    lat: f64,
+    h: f64,
+    pitch: f64,
+    roll: f64,
+    heading: f64,
+    hz: f64,
+    seconds: f64,
+) -> Vec<(f64, [f64; 3], [f64; 3])> {
     use nalgebra::{Rotation3, Vector3};
-    let c_bn = Rotation3::from_axis_angle(&Vector3::z_axis(), -heading) * Rotation3::from_axis_angle(&Vector3::x_axis(), pitch) * Rotation3::from_axis_angle(&Vector3::y_axis(), roll);
+    let c_bn = Rotation3::from_axis_angle(&Vector3::z_axis(), -heading)
+        * Rotation3::from_axis_angle(&Vector3::x_axis(), pitch)
+        * Rotation3::from_axis_angle(&Vector3::y_axis(), roll);
     let w = c_bn.inverse() * Vector3::new(0.0, OMEGA * lat.cos(), OMEGA * lat.sin());
     let f = c_bn.inverse() * Vector3::new(0.0, 0.0, gravity(lat, h));
     let dt = 1.0 / hz;
@@ -211,11 +286,28 @@ fn a_psins_imu_file_replays_with_nothing_else_and_is_aligned_on_its_data() {
     // 2° wrong) heading; the vehicle is parked, so the INS aligns on the data and finds the true one.
     let dir = scratch("psins");
     let (lat, heading) = (34.246_048_f64, 90.6_f64);
-    let samples = parked(lat.to_radians(), 380.0, 0.3_f64.to_radians(), -0.2_f64.to_radians(), heading.to_radians(), 100.0, 600.0);
+    let samples = parked(
+        lat.to_radians(),
+        380.0,
+        0.3_f64.to_radians(),
+        -0.2_f64.to_radians(),
+        heading.to_radians(),
+        100.0,
+        600.0,
+    );
     // PSINS yaw = −heading; the header says −92.6 (heading 92.6°).
     write_psins(&dir.join("run.imu"), &samples, [0.3, -0.2, -92.6, 0.0, 0.0, 0.0, lat, 108.909_664, 380.0, 0.0], 0.01);
     let summary = dir.join("s.json");
-    let o = rinscope().arg("replay").arg("--imu").arg(dir.join("run.imu")).arg("--save").arg(dir.join("r.rrd")).arg("--summary-json").arg(&summary).output().expect("replay");
+    let o = rinscope()
+        .arg("replay")
+        .arg("--imu")
+        .arg(dir.join("run.imu"))
+        .arg("--save")
+        .arg(dir.join("r.rrd"))
+        .arg("--summary-json")
+        .arg(&summary)
+        .output()
+        .expect("replay");
     ok(&o);
     let s = json(&summary);
     let a = &s["alignment"];
@@ -223,7 +315,11 @@ fn a_psins_imu_file_replays_with_nothing_else_and_is_aligned_on_its_data() {
     let (h, sigma) = (a["imu_heading_deg"].as_f64().expect("heading"), a["sigma_deg"][2].as_f64().expect("σ"));
     assert!((h - heading).abs() < 3.0 * sigma + 0.01, "heading {h}° ± {sigma}° vs the true {heading}°");
     assert!((h - heading).abs() < 0.5, "heading {h}° vs the true {heading}° (the header's 92.6° was not taken)");
-    assert!(stdout(&o).contains("PSINS header") && stdout(&o).contains("92.6"), "the header's heading is compared: {}", stdout(&o));
+    assert!(
+        stdout(&o).contains("PSINS header") && stdout(&o).contains("92.6"),
+        "the header's heading is compared: {}",
+        stdout(&o)
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -234,10 +330,23 @@ fn a_psins_imu_file_that_starts_moving_starts_from_its_header() {
     let (samples, lat_end, v_end) = drive_north(LAT0_DEG.to_radians(), H0, 12.0, accel, 100.0, 60.0);
     write_psins(&dir.join("car.imu"), &samples, [0.0, 0.0, 0.0, 0.0, 12.0, 0.0, LAT0_DEG, LON0_DEG, H0, 0.0], 0.01);
     let summary = dir.join("s.json");
-    let o = rinscope().arg("replay").arg("--imu").arg(dir.join("car.imu")).arg("--save").arg(dir.join("c.rrd")).arg("--summary-json").arg(&summary).output().expect("replay");
+    let o = rinscope()
+        .arg("replay")
+        .arg("--imu")
+        .arg(dir.join("car.imu"))
+        .arg("--save")
+        .arg(dir.join("c.rrd"))
+        .arg("--summary-json")
+        .arg(&summary)
+        .output()
+        .expect("replay");
     ok(&o);
     let s = json(&summary);
-    assert!(s["notes"].to_string().contains("moves at the start") && s["notes"].to_string().contains("PSINS header"), "{}", s["notes"]);
+    assert!(
+        s["notes"].to_string().contains("moves at the start") && s["notes"].to_string().contains("PSINS header"),
+        "{}",
+        s["notes"]
+    );
     let f = &s["final_state"];
     let (rm, _) = radii(lat_end);
     let north_err_m = (f["latitude_deg"].as_f64().expect("lat").to_radians() - lat_end) * (rm + H0);
@@ -259,13 +368,28 @@ fn a_headerless_file_is_described_column_by_column_instead_of_rewritten() {
         let (w, a) = ([g[1], g[0], -g[2]].map(|x| x / 0.02), [f[1], f[0], -f[2]].map(|x| x / 0.02));
         let deg = |x: f64| x.to_degrees();
         let gee = |x: f64| x / 9.806_65;
-        writeln!(text, "{:.3} {k} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e}", 1000.0 * (1.0 + t), gee(a[0]), gee(a[1]), gee(a[2]), deg(w[0]), deg(w[1]), deg(w[2])).expect("write");
+        writeln!(
+            text,
+            "{:.3} {k} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e}",
+            1000.0 * (1.0 + t),
+            gee(a[0]),
+            gee(a[1]),
+            gee(a[2]),
+            deg(w[0]),
+            deg(w[1]),
+            deg(w[2])
+        )
+        .expect("write");
     }
     std::fs::write(dir.join("mems.txt"), text).expect("file");
     let columns = "[imu.columns]\ntime = { column = 0, unit = \"ms\" }\n\
         accel_x = { column = 2, unit = \"g\" }\naccel_y = { column = 3, unit = \"g\" }\naccel_z = { column = 4, unit = \"g\" }\n\
         gyro_x = { column = 5, unit = \"deg_per_s\" }\ngyro_y = { column = 6, unit = \"deg_per_s\" }\ngyro_z = { column = 7, unit = \"deg_per_s\" }\n";
-    let manifest = |frame: &str| format!("[log]\nname = \"mems\"\n[imu]\nfile = \"mems.txt\"\n{frame}[initial]\nposition = [{LAT0_DEG}, {LON0_DEG}, {H0}]\n{columns}");
+    let manifest = |frame: &str| {
+        format!(
+            "[log]\nname = \"mems\"\n[imu]\nfile = \"mems.txt\"\n{frame}[initial]\nposition = [{LAT0_DEG}, {LON0_DEG}, {H0}]\n{columns}"
+        )
+    };
     // No frame: the message asks for it by key.
     std::fs::write(dir.join("log.toml"), manifest("")).expect("manifest");
     let o = rinscope().arg("replay").arg(&dir).arg("--save").arg(dir.join("x.rrd")).output().expect("replay");
@@ -273,13 +397,28 @@ fn a_headerless_file_is_described_column_by_column_instead_of_rewritten() {
     assert!(stderr(&o).contains("imu.frame"), "{}", stderr(&o));
     std::fs::write(dir.join("log.toml"), manifest("frame = \"frd\"\n")).expect("manifest");
     let summary = dir.join("s.json");
-    let o = rinscope().arg("replay").arg(&dir).arg("--save").arg(dir.join("m.rrd")).arg("--summary-json").arg(&summary).output().expect("replay");
+    let o = rinscope()
+        .arg("replay")
+        .arg(&dir)
+        .arg("--save")
+        .arg(dir.join("m.rrd"))
+        .arg("--summary-json")
+        .arg(&summary)
+        .output()
+        .expect("replay");
     ok(&o);
     let a = &json(&summary)["alignment"];
     let (h, sigma) = (a["imu_heading_deg"].as_f64().expect("heading"), a["sigma_deg"][2].as_f64().expect("σ"));
-    assert!((h - heading).abs() < (3.0 * sigma).max(0.01), "heading {h}° ± {sigma}° vs {heading}°: the columns, units and frame were read as described");
+    assert!(
+        (h - heading).abs() < (3.0 * sigma).max(0.01),
+        "heading {h}° ± {sigma}° vs {heading}°: the columns, units and frame were read as described"
+    );
     // A unit of the wrong quantity is named with its key.
-    std::fs::write(dir.join("log.toml"), manifest("frame = \"frd\"\n").replace("column = 5, unit = \"deg_per_s\"", "column = 5, unit = \"mps2\"")).expect("manifest");
+    std::fs::write(
+        dir.join("log.toml"),
+        manifest("frame = \"frd\"\n").replace("column = 5, unit = \"deg_per_s\"", "column = 5, unit = \"mps2\""),
+    )
+    .expect("manifest");
     let o = rinscope().arg("replay").arg(&dir).arg("--save").arg(dir.join("y.rrd")).output().expect("replay");
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("imu.columns.gyro_x") && stderr(&o).contains("mps2"), "{}", stderr(&o));
@@ -294,10 +433,20 @@ fn data_from_another_latitude_than_the_site_s_are_warned_about() {
     let samples = parked(42.0_f64.to_radians(), H0, 0.0, 0.0, 1.0, 100.0, 300.0);
     write_imu_csv(&dir.join("imu.csv"), 0.0, &samples);
     let summary = dir.join("s.json");
-    let o = rinscope().arg("replay").arg("--imu").arg(dir.join("imu.csv")).args(["--position", "34", "108.9", "380", "--save"]).arg(dir.join("l.rrd")).arg("--summary-json").arg(&summary).output().expect("replay");
+    let o = rinscope()
+        .arg("replay")
+        .arg("--imu")
+        .arg(dir.join("imu.csv"))
+        .args(["--position", "34", "108.9", "380", "--save"])
+        .arg(dir.join("l.rrd"))
+        .arg("--summary-json")
+        .arg(&summary)
+        .output()
+        .expect("replay");
     ok(&o);
     let a = &json(&summary)["alignment"];
-    let (lat, sigma) = (a["latitude_implied_deg"][0].as_f64().expect("lat"), a["latitude_implied_deg"][1].as_f64().expect("σ"));
+    let (lat, sigma) =
+        (a["latitude_implied_deg"][0].as_f64().expect("lat"), a["latitude_implied_deg"][1].as_f64().expect("σ"));
     assert!((lat - 42.0).abs() < 3.0 * sigma + 0.1, "implied {lat}° ± {sigma}°");
     assert!(a["warnings"].to_string().contains("imply a latitude"), "{a}");
     assert!(stdout(&o).contains("WARNING"), "{}", stdout(&o));

@@ -44,10 +44,24 @@ fn shards_run_in_parallel_processes_merge_into_the_unsharded_statistics() {
     assert_eq!(without_wall_clock(&whole), without_wall_clock(&merged));
 
     // A shard missing, or given twice, is refused with exit code 2.
-    let o = rinscope().args(["montecarlo", "merge"]).arg(dir.join("shard0.json")).arg(dir.join("shard1.json")).output().expect("merge");
+    let o = rinscope()
+        .args(["montecarlo", "merge"])
+        .arg(dir.join("shard0.json"))
+        .arg(dir.join("shard1.json"))
+        .output()
+        .expect("merge");
     assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("shard 2/3 is missing"), "{}", String::from_utf8_lossy(&o.stderr));
-    let o = rinscope().args(["montecarlo", "merge"]).arg(dir.join("shard0.json")).arg(dir.join("shard0.json")).output().expect("merge");
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("shard 2/3 is missing"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let o = rinscope()
+        .args(["montecarlo", "merge"])
+        .arg(dir.join("shard0.json"))
+        .arg(dir.join("shard0.json"))
+        .output()
+        .expect("merge");
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("given twice"), "{}", String::from_utf8_lossy(&o.stderr));
     // A malformed shard argument.

@@ -19,7 +19,11 @@ fn json(path: &Path) -> serde_json::Value {
 /// A log set of a scenario preset (default format csv).
 fn export(dir: &Path, scenario: &str, format: &str) -> PathBuf {
     let out = dir.join(format!("log-{format}"));
-    ok(&rinscope().args(["export-log", "--scenario", scenario, "--format", format, "--out"]).arg(&out).output().expect("export-log"));
+    ok(&rinscope()
+        .args(["export-log", "--scenario", scenario, "--format", format, "--out"])
+        .arg(&out)
+        .output()
+        .expect("export-log"));
     out
 }
 
@@ -73,7 +77,10 @@ fn export_then_replay_reproduces_the_in_loop_run_and_the_calibration() {
         let name = format!("ins__attitude_error_arcsec__{axis}.csv");
         let ((hx, x), (hy, y)) = (csv_table(&run_tables.join(&name)), csv_table(&replay_tables.join(&name)));
         let column = format!("two_sample_p1_{axis}_error_arcsec");
-        let (kx, ky) = (hx.iter().position(|c| *c == column).expect("run column"), hy.iter().position(|c| *c == column).expect("replay column"));
+        let (kx, ky) = (
+            hx.iter().position(|c| *c == column).expect("run column"),
+            hy.iter().position(|c| *c == column).expect("replay column"),
+        );
         assert_eq!(hy[1], "t_file_s", "{hy:?}");
         assert_eq!(x.len(), y.len(), "{axis}: same output instants");
         assert!(x.len() >= 1_900, "{} rows (10 Hz over 200 s)", x.len());
@@ -97,7 +104,13 @@ fn export_then_replay_reproduces_the_in_loop_run_and_the_calibration() {
     // calibrate --log on the exported log: the in-loop calibration's estimates (issue: 1e-6″).
     let (loop_cal, log_cal) = (dir.join("cal-loop.json"), dir.join("cal-log.json"));
     ok(&rinscope().args(["calibrate", "--no-recording", "--json"]).arg(&loop_cal).output().expect("calibrate"));
-    ok(&rinscope().args(["calibrate", "--no-recording", "--log"]).arg(&log).arg("--json").arg(&log_cal).output().expect("calibrate --log"));
+    ok(&rinscope()
+        .args(["calibrate", "--no-recording", "--log"])
+        .arg(&log)
+        .arg("--json")
+        .arg(&log_cal)
+        .output()
+        .expect("calibrate --log"));
     let (a, b) = (json(&loop_cal), json(&log_cal));
     for section in ["state", "angles"] {
         for (ra, rb) in a[section].as_array().expect("rows").iter().zip(b[section].as_array().expect("rows")) {
@@ -110,7 +123,15 @@ fn export_then_replay_reproduces_the_in_loop_run_and_the_calibration() {
         }
     }
     // And replay --compensation takes the calibration's estimates.
-    let o = rinscope().arg("replay").arg(&log).arg("--compensation").arg(&log_cal).arg("--save").arg(dir.join("rc.rrd")).output().expect("replay");
+    let o = rinscope()
+        .arg("replay")
+        .arg(&log)
+        .arg("--compensation")
+        .arg(&log_cal)
+        .arg("--save")
+        .arg(dir.join("rc.rrd"))
+        .output()
+        .expect("replay");
     ok(&o);
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -124,7 +145,15 @@ fn every_log_format_replays_to_the_same_result() {
     for format in ["csv", "npy", "parquet"] {
         let log = export(&dir, "li2014-coning", format);
         let out = dir.join(format!("{format}.json"));
-        ok(&rinscope().arg("replay").arg(&log).arg("--save").arg(dir.join(format!("{format}.rrd"))).arg("--summary-json").arg(&out).output().expect("replay"));
+        ok(&rinscope()
+            .arg("replay")
+            .arg(&log)
+            .arg("--save")
+            .arg(dir.join(format!("{format}.rrd")))
+            .arg("--summary-json")
+            .arg(&out)
+            .output()
+            .expect("replay"));
         summaries.push(json(&out)["ins_attitude_error_arcsec"].clone());
     }
     assert!(summaries[0].as_object().is_some_and(|m| m.len() == 5), "five algorithms compared: {}", summaries[0]);
@@ -198,7 +227,8 @@ fn broken(base: &Path, dir: &Path, name: &str, file: &str, edit: &dyn Fn(Vec<Str
     for e in std::fs::read_dir(base).expect("log").flatten() {
         std::fs::copy(e.path(), out.join(e.file_name())).expect("copy");
     }
-    let lines: Vec<String> = std::fs::read_to_string(base.join(file)).expect("file").lines().map(String::from).collect();
+    let lines: Vec<String> =
+        std::fs::read_to_string(base.join(file)).expect("file").lines().map(String::from).collect();
     std::fs::write(out.join(file), edit(lines).join("\n") + "\n").expect("write");
     out
 }
@@ -207,19 +237,46 @@ fn broken(base: &Path, dir: &Path, name: &str, file: &str, edit: &dyn Fn(Vec<Str
 fn bad_logs_are_refused_with_file_row_and_column() {
     let dir = scratch("bad");
     let base = export(&dir, "jiang2017-calibration", "csv");
-    let replace_header = |from: &'static str, to: &'static str| move |mut l: Vec<String>| {
-        l[0] = l[0].replace(from, to);
-        l
+    let replace_header = |from: &'static str, to: &'static str| {
+        move |mut l: Vec<String>| {
+            l[0] = l[0].replace(from, to);
+            l
+        }
     };
     // A missing column (the message lists the columns there are).
-    refused(&broken(&base, &dir, "missing", "imu.csv", &replace_header("dv_z_mps", "dv_q_mps")), &["imu.csv", "dv_z", "dv_q_mps"]);
+    refused(
+        &broken(&base, &dir, "missing", "imu.csv", &replace_header("dv_z_mps", "dv_q_mps")),
+        &["imu.csv", "dv_z", "dv_q_mps"],
+    );
     // A unit the name does not state / a wrong unit.
-    refused(&broken(&base, &dir, "unit", "imu.csv", &replace_header("dtheta_x_rad", "dtheta_x_furlong")), &["imu.csv", "dtheta_x"]);
+    refused(
+        &broken(&base, &dir, "unit", "imu.csv", &replace_header("dtheta_x_rad", "dtheta_x_furlong")),
+        &["imu.csv", "dtheta_x"],
+    );
     // Time going backwards, and a duplicated stamp.
-    refused(&broken(&base, &dir, "backwards", "imu.csv", &|mut l| { l.swap(100, 101); l }), &["imu.csv", "row"]);
-    refused(&broken(&base, &dir, "duplicate", "imu.csv", &|mut l| { let x = l[100].clone(); l.insert(100, x); l }), &["imu.csv", "row"]);
+    refused(
+        &broken(&base, &dir, "backwards", "imu.csv", &|mut l| {
+            l.swap(100, 101);
+            l
+        }),
+        &["imu.csv", "row"],
+    );
+    refused(
+        &broken(&base, &dir, "duplicate", "imu.csv", &|mut l| {
+            let x = l[100].clone();
+            l.insert(100, x);
+            l
+        }),
+        &["imu.csv", "row"],
+    );
     // A gap of 2 s (refused by default).
-    refused(&broken(&base, &dir, "gap", "imu.csv", &|mut l| { l.drain(1000..1400); l }), &["imu.csv", "gap"]);
+    refused(
+        &broken(&base, &dir, "gap", "imu.csv", &|mut l| {
+            l.drain(1000..1400);
+            l
+        }),
+        &["imu.csv", "gap"],
+    );
     // A NaN row.
     refused(
         &broken(&base, &dir, "nan", "imu.csv", &|mut l| {
@@ -231,26 +288,51 @@ fn bad_logs_are_refused_with_file_row_and_column() {
         &["imu.csv", "dtheta_z_rad", "NaN"],
     );
     // A truncated last line.
-    refused(&broken(&base, &dir, "truncated", "imu.csv", &|mut l| { let n = l.len() - 1; l[n] = l[n][..20].to_owned(); l }), &["imu.csv", "line"]);
+    refused(
+        &broken(&base, &dir, "truncated", "imu.csv", &|mut l| {
+            let n = l.len() - 1;
+            l[n] = l[n][..20].to_owned();
+            l
+        }),
+        &["imu.csv", "line"],
+    );
     // A file that is not what its extension says.
     let notnpy = broken(&base, &dir, "notnpy", "imu.csv", &|l| l);
     std::fs::rename(notnpy.join("imu.csv"), notnpy.join("imu.npy")).expect("rename");
-    let manifest = std::fs::read_to_string(notnpy.join("log.toml")).expect("manifest").replace("file = \"imu.csv\"", "file = \"imu.npy\"\n").replace("layout = \"rinscope\"", "layout = \"npy7\"");
+    let manifest = std::fs::read_to_string(notnpy.join("log.toml"))
+        .expect("manifest")
+        .replace("file = \"imu.csv\"", "file = \"imu.npy\"\n")
+        .replace("layout = \"rinscope\"", "layout = \"npy7\"");
     std::fs::write(notnpy.join("log.toml"), manifest).expect("manifest");
     refused(&notnpy, &["imu.npy"]);
     // Encoder and IMU clocks that do not overlap (the encoder log starts 50 s late).
-    refused(&broken(&base, &dir, "clocks", "encoders.csv", &|mut l| { l.drain(1..10_000); l }), &["encoders.csv", "clocks do not overlap"]);
+    refused(
+        &broken(&base, &dir, "clocks", "encoders.csv", &|mut l| {
+            l.drain(1..10_000);
+            l
+        }),
+        &["encoders.csv", "clocks do not overlap"],
+    );
     // Rates declared as increments: the static check sees 1/200 of gravity per sample... as rates.
     let rates = broken(&base, &dir, "rates", "imu.csv", &|l| {
-        let mut out = vec!["t_s,gyro_x_rad_per_s,gyro_y_rad_per_s,gyro_z_rad_per_s,accel_x_mps2,accel_y_mps2,accel_z_mps2".to_owned()];
+        let mut out = vec![
+            "t_s,gyro_x_rad_per_s,gyro_y_rad_per_s,gyro_z_rad_per_s,accel_x_mps2,accel_y_mps2,accel_z_mps2".to_owned(),
+        ];
         out.extend(l.into_iter().skip(1));
         out
     });
-    let manifest = std::fs::read_to_string(rates.join("log.toml")).expect("manifest").replace("[reference]\nsource = \"the simulation's truth\"\nfile = \"reference.csv\"", "[reference]\nattitude_deg = [0.0, 0.0, 0.0]").replace("kind = \"increments\"", "kind = \"rates\"");
+    let manifest = std::fs::read_to_string(rates.join("log.toml"))
+        .expect("manifest")
+        .replace(
+            "[reference]\nsource = \"the simulation's truth\"\nfile = \"reference.csv\"",
+            "[reference]\nattitude_deg = [0.0, 0.0, 0.0]",
+        )
+        .replace("kind = \"increments\"", "kind = \"rates\"");
     std::fs::write(rates.join("log.toml"), manifest).expect("manifest");
     refused(&rates, &["imu.csv", "increments"]);
     // A typo in the manifest.
-    let typo = broken(&base, &dir, "typo", "log.toml", &|l| l.into_iter().map(|x| x.replace("rate_hz", "rate_hzz")).collect());
+    let typo =
+        broken(&base, &dir, "typo", "log.toml", &|l| l.into_iter().map(|x| x.replace("rate_hz", "rate_hzz")).collect());
     refused(&typo, &["log.toml", "rate_hzz"]);
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -259,8 +341,18 @@ fn bad_logs_are_refused_with_file_row_and_column() {
 fn export_tables_read_back_and_say_their_units() {
     let dir = scratch("export");
     let tables = dir.join("tables");
-    ok(&rinscope().args(["run", "--scenario", "li2014-coning", "--duration-s", "20", "--save"]).arg(dir.join("x.rrd")).arg("--export").arg(&tables).output().expect("run"));
-    let names: Vec<String> = std::fs::read_dir(&tables).expect("tables").flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
+    ok(&rinscope()
+        .args(["run", "--scenario", "li2014-coning", "--duration-s", "20", "--save"])
+        .arg(dir.join("x.rrd"))
+        .arg("--export")
+        .arg(&tables)
+        .output()
+        .expect("run"));
+    let names: Vec<String> = std::fs::read_dir(&tables)
+        .expect("tables")
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
     assert!(names.iter().any(|n| n == "ins__attitude_error_arcsec__pitch.parquet"), "{names:?}");
     assert!(names.iter().all(|n| !n.ends_with(".partial")), "{names:?}");
     // Read back with rinscope's own Parquet reader: a t_s column and one arcsec column per algorithm.
@@ -288,12 +380,17 @@ fn csv_table(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
 /// Every column of every table in `dir` has at least two distinct finite values (the issue: no
 /// all-NaN or always-equal columns); returns the tables' file names.
 fn every_column_varies(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir).expect("tables").flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .expect("tables")
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
     names.sort();
     for name in &names {
         let (header, rows) = csv_table(&dir.join(name));
         for (k, column) in header.iter().enumerate() {
-            let distinct: std::collections::BTreeSet<u64> = rows.iter().map(|r| r[k]).filter(|v| v.is_finite()).map(f64::to_bits).collect();
+            let distinct: std::collections::BTreeSet<u64> =
+                rows.iter().map(|r| r[k]).filter(|v| v.is_finite()).map(f64::to_bits).collect();
             assert!(distinct.len() >= 2, "{name}: column {column} has {} distinct finite values", distinct.len());
         }
     }
@@ -315,7 +412,13 @@ fn strapdown_log(dir: &Path) -> PathBuf {
     )
     .expect("scenario");
     let log = dir.join("strapdown");
-    ok(&rinscope().args(["export-log", "--config"]).arg(&scenario).arg("--out").arg(&log).output().expect("export-log"));
+    ok(&rinscope()
+        .args(["export-log", "--config"])
+        .arg(&scenario)
+        .arg("--out")
+        .arg(&log)
+        .output()
+        .expect("export-log"));
     std::fs::remove_file(log.join("table.toml")).expect("table.toml");
     std::fs::remove_file(log.join("encoders.csv")).expect("encoders.csv");
     let manifest = std::fs::read_to_string(log.join("log.toml")).expect("manifest");
@@ -344,17 +447,43 @@ fn a_strapdown_replay_records_and_exports_the_ins_alone() {
     let dir = scratch("strapdown");
     let log = strapdown_log(&dir);
     let (rrd, tables, summary) = (dir.join("sd.rrd"), dir.join("sd-tables"), dir.join("sd.json"));
-    ok(&rinscope().arg("replay").arg(&log).arg("--save").arg(&rrd).arg("--summary-json").arg(&summary).args(["--export-format", "csv", "--export"]).arg(&tables).output().expect("replay"));
+    ok(&rinscope()
+        .arg("replay")
+        .arg(&log)
+        .arg("--save")
+        .arg(&rrd)
+        .arg("--summary-json")
+        .arg(&summary)
+        .args(["--export-format", "csv", "--export"])
+        .arg(&tables)
+        .output()
+        .expect("replay"));
     let s = json(&summary);
     assert_eq!(s["strapdown"], true);
     assert!(s.get("attitude_error_arcsec").is_none(), "no table rows in the summary: {s}");
     // The recording: the IMU's (body) axes and the reference's, the INS's plots; no gimbal, table,
     // swing, vehicle or trace entity; and its layout shows only what it holds.
     let c = rinscope::record::read::contents(&rrd).expect("recording");
-    for table_entity in ["world/vehicle", "world/ins_trace", "gimbal_angle_deg", "swing_arcsec", "attitude_error_", "closed_form", "vehicle_attitude_deg"] {
+    for table_entity in [
+        "world/vehicle",
+        "world/ins_trace",
+        "gimbal_angle_deg",
+        "swing_arcsec",
+        "attitude_error_",
+        "closed_form",
+        "vehicle_attitude_deg",
+    ] {
         assert!(!c.entities.iter().any(|e| e.starts_with(table_entity)), "{table_entity}: {:?}", c.entities);
     }
-    for wanted in ["world/ins_body", "world/reference_body", "ins/body_attitude_deg", "ins/attitude_error_arcsec/heading", "ins/velocity_enu_mps", "ins/position_from_start_m", "ins/latitude_longitude_deg"] {
+    for wanted in [
+        "world/ins_body",
+        "world/reference_body",
+        "ins/body_attitude_deg",
+        "ins/attitude_error_arcsec/heading",
+        "ins/velocity_enu_mps",
+        "ins/position_from_start_m",
+        "ins/latitude_longitude_deg",
+    ] {
         assert!(c.entities.contains(wanted), "{wanted}: {:?}", c.entities);
     }
     assert!(c.empty_views().is_empty(), "views of entities the recording lacks: {:?}", c.empty_views());
@@ -384,10 +513,21 @@ fn a_strapdown_replay_records_and_exports_the_ins_alone() {
     // The INS's attitude (not a copy of the reference: its error above is not zero) follows the
     // turn from 10° to 100° and the 3° roll.
     let heading: Vec<f64> = rows.iter().map(|r| r[4]).collect();
-    assert!(heading.iter().copied().fold(f64::INFINITY, f64::min) < 10.5 && heading.iter().copied().fold(f64::NEG_INFINITY, f64::max) > 99.5, "heading {heading:?}");
+    assert!(
+        heading.iter().copied().fold(f64::INFINITY, f64::min) < 10.5
+            && heading.iter().copied().fold(f64::NEG_INFINITY, f64::max) > 99.5,
+        "heading {heading:?}"
+    );
     assert!(rows.iter().map(|r| r[3].abs()).fold(0.0, f64::max) > 2.9, "roll");
-    assert_eq!(csv_table(&tables.join("ins__velocity_enu_mps.csv")).0, ["t_s", "t_file_s", "east_mps", "north_mps"], "held vertical channel: no up column");
-    assert_eq!(csv_table(&tables.join("ins__latitude_longitude_deg.csv")).0, ["t_s", "t_file_s", "latitude_deg", "longitude_deg"]);
+    assert_eq!(
+        csv_table(&tables.join("ins__velocity_enu_mps.csv")).0,
+        ["t_s", "t_file_s", "east_mps", "north_mps"],
+        "held vertical channel: no up column"
+    );
+    assert_eq!(
+        csv_table(&tables.join("ins__latitude_longitude_deg.csv")).0,
+        ["t_s", "t_file_s", "latitude_deg", "longitude_deg"]
+    );
 
     // Without a reference: no errors anywhere (they would be zero), no reference axes.
     let manifest = std::fs::read_to_string(log.join("log.toml")).expect("manifest");
@@ -395,9 +535,23 @@ fn a_strapdown_replay_records_and_exports_the_ins_alone() {
     assert_ne!(cut, manifest, "the reference section was removed");
     std::fs::write(log.join("log.toml"), cut).expect("manifest");
     let (rrd, tables) = (dir.join("noref.rrd"), dir.join("noref-tables"));
-    ok(&rinscope().arg("replay").arg(&log).arg("--save").arg(&rrd).args(["--export-format", "csv", "--export"]).arg(&tables).output().expect("replay"));
+    ok(&rinscope()
+        .arg("replay")
+        .arg(&log)
+        .arg("--save")
+        .arg(&rrd)
+        .args(["--export-format", "csv", "--export"])
+        .arg(&tables)
+        .output()
+        .expect("replay"));
     let c = rinscope::record::read::contents(&rrd).expect("recording");
-    assert!(!c.entities.iter().any(|e| e.contains("attitude_error") || e.starts_with("world/reference_body") || e.starts_with("world/vehicle")), "{:?}", c.entities);
+    assert!(
+        !c.entities.iter().any(|e| e.contains("attitude_error")
+            || e.starts_with("world/reference_body")
+            || e.starts_with("world/vehicle")),
+        "{:?}",
+        c.entities
+    );
     assert!(c.entities.contains("world/ins_body"), "{:?}", c.entities);
     assert!(c.empty_views().is_empty(), "views of entities the recording lacks: {:?}", c.empty_views());
     let names = every_column_varies(&tables);
@@ -418,7 +572,8 @@ fn refused_by(command: &str, log: &Path, expected: &[&str]) -> String {
     let o = c.output().expect(command);
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{command}: exit code; stderr: {err}");
-    let lines: Vec<&str> = err.lines().filter(|l| !l.starts_with("rinscope: saving to") && !l.starts_with("rinscope: reading")).collect();
+    let lines: Vec<&str> =
+        err.lines().filter(|l| !l.starts_with("rinscope: saving to") && !l.starts_with("rinscope: reading")).collect();
     // One message (a TOML error quotes its line under it), and a short one.
     assert_eq!(lines.iter().filter(|l| l.starts_with("rinscope: ")).count(), 1, "{command}: one message: {err}");
     let message = lines.join("\n");
@@ -441,7 +596,8 @@ fn rewritten(base: &Path, dir: &Path, case: &str, name: &str, edit: TableEdit<'_
     let probe = rinscope::io::ColumnReader::open(&source, &[], &rinscope::io::ReadOptions::default()).expect("probe");
     let n = probe.all_columns().len();
     let cols: Vec<rinscope::io::Col> = (0..n).map(rinscope::io::Col::Index).collect();
-    let mut reader = rinscope::io::ColumnReader::open(&source, &cols, &rinscope::io::ReadOptions::default()).expect("open");
+    let mut reader =
+        rinscope::io::ColumnReader::open(&source, &cols, &rinscope::io::ReadOptions::default()).expect("open");
     let (mut names, mut rows): (Vec<String>, Vec<Vec<f64>>) = ((0..n).map(|i| format!("c{i}")).collect(), Vec::new());
     let mut row = vec![0.0; n];
     while reader.next_row(&mut row).expect("row") {
@@ -476,9 +632,17 @@ fn trust_round_2_each_defect_is_refused_where_it_is() {
     // 6: one finite but absurd value turned the attitude into NaN (exit 0, NaN RMS, nulls).
     let absurd = broken(&base, &dir, "absurd", "imu.csv", &set_cell(500, 2, "1e300"));
     for command in ["replay", "calibrate", "allan"] {
-        refused_by(command, &absurd, &["imu.csv", "data row 500 (line 501)", "column dtheta_y_rad", "\"1e300\"", "gyro"]);
+        refused_by(
+            command,
+            &absurd,
+            &["imu.csv", "data row 500 (line 501)", "column dtheta_y_rad", "\"1e300\"", "gyro"],
+        );
     }
-    refused_by("replay", &broken(&base, &dir, "absurd-ref", "reference.csv", &set_cell(9000, 1, "-1e30")), &["reference.csv", "line 9001", "pitch_rad", "\"-1e30\""]);
+    refused_by(
+        "replay",
+        &broken(&base, &dir, "absurd-ref", "reference.csv", &set_cell(9000, 1, "-1e30")),
+        &["reference.csv", "line 9001", "pitch_rad", "\"-1e30\""],
+    );
     // 3: the last line cut inside its last field, no line end.
     let cut = broken(&base, &dir, "cut", "imu.csv", &|l| l);
     let text = std::fs::read_to_string(cut.join("imu.csv")).expect("imu");
@@ -504,9 +668,17 @@ fn trust_round_2_each_defect_is_refused_where_it_is() {
     let mut bytes = std::fs::read(garbage.join("reference.csv")).expect("reference");
     bytes.extend([0x00, 0xff, 0x13, b'x', b'\n']);
     std::fs::write(garbage.join("reference.csv"), bytes).expect("garbage");
-    refused_by("replay", &garbage, &["reference.csv", "data row 40003 (line 40004)", "1 fields where the header has 4"]);
+    refused_by(
+        "replay",
+        &garbage,
+        &["reference.csv", "data row 40003 (line 40004)", "1 fields where the header has 4"],
+    );
     // 9: the messages. NaN in an encoder file is not "an IMU log's"; a refused encoder gap has its row.
-    let m = refused_by("replay", &broken(&base, &dir, "nan-enc", "encoders.csv", &set_cell(300, 1, "NaN")), &["encoders.csv", "data row 300 (line 301)", "outer_rad", "NaN"]);
+    let m = refused_by(
+        "replay",
+        &broken(&base, &dir, "nan-enc", "encoders.csv", &set_cell(300, 1, "NaN")),
+        &["encoders.csv", "data row 300 (line 301)", "outer_rad", "NaN"],
+    );
     assert!(!m.contains("IMU log"), "{m}");
     let gap = broken(&base, &dir, "enc-gap", "encoders.csv", &|mut l| {
         l.drain(1000..1010);
@@ -520,22 +692,43 @@ fn trust_round_2_each_defect_is_refused_where_it_is() {
         std::fs::write(log.join("log.toml"), text.replacen(from, to, 1)).expect("manifest");
         log
     };
-    let m = refused_by("replay", &edit_manifest("kalibr", "layout = \"rinscope\"", "layout = \"kalibr\""), &["imu.csv", "rinscope columns", "use layout = \"rinscope\""]);
+    let m = refused_by(
+        "replay",
+        &edit_manifest("kalibr", "layout = \"rinscope\"", "layout = \"kalibr\""),
+        &["imu.csv", "rinscope columns", "use layout = \"rinscope\""],
+    );
     assert!(!m.contains("holds rates"), "{m}");
-    let m = refused_by("replay", &edit_manifest("frame", "frame = \"rfu\"", "frame = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]"), &["log.toml", "frame", "2 rows", "3×3 matrix"]);
+    let m = refused_by(
+        "replay",
+        &edit_manifest("frame", "frame = \"rfu\"", "frame = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]"),
+        &["log.toml", "frame", "2 rows", "3×3 matrix"],
+    );
     assert!(!m.contains("untagged"), "{m}");
-    refused_by("replay", &edit_manifest("topic", "layout = \"rinscope\"", "layout = \"rinscope\"\ntopic = \"/imu\""), &["imu.topic", "ros2"]);
-    refused_by("replay", &edit_manifest("latch", "latch_delay_ms = 0.0", "latch_delay_ms = 1e300"), &["encoders.latch_delay_ms", "1e300 ms"]);
+    refused_by(
+        "replay",
+        &edit_manifest("topic", "layout = \"rinscope\"", "layout = \"rinscope\"\ntopic = \"/imu\""),
+        &["imu.topic", "ros2"],
+    );
+    refused_by(
+        "replay",
+        &edit_manifest("latch", "latch_delay_ms = 0.0", "latch_delay_ms = 1e300"),
+        &["encoders.latch_delay_ms", "1e300 ms"],
+    );
     let nested = broken(&base, &dir, "nested", "log.toml", &|l| l);
     let table = std::fs::read_to_string(nested.join("table.toml")).expect("table");
-    std::fs::write(nested.join("table.toml"), format!("{table}\nx = {}1{}\n", "[".repeat(100_000), "]".repeat(100_000))).expect("table");
+    std::fs::write(
+        nested.join("table.toml"),
+        format!("{table}\nx = {}1{}\n", "[".repeat(100_000), "]".repeat(100_000)),
+    )
+    .expect("table");
     refused_by("replay", &nested, &["table.toml"]);
     // 5: a declared rate the stamps contradict, refused naming both — also by calibrate and allan,
     // and 20 Hz (which made series_hz 25 Hz out of range) no longer blames series_hz.
     for (case, rate) in [("rate20", "20.0"), ("rate210", "210.0")] {
         let log = edit_manifest(case, "rate_hz = 200.0", &format!("rate_hz = {rate}"));
         for command in ["replay", "calibrate", "allan"] {
-            let m = refused_by(command, &log, &["imu.rate_hz", "the time stamps of", "step by 0.005000 s = 200.0000 Hz"]);
+            let m =
+                refused_by(command, &log, &["imu.rate_hz", "the time stamps of", "step by 0.005000 s = 200.0000 Hz"]);
             assert!(!m.contains("series_hz"), "{m}");
         }
     }
@@ -556,7 +749,9 @@ fn trust_round_2_each_defect_is_refused_where_it_is() {
         rows.iter_mut().for_each(|r| r.push(1.0));
     });
     refused_by("calibrate", &wide_ref, &["reference.npy", "5 columns", "holds exactly 4"]);
-    let ms = broken(&npy, &dir, "npy-ms", "log.toml", &|l| l.into_iter().map(|x| if x == "time = \"s\"" { "time = \"ms\"".to_owned() } else { x }).collect());
+    let ms = broken(&npy, &dir, "npy-ms", "log.toml", &|l| {
+        l.into_iter().map(|x| if x == "time = \"s\"" { "time = \"ms\"".to_owned() } else { x }).collect()
+    });
     for command in ["replay", "calibrate", "allan"] {
         refused_by(command, &ms, &["imu.rate_hz", "read in ms", "200000"]);
     }

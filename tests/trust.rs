@@ -13,7 +13,12 @@ use std::time::{Duration, Instant};
 use rinscope::record::sink::verify_recording;
 
 fn partials(dir: &Path) -> Vec<PathBuf> {
-    std::fs::read_dir(dir).expect("dir").flatten().map(|e| e.path()).filter(|p| p.to_string_lossy().ends_with(".partial")).collect()
+    std::fs::read_dir(dir)
+        .expect("dir")
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.to_string_lossy().ends_with(".partial"))
+        .collect()
 }
 
 /// A run long enough to be interrupted: the rotary-table preset (small recording rates) for 100 h.
@@ -127,7 +132,14 @@ fn cut_short_commands_say_so_and_exit_non_zero() {
         let dir = scratch(&format!("cut-{}", args[0]));
         let save = dir.join("x.rrd");
         let mut cmd = rinscope();
-        let child = cmd.args(args).arg("--save").arg(&save).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("runs");
+        let child = cmd
+            .args(args)
+            .arg("--save")
+            .arg(&save)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("runs");
         wait_for_file(&dir.join("x.rrd.partial"));
         std::thread::sleep(Duration::from_millis(500));
         signal(&child, "-INT");
@@ -140,7 +152,13 @@ fn cut_short_commands_say_so_and_exit_non_zero() {
     // bench ignored Ctrl-C for a minute and then wrote its figures with exit 0.
     let dir = scratch("cut-bench");
     let json = dir.join("figures.json");
-    let child = rinscope().args(["bench", "--json"]).arg(&json).stdout(Stdio::null()).stderr(Stdio::piped()).spawn().expect("runs");
+    let child = rinscope()
+        .args(["bench", "--json"])
+        .arg(&json)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("runs");
     std::thread::sleep(Duration::from_millis(1500));
     signal(&child, "-INT");
     let (code, err, took) = finish(child);
@@ -149,7 +167,15 @@ fn cut_short_commands_say_so_and_exit_non_zero() {
     assert!(err.contains("interrupted by") && !json.exists() && partials(&dir).is_empty(), "{err}");
     let dir = scratch("cut-calibrate");
     let cal = tempconfig(&dir, "jiang2017-calibration", "duration_s = 200.0", "duration_s = 20000.0");
-    let child = rinscope().args(["calibrate", "--config"]).arg(&cal).arg("--save").arg(dir.join("c.rrd")).stdout(Stdio::null()).stderr(Stdio::piped()).spawn().expect("runs");
+    let child = rinscope()
+        .args(["calibrate", "--config"])
+        .arg(&cal)
+        .arg("--save")
+        .arg(dir.join("c.rrd"))
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("runs");
     std::thread::sleep(Duration::from_millis(800));
     signal(&child, "-INT");
     let (code, err, took) = finish(child);
@@ -160,7 +186,9 @@ fn cut_short_commands_say_so_and_exit_non_zero() {
 
 /// A preset's text with one edit, as a file in `dir`.
 fn tempconfig(dir: &Path, preset: &str, from: &str, to: &str) -> PathBuf {
-    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("assets/scenarios/{preset}.toml"))).expect("preset");
+    let text =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("assets/scenarios/{preset}.toml")))
+            .expect("preset");
     assert!(text.contains(from), "{preset} has `{from}`");
     let p = dir.join(format!("{preset}.toml"));
     std::fs::write(&p, text.replacen(from, to, 1)).expect("write");
@@ -177,8 +205,14 @@ fn outputs_never_follow_a_symlink_never_replace_an_input_and_are_checked_before_
     let config = tempconfig(&dir, "jiang2017-dual-axis", "duration_s = 360.0", "duration_s = 360.0");
     let cases: Vec<(Vec<std::ffi::OsString>, &str)> = vec![
         (vec!["--save".into(), dir.join("out.rrd").into()], "is a symlink"),
-        (vec!["--save".into(), dir.join("ok.rrd").into(), "--summary-json".into(), dir.join("s.json").into()], "is a symlink"),
-        (vec!["--config".into(), config.clone().into(), "--save".into(), config.clone().into()], "is an input of this run"),
+        (
+            vec!["--save".into(), dir.join("ok.rrd").into(), "--summary-json".into(), dir.join("s.json").into()],
+            "is a symlink",
+        ),
+        (
+            vec!["--config".into(), config.clone().into(), "--save".into(), config.clone().into()],
+            "is an input of this run",
+        ),
         (vec!["--save".into(), dir.clone().into()], "is a directory"),
         (vec!["--save".into(), format!("{}/new/", dir.display()).into()], "is a directory"),
         (vec!["--summary-json".into(), dir.clone().into()], "is a directory"),
@@ -189,7 +223,11 @@ fn outputs_never_follow_a_symlink_never_replace_an_input_and_are_checked_before_
         let out = rinscope().arg("run").args(["--duration-s", "36000"]).args(&args).output().expect("runs");
         assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
         assert!(stderr(&out).contains(expected), "{args:?}: {}", stderr(&out));
-        assert!(started.elapsed() < Duration::from_secs(2), "{args:?}: refused before the run, not after ({:?})", started.elapsed());
+        assert!(
+            started.elapsed() < Duration::from_secs(2),
+            "{args:?}: refused before the run, not after ({:?})",
+            started.elapsed()
+        );
     }
     assert_eq!(std::fs::read_to_string(&victim).expect("victim"), "precious");
     assert!(std::fs::read_to_string(&config).expect("config").contains("[scenario]"), "the scenario file is intact");
@@ -291,7 +329,16 @@ fn serve_listens_on_loopback_unless_told_otherwise() {
     drop(probe);
     let dir = scratch("serve");
     let mut child = rinscope()
-        .args(["run", "--scenario", "rotary-table-2016-wobble", "--duration-s", "360000", "--serve", &port.to_string(), "--save"])
+        .args([
+            "run",
+            "--scenario",
+            "rotary-table-2016-wobble",
+            "--duration-s",
+            "360000",
+            "--serve",
+            &port.to_string(),
+            "--save",
+        ])
         .arg(dir.join("x.rrd"))
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
@@ -306,7 +353,14 @@ fn serve_listens_on_loopback_unless_told_otherwise() {
         let mut found = Vec::new();
         for table in ["/proc/net/tcp", "/proc/net/tcp6"] {
             let text = std::fs::read_to_string(table).unwrap_or_default();
-            found.extend(text.lines().filter(|l| l.split_whitespace().nth(1).is_some_and(|a| a.ends_with(&port_hex)) && l.split_whitespace().nth(3) == Some("0A")).map(str::to_owned));
+            found.extend(
+                text.lines()
+                    .filter(|l| {
+                        l.split_whitespace().nth(1).is_some_and(|a| a.ends_with(&port_hex))
+                            && l.split_whitespace().nth(3) == Some("0A")
+                    })
+                    .map(str::to_owned),
+            );
         }
         if !found.is_empty() || started.elapsed() > Duration::from_secs(10) {
             break found;
@@ -381,7 +435,11 @@ fn bounded(cmd: &mut Command) -> Output {
 /// A static calibration log set (turntable, encoders, reference file), exported once per test.
 fn calibration_log_set(dir: &Path) -> PathBuf {
     let out = dir.join("base");
-    let o = rinscope().args(["export-log", "--scenario", "jiang2017-calibration", "--out"]).arg(&out).output().expect("export-log");
+    let o = rinscope()
+        .args(["export-log", "--scenario", "jiang2017-calibration", "--out"])
+        .arg(&out)
+        .output()
+        .expect("export-log");
     assert!(o.status.success(), "{}", stderr(&o));
     out
 }
@@ -435,7 +493,10 @@ fn every_input_that_is_not_a_regular_file_is_refused_at_once() {
         let out = bounded(&mut c);
         let err = stderr(&out);
         assert_eq!(out.status.code(), Some(2), "{command} with a FIFO as {file}: {err}");
-        assert!(err.contains(&fifo.display().to_string()) && err.contains("not a regular file"), "{command}, {file}: names the path and why: {err}");
+        assert!(
+            err.contains(&fifo.display().to_string()) && err.contains("not a regular file"),
+            "{command}, {file}: names the path and why: {err}"
+        );
         assert!(!rec.exists() && partials(&dir).is_empty(), "{command}, {file}: nothing written");
     }
     // Files named on the command line: --compensation, --imu (a PSINS .imu, its layout guessed
@@ -447,11 +508,43 @@ fn every_input_that_is_not_a_regular_file_is_refused_at_once() {
     let flag_cases: Vec<(Vec<std::ffi::OsString>, PathBuf)> = vec![
         (vec!["replay".into(), base.clone().into(), "--compensation".into(), fifo.clone().into()], fifo.clone()),
         (vec!["replay".into(), base.clone().into(), "--compensation".into(), "/dev/zero".into()], "/dev/zero".into()),
-        (vec!["replay".into(), "--imu".into(), fifo.clone().into()].into_iter().chain(psins.iter().map(Into::into)).collect(), fifo.clone()),
-        (vec!["replay".into(), "--imu".into(), fifo.clone().into(), "--imu-layout".into(), "psins-imu".into()].into_iter().chain(psins.iter().map(Into::into)).collect(), fifo.clone()),
-        (vec!["replay".into(), "--imu".into(), base.join("imu.csv").into(), "--table".into(), fifo.clone().into()], fifo.clone()),
-        (vec!["replay".into(), "--imu".into(), base.join("imu.csv").into(), "--table".into(), base.join("table.toml").into(), "--encoders".into(), fifo.clone().into()], fifo.clone()),
-        (vec!["replay".into(), "--imu".into(), dir.clone().into()].into_iter().chain(psins.iter().map(Into::into)).collect(), dir.clone()),
+        (
+            vec!["replay".into(), "--imu".into(), fifo.clone().into()]
+                .into_iter()
+                .chain(psins.iter().map(Into::into))
+                .collect(),
+            fifo.clone(),
+        ),
+        (
+            vec!["replay".into(), "--imu".into(), fifo.clone().into(), "--imu-layout".into(), "psins-imu".into()]
+                .into_iter()
+                .chain(psins.iter().map(Into::into))
+                .collect(),
+            fifo.clone(),
+        ),
+        (
+            vec!["replay".into(), "--imu".into(), base.join("imu.csv").into(), "--table".into(), fifo.clone().into()],
+            fifo.clone(),
+        ),
+        (
+            vec![
+                "replay".into(),
+                "--imu".into(),
+                base.join("imu.csv").into(),
+                "--table".into(),
+                base.join("table.toml").into(),
+                "--encoders".into(),
+                fifo.clone().into(),
+            ],
+            fifo.clone(),
+        ),
+        (
+            vec!["replay".into(), "--imu".into(), dir.clone().into()]
+                .into_iter()
+                .chain(psins.iter().map(Into::into))
+                .collect(),
+            dir.clone(),
+        ),
         (vec!["events".into(), fifo.clone().into()], fifo.clone()),
         (vec!["montecarlo".into(), "merge".into(), fifo.clone().into()], fifo.clone()),
     ];
@@ -464,7 +557,10 @@ fn every_input_that_is_not_a_regular_file_is_refused_at_once() {
         let out = bounded(&mut c);
         let err = stderr(&out);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
-        assert!(err.contains(&named.display().to_string()) && err.contains("not a regular file"), "{args:?}: names the path and why: {err}");
+        assert!(
+            err.contains(&named.display().to_string()) && err.contains("not a regular file"),
+            "{args:?}: names the path and why: {err}"
+        );
         assert!(!rec.exists() && partials(&dir).is_empty(), "{args:?}: nothing written");
     }
 }
@@ -483,7 +579,8 @@ fn the_same_bad_log_gives_the_same_exit_code_and_message_in_every_command() {
     cells[2] = "abc".into();
     lines[100] = cells.join(",");
     std::fs::write(&imu, lines.join("\n") + "\n").expect("write");
-    let commands: [(&str, &[&str]); 3] = [("replay", &[]), ("calibrate --log", &["calibrate", "--log"]), ("allan", &[])];
+    let commands: [(&str, &[&str]); 3] =
+        [("replay", &[]), ("calibrate --log", &["calibrate", "--log"]), ("allan", &[])];
     let mut messages = Vec::new();
     for (name, args) in commands {
         let mut c = rinscope();
@@ -496,7 +593,10 @@ fn the_same_bad_log_gives_the_same_exit_code_and_message_in_every_command() {
         let out = bounded(&mut c);
         let err = stderr(&out);
         assert_eq!(out.status.code(), Some(2), "{name}: bad data is bad input: {err}");
-        let line = err.lines().find(|l| l.starts_with(&format!("rinscope: {name}: "))).unwrap_or_else(|| panic!("{name}: one message: {err}"));
+        let line = err
+            .lines()
+            .find(|l| l.starts_with(&format!("rinscope: {name}: ")))
+            .unwrap_or_else(|| panic!("{name}: one message: {err}"));
         messages.push(line.trim_start_matches(&format!("rinscope: {name}: ")).to_owned());
     }
     assert!(messages[0].contains(&imu.display().to_string()) && messages[0].contains("abc"), "{}", messages[0]);
@@ -518,11 +618,18 @@ fn the_same_bad_log_gives_the_same_exit_code_and_message_in_every_command() {
 fn long_replay_set(dir: &Path) -> PathBuf {
     let cfg = tempconfig(dir, "jiang2017-dual-axis", "duration_s = 360.0", "duration_s = 3600.0");
     let out = dir.join("long");
-    let o = rinscope().args(["export-log", "--format", "npy", "--config"]).arg(&cfg).arg("--out").arg(&out).output().expect("export-log");
+    let o = rinscope()
+        .args(["export-log", "--format", "npy", "--config"])
+        .arg(&cfg)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .expect("export-log");
     assert!(o.status.success(), "{}", stderr(&o));
     let table = out.join("table.toml");
     let text = std::fs::read_to_string(&table).expect("table.toml");
-    let text = text.replacen("series_hz = 10.0", "series_hz = 200.0", 1).replacen("scene_hz = 10.0", "scene_hz = 200.0", 1);
+    let text =
+        text.replacen("series_hz = 10.0", "series_hz = 200.0", 1).replacen("scene_hz = 10.0", "scene_hz = 200.0", 1);
     std::fs::write(&table, text).expect("table.toml");
     out
 }
@@ -546,7 +653,13 @@ fn a_closed_or_broken_stderr_does_not_silence_the_signals() {
             } else {
                 Command::new(bin)
             };
-            cmd.env_remove("DISPLAY").env_remove("WAYLAND_DISPLAY").arg("replay").arg(&set).arg("--save").arg(&save).stdout(Stdio::null());
+            cmd.env_remove("DISPLAY")
+                .env_remove("WAYLAND_DISPLAY")
+                .arg("replay")
+                .arg(&set)
+                .arg("--save")
+                .arg(&save)
+                .stdout(Stdio::null());
             if how.starts_with("closed") {
                 cmd.stderr(Stdio::null());
             } else {

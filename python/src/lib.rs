@@ -5,8 +5,8 @@
 //! DataFrames).
 
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use pyo3::exceptions::{PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyValueError};
@@ -17,11 +17,11 @@ use serde::Serialize;
 use rinscope::app::allan::AllanRequest;
 use rinscope::calib::MonteCarloConfig;
 
-use rinscope::record::export::Table;
 use rinscope::app::outputs::RecordingRequest;
-use rinscope::record::sink::{self, SinkRequest};
 use rinscope::record::APPLICATION_ID;
-use rinscope::scenario::{self, logset, presets, Params};
+use rinscope::record::export::Table;
+use rinscope::record::sink::{self, SinkRequest};
+use rinscope::scenario::{self, Params, logset, presets};
 
 /// What went wrong, as the Python exception it becomes.
 enum Failure {
@@ -63,7 +63,9 @@ impl From<sink::SinkError> for Failure {
     fn from(e: sink::SinkError) -> Self {
         match e {
             sink::SinkError::Interrupted(m) => Self::Interrupted(m),
-            sink::SinkError::Write(_) | sink::SinkError::File(_) | sink::SinkError::ExportWrite(_) => Self::Output(e.to_string()),
+            sink::SinkError::Write(_) | sink::SinkError::File(_) | sink::SinkError::ExportWrite(_) => {
+                Self::Output(e.to_string())
+            }
             sink::SinkError::Rerun(_) | sink::SinkError::FiguresWrite(_) => Self::Run(e.to_string()),
             _ => Self::Input(e.to_string()),
         }
@@ -96,7 +98,11 @@ fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce(&Arc<AtomicBool>) ->
                         return Err(e);
                     }
                 }
-                Err(RecvTimeoutError::Disconnected) => return Err(PyRuntimeError::new_err("rinscope: the work ended without a result (see the panic message on stderr)")),
+                Err(RecvTimeoutError::Disconnected) => {
+                    return Err(PyRuntimeError::new_err(
+                        "rinscope: the work ended without a result (see the panic message on stderr)",
+                    ));
+                }
             }
         }
     })
@@ -104,7 +110,15 @@ fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce(&Arc<AtomicBool>) ->
 
 /// Where a call's recording goes: the file if `save`, and the tables in memory.
 fn recording(save: Option<PathBuf>, stop: &Arc<AtomicBool>) -> RecordingRequest {
-    RecordingRequest { sinks: SinkRequest { save, stop_on_failure: Some(Arc::clone(stop)), tables_in_memory: true, ..Default::default() }, save_by_default: false }
+    RecordingRequest {
+        sinks: SinkRequest {
+            save,
+            stop_on_failure: Some(Arc::clone(stop)),
+            tables_in_memory: true,
+            ..Default::default()
+        },
+        save_by_default: false,
+    }
 }
 
 /// One table as an Arrow IPC stream: float64 columns named as `--export` names them, the entity in
@@ -114,7 +128,10 @@ fn ipc(table: Table) -> Result<(String, String, Vec<u8>), Failure> {
     use arrow_schema::{DataType, Field, Schema};
     let arrow = |e: arrow_schema::ArrowError| Failure::Run(format!("arrow: {e}"));
     let fields: Vec<Field> = table.columns.iter().map(|c| Field::new(c, DataType::Float64, false)).collect();
-    let metadata = [("rinscope.entity".to_owned(), table.entity.clone()), ("rinscope.table".to_owned(), table.name.clone())].into_iter().collect();
+    let metadata =
+        [("rinscope.entity".to_owned(), table.entity.clone()), ("rinscope.table".to_owned(), table.name.clone())]
+            .into_iter()
+            .collect();
     let schema = Arc::new(Schema::new(fields).with_metadata(metadata));
     let arrays: Vec<ArrayRef> = table.values.into_iter().map(|v| Arc::new(Float64Array::from(v)) as ArrayRef).collect();
     let batch = RecordBatch::try_new(Arc::clone(&schema), arrays).map_err(arrow)?;
@@ -150,14 +167,21 @@ fn output<S: Serialize>(summary: S, saved: sink::Saved) -> Result<Output, Failur
 fn scenarios() -> Vec<(String, String)> {
     presets::PRESETS
         .iter()
-        .map(|(name, _)| ((*name).to_owned(), presets::load(name).map(|p| p.meta.title).unwrap_or_else(|e| format!("BROKEN: {e}"))))
+        .map(|(name, _)| {
+            ((*name).to_owned(), presets::load(name).map(|p| p.meta.title).unwrap_or_else(|e| format!("BROKEN: {e}")))
+        })
         .collect()
 }
 
 /// A preset's TOML text.
 #[pyfunction]
 fn preset_toml(name: &str) -> PyResult<String> {
-    presets::text(name).map(str::to_owned).ok_or_else(|| PyValueError::new_err(format!("{name:?} is not a preset; rinscope.scenarios() lists them: {}", presets::PRESETS.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", "))))
+    presets::text(name).map(str::to_owned).ok_or_else(|| {
+        PyValueError::new_err(format!(
+            "{name:?} is not a preset; rinscope.scenarios() lists them: {}",
+            presets::PRESETS.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ")
+        ))
+    })
 }
 
 /// Validates a scenario's TOML text (`origin` names it in messages); returns the resolved TOML
@@ -171,14 +195,16 @@ fn check(toml: &str, origin: &str) -> PyResult<String> {
 /// TOML text as JSON (for the dict-like Scenario); a syntax error is a ValueError.
 #[pyfunction]
 fn toml_to_json(text: &str) -> PyResult<String> {
-    let value: toml::Value = toml::from_str(text).map_err(|e| PyValueError::new_err(format!("config error: {}", rinscope::scenario::parse_message(&e))))?;
+    let value: toml::Value = toml::from_str(text)
+        .map_err(|e| PyValueError::new_err(format!("config error: {}", rinscope::scenario::parse_message(&e))))?;
     serde_json::to_string(&value).map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
 /// JSON (a Scenario's dict) as TOML text; a value TOML cannot hold (null, a mixed array) is a ValueError.
 #[pyfunction]
 fn json_to_toml(json: &str) -> PyResult<String> {
-    let value: toml::Value = serde_json::from_str(json).map_err(|e| PyValueError::new_err(format!("not a TOML document: {e}")))?;
+    let value: toml::Value =
+        serde_json::from_str(json).map_err(|e| PyValueError::new_err(format!("not a TOML document: {e}")))?;
     toml::to_string(&value).map_err(|e| PyValueError::new_err(format!("not a TOML document: {e}")))
 }
 
@@ -192,9 +218,14 @@ fn set_duration(params: &mut Params, duration_s: Option<f64>) -> Result<(), Fail
 
 /// The library's run of `params` into the sinks of a call (the recording if `save`, the tables in
 /// memory), finished: what `run` converts, and what `_time_run` times.
-fn run_to_sinks(params: Params, save: Option<PathBuf>, stop: &Arc<AtomicBool>) -> Result<(rinscope::app::run::RunSummary, sink::Saved), Failure> {
-    use rinscope::app::run::{execute, RunRequest};
-    let report = execute(&RunRequest { params, recording: recording(save, stop), summary_json: None, progress: false }, stop)?;
+fn run_to_sinks(
+    params: Params,
+    save: Option<PathBuf>,
+    stop: &Arc<AtomicBool>,
+) -> Result<(rinscope::app::run::RunSummary, sink::Saved), Failure> {
+    use rinscope::app::run::{RunRequest, execute};
+    let report =
+        execute(&RunRequest { params, recording: recording(save, stop), summary_json: None, progress: false }, stop)?;
     Ok((report.summary, report.saved))
 }
 
@@ -238,11 +269,15 @@ fn run(py: Python<'_>, toml: &str, duration_s: Option<f64>, save: Option<PathBuf
 #[pyfunction]
 #[pyo3(signature = (dir, save=None, compensation=None))]
 fn replay(py: Python<'_>, dir: PathBuf, save: Option<PathBuf>, compensation: Option<&str>) -> PyResult<PyOutput> {
-    use rinscope::app::replay::{execute, ReplayRequest};
+    use rinscope::app::replay::{ReplayRequest, execute};
     let log = logset::load(&dir).map_err(|e| Failure::Input(e.to_string()))?;
     let compensation = compensation.map(|text| (text.to_owned(), "compensation".to_owned()));
     let out = interruptible(py, move |stop| -> Result<Output, Failure> {
-        let report = execute(&ReplayRequest { log, compensation, recording: recording(save, stop), summary_json: None }, stop, None)?;
+        let report = execute(
+            &ReplayRequest { log, compensation, recording: recording(save, stop), summary_json: None },
+            stop,
+            None,
+        )?;
         output(report.summary, report.saved)
     })??;
     Ok(to_python(py, out))
@@ -252,11 +287,18 @@ fn replay(py: Python<'_>, dir: PathBuf, save: Option<PathBuf>, compensation: Opt
 /// with the least-squares compensation (as `calibrate --json` writes it) and every series.
 #[pyfunction]
 #[pyo3(signature = (toml=None, log_dir=None, save=None))]
-fn calibrate(py: Python<'_>, toml: Option<&str>, log_dir: Option<PathBuf>, save: Option<PathBuf>) -> PyResult<PyOutput> {
-    use rinscope::app::calibrate::{execute, CalibrateInput, CalibrateRequest};
+fn calibrate(
+    py: Python<'_>,
+    toml: Option<&str>,
+    log_dir: Option<PathBuf>,
+    save: Option<PathBuf>,
+) -> PyResult<PyOutput> {
+    use rinscope::app::calibrate::{CalibrateInput, CalibrateRequest, execute};
     let input = match (toml, log_dir) {
         (Some(toml), None) => CalibrateInput::Scenario(Box::new(parse(toml, "the scenario")?)),
-        (None, Some(dir)) => CalibrateInput::Log(Box::new(logset::load(&dir).map_err(|e| Failure::Input(e.to_string()))?)),
+        (None, Some(dir)) => {
+            CalibrateInput::Log(Box::new(logset::load(&dir).map_err(|e| Failure::Input(e.to_string()))?))
+        }
         _ => return Err(PyValueError::new_err("calibrate: give a scenario or log_dir (one of them)")),
     };
     let out = interruptible(py, move |stop| -> Result<Output, Failure> {
@@ -298,22 +340,45 @@ fn allan(
     let spacing = parse_taus(taus).map_err(|e| Failure::Input(format!("allan: taus {e}")))?;
     let estimators = parse_estimators(estimators).map_err(|e| Failure::Input(format!("allan: estimators {e}")))?;
     let request = AllanRequest { spacing, estimators, decimate, ci_sigma, errors_only: false };
-    options(&request).map_err(|e| Failure::Input(format!("allan: {}", e.to_string().replace("--ci-sigma", "ci_sigma").replace("--decimate", "decimate"))))?;
-    let specs: Vec<_> = specs.iter().map(|s| rinscope::io::series::SeriesColumn::parse(s).map_err(|e| Failure::Input(format!("allan: {e}")))).collect::<Result<_, _>>()?;
+    options(&request).map_err(|e| {
+        Failure::Input(format!(
+            "allan: {}",
+            e.to_string().replace("--ci-sigma", "ci_sigma").replace("--decimate", "decimate")
+        ))
+    })?;
+    let specs: Vec<_> = specs
+        .iter()
+        .map(|s| rinscope::io::series::SeriesColumn::parse(s).map_err(|e| Failure::Input(format!("allan: {e}"))))
+        .collect::<Result<_, _>>()?;
     if specs.len() != columns.len() {
-        return Err(PyValueError::new_err(format!("allan: {} column specs for {} columns", specs.len(), columns.len())));
+        return Err(PyValueError::new_err(format!(
+            "allan: {} column specs for {} columns",
+            specs.len(),
+            columns.len()
+        )));
     }
-    let values: Vec<Vec<f64>> = columns.iter().zip(&specs).map(|(b, s)| floats(b, &s.col.to_string())).collect::<Result<_, _>>()?;
+    let values: Vec<Vec<f64>> =
+        columns.iter().zip(&specs).map(|(b, s)| floats(b, &s.col.to_string())).collect::<Result<_, _>>()?;
     let times = time_s.map(|b| floats(&b, "time_s")).transpose()?;
     let out = interruptible(py, |stop| -> Result<Output, Failure> {
-        let data = rinscope::io::series::series_in_memory(&specs, values, rate_hz, times.as_deref()).map_err(|e| Failure::Input(format!("allan: {e}")))?;
-        let result = analyze_series(data, "arrays from Python", &request, 0.0).map_err(|e| Failure::Input(format!("allan: {e}")))?;
+        let data = rinscope::io::series::series_in_memory(&specs, values, rate_hz, times.as_deref())
+            .map_err(|e| Failure::Input(format!("allan: {e}")))?;
+        let result = analyze_series(data, "arrays from Python", &request, 0.0)
+            .map_err(|e| Failure::Input(format!("allan: {e}")))?;
         let mut tables = rinscope::record::export::Exporter::in_memory();
         rinscope::record::allan::export(&mut tables, &result).map_err(|e| Failure::Run(e.to_string()))?;
         let tables = tables.finish().map_err(|e| Failure::Run(e.to_string()))?.tables;
         if let Some(path) = save {
-            let sinks = sink::open(&SinkRequest { save: Some(path), stop_on_failure: Some(Arc::clone(stop)), ..Default::default() }, APPLICATION_ID, "python-allan")?;
-            rinscope::app::outputs::logged(rinscope::record::allan::log(&sinks.stream(), &result, description.as_deref().unwrap_or("Arrays analysed from Python.")))?;
+            let sinks = sink::open(
+                &SinkRequest { save: Some(path), stop_on_failure: Some(Arc::clone(stop)), ..Default::default() },
+                APPLICATION_ID,
+                "python-allan",
+            )?;
+            rinscope::app::outputs::logged(rinscope::record::allan::log(
+                &sinks.stream(),
+                &result,
+                description.as_deref().unwrap_or("Arrays analysed from Python."),
+            ))?;
             sinks.finish()?;
         }
         Ok((result.json().to_string(), tables.into_iter().map(ipc).collect::<Result<_, _>>()?))
@@ -325,17 +390,28 @@ fn allan(
 /// the summary (as `montecarlo --json` writes it) with each run's estimation errors under "runs".
 #[pyfunction]
 #[pyo3(signature = (toml, runs=None, eta_measured_sigma_arcsec=None))]
-fn montecarlo(py: Python<'_>, toml: &str, runs: Option<usize>, eta_measured_sigma_arcsec: Option<f64>) -> PyResult<String> {
+fn montecarlo(
+    py: Python<'_>,
+    toml: &str,
+    runs: Option<usize>,
+    eta_measured_sigma_arcsec: Option<f64>,
+) -> PyResult<String> {
     use rinscope::app::calibrate::{monte_carlo_runs, monte_carlo_setup};
-    use rinscope::calib::montecarlo::{summarize, Shard};
+    use rinscope::calib::montecarlo::{Shard, summarize};
     let mut params = parse(toml, "the scenario")?;
     if let Some(s) = eta_measured_sigma_arcsec {
-        params.calibration.montecarlo.set_eta_measured_sigma_arcsec(s).map_err(|e| PyValueError::new_err(format!("eta_measured_sigma_arcsec {e}")))?;
+        params
+            .calibration
+            .montecarlo
+            .set_eta_measured_sigma_arcsec(s)
+            .map_err(|e| PyValueError::new_err(format!("eta_measured_sigma_arcsec {e}")))?;
     }
-    let runs = MonteCarloConfig::check_runs(runs.unwrap_or(params.calibration.montecarlo.runs as usize)).map_err(|e| PyValueError::new_err(format!("runs {e}")))?;
+    let runs = MonteCarloConfig::check_runs(runs.unwrap_or(params.calibration.montecarlo.runs as usize))
+        .map_err(|e| PyValueError::new_err(format!("runs {e}")))?;
     let json = interruptible(py, |stop| -> Result<String, Failure> {
         let started = std::time::Instant::now();
-        let done = monte_carlo_runs(&params, runs, Shard::WHOLE, &|| (), stop).map_err(|e| Failure::Input(format!("montecarlo: {e}")))?;
+        let done = monte_carlo_runs(&params, runs, Shard::WHOLE, &|| (), stop)
+            .map_err(|e| Failure::Input(format!("montecarlo: {e}")))?;
         if done.len() < runs {
             return Err(Failure::Interrupted(format!("montecarlo: stopped after {} of {runs} runs", done.len())));
         }
@@ -353,16 +429,26 @@ fn montecarlo(py: Python<'_>, toml: &str, runs: Option<usize>, eta_measured_sigm
 /// (with the printed table under "table") and the recording's series.
 #[pyfunction]
 #[pyo3(signature = (toml, sequence="dual-axis-29", monte_carlo=None, navigate_hours=24.0, save=None))]
-fn selfcal(py: Python<'_>, toml: &str, sequence: &str, monte_carlo: Option<usize>, navigate_hours: f64, save: Option<PathBuf>) -> PyResult<PyOutput> {
-    use rinscope::app::selfcal::{self as sc, execute, SelfcalInput, SelfcalRequest, SequenceChoice};
+fn selfcal(
+    py: Python<'_>,
+    toml: &str,
+    sequence: &str,
+    monte_carlo: Option<usize>,
+    navigate_hours: f64,
+    save: Option<PathBuf>,
+) -> PyResult<PyOutput> {
+    use rinscope::app::selfcal::{self as sc, SelfcalInput, SelfcalRequest, SequenceChoice, execute};
     let params = parse(toml, "the scenario")?;
     sc::check_navigate_hours(navigate_hours).map_err(|e| PyValueError::new_err(format!("navigate_hours {e}")))?;
     if let Some(n) = monte_carlo.filter(|n| !sc::MONTE_CARLO_RUNS.contains(&(*n as u64))) {
         let (lo, hi) = (sc::MONTE_CARLO_RUNS.start(), sc::MONTE_CARLO_RUNS.end());
-        return Err(PyValueError::new_err(format!("monte_carlo {n}: must be {lo} ..= {hi} runs (or None), as --monte-carlo")));
+        return Err(PyValueError::new_err(format!(
+            "monte_carlo {n}: must be {lo} ..= {hi} runs (or None), as --monte-carlo"
+        )));
     }
     let sequence = SequenceChoice::parse(sequence).map_err(|e| PyValueError::new_err(format!("sequence {e}")))?;
-    let input = SelfcalInput::Scenario { params: Box::new(params), sequence, monte_carlo, navigate_hours, plan_only: false };
+    let input =
+        SelfcalInput::Scenario { params: Box::new(params), sequence, monte_carlo, navigate_hours, plan_only: false };
     let out = interruptible(py, move |stop| -> Result<Output, Failure> {
         let report = execute(&SelfcalRequest { input, recording: Some(recording(save, stop)), json: None }, stop)?;
         let mut json = report.document;

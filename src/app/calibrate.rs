@@ -2,23 +2,26 @@
 //! turning, INS and encoder noise in the loop), hand its data to the estimators of `calib`, validate
 //! the compensation on an independent run.
 
-use crate::calib::report::{build as build_report, Compensation, Report};
-use crate::calib::montecarlo::{self, RunErrors, Setup, Shard, Summary};
-use crate::calib::{attitude_errors, calibrate, AttitudeSource, CalibError, Calibration, Data, History, Measurement, Nuisance, ParamSet, Samples, Thinned};
 use crate::app::playback::{Playback, PlaybackError};
+use crate::calib::montecarlo::{self, RunErrors, Setup, Shard, Summary};
+use crate::calib::report::{Compensation, Report, build as build_report};
+use crate::calib::{
+    AttitudeSource, CalibError, Calibration, Data, History, Measurement, Nuisance, ParamSet, Samples, Thinned,
+    attitude_errors, calibrate,
+};
 use crate::ins::pipeline::InsRun;
-use crate::scenario::logset::LogSet;
 use crate::model::gimbal::TableErrors;
 use crate::scenario::Params;
+use crate::scenario::logset::LogSet;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 
 use crate::app::failure::Failure;
-use crate::app::outputs::{check_output, logged, write_json, RecordingName, RecordingRequest};
+use crate::app::outputs::{RecordingName, RecordingRequest, check_output, logged, write_json};
 use crate::record::sink::Saved;
 
 use crate::app::run::record_run;
-use crate::sim::{encoder_readings, DemodState};
+use crate::sim::{DemodState, encoder_readings};
 
 /// Runs the static test of `params` with noise seed `seed` and collects one sample per INS output
 /// (kept in memory while it fits, else simulated again for each pass: see [`Samples`]).
@@ -131,9 +134,22 @@ pub struct Outcome {
 
 /// The four demodulations a calibration is judged by, on `data`: before (the estimated errors
 /// unknown), after the filter's and the least squares' estimates, and with the true values.
-fn judge(chain: &crate::model::gimbal::Chain, cal: &Calibration, known: &TableErrors, truth: &TableErrors, data: &Data, series_hz: f64, stop: &AtomicBool) -> Result<(Compensation, ValidationTrace), CalibError> {
+fn judge(
+    chain: &crate::model::gimbal::Chain,
+    cal: &Calibration,
+    known: &TableErrors,
+    truth: &TableErrors,
+    data: &Data,
+    series_hz: f64,
+    stop: &AtomicBool,
+) -> Result<(Compensation, ValidationTrace), CalibError> {
     let set = &cal.set;
-    let variants = [set.without_estimated(known), set.errors(&cal.kf.theta, known), set.errors(&cal.nls.theta, known), set.errors(&set.values(truth), known)];
+    let variants = [
+        set.without_estimated(known),
+        set.errors(&cal.kf.theta, known),
+        set.errors(&cal.nls.theta, known),
+        set.errors(&set.values(truth), known),
+    ];
     let mut trace = Thinned::new(1.0 / series_hz.max(1e-6));
     let s = attitude_errors(chain, &variants, data, stop, &mut trace)?;
     // The recording plots the first three.
@@ -155,13 +171,29 @@ pub fn calibrate_scenario(params: &Params, history: bool, stop: &AtomicBool) -> 
     });
     let (data, validation) = (data?, validation?);
     let cfg = &params.calibration;
-    let cal = calibrate(&params.table.chain, &params.calibration_known, &data, cfg, if history { History::Snapshots(cfg.record_hz) } else { History::Final }, stop)?;
-    let (compensation, validation_trace) = judge(&params.table.chain, &cal, &params.calibration_known, &params.table.truth, &validation, params.recording.series_hz, stop)?;
-    let mut report = build_report(&params.meta.name, &params.table.chain, &params.table.truth, &cal, &data, Some(compensation));
-    report.aliases = crate::calib::alias::aliases(&params.table.chain, &params.calibration_known, &data, &cal, cfg, stop)?;
+    let cal = calibrate(
+        &params.table.chain,
+        &params.calibration_known,
+        &data,
+        cfg,
+        if history { History::Snapshots(cfg.record_hz) } else { History::Final },
+        stop,
+    )?;
+    let (compensation, validation_trace) = judge(
+        &params.table.chain,
+        &cal,
+        &params.calibration_known,
+        &params.table.truth,
+        &validation,
+        params.recording.series_hz,
+        stop,
+    )?;
+    let mut report =
+        build_report(&params.meta.name, &params.table.chain, &params.table.truth, &cal, &data, Some(compensation));
+    report.aliases =
+        crate::calib::alias::aliases(&params.table.chain, &params.calibration_known, &data, &cal, cfg, stop)?;
     Ok(Outcome { data, validation, cal, report, validation_trace })
 }
-
 
 /// The Monte Carlo's fixed part for `params`: its table, what the calibration knows, the seed.
 #[must_use]
@@ -179,7 +211,13 @@ pub fn monte_carlo_setup(params: &Params) -> Setup<'_> {
 /// Jiang et al. 2017's Monte Carlo on `params`' table, the runs of `shard` out of `runs`: each run a
 /// calibration of a drawn table on its simulated static test, in parallel (`progress` ticks once
 /// per run, `stop` ends early). Returns the runs' errors; `montecarlo::summarize` makes the table.
-pub fn monte_carlo_runs(params: &Params, runs: usize, shard: Shard, progress: &(dyn Fn() + Sync), stop: &AtomicBool) -> Result<Vec<RunErrors>, CalibError> {
+pub fn monte_carlo_runs(
+    params: &Params,
+    runs: usize,
+    shard: Shard,
+    progress: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
+) -> Result<Vec<RunErrors>, CalibError> {
     let simulate = |truth: &TableErrors, seed: u64| {
         let mut p = params.clone();
         p.table.truth = truth.clone();
@@ -189,7 +227,12 @@ pub fn monte_carlo_runs(params: &Params, runs: usize, shard: Shard, progress: &(
 }
 
 /// The whole Monte Carlo of `params` (`runs` runs), summarised.
-pub fn monte_carlo(params: &Params, runs: usize, progress: &(dyn Fn() + Sync), stop: &AtomicBool) -> Result<Summary, CalibError> {
+pub fn monte_carlo(
+    params: &Params,
+    runs: usize,
+    progress: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
+) -> Result<Summary, CalibError> {
     let started = std::time::Instant::now();
     let done = monte_carlo_runs(params, runs, Shard::WHOLE, progress, stop)?;
     Ok(montecarlo::summarize(&monte_carlo_setup(params), runs, &done, started.elapsed().as_secs_f64()))
@@ -198,9 +241,22 @@ pub fn monte_carlo(params: &Params, runs: usize, progress: &(dyn Fn() + Sync), s
 /// Writes `outcome`'s recording into `rec`: the calibration's panels, then the table turning as in
 /// a plain run of the ideal demodulation (the INS is the calibration's business here), whose error
 /// plots the layout keeps in its tabs.
-pub fn record_outcome(rec: crate::record::Stream, params: &Params, outcome: &Outcome, stop: &AtomicBool) -> anyhow::Result<()> {
-    let recorder = crate::record::calibration::log(rec, params, &outcome.cal, &outcome.report, &outcome.validation_trace)?;
-    recorder.event(params.duration_s, &format!("calibration: {} samples, {} Gauss–Newton iterations", outcome.cal.samples, outcome.cal.nls_iterations), "INFO")?;
+pub fn record_outcome(
+    rec: crate::record::Stream,
+    params: &Params,
+    outcome: &Outcome,
+    stop: &AtomicBool,
+) -> anyhow::Result<()> {
+    let recorder =
+        crate::record::calibration::log(rec, params, &outcome.cal, &outcome.report, &outcome.validation_trace)?;
+    recorder.event(
+        params.duration_s,
+        &format!(
+            "calibration: {} samples, {} Gauss–Newton iterations",
+            outcome.cal.samples, outcome.cal.nls_iterations
+        ),
+        "INFO",
+    )?;
     for w in &outcome.report.warnings {
         recorder.event(params.duration_s, w, "WARN")?;
     }
@@ -230,11 +286,20 @@ pub fn collect_from_log(log: &LogSet, known: &TableErrors, stop: &AtomicBool) ->
                 continue;
             }
             let (t, n_from_s) = pb.core.output_attitude(0);
-            let reference = pb.reference_at(t).map_err(|e| fail(e.into()))?.ok_or_else(|| fail(LogCalibrationError::NoReference))?;
+            let reference = pb
+                .reference_at(t)
+                .map_err(|e| fail(e.into()))?
+                .ok_or_else(|| fail(LogCalibrationError::NoReference))?;
             let first = *attitude.get_or_insert(reference);
-            let moved = (reference.pitch_rad - first.pitch_rad).abs().max(crate::math::units::wrap_pi(reference.roll_rad - first.roll_rad).abs()).max(crate::math::units::wrap_pi(reference.heading_rad - first.heading_rad).abs());
+            let moved = (reference.pitch_rad - first.pitch_rad)
+                .abs()
+                .max(crate::math::units::wrap_pi(reference.roll_rad - first.roll_rad).abs())
+                .max(crate::math::units::wrap_pi(reference.heading_rad - first.heading_rad).abs());
             if moved > 1e-9 {
-                return Err(fail(LogCalibrationError::Moves { t_s: t, arcsec: moved * crate::math::units::ARCSEC_PER_RAD }));
+                return Err(fail(LogCalibrationError::Moves {
+                    t_s: t,
+                    arcsec: moved * crate::math::units::ARCSEC_PER_RAD,
+                }));
             }
             // Matched synchronisation: the encoders are read for the instant the data represent.
             let angles = demod.correct(&known2, t, &pb.encoders_at(t).map_err(|e| fail(e.into()))?);
@@ -253,10 +318,18 @@ pub fn collect_from_log(log: &LogSet, known: &TableErrors, stop: &AtomicBool) ->
     if samples.is_empty() {
         return Err(LogCalibrationError::NoMeasurements(log.imu.path.display().to_string()));
     }
-    let attitude = found.lock().unwrap_or_else(std::sync::PoisonError::into_inner).ok_or(LogCalibrationError::NoReference)?;
+    let attitude =
+        found.lock().unwrap_or_else(std::sync::PoisonError::into_inner).ok_or(LogCalibrationError::NoReference)?;
     // τ ∈ [−1, 1] over the test, as the simulation's calibration has it.
     let duration_s = samples.last_t_s().max(1e-9);
-    Ok(Data { samples, duration_s, n_from_b: attitude.n_from_b(), attitude, source: AttitudeSource::Log, seed: log.seed.unwrap_or(0) })
+    Ok(Data {
+        samples,
+        duration_s,
+        n_from_b: attitude.n_from_b(),
+        attitude,
+        source: AttitudeSource::Log,
+        seed: log.seed.unwrap_or(0),
+    })
 }
 
 /// Why a log cannot be calibrated.
@@ -266,13 +339,19 @@ pub enum LogCalibrationError {
     #[error("{0}")]
     Playback(#[from] PlaybackError),
     /// No known body attitude.
-    #[error("calibration needs the body's attitude at rest: give the log set a [reference] (attitude_deg = [pitch, roll, heading], or a file)")]
+    #[error(
+        "calibration needs the body's attitude at rest: give the log set a [reference] (attitude_deg = [pitch, roll, heading], or a file)"
+    )]
     NoReference,
     /// The IMU file ends before the INS's first update: nothing to calibrate on.
-    #[error("{0}: too few samples: the log ends before the INS's first update, so there is no measurement to calibrate on")]
+    #[error(
+        "{0}: too few samples: the log ends before the INS's first update, so there is no measurement to calibrate on"
+    )]
     NoMeasurements(String),
     /// The reference attitude changes.
-    #[error("the reference attitude changes by {arcsec:.3}″ at {t_s:.3} s: a static calibration needs the vehicle at rest")]
+    #[error(
+        "the reference attitude changes by {arcsec:.3}″ at {t_s:.3} s: a static calibration needs the vehicle at rest"
+    )]
     Moves {
         /// When, s.
         t_s: f64,
@@ -289,16 +368,26 @@ pub enum LogCalibrationError {
 
 /// `calibrate --log`: Jiang et al. 2017's filter and the exact least squares on a log set, the compensation
 /// before/after on the same data (a log has no independent second run).
-pub fn calibrate_log(log: &LogSet, history: bool, stop: &AtomicBool) -> Result<(Calibration, Report, Data, ValidationTrace), LogCalibrationError> {
+pub fn calibrate_log(
+    log: &LogSet,
+    history: bool,
+    stop: &AtomicBool,
+) -> Result<(Calibration, Report, Data, ValidationTrace), LogCalibrationError> {
     calibrate_log_files(log, history, stop).map_err(|e| match e {
         // A pass over the log's files failed on their data (every pass reads them again when they
         // do not fit in memory): the data's error, as `replay` gives it, not the estimators'.
-        LogCalibrationError::Calibration(CalibError::Data(message)) => LogCalibrationError::Playback(PlaybackError::Data(message)),
+        LogCalibrationError::Calibration(CalibError::Data(message)) => {
+            LogCalibrationError::Playback(PlaybackError::Data(message))
+        }
         other => other,
     })
 }
 
-fn calibrate_log_files(log: &LogSet, history: bool, stop: &AtomicBool) -> Result<(Calibration, Report, Data, ValidationTrace), LogCalibrationError> {
+fn calibrate_log_files(
+    log: &LogSet,
+    history: bool,
+    stop: &AtomicBool,
+) -> Result<(Calibration, Report, Data, ValidationTrace), LogCalibrationError> {
     let cfg = &log.table.calibration;
     let set = ParamSet::new(&log.table.chain, Nuisance::None);
     let known = set.without_estimated(&log.table.compensation);
@@ -308,10 +397,21 @@ fn calibrate_log_files(log: &LogSet, history: bool, stop: &AtomicBool) -> Result
         CalibError::Interrupted => LogCalibrationError::Interrupted,
         other => LogCalibrationError::Calibration(other),
     };
-    let cal = calibrate(chain, &log.table.compensation, &data, cfg, if history { History::Snapshots(cfg.record_hz) } else { History::Final }, stop).map_err(interrupted)?;
-    let (compensation, trace) = judge(chain, &cal, &log.table.compensation, &log.table.stated, &data, log.table.recording.series_hz, stop).map_err(interrupted)?;
+    let cal = calibrate(
+        chain,
+        &log.table.compensation,
+        &data,
+        cfg,
+        if history { History::Snapshots(cfg.record_hz) } else { History::Final },
+        stop,
+    )
+    .map_err(interrupted)?;
+    let (compensation, trace) =
+        judge(chain, &cal, &log.table.compensation, &log.table.stated, &data, log.table.recording.series_hz, stop)
+            .map_err(interrupted)?;
     let mut report = build_report(&log.name, chain, &log.table.stated, &cal, &data, Some(compensation));
-    report.aliases = crate::calib::alias::aliases(chain, &log.table.compensation, &data, &cal, cfg, stop).map_err(interrupted)?;
+    report.aliases =
+        crate::calib::alias::aliases(chain, &log.table.compensation, &data, &cal, cfg, stop).map_err(interrupted)?;
     Ok((cal, report, data, trace))
 }
 
@@ -328,7 +428,11 @@ pub struct CalibrationOutput<'a> {
 
 /// The `[compensation]` keys of a calibration's least-squares estimates over `known`.
 #[must_use]
-pub fn estimated_compensation(chain: &crate::model::gimbal::Chain, cal: &Calibration, known: &TableErrors) -> crate::scenario::raw::RawCompensation {
+pub fn estimated_compensation(
+    chain: &crate::model::gimbal::Chain,
+    cal: &Calibration,
+    known: &TableErrors,
+) -> crate::scenario::raw::RawCompensation {
     crate::scenario::compensation_keys(chain, &cal.set.errors(&cal.nls.theta, known))
 }
 
@@ -374,19 +478,38 @@ pub fn execute(req: &CalibrateRequest, stop: &AtomicBool) -> Result<CalibrateRep
         CalibrateInput::Scenario(p) => (&p.meta.name, Some(p.meta.seed)),
         CalibrateInput::Log(log) => {
             if log.table.strapdown {
-                return Err(Failure::input(format!("calibrate --log: {} has no table description with [turntable] (log.table): there is no table to calibrate", log.dir.display())));
+                return Err(Failure::input(format!(
+                    "calibrate --log: {} has no table description with [turntable] (log.table): there is no table to calibrate",
+                    log.dir.display()
+                )));
             }
             (&log.name, None)
         }
     };
     // Dropped unfinished (any error below), the sinks are abandoned.
-    let sinks = req.recording.as_ref().map(|r| r.open(RecordingName { name, kind: Some("calibration"), seed })).transpose()?;
+    let sinks =
+        req.recording.as_ref().map(|r| r.open(RecordingName { name, kind: Some("calibration"), seed })).transpose()?;
     let (text, output, saved) = match &req.input {
         CalibrateInput::Scenario(params) => {
-            let outcome = calibrate_scenario(params, sinks.is_some(), stop).map_err(|e| Failure::calibration("calibrate", e, "calibrate did not finish; nothing was estimated and no recording was made"))?;
-            let text = format!("{}({:.2} s wall: two {:.0}-s runs simulated, filter and least squares)\n", outcome.report.text(), started.elapsed().as_secs_f64(), params.duration_s);
+            let outcome = calibrate_scenario(params, sinks.is_some(), stop).map_err(|e| {
+                Failure::calibration(
+                    "calibrate",
+                    e,
+                    "calibrate did not finish; nothing was estimated and no recording was made",
+                )
+            })?;
+            let text = format!(
+                "{}({:.2} s wall: two {:.0}-s runs simulated, filter and least squares)\n",
+                outcome.report.text(),
+                started.elapsed().as_secs_f64(),
+                params.duration_s
+            );
             let compensation = estimated_compensation(&params.table.chain, &outcome.cal, &params.calibration_known);
-            let output = serde_json::to_value(CalibrationOutput { report: &outcome.report, estimated_compensation: compensation }).map_err(|e| Failure::run(e.to_string()))?;
+            let output = serde_json::to_value(CalibrationOutput {
+                report: &outcome.report,
+                estimated_compensation: compensation,
+            })
+            .map_err(|e| Failure::run(e.to_string()))?;
             let saved = match sinks {
                 Some(s) => {
                     logged(record_outcome(s.stream(), params, &outcome, stop))?;
@@ -403,13 +526,24 @@ pub fn execute(req: &CalibrateRequest, stop: &AtomicBool) -> Result<CalibrateRep
                 LogCalibrationError::Calibration(c) => Failure::calibration("calibrate --log", c, interrupted),
                 other => Failure::input(format!("calibrate --log: {other}")),
             })?;
-            let text = format!("{}({:.2} s wall: {} measurements of {}, filter and least squares; before/after on the same data)\n", report.text(), started.elapsed().as_secs_f64(), data.samples.len(), log.dir.display());
+            let text = format!(
+                "{}({:.2} s wall: {} measurements of {}, filter and least squares; before/after on the same data)\n",
+                report.text(),
+                started.elapsed().as_secs_f64(),
+                data.samples.len(),
+                log.dir.display()
+            );
             let compensation = estimated_compensation(&log.table.chain, &cal, &log.table.compensation);
-            let output = serde_json::to_value(CalibrationOutput { report: &report, estimated_compensation: compensation }).map_err(|e| Failure::run(e.to_string()))?;
+            let output =
+                serde_json::to_value(CalibrationOutput { report: &report, estimated_compensation: compensation })
+                    .map_err(|e| Failure::run(e.to_string()))?;
             let saved = match sinks {
                 Some(s) => {
                     let params = log.recording_params(data.samples.last_t_s().max(1.0))?;
-                    logged(crate::record::calibration::log(s.stream(), &params, &cal, &report, &traces).and_then(|mut r| r.finish()))?;
+                    logged(
+                        crate::record::calibration::log(s.stream(), &params, &cal, &report, &traces)
+                            .and_then(|mut r| r.finish()),
+                    )?;
                     Some(s.finish()?)
                 }
                 None => None,

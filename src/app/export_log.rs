@@ -12,8 +12,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use crate::ins::InsParams;
 use crate::io::TableWriter;
 use crate::math::timeline::Timeline;
-use crate::scenario::logset::{RawEncoderFile, RawFrame, RawImuFile, RawInitial, RawLogInfo, RawManifest, RawReference, RawTable, MANIFEST};
 use crate::scenario::Params;
+use crate::scenario::logset::{
+    MANIFEST, RawEncoderFile, RawFrame, RawImuFile, RawInitial, RawLogInfo, RawManifest, RawReference, RawTable,
+};
 use crate::sim::encoder_readings;
 
 /// The file formats a log set can be written in.
@@ -80,7 +82,13 @@ fn write_err(e: impl std::fmt::Display) -> ExportError {
 }
 
 /// Writes the log set of `params` into the new folder `out`.
-pub fn export_log(params: &Params, out: &Path, format: LogFormat, aligned: bool, stop: &AtomicBool) -> Result<ExportedLog, ExportError> {
+pub fn export_log(
+    params: &Params,
+    out: &Path,
+    format: LogFormat,
+    aligned: bool,
+    stop: &AtomicBool,
+) -> Result<ExportedLog, ExportError> {
     if out.exists() {
         return Err(ExportError::Exists(out.display().to_string()));
     }
@@ -99,8 +107,11 @@ pub fn export_log(params: &Params, out: &Path, format: LogFormat, aligned: bool,
     crate::io::files::finished_dir(&partial);
     match result {
         Ok(samples) => {
-            std::fs::rename(&partial, out).map_err(|e| ExportError::Write(format!("{} → {}: {e}", partial.display(), out.display())))?;
-            let bytes = std::fs::read_dir(out).map(|d| d.flatten().filter_map(|e| e.metadata().ok()).map(|m| m.len()).sum()).unwrap_or(0);
+            std::fs::rename(&partial, out)
+                .map_err(|e| ExportError::Write(format!("{} → {}: {e}", partial.display(), out.display())))?;
+            let bytes = std::fs::read_dir(out)
+                .map(|d| d.flatten().filter_map(|e| e.metadata().ok()).map(|m| m.len()).sum())
+                .unwrap_or(0);
             Ok(ExportedLog { dir: out.to_path_buf(), samples, bytes })
         }
         Err(e) => {
@@ -115,7 +126,13 @@ fn logged_imu(params: &Params) -> InsParams {
     params.ins.clone().unwrap_or_else(|| InsParams::ideal(params.step_hz, crate::ins::coning::Algorithm::TwoSampleP1))
 }
 
-fn write_files(params: &Params, dir: &Path, format: LogFormat, aligned: bool, stop: &AtomicBool) -> Result<u64, ExportError> {
+fn write_files(
+    params: &Params,
+    dir: &Path,
+    format: LogFormat,
+    aligned: bool,
+    stop: &AtomicBool,
+) -> Result<u64, ExportError> {
     let ext = format.extension();
     let ins_params = logged_imu(params);
     let mut ins = crate::ins::pipeline::InsRun::new(&ins_params, params.site, params.meta.seed, params.table_model());
@@ -123,11 +140,18 @@ fn write_files(params: &Params, dir: &Path, format: LogFormat, aligned: bool, st
     let axis_names: Vec<String> = params.table.chain.axes().iter().map(|a| a.name.clone()).collect();
 
     let imu_path = dir.join(format!("imu.{ext}"));
-    let mut imu = TableWriter::create(&imu_path, &["t_s", "dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad", "dv_x_mps", "dv_y_mps", "dv_z_mps"]).map_err(write_err)?;
-    let encoder_columns: Vec<String> = std::iter::once("t_s".to_owned()).chain(axis_names.iter().map(|n| format!("{n}_rad"))).collect();
+    let mut imu = TableWriter::create(
+        &imu_path,
+        &["t_s", "dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad", "dv_x_mps", "dv_y_mps", "dv_z_mps"],
+    )
+    .map_err(write_err)?;
+    let encoder_columns: Vec<String> =
+        std::iter::once("t_s".to_owned()).chain(axis_names.iter().map(|n| format!("{n}_rad"))).collect();
     let encoder_refs: Vec<&str> = encoder_columns.iter().map(String::as_str).collect();
     let mut encoders = TableWriter::create(dir.join(format!("encoders.{ext}")), &encoder_refs).map_err(write_err)?;
-    let mut reference = TableWriter::create(dir.join(format!("reference.{ext}")), &["t_s", "pitch_rad", "roll_rad", "heading_rad"]).map_err(write_err)?;
+    let mut reference =
+        TableWriter::create(dir.join(format!("reference.{ext}")), &["t_s", "pitch_rad", "roll_rad", "heading_rad"])
+            .map_err(write_err)?;
 
     let n_axes = axis_names.len();
     let mut row = |t: f64, g: nalgebra::Vector3<f64>, a: nalgebra::Vector3<f64>| -> Result<(), ExportError> {
@@ -198,18 +222,33 @@ fn write_files(params: &Params, dir: &Path, format: LogFormat, aligned: bool, st
             gap_policy: "refuse".into(),
             gap_factor: 3.0,
         },
-        encoders: Some(RawEncoderFile { file: format!("encoders.{ext}"), latch_delay_ms: 0.0, gap_policy: "refuse".into() }),
-        reference: Some(RawReference { source: Some("the simulation's truth".into()), file: Some(format!("reference.{ext}")), attitude_deg: None }),
+        encoders: Some(RawEncoderFile {
+            file: format!("encoders.{ext}"),
+            latch_delay_ms: 0.0,
+            gap_policy: "refuse".into(),
+        }),
+        reference: Some(RawReference {
+            source: Some("the simulation's truth".into()),
+            file: Some(format!("reference.{ext}")),
+            attitude_deg: None,
+        }),
         // Exact: the INS starts from the truth. Aligned: the manifest says nothing and the replay
         // aligns on the data, as it would on a real log.
-        initial: if aligned { RawInitial::default() } else { RawInitial { imu_quaternion_wxyz: Some([q.w, q.i, q.j, q.k]), ..RawInitial::default() } },
+        initial: if aligned {
+            RawInitial::default()
+        } else {
+            RawInitial { imu_quaternion_wxyz: Some([q.w, q.i, q.j, q.k]), ..RawInitial::default() }
+        },
     };
     let table_text = format!(
         "# The table description of the log set (the [site], [turntable], [compensation], [imu], [navigation],\n# [calibration] and [recording] sections of the scenario `{}`, resolved). docs/logs.md.\n{}",
         params.meta.name,
         toml::to_string_pretty(&table).map_err(write_err)?
     );
-    let manifest_text = format!("# A rinscope log set (docs/logs.md), written by `rinscope export-log`.\n{}", toml::to_string_pretty(&manifest).map_err(write_err)?);
+    let manifest_text = format!(
+        "# A rinscope log set (docs/logs.md), written by `rinscope export-log`.\n{}",
+        toml::to_string_pretty(&manifest).map_err(write_err)?
+    );
     crate::io::files::write_atomically(&dir.join("table.toml"), table_text.as_bytes()).map_err(write_err)?;
     crate::io::files::write_atomically(&dir.join(MANIFEST), manifest_text.as_bytes()).map_err(write_err)?;
     Ok(samples)

@@ -51,7 +51,11 @@ impl Failure {
     /// Stopped before the end by a signal (exit 128 + the signal: 130, 143, 129).
     pub fn interrupted(message: impl Into<String>) -> Self {
         let by = super::terminate::stop_reason().unwrap_or("a stop request");
-        Self { code: super::terminate::interrupted_exit_code(), kind: FailureKind::Interrupted, message: format!("interrupted by {by}: {}", message.into()) }
+        Self {
+            code: super::terminate::interrupted_exit_code(),
+            kind: FailureKind::Interrupted,
+            message: format!("interrupted by {by}: {}", message.into()),
+        }
     }
 
     /// An output file `flag` names that could not be written: exit 1 when writing failed (disk
@@ -87,7 +91,9 @@ impl From<SinkError> for Failure {
         let message = e.to_string();
         match e {
             SinkError::Interrupted(m) => Self::interrupted(m),
-            SinkError::Write(_) | SinkError::ExportWrite(_) | SinkError::FiguresWrite(_) => Self { code: 1, kind: FailureKind::Output, message },
+            SinkError::Write(_) | SinkError::ExportWrite(_) | SinkError::FiguresWrite(_) => {
+                Self { code: 1, kind: FailureKind::Output, message }
+            }
             SinkError::File(_) => Self { code: 2, kind: FailureKind::Output, message },
             SinkError::Rerun(_) | SinkError::Spawn(_) => Self::run(message),
             _ => Self::input(message),
@@ -106,7 +112,9 @@ impl From<super::allan::AllanRunError> for Failure {
         use super::allan::AllanRunError;
         match e {
             // Every channel error is of the data: too few samples, a non-finite value, a bad rate.
-            AllanRunError::Config(_) | AllanRunError::Data(_) | AllanRunError::Analysis(_) => Self::input(format!("allan: {e}")),
+            AllanRunError::Config(_) | AllanRunError::Data(_) | AllanRunError::Analysis(_) => {
+                Self::input(format!("allan: {e}"))
+            }
             AllanRunError::Interrupted(_) => Self::interrupted(format!("allan: {e}")),
         }
     }

@@ -5,19 +5,28 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::app::failure::Failure;
-use crate::app::outputs::{logged, RecordingName, RecordingRequest};
+use crate::app::outputs::{RecordingName, RecordingRequest, logged};
 use crate::ins::trace::{NavSample, NavTrace};
-use crate::record::sink::Saved;
 use crate::math::units::ARCSEC_PER_RAD;
-use crate::scenario::{presets, Params};
+use crate::record::sink::Saved;
+use crate::scenario::{Params, presets};
 
 /// The three variants: preset name and label.
-pub const MODULATION_PRESETS: [(&str, &str); 3] =
-    [("rotation-modulation-none", "no rotation"), ("rotation-modulation-continuous", "continuous azimuth"), ("rotation-modulation-16-position", "16-position")];
+pub const MODULATION_PRESETS: [(&str, &str); 3] = [
+    ("rotation-modulation-none", "no rotation"),
+    ("rotation-modulation-continuous", "continuous azimuth"),
+    ("rotation-modulation-16-position", "16-position"),
+];
 
 /// `p`'s INS navigating its whole duration, sampled every `sample_s`; the IMU compensated with
 /// `compensation` (a self-calibration's estimates) if given.
-pub(crate) fn simulate(p: &Params, label: &str, sample_s: f64, stop: &AtomicBool, compensation: Option<crate::ins::selfcal::ImuErrors>) -> NavTrace {
+pub(crate) fn simulate(
+    p: &Params,
+    label: &str,
+    sample_s: f64,
+    stop: &AtomicBool,
+    compensation: Option<crate::ins::selfcal::ImuErrors>,
+) -> NavTrace {
     let mut trace = NavTrace { label: label.to_owned(), samples: Vec::new() };
     let Some(mut ins) = p.ins_run() else { return trace };
     ins.set_imu_compensation(compensation);
@@ -32,7 +41,11 @@ pub(crate) fn simulate(p: &Params, label: &str, sample_s: f64, stop: &AtomicBool
             next += sample_s;
             let v = ins.view(s.t_s);
             let e = v.nav.unwrap_or_default();
-            trace.samples.push(NavSample { t_s: s.t_s, position_m: [e.east_m, e.north_m, e.radial_m], heading_arcsec: v.errors[0].heading_rad * ARCSEC_PER_RAD });
+            trace.samples.push(NavSample {
+                t_s: s.t_s,
+                position_m: [e.east_m, e.north_m, e.radial_m],
+                heading_arcsec: v.errors[0].heading_rad * ARCSEC_PER_RAD,
+            });
         }
     }
     trace
@@ -48,8 +61,12 @@ pub fn simulate_variants(hours: f64, stop: &AtomicBool) -> anyhow::Result<Vec<Na
     }
     let sample_s = (hours * 3600.0 / 2000.0).max(1.0);
     let traces = std::thread::scope(|scope| {
-        let handles: Vec<_> = params.iter().map(|(p, label)| scope.spawn(move || simulate(p, label, sample_s, stop, None))).collect();
-        handles.into_iter().map(|h| h.join().map_err(|_| anyhow::anyhow!("a simulation thread panicked"))).collect::<anyhow::Result<Vec<_>>>()
+        let handles: Vec<_> =
+            params.iter().map(|(p, label)| scope.spawn(move || simulate(p, label, sample_s, stop, None))).collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().map_err(|_| anyhow::anyhow!("a simulation thread panicked")))
+            .collect::<anyhow::Result<Vec<_>>>()
     })?;
     Ok(traces)
 }
@@ -57,14 +74,22 @@ pub fn simulate_variants(hours: f64, stop: &AtomicBool) -> anyhow::Result<Vec<Na
 /// The end-of-run table.
 #[must_use]
 pub fn table(traces: &[NavTrace], wall_s: f64) -> String {
-    let mut s = format!("rotation modulation, {wall_s:.1} s wall\n{:<22} {:>16} {:>16} {:>18}\n", "variant", "peak radial (m)", "final radial (m)", "peak heading (″)");
+    let mut s = format!(
+        "rotation modulation, {wall_s:.1} s wall\n{:<22} {:>16} {:>16} {:>18}\n",
+        "variant", "peak radial (m)", "final radial (m)", "peak heading (″)"
+    );
     for t in traces {
         let last = t.samples.last().copied().unwrap_or_default();
-        s.push_str(&format!("{:<22} {:>16.1} {:>16.1} {:>18.1}\n", t.label, t.peak_radial_m(), last.position_m[2], t.peak_heading_arcsec()));
+        s.push_str(&format!(
+            "{:<22} {:>16.1} {:>16.1} {:>18.1}\n",
+            t.label,
+            t.peak_radial_m(),
+            last.position_m[2],
+            t.peak_heading_arcsec()
+        ));
     }
     s
 }
-
 
 /// What `modulation` reports.
 pub struct ModulationReport {
@@ -91,8 +116,11 @@ pub fn execute(hours: f64, recording: &RecordingRequest, stop: &AtomicBool) -> R
     let interrupted = stop.load(Ordering::SeqCst);
     let mut text = table(&traces, started.elapsed().as_secs_f64());
     if interrupted {
-        let reached = traces.iter().filter_map(|t| t.samples.last()).map(|s| s.t_s / 3600.0).fold(f64::INFINITY, f64::min);
-        text = format!("INTERRUPTED after {reached:.2} of {hours} h: the numbers below are over that part only, not the run's\n{text}");
+        let reached =
+            traces.iter().filter_map(|t| t.samples.last()).map(|s| s.t_s / 3600.0).fold(f64::INFINITY, f64::min);
+        text = format!(
+            "INTERRUPTED after {reached:.2} of {hours} h: the numbers below are over that part only, not the run's\n{text}"
+        );
     }
     logged(crate::record::modulation::log(&sinks.stream(), &traces, &text))?;
     Ok(ModulationReport { table: text, saved: sinks.finish()?, interrupted })
@@ -111,9 +139,17 @@ mod tests {
         let traces = simulate_variants(6.0, &AtomicBool::new(false)).expect("runs");
         let (none, cont, sixteen) = (&traces[0], &traces[1], &traces[2]);
         assert!(none.peak_radial_m() > 1000.0, "static INS: {} m", none.peak_radial_m());
-        assert!(sixteen.peak_radial_m() < none.peak_radial_m() / 50.0, "16-position {} m vs static {} m", sixteen.peak_radial_m(), none.peak_radial_m());
+        assert!(
+            sixteen.peak_radial_m() < none.peak_radial_m() / 50.0,
+            "16-position {} m vs static {} m",
+            sixteen.peak_radial_m(),
+            none.peak_radial_m()
+        );
         assert!(cont.peak_radial_m() < none.peak_radial_m(), "continuous {} m", cont.peak_radial_m());
         assert!(sixteen.peak_heading_arcsec() < none.peak_heading_arcsec() / 20.0);
-        assert!(cont.peak_heading_arcsec() > none.peak_heading_arcsec() / 3.0, "the azimuth gyro is not modulated by azimuth rotation");
+        assert!(
+            cont.peak_heading_arcsec() > none.peak_heading_arcsec() / 3.0,
+            "the azimuth gyro is not modulated by azimuth rotation"
+        );
     }
 }

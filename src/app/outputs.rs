@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 
 use super::failure::Failure;
 use crate::io::files::{check_output_path, open_input, write_atomically};
-use crate::record::sink::{self, OpenSinks, Saved, SinkRequest};
 use crate::record::APPLICATION_ID;
+use crate::record::sink::{self, OpenSinks, Saved, SinkRequest};
 
 /// What a recording is of: its name (a scenario's or a log set's), the kind of work (`None` for
 /// a plain run) and the seed when it was simulated. It names the recording in the viewer
@@ -102,7 +102,10 @@ pub fn write_json(flag: &str, path: &Path, value: &impl serde::Serialize) -> Res
 /// Nothing kept this run's data.
 pub fn kept(saved: &Saved) -> Result<(), Failure> {
     if saved.recording.is_none() && !saved.viewer_problems.is_empty() {
-        return Err(Failure::run(format!("nothing kept this run's data: {} (add --save FILE)", saved.viewer_problems.join("; "))));
+        return Err(Failure::run(format!(
+            "nothing kept this run's data: {} (add --save FILE)",
+            saved.viewer_problems.join("; ")
+        )));
     }
     Ok(())
 }
@@ -126,7 +129,10 @@ pub fn read_small_file(path: &Path, what: &str) -> Result<String, Failure> {
     let file = open_input(path).map_err(fail)?;
     let len = file.metadata().map_err(fail)?.len();
     if len > 1 << 30 {
-        return Err(Failure::input(format!("{what} {}: {len} bytes, more than the 1 GB such a file can be", path.display())));
+        return Err(Failure::input(format!(
+            "{what} {}: {len} bytes, more than the 1 GB such a file can be",
+            path.display()
+        )));
     }
     let mut text = String::new();
     file.take((1 << 30) + 1).read_to_string(&mut text).map_err(fail)?;

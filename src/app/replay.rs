@@ -11,20 +11,20 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::failure::Failure;
-use super::outputs::{check_output, kept, write_json, RecordingName, RecordingRequest};
+use super::outputs::{RecordingName, RecordingRequest, check_output, kept, write_json};
 use super::playback::{AlignmentReport, Gap, Playback, PlaybackError};
 use super::run::{NavSummary, RmsPeak};
 use crate::ins::pipeline::InsView;
 use crate::math::attitude::{Attitude, AttitudeError};
 use crate::math::frames::Rot;
-use crate::model::gimbal::ChainMemo;
 use crate::math::stats::RunningStat;
 use crate::math::timeline::decimation;
 use crate::math::units::ARCSEC_PER_RAD;
+use crate::model::gimbal::ChainMemo;
 use crate::model::gimbal::TableErrors;
 use crate::record::{Recorder, Solution};
 use crate::scenario::logset::{LogSet, Reference};
-use crate::sim::{DemodState, StepOutput, ERROR_AXES};
+use crate::sim::{DemodState, ERROR_AXES, StepOutput};
 
 /// The result of a replay, as printed and as written by `--summary-json`.
 #[derive(Debug, Clone, Serialize)]
@@ -105,7 +105,16 @@ fn table(names: &[String], stats: &[[RunningStat; 3]]) -> BTreeMap<String, BTree
         .iter()
         .zip(stats)
         .map(|(name, s)| {
-            let row = ERROR_AXES.iter().zip(s).map(|(axis, st)| ((*axis).to_owned(), RmsPeak { rms_arcsec: st.rms() * ARCSEC_PER_RAD, peak_arcsec: st.peak() * ARCSEC_PER_RAD })).collect();
+            let row = ERROR_AXES
+                .iter()
+                .zip(s)
+                .map(|(axis, st)| {
+                    (
+                        (*axis).to_owned(),
+                        RmsPeak { rms_arcsec: st.rms() * ARCSEC_PER_RAD, peak_arcsec: st.peak() * ARCSEC_PER_RAD },
+                    )
+                })
+                .collect();
             (name.clone(), row)
         })
         .collect()
@@ -132,7 +141,9 @@ impl ReplaySummary {
             s.push_str(&format!("note: {n}\n"));
         }
         if !self.attitude_error_arcsec.is_empty() || !self.ins_attitude_error_arcsec.is_empty() {
-            s.push_str("attitude error, arcsec     pitch rms  pitch peak    roll rms   roll peak  heading rms heading peak\n");
+            s.push_str(
+                "attitude error, arcsec     pitch rms  pitch peak    roll rms   roll peak  heading rms heading peak\n",
+            );
         }
         let rows = |s: &mut String, label: &str, t: &BTreeMap<String, BTreeMap<String, RmsPeak>>| {
             for (name, row) in t {
@@ -152,9 +163,20 @@ impl ReplaySummary {
             rows(&mut s, "  ", &self.ins_attitude_error_arcsec);
         }
         let f = &self.final_state;
-        s.push_str(&format!("final IMU attitude: pitch {:.4}°, roll {:.4}°, heading {:.4}° at {:.3} s", f.imu_pitch_deg, f.imu_roll_deg, crate::math::units::heading_deg_0_360(f.imu_heading_deg.to_radians()), f.t_s));
-        if let (Some(lat), Some(lon), Some(h), Some(v)) = (f.latitude_deg, f.longitude_deg, f.height_m, f.velocity_enu_mps) {
-            s.push_str(&format!("; position {lat:.6}°, {lon:.6}°, {h:.1} m; velocity E {:.3} N {:.3} U {:.3} m/s", v[0], v[1], v[2]));
+        s.push_str(&format!(
+            "final IMU attitude: pitch {:.4}°, roll {:.4}°, heading {:.4}° at {:.3} s",
+            f.imu_pitch_deg,
+            f.imu_roll_deg,
+            crate::math::units::heading_deg_0_360(f.imu_heading_deg.to_radians()),
+            f.t_s
+        ));
+        if let (Some(lat), Some(lon), Some(h), Some(v)) =
+            (f.latitude_deg, f.longitude_deg, f.height_m, f.velocity_enu_mps)
+        {
+            s.push_str(&format!(
+                "; position {lat:.6}°, {lon:.6}°, {h:.1} m; velocity E {:.3} N {:.3} U {:.3} m/s",
+                v[0], v[1], v[2]
+            ));
         }
         s.push('\n');
         if let Some(n) = &self.navigation {
@@ -164,7 +186,12 @@ impl ReplaySummary {
             ));
         }
         for g in &self.gaps {
-            s.push_str(&format!("gap in the IMU data: {:.3} s → {:.3} s ({:.3} s), attitude carried across\n", g.from_s, g.to_s, g.to_s - g.from_s));
+            s.push_str(&format!(
+                "gap in the IMU data: {:.3} s → {:.3} s ({:.3} s), attitude carried across\n",
+                g.from_s,
+                g.to_s,
+                g.to_s - g.from_s
+            ));
         }
         s
     }
@@ -193,10 +220,17 @@ fn final_state(pb: &Playback) -> FinalState {
 ///
 /// # Errors
 /// As [`replay`]; the recording's own failures are [`PlaybackError::Record`].
-pub fn replay_recorded(log: &LogSet, compensation: &TableErrors, sinks: &crate::record::sink::OpenSinks, stop: &AtomicBool, bar: Option<&indicatif::ProgressBar>) -> Result<ReplaySummary, PlaybackError> {
+pub fn replay_recorded(
+    log: &LogSet,
+    compensation: &TableErrors,
+    sinks: &crate::record::sink::OpenSinks,
+    stop: &AtomicBool,
+    bar: Option<&indicatif::ProgressBar>,
+) -> Result<ReplaySummary, PlaybackError> {
     let rerun = |e: crate::record::RecordError| PlaybackError::Record(e.to_string());
     let params = log.recording_params(1.0).map_err(|e| PlaybackError::Data(e.to_string()))?;
-    let kind = crate::record::ReplayKind { table: !log.table.strapdown, reference: !matches!(log.reference, Reference::None) };
+    let kind =
+        crate::record::ReplayKind { table: !log.table.strapdown, reference: !matches!(log.reference, Reference::None) };
     let mut recorder = Recorder::new_replay(sinks.stream(), &params, kind).map_err(rerun)?;
     let summary = replay(log, compensation, Some(&mut recorder), stop, bar)?;
     if let Ok(p) = log.recording_params(summary.duration_s) {
@@ -208,7 +242,13 @@ pub fn replay_recorded(log: &LogSet, compensation: &TableErrors, sinks: &crate::
 /// Replays `log` with the compensation `compensation` (the table description's, or a calibration's)
 /// into `recorder` if given; `stop` ends it early (the summary says so); `bar`, if given, shows the
 /// replayed time.
-pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mut Recorder>, stop: &AtomicBool, bar: Option<&indicatif::ProgressBar>) -> Result<ReplaySummary, PlaybackError> {
+pub fn replay(
+    log: &LogSet,
+    compensation: &TableErrors,
+    mut recorder: Option<&mut Recorder>,
+    stop: &AtomicBool,
+    bar: Option<&indicatif::ProgressBar>,
+) -> Result<ReplaySummary, PlaybackError> {
     let started = Instant::now();
     let mut pb = Playback::open(log, compensation)?;
     let rerun = |e: crate::record::RecordError| PlaybackError::Record(e.to_string());
@@ -250,7 +290,11 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
                 break;
             }
             if let Some(bar) = bar {
-                bar.set_message(format!("{:.0} s of the log replayed ({:.1} M samples/s)", s.t_s, i as f64 / started.elapsed().as_secs_f64().max(1e-9) / 1e6));
+                bar.set_message(format!(
+                    "{:.0} s of the log replayed ({:.1} M samples/s)",
+                    s.t_s,
+                    i as f64 / started.elapsed().as_secs_f64().max(1e-9) / 1e6
+                ));
             }
         }
         if s.t_s <= window
@@ -280,7 +324,11 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
                 let raw = demod_nominal.correct(&nominal, t_repr, &encoder);
                 let nominal_b_from_s = nominal_cache.get(chain, &nominal_rot, &raw);
                 // Nothing compensated (no table errors known): the same chain, the same attitude.
-                let body_nominal = if nominal_b_from_s.quaternion() == comp_b_from_s.quaternion() { body } else { pb.body_attitude_through(0, nominal_b_from_s) };
+                let body_nominal = if nominal_b_from_s.quaternion() == comp_b_from_s.quaternion() {
+                    body
+                } else {
+                    pb.body_attitude_through(0, nominal_b_from_s)
+                };
                 primary = Some((t_repr, encoder, corrected, body, body_nominal, reference));
             }
         }
@@ -305,7 +353,12 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
             }
             if let Some(e) = nav_error {
                 let peak = nav.map_or(0.0, |n| n.peak_radial_m).max(e.radial_m);
-                nav = Some(NavSummary { peak_radial_m: peak, final_radial_m: e.radial_m, final_east_m: e.east_m, final_north_m: e.north_m });
+                nav = Some(NavSummary {
+                    peak_radial_m: peak,
+                    final_radial_m: e.radial_m,
+                    final_east_m: e.east_m,
+                    final_north_m: e.north_m,
+                });
             }
         } else {
             errors.iter_mut().for_each(|e| *e = nan);
@@ -330,7 +383,14 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
             Some(r) => r.n_from_b() * chain.b_from_s(&comp_rot, &corrected),
             None => imu_ins,
         });
-        let view = InsView { t_s: s.t_s, t_ref_s: pb.core.reference_instant(t_repr), errors: errors.clone(), imu_true, imu_ins, nav: nav_error };
+        let view = InsView {
+            t_s: s.t_s,
+            t_ref_s: pb.core.reference_instant(t_repr),
+            errors: errors.clone(),
+            imu_true,
+            imu_ins,
+            nav: nav_error,
+        };
         if want_series {
             next_series = i.saturating_add(series_every);
             if let Some(r) = recorder.as_deref_mut() {
@@ -349,9 +409,18 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
         pb.finish()?;
     }
     let reference = match &log.reference {
-        Reference::None if log.table.strapdown => "none: the INS's own solution (give [reference] to compare it with one)".to_owned(),
-        Reference::None => "none: the compensated demodulation (the \"nominal\" row is nominal − compensated)".to_owned(),
-        Reference::Static(a) => format!("a static attitude (pitch {:.4}°, roll {:.4}°, heading {:.4}°)", a.pitch_rad.to_degrees(), a.roll_rad.to_degrees(), a.heading_rad.to_degrees()),
+        Reference::None if log.table.strapdown => {
+            "none: the INS's own solution (give [reference] to compare it with one)".to_owned()
+        }
+        Reference::None => {
+            "none: the compensated demodulation (the \"nominal\" row is nominal − compensated)".to_owned()
+        }
+        Reference::Static(a) => format!(
+            "a static attitude (pitch {:.4}°, roll {:.4}°, heading {:.4}°)",
+            a.pitch_rad.to_degrees(),
+            a.roll_rad.to_degrees(),
+            a.heading_rad.to_degrees()
+        ),
         Reference::File(p) => format!("the attitude in {}", p.display()),
     };
     let wall = started.elapsed().as_secs_f64();
@@ -369,7 +438,11 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
         wall_time_s: wall,
         samples_per_second: pb.samples as f64 / wall.max(1e-9),
         interrupted,
-        attitude_error_arcsec: if strapdown { BTreeMap::new() } else { table(&["nominal".to_owned(), "compensated".to_owned()], &stats) },
+        attitude_error_arcsec: if strapdown {
+            BTreeMap::new()
+        } else {
+            table(&["nominal".to_owned(), "compensated".to_owned()], &stats)
+        },
         ins_attitude_error_arcsec: if has_reference { table(&algorithms, &ins_stats) } else { BTreeMap::new() },
         navigation: nav,
         gaps: pb.gaps.clone(),
@@ -380,15 +453,30 @@ pub fn replay(log: &LogSet, compensation: &TableErrors, mut recorder: Option<&mu
     };
     if let Some(r) = recorder {
         for g in &summary.gaps {
-            r.event(g.to_s, &format!("gap in the IMU data from {:.3} s to {:.3} s: the attitude was carried across", g.from_s, g.to_s), "WARN").map_err(rerun)?;
+            r.event(
+                g.to_s,
+                &format!(
+                    "gap in the IMU data from {:.3} s to {:.3} s: the attitude was carried across",
+                    g.from_s, g.to_s
+                ),
+                "WARN",
+            )
+            .map_err(rerun)?;
         }
         if let Some(a) = &summary.alignment {
-            r.event(0.0, &format!("alignment:\n{}", a.text()), if a.warnings.is_empty() { "INFO" } else { "WARN" }).map_err(rerun)?;
+            r.event(0.0, &format!("alignment:\n{}", a.text()), if a.warnings.is_empty() { "INFO" } else { "WARN" })
+                .map_err(rerun)?;
         }
         for n in &summary.notes {
             r.event(0.0, n, "INFO").map_err(rerun)?;
         }
-        let end = if interrupted { format!("replay interrupted by the user at {t_end:.3} s; the recording holds everything replayed until then") } else { format!("replay finished at {t_end:.3} s") };
+        let end = if interrupted {
+            format!(
+                "replay interrupted by the user at {t_end:.3} s; the recording holds everything replayed until then"
+            )
+        } else {
+            format!("replay finished at {t_end:.3} s")
+        };
         r.event(t_end, &end, if interrupted { "WARN" } else { "INFO" }).map_err(rerun)?;
         r.event(t_end, &format!("summary:\n{}", summary.text()), "INFO").map_err(rerun)?;
         r.finish().map_err(rerun)?;
@@ -421,7 +509,11 @@ pub struct ReplayReport {
 ///
 /// # Errors
 /// Bad data or compensation, a sink or output that cannot be opened or written.
-pub fn execute(req: &ReplayRequest, stop: &AtomicBool, bar: Option<&indicatif::ProgressBar>) -> Result<ReplayReport, Failure> {
+pub fn execute(
+    req: &ReplayRequest,
+    stop: &AtomicBool,
+    bar: Option<&indicatif::ProgressBar>,
+) -> Result<ReplayReport, Failure> {
     let log = &req.log;
     check_output("--summary-json", req.summary_json.as_deref())?;
     let compensation = match &req.compensation {

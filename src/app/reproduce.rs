@@ -3,11 +3,11 @@
 //! Each row states the quantity, the paper's value as printed, rinscope's value and the tolerance
 //! band it must fall in. Later issues add rows; docs/reproduce.md keeps the latest table.
 
+use crate::math::stats::RunningStat;
+use crate::math::units::{ARCSEC_PER_RAD, DEG_PER_RAD};
 use crate::scenario::Params;
 use crate::scenario::presets;
-use crate::math::stats::RunningStat;
 use crate::sim::run_stats;
-use crate::math::units::{ARCSEC_PER_RAD, DEG_PER_RAD};
 
 /// Runs the INS of a scenario and returns, per algorithm and axis, the statistics of the body
 /// attitude error at every attitude update after `settle_s` (the FIR and the alignment settle).
@@ -71,8 +71,26 @@ fn num(x: f64) -> String {
 
 impl Row {
     /// A row checked against `band`.
-    fn new(source: &str, scenario: &str, quantity: String, paper: String, value: f64, band: (f64, f64), tolerance: String) -> Self {
-        Self { source: source.into(), scenario: scenario.into(), quantity, paper, value, band, tolerance, paper_note: String::new(), not_reproduced: None }
+    fn new(
+        source: &str,
+        scenario: &str,
+        quantity: String,
+        paper: String,
+        value: f64,
+        band: (f64, f64),
+        tolerance: String,
+    ) -> Self {
+        Self {
+            source: source.into(),
+            scenario: scenario.into(),
+            quantity,
+            paper,
+            value,
+            band,
+            tolerance,
+            paper_note: String::new(),
+            not_reproduced: None,
+        }
     }
 
     /// The same row with an explanation of its difference from the paper.
@@ -122,7 +140,10 @@ impl Table {
     /// Plain-text table for the terminal.
     #[must_use]
     pub fn text(&self) -> String {
-        let mut s = format!("{:<34} {:<64} {:>14} {:>12}  {:<24} {}\n", "scenario", "quantity", "paper", "rinscope", "accepted band", "agrees");
+        let mut s = format!(
+            "{:<34} {:<64} {:>14} {:>12}  {:<24} {}\n",
+            "scenario", "quantity", "paper", "rinscope", "accepted band", "agrees"
+        );
         for r in &self.rows {
             s.push_str(&format!(
                 "{:<34} {:<64} {:>14} {:>12.5}  {:<24} {}\n",
@@ -225,12 +246,17 @@ pub fn run_all() -> anyhow::Result<Table> {
     let p = presets::load("rotary-table-2016-wobble")?;
     let stats = run_stats(&p.table_model(), &p.timeline());
     let mut level = p.clone();
-    level.table.vehicle = crate::model::motion::VehicleMotion::new(crate::math::attitude::Attitude::default(), Vec::new(), Vec::new()).map_err(anyhow::Error::msg)?;
+    level.table.vehicle =
+        crate::model::motion::VehicleMotion::new(crate::math::attitude::Attitude::default(), Vec::new(), Vec::new())
+            .map_err(anyhow::Error::msg)?;
     let model = level.table_model();
     // The 180° dwell of the 4-position scheme: 0° 290 s, move 9 s, 90° 290 s, move 9 s, 180° from 598 s.
     let t_dwell = 598.0 + 145.0;
     let (angles, rates) = model.scheme.state(t_dwell - model.scheme_t0_s);
-    anyhow::ensure!((angles[0] - std::f64::consts::PI).abs() < 1e-9 && rates[0] == 0.0, "the wobble preset's 180° dwell moved (t = {t_dwell} s)");
+    anyhow::ensure!(
+        (angles[0] - std::f64::consts::PI).abs() < 1e-9 && rates[0] == 0.0,
+        "the wobble preset's 180° dwell moved (t = {t_dwell} s)"
+    );
     let out = crate::sim::step(&model, &mut crate::sim::DemodState::default(), t_dwell);
     let dwell_deg = out.errors[0].as_array().iter().fold(0.0_f64, |m, x| m.max(x.abs())) * DEG_PER_RAD;
     let theta = 0.01;
@@ -263,7 +289,9 @@ pub fn run_all() -> anyhow::Result<Table> {
             "< 0.02°".into(),
             stats.peak_over_axes(0) * DEG_PER_RAD,
             (one_arcmin_deg * (1.0 - 10.0 * th), one_arcmin_deg * (1.0 + 10.0 * th)),
-            format!("analytic: the encoder error itself, 1′ = {one_arcmin_deg:.5}°, ± 10·θ relative (second order, θ = 1′)"),
+            format!(
+                "analytic: the encoder error itself, 1′ = {one_arcmin_deg:.5}°, ± 10·θ relative (second order, θ = 1′)"
+            ),
         )
         .note("consistent: the paper gives only the bound \"less than 0.02 degrees\""),
     );
@@ -283,7 +311,10 @@ pub fn run_all() -> anyhow::Result<Table> {
         "small-angle model".into(),
         dev,
         (a2 / 20.0, 2.0 * a2),
-        format!("second order: c·α², α = {:.1}′ the largest error angle (α² = {a2:.3}″), c ∈ [1/20, 2]", alpha / rad_per_arcmin),
+        format!(
+            "second order: c·α², α = {:.1}′ the largest error angle (α² = {a2:.3}″), c ∈ [1/20, 2]",
+            alpha / rad_per_arcmin
+        ),
     ));
 
     // Li et al. 2014 §3 eq. 16/19 and Figure 10: 7°, 0.5 Hz azimuth wobble, 6.25 ms lag. Theorem: the
@@ -307,7 +338,9 @@ pub fn run_all() -> anyhow::Result<Table> {
         .note("the paper's 0.1368 is its measured value (noise and its wobbler); its theorem gives 0.1374"),
     );
     // Li et al. 2014 Table 3: the synchronisation sweep. Theorem: 1σ = A·ω·τ_res/√2, τ_res = 6.25 ms − Δt.
-    for (dt_ms, paper_lag, paper_sigma) in [(0.0, "6.22", 0.097), (3.0, "3.21", 0.053), (5.0, "1.20", 0.021), (6.1, "0.27", 0.011), (6.25, "×", 0.003)] {
+    for (dt_ms, paper_lag, paper_sigma) in
+        [(0.0, "6.22", 0.097), (3.0, "3.21", 0.053), (5.0, "1.20", 0.021), (6.1, "0.27", 0.011), (6.25, "×", 0.003)]
+    {
         let mut p = base.clone();
         if let Some(ins) = p.ins.as_mut() {
             ins.output_compensation_s = dt_ms * 1e-3;
@@ -320,14 +353,21 @@ pub fn run_all() -> anyhow::Result<Table> {
         // only the second-order term A·(ωτ)²/2 is left.
         let second = amp * (omega * tau).powi(2) / 2.0;
         let (band, why) = if tau_res > 0.0 {
-            ((expected * (1.0 - 2.0 * omega * tau), expected * (1.0 + 2.0 * omega * tau)), format!("theorem A·ω·τ_res/√2 = {expected:.5}°, ± 2ωτ = {:.1} % (second order)", 200.0 * omega * tau))
+            (
+                (expected * (1.0 - 2.0 * omega * tau), expected * (1.0 + 2.0 * omega * tau)),
+                format!("theorem A·ω·τ_res/√2 = {expected:.5}°, ± 2ωτ = {:.1} % (second order)", 200.0 * omega * tau),
+            )
         } else {
             ((0.0, second), format!("theorem: 0; what the theorem neglects, A·(ωτ)²/2 = {second:.1e}°"))
         };
         let mut row = Row::new(
             "Li et al. 2014 Table 3",
             "li2014-phase-lag",
-            format!("Δt = {dt_ms} ms: 1σ heading error, deg (residual lag {:.2} ms; paper {})", tau_res * 1e3, if paper_lag == "×" { "gives no lag".to_owned() } else { format!("{paper_lag} ms") }),
+            format!(
+                "Δt = {dt_ms} ms: 1σ heading error, deg (residual lag {:.2} ms; paper {})",
+                tau_res * 1e3,
+                if paper_lag == "×" { "gives no lag".to_owned() } else { format!("{paper_lag} ms") }
+            ),
             format!("{paper_sigma}"),
             sig,
             band,
@@ -395,7 +435,15 @@ fn calibration_rows(rows: &mut Vec<Row>) -> anyhow::Result<()> {
     // the noise could lower it by no more than p/n.
     // The table states the data determine (a prior-dominated direction does not change the
     // demodulation; the reference's nuisance states are not part of the compensation).
-    let sig = outcome.report.state.iter().take(outcome.cal.set.n_table).filter(|r| r.flag.is_empty() && r.unit == "arcsec").map(|r| r.nls.sigma).fold(0.0, f64::max) * crate::math::units::RAD_PER_ARCSEC;
+    let sig = outcome
+        .report
+        .state
+        .iter()
+        .take(outcome.cal.set.n_table)
+        .filter(|r| r.flag.is_empty() && r.unit == "arcsec")
+        .map(|r| r.nls.sigma)
+        .fold(0.0, f64::max)
+        * crate::math::units::RAD_PER_ARCSEC;
     let n = outcome.cal.samples.max(1) as f64;
     let p_over_n = outcome.cal.set.len() as f64 / n;
     if let Some(c) = outcome.report.compensation {
@@ -434,23 +482,29 @@ fn calibration_rows(rows: &mut Vec<Row>) -> anyhow::Result<()> {
         for (axis, name) in ["pitch", "roll", "heading"].iter().enumerate() {
             let expected = analytic[axis];
             let rel = 3.0 / (2.0 * n).sqrt();
-            rows.push(
-                Row::new(
-                    "Jiang et al. 2017 §6.2",
-                    "jiang2017-calibration (no INS)",
-                    format!("{name}: RMS error with the true values (encoder noise only), arcsec"),
-                    "—".into(),
-                    c.with_truth.rms_rad[axis] * ARCSEC_PER_RAD,
-                    (expected * (1.0 - rel) * ARCSEC_PER_RAD, expected * (1.0 + rel) * ARCSEC_PER_RAD),
-                    format!("the encoders' 12″ white noise propagated through the chain: {:.3}″, ± 3/√(2n)", expected * ARCSEC_PER_RAD),
+            rows.push(Row::new(
+                "Jiang et al. 2017 §6.2",
+                "jiang2017-calibration (no INS)",
+                format!("{name}: RMS error with the true values (encoder noise only), arcsec"),
+                "—".into(),
+                c.with_truth.rms_rad[axis] * ARCSEC_PER_RAD,
+                (expected * (1.0 - rel) * ARCSEC_PER_RAD, expected * (1.0 + rel) * ARCSEC_PER_RAD),
+                format!(
+                    "the encoders' 12″ white noise propagated through the chain: {:.3}″, ± 3/√(2n)",
+                    expected * ARCSEC_PER_RAD
                 ),
-            );
+            ));
         }
     }
     // Jiang et al. 2017 Table 3: mean calibration errors over many runs; rinscope's mean |error| of each
     // identifiable quantity, against the spread the filter reports for it: E|x| = σ·√(2/π).
     let mc = crate::app::calibrate::monte_carlo(&p, 200, &|| {}, &stop)?;
-    let worst = mc.rows.iter().filter(|r| r.identifiable && !r.label.contains("of phase")).map(|r| r.nls.mean_abs).fold(0.0, f64::max);
+    let worst = mc
+        .rows
+        .iter()
+        .filter(|r| r.identifiable && !r.label.contains("of phase"))
+        .map(|r| r.nls.mean_abs)
+        .fold(0.0, f64::max);
     rows.push(
         Row::new(
             "Jiang et al. 2017 §6.1, Table 3",

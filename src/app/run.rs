@@ -8,16 +8,16 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::app::failure::Failure;
-use crate::app::outputs::{check_output, kept, write_json, RecordingName, RecordingRequest};
+use crate::app::outputs::{RecordingName, RecordingRequest, check_output, kept, write_json};
 use crate::ins::core::SampleOut;
 use crate::ins::pipeline::{InsRun, InsView};
 use crate::math::stats::RunningStat;
-use crate::math::timeline::{decimation, Timeline};
+use crate::math::timeline::{Timeline, decimation};
 use crate::math::units::ARCSEC_PER_RAD;
-use crate::record::sink::OpenSinks;
 use crate::record::Recorder;
+use crate::record::sink::OpenSinks;
 use crate::scenario::Params;
-use crate::sim::{step, DemodState, ErrorStats, Model, StepOutput, DEMODULATIONS, ERROR_AXES};
+use crate::sim::{DEMODULATIONS, DemodState, ERROR_AXES, ErrorStats, Model, StepOutput, step};
 
 /// Summary row of the closed form minus the exact (uncompensated) error.
 pub const CLOSED_FORM_DEVIATION: &str = "closed_form_minus_exact";
@@ -64,7 +64,12 @@ impl InsStats {
         }
         if let Some(e) = v.nav {
             let peak = self.nav.map_or(0.0, |n| n.peak_radial_m).max(e.radial_m);
-            self.nav = Some(NavSummary { peak_radial_m: peak, final_radial_m: e.radial_m, final_east_m: e.east_m, final_north_m: e.north_m });
+            self.nav = Some(NavSummary {
+                peak_radial_m: peak,
+                final_radial_m: e.radial_m,
+                final_east_m: e.east_m,
+                final_north_m: e.north_m,
+            });
         }
     }
 }
@@ -112,7 +117,8 @@ pub struct RunSummary {
     pub attitude_error_arcsec: std::collections::BTreeMap<String, std::collections::BTreeMap<String, RmsPeak>>,
     /// With an IMU in the loop: the INS body-attitude error `[algorithm][axis]`.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub ins_attitude_error_arcsec: Option<std::collections::BTreeMap<String, std::collections::BTreeMap<String, RmsPeak>>>,
+    pub ins_attitude_error_arcsec:
+        Option<std::collections::BTreeMap<String, std::collections::BTreeMap<String, RmsPeak>>>,
     /// With navigation: radial position error, m (peak and final) and the final east/north error.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub navigation: Option<NavSummary>,
@@ -138,14 +144,20 @@ impl RunSummary {
             let mut row = std::collections::BTreeMap::new();
             for (a, axis) in ERROR_AXES.iter().enumerate() {
                 let s = &stats.stats[v][a];
-                row.insert((*axis).to_owned(), RmsPeak { rms_arcsec: s.rms() * ARCSEC_PER_RAD, peak_arcsec: s.peak() * ARCSEC_PER_RAD });
+                row.insert(
+                    (*axis).to_owned(),
+                    RmsPeak { rms_arcsec: s.rms() * ARCSEC_PER_RAD, peak_arcsec: s.peak() * ARCSEC_PER_RAD },
+                );
             }
             table.insert((*variant).to_owned(), row);
         }
         let mut row = std::collections::BTreeMap::new();
         for (a, axis) in ERROR_AXES.iter().enumerate() {
             let s = &stats.closed_form_deviation[a];
-            row.insert((*axis).to_owned(), RmsPeak { rms_arcsec: s.rms() * ARCSEC_PER_RAD, peak_arcsec: s.peak() * ARCSEC_PER_RAD });
+            row.insert(
+                (*axis).to_owned(),
+                RmsPeak { rms_arcsec: s.rms() * ARCSEC_PER_RAD, peak_arcsec: s.peak() * ARCSEC_PER_RAD },
+            );
         }
         table.insert(CLOSED_FORM_DEVIATION.to_owned(), row);
         Self {
@@ -176,7 +188,10 @@ impl RunSummary {
             let mut row = std::collections::BTreeMap::new();
             for (a, axis) in ERROR_AXES.iter().enumerate() {
                 let s = ins.stats.get(k).map_or(RunningStat::default(), |s| s[a]);
-                row.insert((*axis).to_owned(), RmsPeak { rms_arcsec: s.rms() * ARCSEC_PER_RAD, peak_arcsec: s.peak() * ARCSEC_PER_RAD });
+                row.insert(
+                    (*axis).to_owned(),
+                    RmsPeak { rms_arcsec: s.rms() * ARCSEC_PER_RAD, peak_arcsec: s.peak() * ARCSEC_PER_RAD },
+                );
             }
             table.insert(name.clone(), row);
         }
@@ -205,7 +220,9 @@ impl RunSummary {
             self.steps_per_second / 1e6,
             if self.interrupted { " — INTERRUPTED" } else { "" }
         ));
-        s.push_str("attitude error, arcsec     pitch rms  pitch peak    roll rms   roll peak  heading rms heading peak\n");
+        s.push_str(
+            "attitude error, arcsec     pitch rms  pitch peak    roll rms   roll peak  heading rms heading peak\n",
+        );
         for variant in DEMODULATIONS.iter().chain([&CLOSED_FORM_DEVIATION]) {
             s.push_str(&format!("{:<24}", variant.replace('_', " ")));
             for axis in ERROR_AXES {
@@ -240,13 +257,23 @@ impl RunSummary {
 
 /// Simulates `params`, streaming to `sinks`; Ctrl-C (`stop`) ends the run early and keeps what was
 /// simulated. Returns the summary; the sinks stay open (the caller finishes or abandons them).
-pub fn run_recorded(params: &Params, sinks: &OpenSinks, stop: &AtomicBool, progress: bool) -> anyhow::Result<RunSummary> {
+pub fn run_recorded(
+    params: &Params,
+    sinks: &OpenSinks,
+    stop: &AtomicBool,
+    progress: bool,
+) -> anyhow::Result<RunSummary> {
     record_run(Recorder::new(sinks.stream(), params)?, params, stop, progress)
 }
 
 /// Simulates `params` into `recorder` (whose layout the caller chose), ends it with the run's
 /// events and flushes it.
-pub fn record_run(mut recorder: Recorder, params: &Params, stop: &AtomicBool, progress: bool) -> anyhow::Result<RunSummary> {
+pub fn record_run(
+    mut recorder: Recorder,
+    params: &Params,
+    stop: &AtomicBool,
+    progress: bool,
+) -> anyhow::Result<RunSummary> {
     let started = Instant::now();
     let model = params.table_model();
     let timeline = params.timeline();
@@ -267,35 +294,48 @@ pub fn record_run(mut recorder: Recorder, params: &Params, stop: &AtomicBool, pr
     };
 
     let (tx, rx) = crossbeam_channel::bounded::<Batch>(8);
-    let (stats, ins_stats, done, interrupted) = std::thread::scope(|scope| -> anyhow::Result<(ErrorStats, InsStats, u64, bool)> {
-        let sim = scope.spawn(|| {
-            let ctx = Producer { model: &model, params, stop, bar: bar.as_ref(), tx: &tx, series_every, scene_every, stats_every };
-            let r = if params.ins.is_some() { ctx.run_ins(&timeline) } else { ctx.run_ideal(&timeline) };
-            drop(tx);
-            r
-        });
-        let mut result = Ok(());
-        for batch in &rx {
-            let r = match batch {
-                Batch::Series(rows) => rows.iter().try_for_each(|o| recorder.push_row(&o.core, o.ins.as_ref())),
-                Batch::Scene(rows) => rows.iter().try_for_each(|o| recorder.push_scene_row(&o.core, o.ins.as_ref())),
-                Batch::Signal(samples) => samples.iter().try_for_each(|o| recorder.push_signal(o)),
-            };
-            if let Err(e) = r {
-                result = Err(e);
-                break;
+    let (stats, ins_stats, done, interrupted) =
+        std::thread::scope(|scope| -> anyhow::Result<(ErrorStats, InsStats, u64, bool)> {
+            let sim = scope.spawn(|| {
+                let ctx = Producer {
+                    model: &model,
+                    params,
+                    stop,
+                    bar: bar.as_ref(),
+                    tx: &tx,
+                    series_every,
+                    scene_every,
+                    stats_every,
+                };
+                let r = if params.ins.is_some() { ctx.run_ins(&timeline) } else { ctx.run_ideal(&timeline) };
+                drop(tx);
+                r
+            });
+            let mut result = Ok(());
+            for batch in &rx {
+                let r = match batch {
+                    Batch::Series(rows) => rows.iter().try_for_each(|o| recorder.push_row(&o.core, o.ins.as_ref())),
+                    Batch::Scene(rows) => {
+                        rows.iter().try_for_each(|o| recorder.push_scene_row(&o.core, o.ins.as_ref()))
+                    }
+                    Batch::Signal(samples) => samples.iter().try_for_each(|o| recorder.push_signal(o)),
+                };
+                if let Err(e) = r {
+                    result = Err(e);
+                    break;
+                }
             }
-        }
-        drop(rx);
-        let r = sim.join().map_err(|_| anyhow::anyhow!("simulation thread panicked"))?;
-        result?;
-        Ok(r)
-    })?;
+            drop(rx);
+            let r = sim.join().map_err(|_| anyhow::anyhow!("simulation thread panicked"))?;
+            result?;
+            Ok(r)
+        })?;
     if let Some(b) = bar {
         b.finish_and_clear();
     }
 
-    let summary = RunSummary::new(params, &stats, done, started.elapsed().as_secs_f64(), interrupted).with_ins(&ins_stats);
+    let summary =
+        RunSummary::new(params, &stats, done, started.elapsed().as_secs_f64(), interrupted).with_ins(&ins_stats);
     let t_end = timeline.t_s(done.saturating_sub(1));
     let end_text = if interrupted {
         format!("run interrupted by the user at {t_end:.3} s; the recording holds everything simulated until then")
@@ -310,7 +350,13 @@ pub fn record_run(mut recorder: Recorder, params: &Params, stop: &AtomicBool, pr
         let ranges = crate::record::PlotRanges {
             table_peak_rad: peak(&stats.stats[0]),
             // Every algorithm's line must fit (a comparison's largest is the point of the plot).
-            ins_peak_rad: (!ins_stats.stats.is_empty()).then(|| ins_stats.stats.iter().map(peak).fold([0.0_f64; 3], |m, p| [m[0].max(p[0]), m[1].max(p[1]), m[2].max(p[2])])),
+            ins_peak_rad: (!ins_stats.stats.is_empty()).then(|| {
+                ins_stats
+                    .stats
+                    .iter()
+                    .map(peak)
+                    .fold([0.0_f64; 3], |m, p| [m[0].max(p[0]), m[1].max(p[1]), m[2].max(p[2])])
+            }),
             closed_form_peak_rad: peak(&stats.closed_form_deviation),
         };
         recorder.frame_plots(params, ranges)?;
@@ -421,7 +467,10 @@ impl Producer<'_> {
         let mut ins = InsRun::new(ins_params, self.params.site, self.params.meta.seed, self.model.clone());
         let mut state = DemodState::default();
         let mut stats = ErrorStats::default();
-        let mut ins_stats = InsStats { algorithms: ins.algorithms().iter().map(|a| a.name().to_owned()).collect(), ..InsStats::default() };
+        let mut ins_stats = InsStats {
+            algorithms: ins.algorithms().iter().map(|a| a.name().to_owned()).collect(),
+            ..InsStats::default()
+        };
         let mut out = Outbox { tx: self.tx, series: Vec::new(), scene: Vec::new(), signal: Vec::new() };
         let window = ins.config().signal_window_s;
         let (mut done, mut interrupted) = (1, false);
@@ -481,7 +530,6 @@ impl Producer<'_> {
     }
 }
 
-
 /// `rinscope run` (and Python's `run`): the scenario and where its outputs go.
 pub struct RunRequest {
     /// The scenario.
@@ -510,7 +558,8 @@ pub fn execute(req: &RunRequest, stop: &AtomicBool) -> Result<RunReport, Failure
     let params = &req.params;
     // The summary file is checked before anything runs, so a typo costs nothing.
     check_output("--summary-json", req.summary_json.as_deref())?;
-    let sinks = req.recording.open(RecordingName { name: &params.meta.name, kind: None, seed: Some(params.meta.seed) })?;
+    let sinks =
+        req.recording.open(RecordingName { name: &params.meta.name, kind: None, seed: Some(params.meta.seed) })?;
     let mut summary = run_recorded(params, &sinks, stop, req.progress)?;
     let saved = sinks.finish()?;
     (summary.recording_path, summary.recording_bytes) = saved.recording_fields();
@@ -541,7 +590,8 @@ mod tests {
         assert_eq!(p.statistics_every(), 4, "2 Hz wobble: 500 Hz statistics at a 2000 Hz IMU");
         let dir = std::env::temp_dir().join(format!("rinscope-stats-{}", std::process::id()));
         std::fs::create_dir_all(&dir)?;
-        let sinks = sink::open(&SinkRequest { save: Some(dir.join("s.rrd")), ..Default::default() }, "rinscope-test", "stats")?;
+        let sinks =
+            sink::open(&SinkRequest { save: Some(dir.join("s.rrd")), ..Default::default() }, "rinscope-test", "stats")?;
         let summary = run_recorded(&p, &sinks, &AtomicBool::new(false), false)?;
         sinks.finish()?;
         std::fs::remove_dir_all(&dir).ok();
@@ -566,17 +616,30 @@ mod tests {
             }
         }
         let close = |what: &str, sampled: f64, all: f64, tolerance: f64| {
-            assert!(sampled <= all * (1.0 + 1e-12) && sampled >= all * (1.0 - tolerance), "{what}: {sampled} in the run, {all} at every update");
+            assert!(
+                sampled <= all * (1.0 + 1e-12) && sampled >= all * (1.0 - tolerance),
+                "{what}: {sampled} in the run, {all} at every update"
+            );
         };
         let ins_summary = summary.ins_attitude_error_arcsec.as_ref().expect("INS statistics");
         for (k, name) in names.iter().enumerate() {
             for (a, axis) in ERROR_AXES.iter().enumerate() {
-                close(&format!("{name} {axis}"), ins_summary[name][*axis].peak_arcsec, every[k][a].peak() * ARCSEC_PER_RAD, 1e-12);
+                close(
+                    &format!("{name} {axis}"),
+                    ins_summary[name][*axis].peak_arcsec,
+                    every[k][a].peak() * ARCSEC_PER_RAD,
+                    1e-12,
+                );
             }
         }
         for (v, variant) in DEMODULATIONS.iter().enumerate() {
             for (a, axis) in ERROR_AXES.iter().enumerate() {
-                close(&format!("{variant} {axis}"), summary.attitude_error_arcsec[*variant][*axis].peak_arcsec, table.stats[v][a].peak() * ARCSEC_PER_RAD, 1e-4);
+                close(
+                    &format!("{variant} {axis}"),
+                    summary.attitude_error_arcsec[*variant][*axis].peak_arcsec,
+                    table.stats[v][a].peak() * ARCSEC_PER_RAD,
+                    1e-4,
+                );
             }
         }
         Ok(())

@@ -5,12 +5,15 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::app::failure::Failure;
-use crate::app::outputs::{check_output, logged, write_json, RecordingName, RecordingRequest};
+use crate::app::outputs::{RecordingName, RecordingRequest, check_output, logged, write_json};
 use crate::ins::pipeline::InsRun;
-use crate::record::sink::Saved;
-use crate::ins::reset::{azimuth_error_at_second_fix, azimuth_error_level_corrected, level_errors_from_velocity, ResetSample, SweepRow, TprResult, BRANCHES};
+use crate::ins::reset::{
+    BRANCHES, ResetSample, SweepRow, TprResult, azimuth_error_at_second_fix, azimuth_error_level_corrected,
+    level_errors_from_velocity,
+};
 use crate::math::units::ARCSEC_PER_RAD;
-use crate::model::earth::{normal_gravity, Earth};
+use crate::model::earth::{Earth, normal_gravity};
+use crate::record::sink::Saved;
 use crate::scenario::Params;
 
 /// Window over which the velocity's slow rate is read before a fix, s (hour-scale dynamics; long
@@ -36,10 +39,16 @@ fn errors(ins: &mut InsRun, t_s: f64) -> (f64, [f64; 2]) {
 /// Whether the scenario can run the comparison: an INS with navigation and two position fixes.
 pub fn check(params: &Params) -> Result<(), TprError> {
     if params.ins.as_ref().is_none_or(|i| i.navigation.is_none()) {
-        return Err(TprError::Config(format!("{}: needs an [imu] and a [navigation] section (see assets/scenarios/zheng2016-tpr.toml)", params.meta.name)));
+        return Err(TprError::Config(format!(
+            "{}: needs an [imu] and a [navigation] section (see assets/scenarios/zheng2016-tpr.toml)",
+            params.meta.name
+        )));
     }
     if params.position_fix_s.len() < 2 {
-        return Err(TprError::Config(format!("{}: [position_fix] at_h needs two fixes (Zheng et al. 2016: at_h = [17.0, 21.0])", params.meta.name)));
+        return Err(TprError::Config(format!(
+            "{}: [position_fix] at_h needs two fixes (Zheng et al. 2016: at_h = [17.0, 21.0])",
+            params.meta.name
+        )));
     }
     Ok(())
 }
@@ -113,7 +122,12 @@ pub fn compare_resets(params: &Params, sample_s: f64, stop: &AtomicBool) -> Resu
             next += sample_s;
             let (h, en) = errors(&mut ins, s.t_s);
             let r = en[0].hypot(en[1]);
-            samples.push(ResetSample { t_s: s.t_s, heading_arcsec: [h; BRANCHES], radial_m: [r; BRANCHES], east_north_m: [[en[0]; BRANCHES], [en[1]; BRANCHES]] });
+            samples.push(ResetSample {
+                t_s: s.t_s,
+                heading_arcsec: [h; BRANCHES],
+                radial_m: [r; BRANCHES],
+                east_north_m: [[en[0]; BRANCHES], [en[1]; BRANCHES]],
+            });
         }
         if i.is_multiple_of(200_000) && stop.load(Ordering::Relaxed) {
             complete = false;
@@ -192,8 +206,11 @@ pub fn compare_resets(params: &Params, sample_s: f64, stop: &AtomicBool) -> Resu
 /// distribution a single run of the paper cannot.
 pub fn sweep(params: &Params, seeds: u64, stop: &AtomicBool) -> Result<Vec<SweepRow>, TprError> {
     use rayon::prelude::*;
+    // A stop ends the sweep at once: the seeds not yet begun are skipped (each would otherwise
+    // set up its navigation before its first look at the flag).
     let rows: Result<Vec<SweepRow>, TprError> = (0..seeds)
         .into_par_iter()
+        .filter(|_| !stop.load(Ordering::Relaxed))
         .map(|k| {
             let mut p = params.clone();
             p.meta.seed = params.meta.seed.wrapping_add(k);
@@ -210,7 +227,6 @@ pub fn sweep(params: &Params, seeds: u64, stop: &AtomicBool) -> Result<Vec<Sweep
         .collect();
     rows
 }
-
 
 /// `rinscope tpr`: the scenario, where its outputs go, and how many seeds to sweep after it.
 pub struct TprRequest {
@@ -244,7 +260,8 @@ pub fn execute(req: &TprRequest, stop: &AtomicBool) -> Result<TprReport, Failure
     let params = &req.params;
     check_output("--json", req.json.as_deref())?;
     check(params).map_err(|e| Failure::input(format!("tpr: {e}")))?;
-    let sinks = req.recording.open(RecordingName { name: &params.meta.name, kind: None, seed: Some(params.meta.seed) })?;
+    let sinks =
+        req.recording.open(RecordingName { name: &params.meta.name, kind: None, seed: Some(params.meta.seed) })?;
     errln!("rinscope: navigating {:.1} h (forking at the second fix)...", params.duration_s / 3600.0);
     let result = compare_resets(params, 60.0, stop).map_err(|e| Failure::input(format!("tpr: {e}")))?;
     let text = result.text();
@@ -292,21 +309,35 @@ mod tests {
         let at_fix = r.heading_at_second_fix_arcsec;
         assert!(at_fix.abs() > 3.0, "a deterministic azimuth error to correct: {at_fix}″");
         let rel = |estimate: f64| (estimate - at_fix).abs() / at_fix.abs();
-        assert!(rel(r.tpr_heading_estimate_arcsec) < 0.15, "TPR estimate {}″ vs {at_fix}″", r.tpr_heading_estimate_arcsec);
-        assert!(rel(r.level_heading_estimate_arcsec) < 0.02, "TPR + level estimate {}″ vs {at_fix}″", r.level_heading_estimate_arcsec);
+        assert!(
+            rel(r.tpr_heading_estimate_arcsec) < 0.15,
+            "TPR estimate {}″ vs {at_fix}″",
+            r.tpr_heading_estimate_arcsec
+        );
+        assert!(
+            rel(r.level_heading_estimate_arcsec) < 0.02,
+            "TPR + level estimate {}″ vs {at_fix}″",
+            r.level_heading_estimate_arcsec
+        );
         let first_after = r.samples.iter().find(|s| s.t_s > r.fixes_s[1]).expect("samples after the fix");
         let [conventional, tpr, level] = first_after.heading_arcsec;
         assert!((conventional - at_fix).abs() < 0.1, "conventional keeps it: {conventional}″");
         assert!(tpr.abs() < 0.15 * at_fix.abs(), "TPR's residual {tpr}″");
         assert!(level.abs() < 0.02 * at_fix.abs(), "TPR + level's residual {level}″");
         let [conv, tpr, level] = r.peak_radial_after_m();
-        assert!(tpr < 0.3 * conv && level < 0.3 * conv, "radial: conventional {conv} m, TPR {tpr} m, TPR + level {level} m");
+        assert!(
+            tpr < 0.3 * conv && level < 0.3 * conv,
+            "radial: conventional {conv} m, TPR {tpr} m, TPR + level {level} m"
+        );
         // The level errors read from the velocity against the INS's own tilts (the simulated truth,
         // not the velocity equation inverted): docs/tpr.md reports agreement to 0.01″.
         for (fix, (read, truth)) in r.level_errors_arcsec.iter().zip(&r.true_level_errors_arcsec).enumerate() {
             for axis in 0..2 {
                 assert!(truth[axis].abs() > 0.1, "fix {fix}: a tilt to read ({truth:?}″)");
-                assert!((read[axis] - truth[axis]).abs() < 0.03, "fix {fix}, axis {axis}: read {read:?}″, true {truth:?}″");
+                assert!(
+                    (read[axis] - truth[axis]).abs() < 0.03,
+                    "fix {fix}, axis {axis}: read {read:?}″, true {truth:?}″"
+                );
             }
         }
     }

@@ -8,7 +8,7 @@ use std::sync::atomic::AtomicBool;
 use nalgebra::{DVector, UnitQuaternion, Vector3};
 use serde::Serialize;
 
-use super::estimate::{exact_residual, SampleModel};
+use super::estimate::{SampleModel, exact_residual};
 use super::{CalibConfig, CalibError, Calibration, Data};
 use crate::math::units::RAD_PER_ARCSEC;
 use crate::model::gimbal::{Chain, ShaftRotations, TableErrors};
@@ -33,7 +33,14 @@ enum Perturbation {
 ///
 /// # Errors
 /// The data source's, or the stop.
-pub fn aliases(chain: &Chain, known: &TableErrors, data: &Data, cal: &Calibration, cfg: &CalibConfig, stop: &AtomicBool) -> Result<Vec<Alias>, CalibError> {
+pub fn aliases(
+    chain: &Chain,
+    known: &TableErrors,
+    data: &Data,
+    cal: &Calibration,
+    cfg: &CalibConfig,
+    stop: &AtomicBool,
+) -> Result<Vec<Alias>, CalibError> {
     let set = &cal.set;
     let one = RAD_PER_ARCSEC;
     let mut cases: Vec<(String, Perturbation)> = Vec::new();

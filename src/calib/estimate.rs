@@ -5,8 +5,10 @@ use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 use std::sync::atomic::AtomicBool;
 
-use super::{CalibConfig, CalibError, Data, InsErrorModel, Measurement, Param, ParamSet, Thinned, MAX_PARAMS, MAX_TABLE};
-use crate::math::frames::{Rot, B, N};
+use super::{
+    CalibConfig, CalibError, Data, InsErrorModel, MAX_PARAMS, MAX_TABLE, Measurement, Param, ParamSet, Thinned,
+};
+use crate::math::frames::{B, N, Rot};
 use crate::math::rotvec;
 use crate::model::gimbal::{Chain, ErrorRotations, TableErrors};
 
@@ -42,11 +44,24 @@ pub struct SampleModel {
 
 impl SampleModel {
     pub(crate) fn new() -> Self {
-        Self { h: [[0.0; MAX_PARAMS]; 3], w: Matrix3::identity(), encoder_basis: [Vector3::zeros(); 3], encoder_rank: 0 }
+        Self {
+            h: [[0.0; MAX_PARAMS]; 3],
+            w: Matrix3::identity(),
+            encoder_basis: [Vector3::zeros(); 3],
+            encoder_rank: 0,
+        }
     }
 
     /// Fills H and R⁻¹ for sample `s` (time τ).
-    pub(crate) fn set(&mut self, set: &ParamSet, chain: &Chain, n_from_b: &Matrix3<f64>, s: &Measurement, tau: f64, cfg: &CalibConfig) {
+    pub(crate) fn set(
+        &mut self,
+        set: &ParamSet,
+        chain: &Chain,
+        n_from_b: &Matrix3<f64>,
+        s: &Measurement,
+        tau: f64,
+        cfg: &CalibConfig,
+    ) {
         let mut table = [[0.0; MAX_TABLE]; 3];
         set.table_rows(chain, n_from_b, s, &mut table);
         let nt = set.n_table;
@@ -115,7 +130,14 @@ impl Normal {
     }
 
     /// Adds one sample with its measurement z (or residual); `wh` = R⁻¹H of its model `m`.
-    fn add(&mut self, p: usize, m: &SampleModel, wh: &[[f64; MAX_PARAMS]; 3], z: &Vector3<f64>, with_information: bool) {
+    fn add(
+        &mut self,
+        p: usize,
+        m: &SampleModel,
+        wh: &[[f64; MAX_PARAMS]; 3],
+        z: &Vector3<f64>,
+        with_information: bool,
+    ) {
         for i in 0..p {
             self.b[i] += (0..3).map(|r| wh[r][i] * z[r]).sum::<f64>();
             if with_information {
@@ -163,7 +185,16 @@ struct InsTerm {
 
 impl InsTerm {
     fn new(model: InsErrorModel) -> Self {
-        Self { model, last_t: None, total: [[0.0; MAX_PARAMS]; 3], q_sum: 0.0, u: [[0.0; MAX_PARAMS]; 3], v: [[0.0; MAX_PARAMS]; MAX_PARAMS], d: Matrix3::zeros(), b: [[0.0; 3]; MAX_PARAMS] }
+        Self {
+            model,
+            last_t: None,
+            total: [[0.0; MAX_PARAMS]; 3],
+            q_sum: 0.0,
+            u: [[0.0; MAX_PARAMS]; 3],
+            v: [[0.0; MAX_PARAMS]; MAX_PARAMS],
+            d: Matrix3::zeros(),
+            b: [[0.0; 3]; MAX_PARAMS],
+        }
     }
 
     /// Adds sample i at `t_s` with the INS attitude `n_from_s` and Gᵢ = `wh`.
@@ -290,7 +321,12 @@ pub struct Calibration {
 
 /// Exact residual of one sample for the table errors `err` (nav frame): the rotation from the known
 /// attitude to the demodulated one.
-pub(crate) fn exact_residual(chain: &Chain, err: &ErrorRotations, s: &Measurement, ref_inv: &Rot<B, N>) -> Vector3<f64> {
+pub(crate) fn exact_residual(
+    chain: &Chain,
+    err: &ErrorRotations,
+    s: &Measurement,
+    ref_inv: &Rot<B, N>,
+) -> Vector3<f64> {
     let b_from_s = chain.b_from_s_with(err, &s.shafts);
     let computed: Rot<N, B> = s.n_from_s * b_from_s.inverse();
     rotvec::log((computed * *ref_inv).quaternion())
@@ -310,7 +346,14 @@ fn solve(a: &DMatrix<f64>, b: &DVector<f64>) -> Result<(DVector<f64>, DMatrix<f6
 ///
 /// # Errors
 /// No parameter, singular normal equations, the data source's error or the stop.
-pub fn calibrate(chain: &Chain, known: &TableErrors, data: &Data, cfg: &CalibConfig, history: History, stop: &AtomicBool) -> Result<Calibration, CalibError> {
+pub fn calibrate(
+    chain: &Chain,
+    known: &TableErrors,
+    data: &Data,
+    cfg: &CalibConfig,
+    history: History,
+    stop: &AtomicBool,
+) -> Result<Calibration, CalibError> {
     let set = ParamSet::new(chain, cfg.nuisance);
     let p = set.len();
     if set.n_table == 0 || p > MAX_PARAMS {
@@ -343,7 +386,14 @@ pub fn calibrate(chain: &Chain, known: &TableErrors, data: &Data, cfg: &CalibCon
             // Early on the information can be singular: that snapshot is skipped.
             if let Ok((x, cov)) = solve(&(&prior_info + a), &(&prior_info * &x0 + b)) {
                 let cov = ins.widen(cov);
-                snapshots.push(s.t_s, Snapshot { t_s: s.t_s, theta: x.iter().copied().collect(), sigma: cov.diagonal().iter().map(|v| v.max(0.0).sqrt()).collect() });
+                snapshots.push(
+                    s.t_s,
+                    Snapshot {
+                        t_s: s.t_s,
+                        theta: x.iter().copied().collect(),
+                        sigma: cov.diagonal().iter().map(|v| v.max(0.0).sqrt()).collect(),
+                    },
+                );
             }
         }
     })?;
@@ -381,7 +431,12 @@ pub fn calibrate(chain: &Chain, known: &TableErrors, data: &Data, cfg: &CalibCon
     };
     // The filter's residuals are reported, not needed by the estimate (the Monte Carlo skips them).
     let kf_rms = if history == History::Lean { [f64::NAN; 3] } else { pass(&x_kf)?.1 };
-    let kf = Estimate { theta: x_kf.iter().copied().collect(), cov: cov.clone(), residual_rms_rad: kf_rms, isotropic_residual_rad: f64::NAN };
+    let kf = Estimate {
+        theta: x_kf.iter().copied().collect(),
+        cov: cov.clone(),
+        residual_rms_rad: kf_rms,
+        isotropic_residual_rad: f64::NAN,
+    };
 
     // Chord Gauss–Newton from the filter's estimate. The residuals are exact; the Jacobian is the
     // first-order H (relative error ~ the error angles, 1e-3), so each step gains ~3 digits.
@@ -398,11 +453,13 @@ pub fn calibrate(chain: &Chain, known: &TableErrors, data: &Data, cfg: &CalibCon
         iterations += 1;
         // Converged when every step is below 1e-4 of its parameter's 1σ (and 2e-7″): the next one
         // would change nothing a user could see.
-        if step.iter().zip(cov.diagonal().iter()).take(set.n_table).all(|(d, v)| d.abs() < (1e-4 * v.sqrt()).max(1e-12)) {
+        if step.iter().zip(cov.diagonal().iter()).take(set.n_table).all(|(d, v)| d.abs() < (1e-4 * v.sqrt()).max(1e-12))
+        {
             break;
         }
     }
-    let nls = Estimate { theta: theta.iter().copied().collect(), cov, residual_rms_rad: rms, isotropic_residual_rad: iso };
+    let nls =
+        Estimate { theta: theta.iter().copied().collect(), cov, residual_rms_rad: rms, isotropic_residual_rad: iso };
     Ok(Calibration {
         set,
         prior: (x0.iter().copied().collect(), s0),
@@ -416,4 +473,3 @@ pub fn calibrate(chain: &Chain, known: &TableErrors, data: &Data, cfg: &CalibCon
         ins_error: cfg.ins_error,
     })
 }
-

@@ -30,14 +30,14 @@ mod estimate;
 pub mod montecarlo;
 pub mod report;
 
-pub use estimate::{calibrate, Calibration, Estimate, History, Snapshot};
+pub use estimate::{Calibration, Estimate, History, Snapshot, calibrate};
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use nalgebra::{Matrix3, Vector3};
 
 use crate::math::attitude::Attitude;
-use crate::math::frames::{Rot, B, N, S};
+use crate::math::frames::{B, N, Rot, S};
 use crate::model::gimbal::{Chain, ShaftRotations, TableErrors};
 use crate::model::scheme::MAX_AXES;
 use crate::sim::demodulate;
@@ -308,7 +308,13 @@ impl ParamSet {
 
     /// The table parameters' columns of H (nav frame) for one sample, as three rows. The nuisance
     /// columns are I (offset) and τ·I (drift) and never stored.
-    pub(crate) fn table_rows(&self, chain: &Chain, n_from_b: &Matrix3<f64>, s: &Measurement, out: &mut [[f64; MAX_TABLE]; 3]) {
+    pub(crate) fn table_rows(
+        &self,
+        chain: &Chain,
+        n_from_b: &Matrix3<f64>,
+        s: &Measurement,
+        out: &mut [[f64; MAX_TABLE]; 3],
+    ) {
         let axes = chain.axes();
         // M_k = C_b^n P_k for every axis, and the (sin, cos) of each shaft angle from its quaternion.
         let mut m = [*n_from_b; MAX_AXES + 1];
@@ -526,7 +532,14 @@ impl Data {
     /// The same test's description with no measurements (for building a `Data` around other samples).
     #[must_use]
     pub fn clone_header(&self) -> Self {
-        Self { samples: Samples::Memory(Vec::new()), duration_s: self.duration_s, n_from_b: self.n_from_b, attitude: self.attitude, source: self.source, seed: self.seed }
+        Self {
+            samples: Samples::Memory(Vec::new()),
+            duration_s: self.duration_s,
+            n_from_b: self.n_from_b,
+            attitude: self.attitude,
+            source: self.source,
+            seed: self.seed,
+        }
     }
 
     /// The drift state's time of a measurement at `t_s`, in [−1, 1].
@@ -540,7 +553,9 @@ impl Data {
 #[derive(Debug, thiserror::Error)]
 pub enum CalibError {
     /// The vehicle moves.
-    #[error("calibration needs the vehicle at rest (its attitude is the reference); remove [vehicle] ramp/wobble/coning from {0}")]
+    #[error(
+        "calibration needs the vehicle at rest (its attitude is the reference); remove [vehicle] ramp/wobble/coning from {0}"
+    )]
     VehicleMoves(String),
     /// No parameter.
     #[error("nothing to calibrate: the table has no axis")]
@@ -610,7 +625,11 @@ impl<T> Thinned<T> {
                 j += 1;
                 j % 2 == 1
             });
-            self.interval_s = if self.interval_s > 0.0 { 2.0 * self.interval_s } else { 2.0 * (t_s - self.t_s.first().copied().unwrap_or(0.0)) / MAX_TRACE_ROWS as f64 };
+            self.interval_s = if self.interval_s > 0.0 {
+                2.0 * self.interval_s
+            } else {
+                2.0 * (t_s - self.t_s.first().copied().unwrap_or(0.0)) / MAX_TRACE_ROWS as f64
+            };
         }
         self.t_s.push(t_s);
         self.rows.push(row);
@@ -624,7 +643,13 @@ impl<T> Thinned<T> {
 ///
 /// # Errors
 /// The data source's, or the stop.
-pub fn attitude_errors(chain: &Chain, variants: &[TableErrors], data: &Data, stop: &AtomicBool, trace: &mut Thinned<Vec<[f64; 3]>>) -> Result<Vec<ErrorSummary>, CalibError> {
+pub fn attitude_errors(
+    chain: &Chain,
+    variants: &[TableErrors],
+    data: &Data,
+    stop: &AtomicBool,
+    trace: &mut Thinned<Vec<[f64; 3]>>,
+) -> Result<Vec<ErrorSummary>, CalibError> {
     let err: Vec<_> = variants.iter().map(|e| chain.error_rotations(e)).collect();
     let mut sums = vec![ErrorSummary::default(); variants.len()];
     data.samples.each(stop, &mut |s| {

@@ -11,11 +11,12 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::{CalibConfig, CalibError, Data, History, Param, ParamSet, calibrate};
-use crate::model::gimbal::{Chain, TableErrors};
 use crate::math::units::{ARCSEC_PER_RAD, wrap_pi};
+use crate::model::gimbal::{Chain, TableErrors};
 
 /// Jiang et al. 2017 Table 3 (500 runs): (quantity, error mean ″, standard deviation ″).
-pub const PAPER_TABLE3: [(&str, f64, f64); 5] = [("α1", 0.98, 0.0238), ("φ1", 1.14, 0.6103), ("α2", 0.78, 0.0078), ("φ2", 0.65, 0.0317), ("η", 1.05, 0.0091)];
+pub const PAPER_TABLE3: [(&str, f64, f64); 5] =
+    [("α1", 0.98, 0.0238), ("φ1", 1.14, 0.6103), ("α2", 0.78, 0.0078), ("φ2", 0.65, 0.0317), ("η", 1.05, 0.0091)];
 
 /// One quantity's error statistics, arcsec.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
@@ -35,7 +36,12 @@ impl ErrorSpread {
         let n = errors.len().max(1) as f64;
         let mean = errors.iter().sum::<f64>() / n;
         let var = errors.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
-        Self { mean, std: var.sqrt(), mean_abs: errors.iter().map(|e| e.abs()).sum::<f64>() / n, max_abs: errors.iter().fold(0.0, |m, e| m.max(e.abs())) }
+        Self {
+            mean,
+            std: var.sqrt(),
+            mean_abs: errors.iter().map(|e| e.abs()).sum::<f64>() / n,
+            max_abs: errors.iter().fold(0.0, |m, e| m.max(e.abs())),
+        }
     }
 }
 
@@ -201,8 +207,13 @@ impl Shard {
 
     /// Parses `K/M` (0 ≤ K < M).
     pub fn parse(text: &str) -> Result<Self, String> {
-        let (k, m) = text.split_once('/').ok_or_else(|| format!("`{text}` is not K/M (e.g. 3/8: slice 3 of 8, counted from 0)"))?;
-        let (k, m): (u64, u64) = (k.trim().parse().map_err(|_| format!("`{k}` in `{text}` is not a whole number"))?, m.trim().parse().map_err(|_| format!("`{m}` in `{text}` is not a whole number"))?);
+        let (k, m) = text
+            .split_once('/')
+            .ok_or_else(|| format!("`{text}` is not K/M (e.g. 3/8: slice 3 of 8, counted from 0)"))?;
+        let (k, m): (u64, u64) = (
+            k.trim().parse().map_err(|_| format!("`{k}` in `{text}` is not a whole number"))?,
+            m.trim().parse().map_err(|_| format!("`{m}` in `{text}` is not a whole number"))?,
+        );
         if m == 0 || k >= m {
             return Err(format!("`{text}`: the slice K must be in 0 ..= M−1 and M ≥ 1"));
         }
@@ -233,7 +244,13 @@ pub struct RunErrors {
 
 /// Runs calibrations `indices` in parallel, each on the data `collect` simulates for a drawn table
 /// (`progress` ticks once per run; `stop` ends early: the runs not started are left out).
-pub fn run_indices(setup: &Setup<'_>, indices: &[u64], collect: &Collect<'_>, progress: &(dyn Fn() + Sync), stop: &AtomicBool) -> Result<Vec<RunErrors>, CalibError> {
+pub fn run_indices(
+    setup: &Setup<'_>,
+    indices: &[u64],
+    collect: &Collect<'_>,
+    progress: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
+) -> Result<Vec<RunErrors>, CalibError> {
     let mc = &setup.cfg.montecarlo;
     let base_seed = setup.seed;
     let results: Vec<Result<Option<RunErrors>, CalibError>> = indices
@@ -278,7 +295,13 @@ pub fn run_indices(setup: &Setup<'_>, indices: &[u64], collect: &Collect<'_>, pr
 }
 
 /// Runs `runs` calibrations in parallel (see [`run_indices`]) and summarises them.
-pub fn run(setup: &Setup<'_>, runs: usize, collect: &Collect<'_>, progress: &(dyn Fn() + Sync), stop: &AtomicBool) -> Result<Summary, CalibError> {
+pub fn run(
+    setup: &Setup<'_>,
+    runs: usize,
+    collect: &Collect<'_>,
+    progress: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
+) -> Result<Summary, CalibError> {
     let started = std::time::Instant::now();
     let done = run_indices(setup, &Shard::WHOLE.indices(runs as u64), collect, progress, stop)?;
     Ok(summarize(setup, runs, &done, started.elapsed().as_secs_f64()))
@@ -299,9 +322,19 @@ pub fn summarize(setup: &Setup<'_>, runs_requested: usize, done: &[RunErrors], w
         .map(|(j, (label, paper, identifiable, given_by_eta))| {
             let kf: Vec<f64> = done.iter().map(|r| r.kf[j]).collect();
             let nls: Vec<f64> = done.iter().map(|r| r.nls[j]).collect();
-            let sig: Vec<f64> = done.iter().filter_map(|r| r.nls_sigma.get(j).copied()).filter(|v| v.is_finite()).collect();
-            let nls_reported_sigma = (!sig.is_empty() && sig.len() == done.len()).then(|| sig.iter().sum::<f64>() / sig.len() as f64);
-            QuantityRow { label: label.clone(), kf: ErrorSpread::of(&kf), nls: ErrorSpread::of(&nls), nls_reported_sigma, paper: *paper, identifiable: *identifiable, given_by_eta: *given_by_eta }
+            let sig: Vec<f64> =
+                done.iter().filter_map(|r| r.nls_sigma.get(j).copied()).filter(|v| v.is_finite()).collect();
+            let nls_reported_sigma =
+                (!sig.is_empty() && sig.len() == done.len()).then(|| sig.iter().sum::<f64>() / sig.len() as f64);
+            QuantityRow {
+                label: label.clone(),
+                kf: ErrorSpread::of(&kf),
+                nls: ErrorSpread::of(&nls),
+                nls_reported_sigma,
+                paper: *paper,
+                identifiable: *identifiable,
+                given_by_eta: *given_by_eta,
+            }
         })
         .collect();
     let deg = |r: [f64; 2]| [r[0].to_degrees(), r[1].to_degrees()];
@@ -362,14 +395,31 @@ pub fn merge(setup: &Setup<'_>, files: &[ShardFile]) -> Result<Summary, MergeErr
     let mut done: Vec<RunErrors> = Vec::new();
     for f in files {
         let s = &f.summary;
-        if f.shard.count != count || s.runs_requested != runs_requested || s.scenario != first.summary.scenario || s.seed != first.summary.seed || s.setup != first.summary.setup {
+        if f.shard.count != count
+            || s.runs_requested != runs_requested
+            || s.scenario != first.summary.scenario
+            || s.seed != first.summary.seed
+            || s.setup != first.summary.setup
+        {
             return Err(MergeError::Mismatch(format!(
                 "shard {}/{} of {} (seed {}, {} runs) does not belong with shard {}/{} of {} (seed {}, {} runs)",
-                f.shard.index, f.shard.count, s.scenario, s.seed, s.runs_requested, first.shard.index, count, first.summary.scenario, first.summary.seed, runs_requested
+                f.shard.index,
+                f.shard.count,
+                s.scenario,
+                s.seed,
+                s.runs_requested,
+                first.shard.index,
+                count,
+                first.summary.scenario,
+                first.summary.seed,
+                runs_requested
             )));
         }
         if s.scenario != setup.scenario || s.seed != setup.seed {
-            return Err(MergeError::Mismatch(format!("the shards are of {} (seed {}), the scenario given is {} (seed {})", s.scenario, s.seed, setup.scenario, setup.seed)));
+            return Err(MergeError::Mismatch(format!(
+                "the shards are of {} (seed {}), the scenario given is {} (seed {})",
+                s.scenario, s.seed, setup.scenario, setup.seed
+            )));
         }
         let slot = &mut seen[f.shard.index as usize];
         if *slot {
@@ -377,7 +427,12 @@ pub fn merge(setup: &Setup<'_>, files: &[ShardFile]) -> Result<Summary, MergeErr
         }
         *slot = true;
         if f.runs.len() != f.shard.indices(runs_requested as u64).len() {
-            return Err(MergeError::Mismatch(format!("shard {}/{count} holds {} of its {} runs (interrupted?)", f.shard.index, f.runs.len(), f.shard.indices(runs_requested as u64).len())));
+            return Err(MergeError::Mismatch(format!(
+                "shard {}/{count} holds {} of its {} runs (interrupted?)",
+                f.shard.index,
+                f.runs.len(),
+                f.shard.indices(runs_requested as u64).len()
+            )));
         }
         wall_s = wall_s.max(s.wall_s);
         done.extend(f.runs.iter().cloned());
@@ -397,7 +452,10 @@ impl Summary {
             "Monte Carlo: {} of {} runs of {} in {:.1} s on {} threads\n{}\nerrors in arcsec (mean ± std of the signed error, mean |error|; the least squares' reported 1σ, mean over the runs, beside its std)\n",
             self.runs, self.runs_requested, self.scenario, self.wall_s, self.threads, self.setup
         );
-        s.push_str(&format!("  {:<24} {:>30} {:>30} {:>12} {:>22}\n", "", "static KF", "exact least squares", "reported 1σ", "Jiang et al. 2017 Table 3"));
+        s.push_str(&format!(
+            "  {:<24} {:>30} {:>30} {:>12} {:>22}\n",
+            "", "static KF", "exact least squares", "reported 1σ", "Jiang et al. 2017 Table 3"
+        ));
         for r in &self.rows {
             let f = |st: &ErrorSpread| format!("{:>+9.4} ±{:>8.4} |{:>8.4}|", st.mean, st.std, st.mean_abs);
             let paper = r.paper.map_or(String::new(), |(m, sd)| format!("{m:>9.2} ±{sd:>8.4}"));
@@ -409,7 +467,15 @@ impl Summary {
                 "   not identifiable: set by the η prior"
             };
             let reported = r.nls_reported_sigma.map_or(String::new(), |v| format!("{v:.4}"));
-            s.push_str(&format!("  {:<24} {} {} {:>12} {:>22}{}\n", r.label, f(&r.kf), f(&r.nls), reported, paper, mark));
+            s.push_str(&format!(
+                "  {:<24} {} {} {:>12} {:>22}{}\n",
+                r.label,
+                f(&r.kf),
+                f(&r.nls),
+                reported,
+                paper,
+                mark
+            ));
         }
         s
     }

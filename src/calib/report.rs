@@ -5,8 +5,8 @@ use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use serde::Serialize;
 
 use super::{Calibration, ErrorSummary, Estimate, Param};
-use crate::model::gimbal::{Chain, TableErrors};
 use crate::math::units::{ARCSEC_PER_RAD, DEG_PER_RAD};
+use crate::model::gimbal::{Chain, TableErrors};
 
 /// A function of the parameter vector.
 type ParamFn = Box<dyn Fn(&[f64]) -> f64>;
@@ -194,9 +194,14 @@ fn unobservable(cal: &Calibration, chain: &Chain) -> Vec<Unobservable> {
             let val = wi * est.theta[i] + wj * est.theta[j];
             let var = wi * wi * est.cov[(i, i)] + wj * wj * est.cov[(j, j)] + 2.0 * wi * wj * est.cov[(i, j)];
             let term = |c: f64, label: String| {
-                if (c.abs() - 1.0).abs() < 1e-3 { format!("{} {label}", if c < 0.0 { "−" } else { "+" }) } else { format!("{c:+.3}·{label}") }
+                if (c.abs() - 1.0).abs() < 1e-3 {
+                    format!("{} {label}", if c < 0.0 { "−" } else { "+" })
+                } else {
+                    format!("{c:+.3}·{label}")
+                }
             };
-            let name = format!("{} {}", term(wi, cal.set.params[i].label(chain)), term(wj, cal.set.params[j].label(chain)));
+            let name =
+                format!("{} {}", term(wi, cal.set.params[i].label(chain)), term(wj, cal.set.params[j].label(chain)));
             let name = name.trim_start_matches("+ ").to_owned();
             Some((name, Value { value: val * ARCSEC_PER_RAD, sigma: var.max(0.0).sqrt() * ARCSEC_PER_RAD }))
         } else {
@@ -209,7 +214,10 @@ fn unobservable(cal: &Calibration, chain: &Chain) -> Vec<Unobservable> {
         let resolved_by_prior = outside_worst > 0.0 && inside.iter().all(|&i| cal.nls.sigma(i) < 3.0 * outside_worst);
         out.push(Unobservable {
             resolved_by_prior,
-            direction: comps.iter().map(|(i, c)| (cal.set.params[*i].key(chain), (c * 1000.0).round() / 1000.0)).collect(),
+            direction: comps
+                .iter()
+                .map(|(i, c)| (cal.set.params[*i].key(chain), (c * 1000.0).round() / 1000.0))
+                .collect(),
             data_sigma_arcsec: data_sigma * ARCSEC_PER_RAD,
             prior_sigma_arcsec: prior_var.sqrt() * ARCSEC_PER_RAD,
             determined,
@@ -233,7 +241,14 @@ pub fn effective_eta(chain: &Chain, set: &super::ParamSet, k: usize) -> Option<i
 
 /// Builds the report of a calibration against the true errors.
 #[must_use]
-pub fn build(scenario: &str, chain: &Chain, truth: &TableErrors, cal: &Calibration, data: &super::Data, compensation: Option<Compensation>) -> Report {
+pub fn build(
+    scenario: &str,
+    chain: &Chain,
+    truth: &TableErrors,
+    cal: &Calibration,
+    data: &super::Data,
+    compensation: Option<Compensation>,
+) -> Report {
     let set = &cal.set;
     let true_values = set.values(truth);
     let mut warnings = Vec::new();
@@ -242,7 +257,8 @@ pub fn build(scenario: &str, chain: &Chain, truth: &TableErrors, cal: &Calibrati
     let prior_dominated: Vec<bool> = (0..set.len())
         .map(|i| {
             let key = set.params[i].key(chain);
-            cal.nls.sigma(i) > 0.5 * cal.prior.1[i] || unobs.iter().any(|u| !u.resolved_by_prior && u.direction.iter().any(|(k, _)| *k == key))
+            cal.nls.sigma(i) > 0.5 * cal.prior.1[i]
+                || unobs.iter().any(|u| !u.resolved_by_prior && u.direction.iter().any(|(k, _)| *k == key))
         })
         .collect();
     let state: Vec<Row> = set
@@ -256,7 +272,11 @@ pub fn build(scenario: &str, chain: &Chain, truth: &TableErrors, cal: &Calibrati
             truth: true_values[i] * ARCSEC_PER_RAD,
             kf: value(&cal.kf, i, ARCSEC_PER_RAD),
             nls: value(&cal.nls, i, ARCSEC_PER_RAD),
-            flag: if prior_dominated[i] { "not determined by the data (see the unobservable combinations)".into() } else { String::new() },
+            flag: if prior_dominated[i] {
+                "not determined by the data (see the unobservable combinations)".into()
+            } else {
+                String::new()
+            },
         })
         .collect();
 
@@ -290,7 +310,10 @@ pub fn build(scenario: &str, chain: &Chain, truth: &TableErrors, cal: &Calibrati
             phase_flag = format!("α = {:.3}″ is within 3σ of 0: the phase is undefined", a_nls.value);
             warnings.push(format!("{name}: {phase_flag}"));
         }
-        let wrap = |v: Value, t: f64| Value { value: t + crate::math::units::wrap_pi((v.value - t) / DEG_PER_RAD) * DEG_PER_RAD, sigma: v.sigma };
+        let wrap = |v: Value, t: f64| Value {
+            value: t + crate::math::units::wrap_pi((v.value - t) / DEG_PER_RAD) * DEG_PER_RAD,
+            sigma: v.sigma,
+        };
         let t_phi = truth.axes[k].swing_phase_rad * DEG_PER_RAD;
         angles.push(Row {
             key: format!("{name}.swing_phase"),
@@ -331,8 +354,13 @@ pub fn build(scenario: &str, chain: &Chain, truth: &TableErrors, cal: &Calibrati
     // Jiang et al. 2017's state (eq. 29) for the dual-axis table: axis 1 = inner (index 1), axis 2 = outer (0).
     let mut paper_state = Vec::new();
     if n_axes == 2
-        && let (Some(a1), Some(a2), Some(b1), Some(b2), Some(e)) =
-            (set.index(Param::SwingCos(1)), set.index(Param::SwingSin(1)), set.index(Param::SwingCos(0)), set.index(Param::SwingSin(0)), set.index(Param::NonOrth(1)))
+        && let (Some(a1), Some(a2), Some(b1), Some(b2), Some(e)) = (
+            set.index(Param::SwingCos(1)),
+            set.index(Param::SwingSin(1)),
+            set.index(Param::SwingCos(0)),
+            set.index(Param::SwingSin(0)),
+            set.index(Param::NonOrth(1)),
+        )
     {
         let xs: [(&str, &str, ParamFn); 5] = [
             ("x1", "x1 = α1 cos φ1", Box::new(move |x: &[f64]| x[a1])),
@@ -350,7 +378,15 @@ pub fn build(scenario: &str, chain: &Chain, truth: &TableErrors, cal: &Calibrati
             } else {
                 String::new()
             };
-            paper_state.push(Row { key: (*key).into(), label: (*label).into(), unit: "arcsec", truth: f(t) * ARCSEC_PER_RAD, kf, nls, flag });
+            paper_state.push(Row {
+                key: (*key).into(),
+                label: (*label).into(),
+                unit: "arcsec",
+                truth: f(t) * ARCSEC_PER_RAD,
+                kf,
+                nls,
+                flag,
+            });
         }
         // Eq. 34 recovers η = atan(x4/x1): meaningless when x1 = α1 cos φ1 is not clearly non-zero.
         let x1 = &paper_state[0].nls;
@@ -396,8 +432,14 @@ pub fn build(scenario: &str, chain: &Chain, truth: &TableErrors, cal: &Calibrati
             cal.measurement_sigma_rad * ARCSEC_PER_RAD
         ));
     }
-    let (walk, bias) = (cal.ins_error.random_walk_rad_per_sqrt_s / crate::math::units::RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H, cal.ins_error.bias_sigma_rad_per_s / crate::math::units::RAD_PER_S_PER_DEG_PER_H);
-    let mut sigma_basis = format!("R per sample: each encoder's noise about its axis + {:.2}″ isotropic", cal.measurement_sigma_rad * ARCSEC_PER_RAD);
+    let (walk, bias) = (
+        cal.ins_error.random_walk_rad_per_sqrt_s / crate::math::units::RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H,
+        cal.ins_error.bias_sigma_rad_per_s / crate::math::units::RAD_PER_S_PER_DEG_PER_H,
+    );
+    let mut sigma_basis = format!(
+        "R per sample: each encoder's noise about its axis + {:.2}″ isotropic",
+        cal.measurement_sigma_rad * ARCSEC_PER_RAD
+    );
     if cal.ins_error.is_some() {
         sigma_basis.push_str(&format!("; the 1σ also carry the INS's error through the whole test (correlated from sample to sample): angle random walk {walk}°/√h, unknown gyro bias {bias}°/h (1σ per axis)"));
     } else if data.source != super::AttitudeSource::Ideal {
@@ -421,7 +463,10 @@ pub fn build(scenario: &str, chain: &Chain, truth: &TableErrors, cal: &Calibrati
         ins_bias_deg_per_h: bias,
         sigma_basis,
         nls_iterations: cal.nls_iterations,
-        residual_rms_arcsec: [cal.kf.residual_rms_rad.map(|v| v * ARCSEC_PER_RAD), cal.nls.residual_rms_rad.map(|v| v * ARCSEC_PER_RAD)],
+        residual_rms_arcsec: [
+            cal.kf.residual_rms_rad.map(|v| v * ARCSEC_PER_RAD),
+            cal.nls.residual_rms_rad.map(|v| v * ARCSEC_PER_RAD),
+        ],
         state,
         angles,
         paper_state,
@@ -467,7 +512,10 @@ impl Report {
     #[must_use]
     pub fn markdown(&self) -> String {
         let head = "| | true | static KF ± 1σ (error) | exact LSQ ± 1σ (error) | |\n|---|---:|---:|---:|---|\n";
-        let mut s = format!("{} samples over {:.0} s, {} (seed {}). {}\n\n", self.samples, self.duration_s, self.source, self.seed, self.sigma_basis);
+        let mut s = format!(
+            "{} samples over {:.0} s, {} (seed {}). {}\n\n",
+            self.samples, self.duration_s, self.source, self.seed, self.sigma_basis
+        );
         let mut table = |title: &str, rows: &[Row]| {
             if !rows.is_empty() {
                 s.push_str(&format!("**{title}**\n\n{head}"));
@@ -482,11 +530,19 @@ impl Report {
         table("State vector (table and reference nuisance)", &self.state);
         if let Some(c) = &self.compensation {
             s.push_str("**Compensation**, on an independent run (other noise seed): attitude error RMS / peak, arcsec\n\n| | pitch | roll | heading |\n|---|---:|---:|---:|\n");
-            for (name, e) in [("before (no swing/η)", c.before), ("after, static KF", c.after_kf), ("after, exact LSQ", c.after_nls), ("with the true values", c.with_truth)] {
-                let cells: Vec<String> = (0..3).map(|i| format!("{:.2} / {:.2}", e.rms_rad[i] * ARCSEC_PER_RAD, e.peak_rad[i] * ARCSEC_PER_RAD)).collect();
+            for (name, e) in [
+                ("before (no swing/η)", c.before),
+                ("after, static KF", c.after_kf),
+                ("after, exact LSQ", c.after_nls),
+                ("with the true values", c.with_truth),
+            ] {
+                let cells: Vec<String> = (0..3)
+                    .map(|i| format!("{:.2} / {:.2}", e.rms_rad[i] * ARCSEC_PER_RAD, e.peak_rad[i] * ARCSEC_PER_RAD))
+                    .collect();
                 s.push_str(&format!("| {name} | {} |\n", cells.join(" | ")));
             }
-            let factors: Vec<String> = (0..3).map(|i| format!("{:.1}×", c.before.peak_rad[i] / c.after_nls.peak_rad[i].max(1e-300))).collect();
+            let factors: Vec<String> =
+                (0..3).map(|i| format!("{:.1}×", c.before.peak_rad[i] / c.after_nls.peak_rad[i].max(1e-300))).collect();
             s.push_str(&format!("| peak reduction (LSQ) | {} |\n", factors.join(" | ")));
             let paper: Vec<String> = PAPER_LAB.iter().map(|(b, a)| format!("{:.1}×", b / a)).collect();
             s.push_str(&format!("| Jiang et al. 2017 laboratory | {} |\n\n", paper.join(" | ")));
@@ -497,8 +553,14 @@ impl Report {
     /// The report as a terminal table.
     #[must_use]
     pub fn text(&self) -> String {
-        let mut s = format!("calibration of {}: {} samples over {:.0} s, {} (seed {})\n{}\n", self.scenario, self.samples, self.duration_s, self.source, self.seed, self.sigma_basis);
-        let header = format!("  {:<26} {:>13}  {:>13} {:>9}  {:>11}  {:>13} {:>9}  {:>11}\n", "", "true", "static KF", "1σ", "(error)", "exact LSQ", "1σ", "(error)");
+        let mut s = format!(
+            "calibration of {}: {} samples over {:.0} s, {} (seed {})\n{}\n",
+            self.scenario, self.samples, self.duration_s, self.source, self.seed, self.sigma_basis
+        );
+        let header = format!(
+            "  {:<26} {:>13}  {:>13} {:>9}  {:>11}  {:>13} {:>9}  {:>11}\n",
+            "", "true", "static KF", "1σ", "(error)", "exact LSQ", "1σ", "(error)"
+        );
         s.push_str("\nangles (phase errors in arcsec of phase):\n");
         s.push_str(&header);
         for r in &self.angles {
@@ -529,10 +591,19 @@ impl Report {
         if let Some(c) = &self.compensation {
             s.push_str("\ncompensation, on an independent run (other noise seed): attitude error RMS / peak, arcsec\n");
             s.push_str(&format!("  {:<22} {:>16} {:>16} {:>16}\n", "", "pitch", "roll", "heading"));
-            for (name, e) in [("before (no swing/η)", c.before), ("after, static KF", c.after_kf), ("after, exact LSQ", c.after_nls), ("with the true values", c.with_truth)] {
+            for (name, e) in [
+                ("before (no swing/η)", c.before),
+                ("after, static KF", c.after_kf),
+                ("after, exact LSQ", c.after_nls),
+                ("with the true values", c.with_truth),
+            ] {
                 s.push_str(&format!("  {name:<22}"));
                 for i in 0..3 {
-                    s.push_str(&format!(" {:>7.2} / {:>6.2}", e.rms_rad[i] * ARCSEC_PER_RAD, e.peak_rad[i] * ARCSEC_PER_RAD));
+                    s.push_str(&format!(
+                        " {:>7.2} / {:>6.2}",
+                        e.rms_rad[i] * ARCSEC_PER_RAD,
+                        e.peak_rad[i] * ARCSEC_PER_RAD
+                    ));
                 }
                 s.push('\n');
             }
@@ -550,7 +621,11 @@ impl Report {
         if !self.aliases.is_empty() {
             s.push_str("\nwhat the calibration assumes: each error it does not estimate is taken as `[compensation]` gives it (nominal, 0, where not given);\n1″ of each would go into the estimates as (″ per ″; |x| ≥ 0.05 shown):\n");
             for a in &self.aliases {
-                let into = if a.into.is_empty() { "nothing".to_owned() } else { a.into.iter().map(|(k, x)| format!("{k} {x:+.2}")).collect::<Vec<_>>().join(", ") };
+                let into = if a.into.is_empty() {
+                    "nothing".to_owned()
+                } else {
+                    a.into.iter().map(|(k, x)| format!("{k} {x:+.2}")).collect::<Vec<_>>().join(", ")
+                };
                 s.push_str(&format!("  {:<28} → {into}\n", a.error));
             }
         }

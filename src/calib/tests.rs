@@ -7,8 +7,8 @@ use crate::math::frames::Rot;
 use super::estimate::exact_residual;
 use super::*;
 use crate::app::calibrate::{calibrate_scenario, collect, monte_carlo};
-use crate::scenario::{presets, Params};
 use crate::math::units::{ARCSEC_PER_RAD, RAD_PER_ARCSEC, RAD_PER_DEG};
+use crate::scenario::{Params, presets};
 
 /// The calibration preset (Jiang et al. 2017 Table 2 truth) with the IMU and encoder noise removed.
 fn noise_free() -> Params {
@@ -54,7 +54,15 @@ fn the_filter_is_eq_33_in_information_form() {
     p.duration_s = 10.0;
     p.calibration.nuisance = Nuisance::None;
     let data = collect(&p, 5, &AtomicBool::new(false)).expect("data");
-    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final, &AtomicBool::new(false)).expect("calibration");
+    let cal = calibrate(
+        &p.table.chain,
+        &p.table.compensation,
+        &data,
+        &p.calibration,
+        History::Final,
+        &AtomicBool::new(false),
+    )
+    .expect("calibration");
     let set = &cal.set;
     let (x0, s0) = set.prior(&p.calibration);
     let mut x = DVector::from_vec(x0);
@@ -93,9 +101,19 @@ fn noise_free_data_give_the_true_parameters() {
     // of phase angle); the first-order filter is off by its neglected second-order terms.
     let p = noise_free();
     let data = collect(&p, 1, &AtomicBool::new(false)).expect("data");
-    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final, &AtomicBool::new(false)).expect("calibration");
+    let cal = calibrate(
+        &p.table.chain,
+        &p.table.compensation,
+        &data,
+        &p.calibration,
+        History::Final,
+        &AtomicBool::new(false),
+    )
+    .expect("calibration");
     let report = report::build("t", &p.table.chain, &p.table.truth, &cal, &data, None);
-    let row = |key: &str| report.angles.iter().chain(&report.state).find(|r| r.key == key).unwrap_or_else(|| panic!("no row {key}"));
+    let row = |key: &str| {
+        report.angles.iter().chain(&report.state).find(|r| r.key == key).unwrap_or_else(|| panic!("no row {key}"))
+    };
     for key in ["inner.swing_half_angle", "outer.swing_cos", "inner.effective_non_orthogonality"] {
         let r = row(key);
         assert!(r.nls_error().abs() < 0.01, "{key}: LSQ error {}″", r.nls_error());
@@ -110,7 +128,15 @@ fn noise_free_data_give_the_true_parameters() {
     let mut p = p;
     p.calibration.prior_eta_rad = p.table.truth.axes[1].non_orthogonality_rad;
     p.calibration.prior_eta_sigma_rad = 1e-9 * RAD_PER_ARCSEC;
-    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final, &AtomicBool::new(false)).expect("calibration");
+    let cal = calibrate(
+        &p.table.chain,
+        &p.table.compensation,
+        &data,
+        &p.calibration,
+        History::Final,
+        &AtomicBool::new(false),
+    )
+    .expect("calibration");
     let report = report::build("t", &p.table.chain, &p.table.truth, &cal, &data, None);
     assert!(report.unobservable.iter().all(|u| u.resolved_by_prior), "{:?}", report.unobservable);
     assert!(report.warnings.is_empty(), "{:?}", report.warnings);
@@ -136,12 +162,22 @@ fn outer_swing_and_eta_are_one_rotation_and_the_report_says_so() {
     let (ra, rb) = (p.table.chain.error_rotations(&ea), p.table.chain.error_rotations(&eb));
     for i in 0..40 {
         let angles = [0.3 * i as f64, 0.71 * i as f64, 0.0];
-        let d = (p.table.chain.b_from_s(&ra, &angles).quaternion().inverse() * p.table.chain.b_from_s(&rb, &angles).quaternion()).angle();
+        let d = (p.table.chain.b_from_s(&ra, &angles).quaternion().inverse()
+            * p.table.chain.b_from_s(&rb, &angles).quaternion())
+        .angle();
         assert!(arcsec(d) < 0.05, "difference {}″", arcsec(d));
     }
     // And the calibration reports exactly that direction as unobservable, with η_eff determined.
     let data = collect(&p, 1, &AtomicBool::new(false)).expect("data");
-    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final, &AtomicBool::new(false)).expect("calibration");
+    let cal = calibrate(
+        &p.table.chain,
+        &p.table.compensation,
+        &data,
+        &p.calibration,
+        History::Final,
+        &AtomicBool::new(false),
+    )
+    .expect("calibration");
     let report = report::build("t", &p.table.chain, &p.table.truth, &cal, &data, None);
     assert_eq!(report.unobservable.len(), 1, "{:?}", report.unobservable);
     let dir = &report.unobservable[0].direction;
@@ -169,22 +205,54 @@ fn phase_and_eq_34_warnings_trigger_where_they_should() {
     p.duration_s = 60.0;
     p.table.truth.axes[1].swing_phase_rad = 90.0 * RAD_PER_DEG;
     let data = collect(&p, 3, &AtomicBool::new(false)).expect("data");
-    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final, &AtomicBool::new(false)).expect("calibration");
+    let cal = calibrate(
+        &p.table.chain,
+        &p.table.compensation,
+        &data,
+        &p.calibration,
+        History::Final,
+        &AtomicBool::new(false),
+    )
+    .expect("calibration");
     let report = report::build("t", &p.table.chain, &p.table.truth, &cal, &data, None);
     assert!(report.warnings.iter().any(|w| w.contains("eq. 34")), "{:?}", report.warnings);
     assert!(!report.warnings.iter().any(|w| w.contains("phase is undefined")), "{:?}", report.warnings);
 
     p.table.truth.axes[1].swing_half_angle_rad = 0.02 * RAD_PER_ARCSEC;
     let data = collect(&p, 3, &AtomicBool::new(false)).expect("data");
-    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final, &AtomicBool::new(false)).expect("calibration");
+    let cal = calibrate(
+        &p.table.chain,
+        &p.table.compensation,
+        &data,
+        &p.calibration,
+        History::Final,
+        &AtomicBool::new(false),
+    )
+    .expect("calibration");
     let report = report::build("t", &p.table.chain, &p.table.truth, &cal, &data, None);
-    assert!(report.warnings.iter().any(|w| w.starts_with("inner: ") && w.contains("phase is undefined")), "{:?}", report.warnings);
+    assert!(
+        report.warnings.iter().any(|w| w.starts_with("inner: ") && w.contains("phase is undefined")),
+        "{:?}",
+        report.warnings
+    );
     // A clearly non-zero α1 at φ1 = 1° raises neither.
     let p = presets::load("jiang2017-calibration").expect("preset");
     let data = collect(&p, 3, &AtomicBool::new(false)).expect("data");
-    let cal = calibrate(&p.table.chain, &p.table.compensation, &data, &p.calibration, History::Final, &AtomicBool::new(false)).expect("calibration");
+    let cal = calibrate(
+        &p.table.chain,
+        &p.table.compensation,
+        &data,
+        &p.calibration,
+        History::Final,
+        &AtomicBool::new(false),
+    )
+    .expect("calibration");
     let report = report::build("t", &p.table.chain, &p.table.truth, &cal, &data, None);
-    assert!(!report.warnings.iter().any(|w| w.contains("eq. 34") || w.contains("phase is undefined")), "{:?}", report.warnings);
+    assert!(
+        !report.warnings.iter().any(|w| w.contains("eq. 34") || w.contains("phase is undefined")),
+        "{:?}",
+        report.warnings
+    );
 }
 
 #[test]
@@ -221,7 +289,13 @@ fn monte_carlo_statistics_are_stable_across_seeds() {
             continue;
         }
         for r in [ra, rb] {
-            assert!(r.nls.mean.abs() < 4.0 * r.nls.std / 40f64.sqrt() + 0.01, "{}: mean {} ± {}", r.label, r.nls.mean, r.nls.std);
+            assert!(
+                r.nls.mean.abs() < 4.0 * r.nls.std / 40f64.sqrt() + 0.01,
+                "{}: mean {} ± {}",
+                r.label,
+                r.nls.mean,
+                r.nls.std
+            );
             // 12″ encoder noise over 20 000 samples: ~0.1″, never arcseconds.
             assert!(r.nls.std < 0.5, "{}: std {}", r.label, r.nls.std);
         }
@@ -235,8 +309,14 @@ fn monte_carlo_statistics_are_stable_across_seeds() {
 #[test]
 fn a_moving_vehicle_is_refused() {
     let mut p = presets::load("jiang2017-calibration").expect("preset");
-    let wobble = crate::model::motion::Wobble { angle: crate::model::motion::AngleKind::Roll, amplitude_rad: 0.01, omega_rad_per_s: 0.5, phase_rad: 0.0 };
-    p.table.vehicle = crate::model::motion::VehicleMotion::new(Attitude::default(), vec![], vec![wobble]).expect("motion");
+    let wobble = crate::model::motion::Wobble {
+        angle: crate::model::motion::AngleKind::Roll,
+        amplitude_rad: 0.01,
+        omega_rad_per_s: 0.5,
+        phase_rad: 0.0,
+    };
+    p.table.vehicle =
+        crate::model::motion::VehicleMotion::new(Attitude::default(), vec![], vec![wobble]).expect("motion");
     assert!(matches!(collect(&p, 0, &AtomicBool::new(false)), Err(CalibError::VehicleMoves(_))));
 }
 
@@ -258,9 +338,12 @@ fn a_replayed_test_calibrates_exactly_as_one_in_memory() {
         }
         Ok(())
     };
-    let replayed = Data { samples: Samples::Replayed { replay: Box::new(replay), count, last_t_s }, ..memory.clone_header() };
-    let a = calibrate(&p.table.chain, &p.table.compensation, &memory, &p.calibration, History::Snapshots(1.0), &stop).expect("memory");
-    let b = calibrate(&p.table.chain, &p.table.compensation, &replayed, &p.calibration, History::Snapshots(1.0), &stop).expect("replayed");
+    let replayed =
+        Data { samples: Samples::Replayed { replay: Box::new(replay), count, last_t_s }, ..memory.clone_header() };
+    let a = calibrate(&p.table.chain, &p.table.compensation, &memory, &p.calibration, History::Snapshots(1.0), &stop)
+        .expect("memory");
+    let b = calibrate(&p.table.chain, &p.table.compensation, &replayed, &p.calibration, History::Snapshots(1.0), &stop)
+        .expect("replayed");
     assert_eq!(a.nls.theta, b.nls.theta);
     assert_eq!(a.kf.theta, b.kf.theta);
     assert_eq!(a.history.len(), b.history.len());
@@ -295,7 +378,8 @@ fn reported_sigmas_match_the_spread_over_repeated_tests() {
             .into_par_iter()
             .map(|i| {
                 let data = collect(&p, 1000 + i, &stop).expect("data");
-                let cal = calibrate(&p.table.chain, &p.calibration_known, &data, &p.calibration, History::Final, &stop).expect("cal");
+                let cal = calibrate(&p.table.chain, &p.calibration_known, &data, &p.calibration, History::Final, &stop)
+                    .expect("cal");
                 let truth = cal.set.values(&p.table.truth);
                 let err: Vec<f64> = cal.nls.theta.iter().zip(&truth).map(|(x, t)| x - t).collect();
                 let sig: Vec<f64> = (0..cal.set.len()).map(|k| cal.nls.sigma(k)).collect();
@@ -317,7 +401,13 @@ fn reported_sigmas_match_the_spread_over_repeated_tests() {
         let flag = &cal.report.state[k].flag;
         let s = spread(results.iter().map(|r| r.0[k]).collect());
         let reported = results.iter().map(|r| r.1[k]).sum::<f64>() / n;
-        eprintln!("{:<40} spread {:.4}″ reported {:.4}″ ratio {:.3} {flag}", param.key(&p.table.chain), arcsec(s), arcsec(reported), reported / s);
+        eprintln!(
+            "{:<40} spread {:.4}″ reported {:.4}″ ratio {:.3} {flag}",
+            param.key(&p.table.chain),
+            arcsec(s),
+            arcsec(reported),
+            reported / s
+        );
         if flag.is_empty() {
             checked.push((param.key(&p.table.chain), s, reported));
         }
@@ -327,7 +417,12 @@ fn reported_sigmas_match_the_spread_over_repeated_tests() {
     eprintln!("{:<40} spread {:.4}″ reported {:.4}″ ratio {:.3}", "η_eff", arcsec(s), arcsec(reported), reported / s);
     checked.push(("η_eff".into(), s, reported));
     for (key, s, reported) in &checked {
-        assert!((reported / s - 1.0).abs() < 0.2, "{key}: reported 1σ {:.4}″, spread over {runs} tests {:.4}″", arcsec(*reported), arcsec(*s));
+        assert!(
+            (reported / s - 1.0).abs() < 0.2,
+            "{key}: reported 1σ {:.4}″, spread over {runs} tests {:.4}″",
+            arcsec(*reported),
+            arcsec(*s)
+        );
     }
     assert!(checked.len() >= 5, "{} states checked", checked.len());
 }

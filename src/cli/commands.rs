@@ -3,15 +3,18 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{CalibrateArgs, Failure, LiveArgs, ModulationArgs, MonteCarloAction, MonteCarloArgs, RunArgs, ScenarioSource, TprArgs};
+use super::{
+    CalibrateArgs, Failure, LiveArgs, ModulationArgs, MonteCarloAction, MonteCarloArgs, RunArgs, ScenarioSource,
+    TprArgs,
+};
 use crate::app::calibrate::{monte_carlo_runs, monte_carlo_setup};
 use crate::app::outputs::{check_output, kept, read_small_file, write_json};
 use crate::app::terminate::stop_flag;
 use crate::app::{live, modulation, reproduce};
-use crate::calib::montecarlo::{self, Shard, ShardFile};
 use crate::calib::MonteCarloConfig;
+use crate::calib::montecarlo::{self, Shard, ShardFile};
 use crate::record::sink;
-use crate::scenario::{self, presets, Params};
+use crate::scenario::{self, Params, presets};
 
 fn load(args: &RunArgs) -> Result<Params, Failure> {
     let mut params = args.source.load(presets::DEFAULT_SCENARIO)?;
@@ -28,8 +31,13 @@ pub(super) fn duration_flag(d: f64) -> Result<f64, Failure> {
 
 /// `rinscope run`.
 pub(super) fn run(args: &RunArgs) -> Result<(), Failure> {
-    use crate::app::run::{execute, RunRequest};
-    let request = RunRequest { params: load(args)?, recording: args.sinks.recording()?, summary_json: args.summary_json.clone(), progress: true };
+    use crate::app::run::{RunRequest, execute};
+    let request = RunRequest {
+        params: load(args)?,
+        recording: args.sinks.recording()?,
+        summary_json: args.summary_json.clone(),
+        progress: true,
+    };
     let report = execute(&request, &stop_flag())?;
     let summary = &report.summary;
     out!("{}", summary.table());
@@ -67,7 +75,13 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
         live::p95(&summary.latencies_ms)
     );
     if let Some((p, bytes)) = &report.recording {
-        outln!("recording: {} ({:.2} MB) — open with `rerun {}`, list its events with `rinscope events {}`", p.display(), *bytes as f64 / 1e6, p.display(), p.display());
+        outln!(
+            "recording: {} ({:.2} MB) — open with `rerun {}`, list its events with `rinscope events {}`",
+            p.display(),
+            *bytes as f64 / 1e6,
+            p.display(),
+            p.display()
+        );
     }
     print_tables(&report.exported);
     // Ended by a signal (not by `q` or its length): 128 + the signal, as every command.
@@ -114,13 +128,16 @@ pub(super) fn print_exported(saved: &sink::Saved) {
 pub(super) fn print_tables(written: &[std::path::PathBuf]) {
     if let Some(first) = written.first() {
         let dir = first.parent().map_or_else(|| ".".into(), |d| d.display().to_string());
-        outln!("exported {} tables to {dir} (pandas: pd.read_parquet(path); MATLAB: parquetread(path); docs/export.md)", written.len());
+        outln!(
+            "exported {} tables to {dir} (pandas: pd.read_parquet(path); MATLAB: parquetread(path); docs/export.md)",
+            written.len()
+        );
     }
 }
 
 /// `rinscope calibrate`.
 pub(super) fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
-    use crate::app::calibrate::{execute, CalibrateInput, CalibrateRequest};
+    use crate::app::calibrate::{CalibrateInput, CalibrateRequest, execute};
     let input = match &args.log {
         Some(dir) => CalibrateInput::Log(Box::new(crate::scenario::logset::load(dir)?)),
         None => CalibrateInput::Scenario(Box::new(args.source.load("jiang2017-calibration")?)),
@@ -132,7 +149,9 @@ pub(super) fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
         print_saved(saved)?;
     }
     if report.interrupted {
-        return Err(Failure::interrupted("the estimates above are complete; the recording's table motion stops where it was cut short"));
+        return Err(Failure::interrupted(
+            "the estimates above are complete; the recording's table motion stops where it was cut short",
+        ));
     }
     Ok(())
 }
@@ -141,7 +160,11 @@ pub(super) fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
 fn monte_carlo_params(source: &ScenarioSource, eta_measured_sigma_arcsec: Option<f64>) -> Result<Params, Failure> {
     let mut params = source.load("jiang2017-calibration")?;
     if let Some(s) = eta_measured_sigma_arcsec {
-        params.calibration.montecarlo.set_eta_measured_sigma_arcsec(s).map_err(|e| Failure::input(format!("--eta-measured-sigma-arcsec {e}")))?;
+        params
+            .calibration
+            .montecarlo
+            .set_eta_measured_sigma_arcsec(s)
+            .map_err(|e| Failure::input(format!("--eta-measured-sigma-arcsec {e}")))?;
     }
     Ok(params)
 }
@@ -153,7 +176,8 @@ pub(super) fn montecarlo(args: &MonteCarloArgs) -> Result<(), Failure> {
     }
     let params = monte_carlo_params(&args.source, args.eta_measured_sigma_arcsec)?;
     check_output("--json", args.json.as_deref())?;
-    let runs = MonteCarloConfig::check_runs(args.runs.unwrap_or(params.calibration.montecarlo.runs as usize)).map_err(|e| Failure::input(format!("--runs {e}")))?;
+    let runs = MonteCarloConfig::check_runs(args.runs.unwrap_or(params.calibration.montecarlo.runs as usize))
+        .map_err(|e| Failure::input(format!("--runs {e}")))?;
     let shard = match &args.shard {
         Some(text) => Shard::parse(text).map_err(|e| Failure::input(format!("--shard {e}")))?,
         None => Shard::WHOLE,
@@ -162,9 +186,11 @@ pub(super) fn montecarlo(args: &MonteCarloArgs) -> Result<(), Failure> {
     let stop = stop_flag();
     let bar = indicatif::ProgressBar::new(mine as u64);
     bar.set_style(
-        indicatif::ProgressStyle::with_template("{spinner} {pos}/{len} calibrations [{bar:40}] {elapsed_precise} (eta {eta})")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
-            .progress_chars("=> "),
+        indicatif::ProgressStyle::with_template(
+            "{spinner} {pos}/{len} calibrations [{bar:40}] {elapsed_precise} (eta {eta})",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+        .progress_chars("=> "),
     );
     let tick = || bar.inc(1);
     let started = std::time::Instant::now();
@@ -173,7 +199,14 @@ pub(super) fn montecarlo(args: &MonteCarloArgs) -> Result<(), Failure> {
     let done = result.map_err(|e| Failure::calibration("montecarlo", e, "montecarlo did not finish"))?;
     let summary = montecarlo::summarize(&monte_carlo_setup(&params), runs, &done, started.elapsed().as_secs_f64());
     if shard != Shard::WHOLE {
-        outln!("shard {}/{}: {} of the {runs} runs (i mod {} == {})", shard.index, shard.count, mine, shard.count, shard.index);
+        outln!(
+            "shard {}/{}: {} of the {runs} runs (i mod {} == {})",
+            shard.index,
+            shard.count,
+            mine,
+            shard.count,
+            shard.index
+        );
     }
     out!("{}", summary.text());
     if let Some(path) = &args.json {
@@ -184,19 +217,32 @@ pub(super) fn montecarlo(args: &MonteCarloArgs) -> Result<(), Failure> {
         }
     }
     if done.len() < mine {
-        return Err(Failure::interrupted(format!("after {} of {mine} runs (the statistics above are over those only)", done.len())));
+        return Err(Failure::interrupted(format!(
+            "after {} of {mine} runs (the statistics above are over those only)",
+            done.len()
+        )));
     }
     Ok(())
 }
 
 /// `rinscope montecarlo merge`.
-fn montecarlo_merge(files: &[PathBuf], source: &ScenarioSource, eta_measured_sigma_arcsec: Option<f64>, json: Option<&Path>) -> Result<(), Failure> {
+fn montecarlo_merge(
+    files: &[PathBuf],
+    source: &ScenarioSource,
+    eta_measured_sigma_arcsec: Option<f64>,
+    json: Option<&Path>,
+) -> Result<(), Failure> {
     let params = monte_carlo_params(source, eta_measured_sigma_arcsec)?;
     check_output("--json", json)?;
     let mut shards = Vec::new();
     for f in files {
         let text = read_small_file(f, "shard file")?;
-        let shard: ShardFile = serde_json::from_str(&text).map_err(|e| Failure::input(format!("{}: not a shard file of `rinscope montecarlo --shard K/M --json` ({e})", f.display())))?;
+        let shard: ShardFile = serde_json::from_str(&text).map_err(|e| {
+            Failure::input(format!(
+                "{}: not a shard file of `rinscope montecarlo --shard K/M --json` ({e})",
+                f.display()
+            ))
+        })?;
         shards.push(shard);
     }
     let setup = monte_carlo_setup(&params);
@@ -218,7 +264,7 @@ fn montecarlo_merge(files: &[PathBuf], source: &ScenarioSource, eta_measured_sig
 
 /// `rinscope tpr`.
 pub(super) fn tpr(args: &TprArgs) -> Result<(), Failure> {
-    use crate::app::tpr::{execute, TprRequest};
+    use crate::app::tpr::{TprRequest, execute};
     let params = args.source.load("zheng2016-tpr")?;
     let request = TprRequest { params, recording: args.sinks.recording()?, json: args.json.clone(), seeds: args.seeds };
     let report = execute(&request, &stop_flag())?;
@@ -281,7 +327,8 @@ pub(super) fn reproduce(markdown: Option<&Path>) -> Result<(), Failure> {
     let table = reproduce::run_all()?;
     out!("{}", table.text());
     if let Some(path) = markdown {
-        crate::io::files::write_atomically(path, table.markdown().as_bytes()).map_err(|e| Failure::output("--markdown", &e))?;
+        crate::io::files::write_atomically(path, table.markdown().as_bytes())
+            .map_err(|e| Failure::output("--markdown", &e))?;
     }
     if table.all_agree() {
         Ok(())
@@ -296,7 +343,9 @@ pub(super) fn bench(steps: u64, json: Option<&std::path::Path>, only: &[String])
     let stop = stop_flag();
     let figures = match crate::app::bench::run_benchmarks(steps, only, &stop) {
         Ok(f) => f,
-        Err(_) if stop.load(std::sync::atomic::Ordering::SeqCst) => return Err(Failure::interrupted("the figures printed so far are not a whole benchmark; none written")),
+        Err(_) if stop.load(std::sync::atomic::Ordering::SeqCst) => {
+            return Err(Failure::interrupted("the figures printed so far are not a whole benchmark; none written"));
+        }
         Err(e) => return Err(Failure::from(e)),
     };
     if let Some(path) = json {
@@ -306,13 +355,20 @@ pub(super) fn bench(steps: u64, json: Option<&std::path::Path>, only: &[String])
 }
 
 /// `bench --peer allantools`.
-pub(super) fn bench_allantools(python: &std::path::Path, rounds: usize, samples: u64, json: Option<&std::path::Path>) -> Result<(), Failure> {
+pub(super) fn bench_allantools(
+    python: &std::path::Path,
+    rounds: usize,
+    samples: u64,
+    json: Option<&std::path::Path>,
+) -> Result<(), Failure> {
     use crate::app::bench::allantools;
     check_output("--json", json)?;
     let stop = stop_flag();
     let reports = match allantools::compare(python, samples, rounds, &stop) {
         Ok(r) => r,
-        Err(_) if stop.load(std::sync::atomic::Ordering::SeqCst) => return Err(Failure::interrupted("the comparison did not finish; nothing written")),
+        Err(_) if stop.load(std::sync::atomic::Ordering::SeqCst) => {
+            return Err(Failure::interrupted("the comparison did not finish; nothing written"));
+        }
         Err(e) => return Err(Failure::run(format!("{e:#}"))),
     };
     out!("{}", allantools::text(&reports, samples));
@@ -323,13 +379,20 @@ pub(super) fn bench_allantools(python: &std::path::Path, rounds: usize, samples:
 }
 
 /// `bench --peer pyins`.
-pub(super) fn bench_peer(python: PathBuf, rounds: usize, samples: u64, json: Option<&std::path::Path>) -> Result<(), Failure> {
+pub(super) fn bench_peer(
+    python: PathBuf,
+    rounds: usize,
+    samples: u64,
+    json: Option<&std::path::Path>,
+) -> Result<(), Failure> {
     use crate::app::bench::peer;
     check_output("--json", json)?;
     let stop = stop_flag();
     let reports = match peer::compare(&peer::PeerOptions { python, rounds, samples }, &stop) {
         Ok(r) => r,
-        Err(_) if stop.load(std::sync::atomic::Ordering::SeqCst) => return Err(Failure::interrupted("the comparison did not finish; nothing written")),
+        Err(_) if stop.load(std::sync::atomic::Ordering::SeqCst) => {
+            return Err(Failure::interrupted("the comparison did not finish; nothing written"));
+        }
         Err(e) => return Err(Failure::run(format!("{e:#}"))),
     };
     out!("{}", peer::text(&reports));

@@ -4,9 +4,9 @@ use std::path::PathBuf;
 
 use super::commands::print_saved;
 use super::{ExportLogArgs, Failure, ReplayArgs};
-use crate::app::export_log::{export_log as write_log_set, LogFormat};
+use crate::app::export_log::{LogFormat, export_log as write_log_set};
 use crate::app::outputs::read_small_file;
-use crate::app::replay::{execute, ReplayRequest};
+use crate::app::replay::{ReplayRequest, execute};
 use crate::app::terminate::stop_flag;
 use crate::scenario::logset::{self, RawImuFile, RawInitial, RawLogInfo, RawManifest, RawReference, RawTable};
 use crate::scenario::presets;
@@ -61,7 +61,8 @@ fn apply_overrides(raw: &mut RawManifest, args: &ReplayArgs) {
         i.position = Some(p);
     }
     if let Some(a) = triple(args.reference_attitude_deg.as_ref()) {
-        raw.reference = Some(RawReference { source: Some("--reference-attitude-deg".into()), file: None, attitude_deg: Some(a) });
+        raw.reference =
+            Some(RawReference { source: Some("--reference-attitude-deg".into()), file: None, attitude_deg: Some(a) });
     }
     if args.from.is_some() {
         raw.log.from_s = args.from;
@@ -86,7 +87,13 @@ fn load_log(args: &ReplayArgs) -> Result<logset::LogSet, Failure> {
     };
     let mut manifest = RawManifest {
         log: RawLogInfo {
-            name: imu.file_stem().and_then(|s| s.to_str()).unwrap_or("replay").chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '_' }).collect(),
+            name: imu
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("replay")
+                .chars()
+                .map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '_' })
+                .collect(),
             description: match &args.table {
                 Some(t) => format!("`{}` replayed with the table {}", imu.display(), t.display()),
                 None => format!("`{}` replayed as a strapdown IMU", imu.display()),
@@ -108,7 +115,11 @@ fn load_log(args: &ReplayArgs) -> Result<logset::LogSet, Failure> {
             gap_policy: "refuse".into(),
             gap_factor: 3.0,
         },
-        encoders: args.encoders.as_ref().map(|e| logset::RawEncoderFile { file: std::path::absolute(e).unwrap_or_else(|_| e.clone()).display().to_string(), latch_delay_ms: 0.0, gap_policy: "interpolate".into() }),
+        encoders: args.encoders.as_ref().map(|e| logset::RawEncoderFile {
+            file: std::path::absolute(e).unwrap_or_else(|_| e.clone()).display().to_string(),
+            latch_delay_ms: 0.0,
+            gap_policy: "interpolate".into(),
+        }),
         reference: None,
         initial: RawInitial::default(),
     };
@@ -128,7 +139,12 @@ pub(super) fn replay(args: &ReplayArgs) -> Result<(), Failure> {
         None => None,
         Some(path) => Some((read_small_file(path, "--compensation")?, path.display().to_string())),
     };
-    let request = ReplayRequest { log, compensation, recording: args.sinks.recording()?, summary_json: args.summary_json.clone() };
+    let request = ReplayRequest {
+        log,
+        compensation,
+        recording: args.sinks.recording()?,
+        summary_json: args.summary_json.clone(),
+    };
     let bar = std::io::IsTerminal::is_terminal(&std::io::stderr()).then(|| {
         let bar = indicatif::ProgressBar::new_spinner();
         bar.enable_steady_tick(std::time::Duration::from_millis(200));

@@ -34,17 +34,24 @@ use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
 
-use crate::io::files::{check_output, OutputKind};
-use crate::io::validity;
-use numbers::{count, duration_s, number, port, ALIGN_S, ANGLE_DEG, CI_SIGMA, ETA_SIGMA_ARCSEC, HOURS, NAVIGATE_HOURS, POSITION_PART, SPEED};
-use crate::record::export::ExportFormat;
 pub(crate) use crate::app::failure::Failure;
 use crate::app::outputs::RecordingRequest;
+use crate::io::files::{OutputKind, check_output};
+use crate::io::validity;
+use crate::record::export::ExportFormat;
 use crate::record::sink::{self, SinkRequest};
-use crate::scenario::{self, presets, ConfigError, Params};
+use crate::scenario::{self, ConfigError, Params, presets};
+use numbers::{
+    ALIGN_S, ANGLE_DEG, CI_SIGMA, ETA_SIGMA_ARCSEC, HOURS, NAVIGATE_HOURS, POSITION_PART, SPEED, count, duration_s,
+    number, port,
+};
 
 #[derive(Parser)]
-#[command(name = "rinscope", version, about = "See the errors of a rotational inertial navigation system (RINS) in the Rerun viewer")]
+#[command(
+    name = "rinscope",
+    version,
+    about = "See the errors of a rotational inertial navigation system (RINS) in the Rerun viewer"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -185,7 +192,8 @@ impl SinkArgs {
         match &self.export {
             None => Ok(None),
             Some(dir) => {
-                let format = ExportFormat::parse(&self.export_format).map_err(|e| Failure::input(format!("--export-format {e}")))?;
+                let format = ExportFormat::parse(&self.export_format)
+                    .map_err(|e| Failure::input(format!("--export-format {e}")))?;
                 check_output("--export", dir, OutputKind::Folder).map_err(|e| Failure::input(e.to_string()))?;
                 Ok(Some((dir.clone(), format)))
             }
@@ -579,8 +587,12 @@ where
         Command::CheckConfig { file } => commands::check_config(&file),
         Command::Reproduce { markdown } => commands::reproduce(markdown.as_deref()),
         Command::Bench { steps, peer: None, json, only, .. } => commands::bench(steps, json.as_deref(), &only),
-        Command::Bench { peer: Some(peer), python, rounds, samples, json, .. } if peer == "allantools" => commands::bench_allantools(&python, rounds, samples, json.as_deref()),
-        Command::Bench { peer: Some(_), python, rounds, samples, json, .. } => commands::bench_peer(python, rounds, samples, json.as_deref()),
+        Command::Bench { peer: Some(peer), python, rounds, samples, json, .. } if peer == "allantools" => {
+            commands::bench_allantools(&python, rounds, samples, json.as_deref())
+        }
+        Command::Bench { peer: Some(_), python, rounds, samples, json, .. } => {
+            commands::bench_peer(python, rounds, samples, json.as_deref())
+        }
     };
     match result {
         Ok(()) => 0,
@@ -590,4 +602,3 @@ where
         }
     }
 }
-

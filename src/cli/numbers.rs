@@ -2,7 +2,7 @@
 //! parsed here, held to its physical range by [`validity::check_number`] (the rule a log's samples
 //! pass), and said short.
 
-use crate::io::validity::{check_number, Range};
+use crate::io::validity::{Range, check_number};
 use crate::scenario;
 
 // The one number rule at the parser (issue 31): every numeric option is parsed by [`number`] or
@@ -14,7 +14,8 @@ use crate::scenario;
 
 /// A simulated duration, s: > 0 and at most 30 days (`scenario::MAX_DURATION_S`, the bound of
 /// `simulation.duration_s`).
-pub(super) const DURATION_S: Range = Range::positive(scenario::MAX_DURATION_S, "s", "a simulated duration (30 days at most, as simulation.duration_s)");
+pub(super) const DURATION_S: Range =
+    Range::positive(scenario::MAX_DURATION_S, "s", "a simulated duration (30 days at most, as simulation.duration_s)");
 /// `modulation --hours`: the same 30 days, in hours.
 pub(super) const HOURS: Range = Range::positive(scenario::MAX_DURATION_S / 3600.0, "h", "a simulated duration");
 /// `selfcal --navigate-hours`: 0 (skip) to 30 days, in hours (`app::selfcal::check_navigate_hours`).
@@ -32,7 +33,8 @@ pub(super) const ALIGN_S: Range = Range::positive(86_400.0, "s", "an alignment t
 pub(super) const ANGLE_DEG: Range = Range::symmetric(360.0, "deg", "an attitude angle");
 /// One of `--position LAT LON HEIGHT`: within ±100 000 (the widest of the three, the height in m;
 /// each one's own bound is the manifest's check, which this option feeds).
-pub(super) const POSITION_PART: Range = Range::symmetric(100_000.0, "", "a latitude (deg), longitude (deg) or height (m)");
+pub(super) const POSITION_PART: Range =
+    Range::symmetric(100_000.0, "", "a latitude (deg), longitude (deg) or height (m)");
 /// `--eta-measured-sigma-arcsec`: > 0 and at most 3600″ (`calib`'s bound: a 1° measurement tells
 /// the filter nothing).
 pub(super) const ETA_SIGMA_ARCSEC: Range = Range::positive(3600.0, "arcsec", "a measurement's 1σ");
@@ -72,7 +74,6 @@ pub(super) fn cut(text: &str) -> String {
     out
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -96,7 +97,8 @@ mod tests {
     fn every_numeric_option_takes_a_negative_number_to_its_range_check() {
         // Issue 31: `run --duration-s -10` said "unexpected argument '-1'".
         use std::any::TypeId;
-        let numeric = [TypeId::of::<f64>(), TypeId::of::<u64>(), TypeId::of::<usize>(), TypeId::of::<u32>(), TypeId::of::<u16>()];
+        let numeric =
+            [TypeId::of::<f64>(), TypeId::of::<u64>(), TypeId::of::<usize>(), TypeId::of::<u32>(), TypeId::of::<u16>()];
         let mut all = Vec::new();
         walk(&Cli::command(), &mut Vec::new(), &mut all);
         let mut checked = 0;
@@ -117,7 +119,10 @@ mod tests {
             };
             assert_eq!(e.kind(), clap::error::ErrorKind::ValueValidation, "{line:?}: {e}");
             let text = e.to_string();
-            assert!(text.contains(&format!("--{long}")) && text.contains("-1e300") && text.len() < 400, "{line:?}: {text}");
+            assert!(
+                text.contains(&format!("--{long}")) && text.contains("-1e300") && text.len() < 400,
+                "{line:?}: {text}"
+            );
             checked += 1;
         }
         assert!(checked >= 25, "{checked} numeric options seen");
@@ -128,10 +133,17 @@ mod tests {
         assert_eq!(number("1e-3", &DURATION_S), Ok(1e-3));
         let e = number("1e308", &validity::IMU_RATE_HZ).expect_err("1e308 Hz");
         assert!(e.starts_with("1e308 Hz") && e.len() < 120, "{e}");
-        assert!(number(&"9".repeat(400), &DURATION_S).expect_err("long").len() < 200, "1e400 parses as inf: said short");
+        assert!(
+            number(&"9".repeat(400), &DURATION_S).expect_err("long").len() < 200,
+            "1e400 parses as inf: said short"
+        );
         assert!(number("abc", &DURATION_S).expect_err("text").contains("not a number"));
         assert_eq!(count("7", 1, 10, "runs"), Ok(7));
-        assert!(count("-7", 1, 10, "runs").expect_err("negative").starts_with("-7: must be a whole number of runs, 1 ..= 10"));
+        assert!(
+            count("-7", 1, 10, "runs")
+                .expect_err("negative")
+                .starts_with("-7: must be a whole number of runs, 1 ..= 10")
+        );
         assert!(count("0", 1, 10, "runs").is_err() && count("1.5", 1, 10, "runs").is_err());
     }
 }

@@ -3,7 +3,7 @@
 
 use super::commands::print_saved;
 use super::{Failure, SelfcalArgs};
-use crate::app::selfcal::{execute, SelfcalInput, SelfcalRequest, SequenceChoice};
+use crate::app::selfcal::{SelfcalInput, SelfcalRequest, SequenceChoice, execute};
 use crate::app::terminate::stop_flag;
 
 /// `rinscope selfcal`.
@@ -12,8 +12,15 @@ pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
         Some(dir) => SelfcalInput::Log(Box::new(crate::scenario::logset::load(dir)?)),
         None => {
             let params = args.source.load("selfcal-nav-grade")?;
-            let sequence = SequenceChoice::parse(&args.sequence).map_err(|e| Failure::input(format!("--sequence {e}")))?;
-            SelfcalInput::Scenario { params: Box::new(params), sequence, monte_carlo: args.monte_carlo.map(|n| n as usize), navigate_hours: args.navigate_hours, plan_only: args.plan }
+            let sequence =
+                SequenceChoice::parse(&args.sequence).map_err(|e| Failure::input(format!("--sequence {e}")))?;
+            SelfcalInput::Scenario {
+                params: Box::new(params),
+                sequence,
+                monte_carlo: args.monte_carlo.map(|n| n as usize),
+                navigate_hours: args.navigate_hours,
+                plan_only: args.plan,
+            }
         }
     };
     let recording = if args.no_recording || args.plan { None } else { Some(args.sinks.recording()?) };

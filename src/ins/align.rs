@@ -26,9 +26,9 @@
 use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
 
 use crate::math::attitude::{Attitude, AttitudeError};
-use crate::math::frames::{Rot, B, N, S, V3};
+use crate::math::frames::{B, N, Rot, S, V3};
 use crate::math::rotvec;
-use crate::model::earth::{normal_gravity, omega_ie_n, EARTH_RATE};
+use crate::model::earth::{EARTH_RATE, normal_gravity, omega_ie_n};
 
 /// One IMU sample: angle increment (rad) and velocity increment (m/s), sensor frame, over the
 /// nominal interval.
@@ -140,7 +140,11 @@ pub fn block_samples(h: f64) -> usize {
 fn specific_force_blocks(samples: &[Increment], h: f64) -> Vec<(f64, Vector3<f64>)> {
     let per = block_samples(h);
     let mut scanner = RestScanner::new(f64::INFINITY);
-    samples.chunks_exact(per).enumerate().map(|(j, chunk)| ((j as f64 + 0.5) * per as f64 * h, scanner.block_mean(chunk, h))).collect()
+    samples
+        .chunks_exact(per)
+        .enumerate()
+        .map(|(j, chunk)| ((j as f64 + 0.5) * per as f64 * h, scanner.block_mean(chunk, h)))
+        .collect()
 }
 
 /// Scans `samples` for the initial rest: one-second means of the specific force in the inertial
@@ -152,10 +156,20 @@ pub fn scan_rest(samples: &[Increment], h: f64, threshold_mps2: f64) -> RestScan
     for (j, chunk) in samples.chunks_exact(per).enumerate() {
         if let Some(change) = scanner.push_block(chunk, h) {
             // Blocks 0..j were at rest; block j moved.
-            return RestScan { rest_s: j as f64 * BLOCK_S, threshold_mps2, largest_change_mps2: scanner.largest_change_mps2, ending_change_mps2: Some(change) };
+            return RestScan {
+                rest_s: j as f64 * BLOCK_S,
+                threshold_mps2,
+                largest_change_mps2: scanner.largest_change_mps2,
+                ending_change_mps2: Some(change),
+            };
         }
     }
-    RestScan { rest_s: samples.len() as f64 * h, threshold_mps2, largest_change_mps2: scanner.largest_change_mps2, ending_change_mps2: None }
+    RestScan {
+        rest_s: samples.len() as f64 * h,
+        threshold_mps2,
+        largest_change_mps2: scanner.largest_change_mps2,
+        ending_change_mps2: None,
+    }
 }
 
 /// The white noise of a triad, unit/√s, from differences of its increments: the k-th difference of
@@ -287,7 +301,15 @@ struct Pass {
 const STEP_S: f64 = 0.1;
 const UPDATE_S: f64 = 1.0;
 
-fn run_pass(samples: &[Increment], cfg: &AlignConfig, start: &UnitQuaternion<f64>, r_mps: f64, noise: (f64, f64), prior: (f64, f64), heading_sigma: f64) -> Pass {
+fn run_pass(
+    samples: &[Increment],
+    cfg: &AlignConfig,
+    start: &UnitQuaternion<f64>,
+    r_mps: f64,
+    noise: (f64, f64),
+    prior: (f64, f64),
+    heading_sigma: f64,
+) -> Pass {
     let h = cfg.interval_s;
     let g = normal_gravity(cfg.latitude_rad, cfg.height_m);
     let w_ie = omega_ie_n(cfg.latitude_rad);
@@ -296,7 +318,10 @@ fn run_pass(samples: &[Increment], cfg: &AlignConfig, start: &UnitQuaternion<f64
     let steps_per_update = ((UPDATE_S / (per_step as f64 * h)).round() as usize).max(1);
     let mut p = P12::zeros();
     let tilt = 1.0_f64.to_radians();
-    for (i, s) in [tilt, tilt, heading_sigma, 0.1, 0.1, 0.1, prior.0, prior.0, prior.0, prior.1, prior.1, prior.1].into_iter().enumerate() {
+    for (i, s) in [tilt, tilt, heading_sigma, 0.1, 0.1, 0.1, prior.0, prior.0, prior.0, prior.1, prior.1, prior.1]
+        .into_iter()
+        .enumerate()
+    {
         p[(i, i)] = s * s;
     }
     let mut q_c = P12::zeros();
@@ -365,10 +390,14 @@ pub enum AlignError {
     #[error("{0:.1} s of data: the alignment needs at least 10 s at rest")]
     TooShort(f64),
     /// The coarse step found no Earth rate.
-    #[error("the gravity direction does not turn with the Earth in these data (a pole, a gyro that reads nothing, or a vehicle that moved): no heading")]
+    #[error(
+        "the gravity direction does not turn with the Earth in these data (a pole, a gyro that reads nothing, or a vehicle that moved): no heading"
+    )]
     NoEarthRate,
     /// The data are not a specific force of gravity's size.
-    #[error("the mean specific force is {measured:.4} m/s², gravity at the site is {gravity:.4} m/s²: the vehicle moved, or the accelerometers' unit is wrong")]
+    #[error(
+        "the mean specific force is {measured:.4} m/s², gravity at the site is {gravity:.4} m/s²: the vehicle moved, or the accelerometers' unit is wrong"
+    )]
     NotGravity {
         /// Measured, m/s².
         measured: f64,
@@ -396,10 +425,22 @@ pub fn fine(samples: &[Increment], cfg: &AlignConfig) -> Result<Alignment, Align
         return Err(AlignError::NotGravity { measured: mean_f, gravity: g });
     }
     let start = coarse(samples, cfg).ok_or(AlignError::NoEarthRate)?;
-    let arw = Assumed { value: cfg.gyro_random_walk.unwrap_or_else(|| random_walk(samples, h, true)), given: cfg.gyro_random_walk.is_some() };
-    let vrw = Assumed { value: cfg.accel_random_walk.unwrap_or_else(|| random_walk(samples, h, false)), given: cfg.accel_random_walk.is_some() };
-    let eb0 = Assumed { value: cfg.gyro_bias_sigma_rad_per_s.unwrap_or_else(|| assumed_gyro_bias(arw.value)), given: cfg.gyro_bias_sigma_rad_per_s.is_some() };
-    let db0 = Assumed { value: cfg.accel_bias_sigma_mps2.unwrap_or_else(|| assumed_accel_bias(vrw.value)), given: cfg.accel_bias_sigma_mps2.is_some() };
+    let arw = Assumed {
+        value: cfg.gyro_random_walk.unwrap_or_else(|| random_walk(samples, h, true)),
+        given: cfg.gyro_random_walk.is_some(),
+    };
+    let vrw = Assumed {
+        value: cfg.accel_random_walk.unwrap_or_else(|| random_walk(samples, h, false)),
+        given: cfg.accel_random_walk.is_some(),
+    };
+    let eb0 = Assumed {
+        value: cfg.gyro_bias_sigma_rad_per_s.unwrap_or_else(|| assumed_gyro_bias(arw.value)),
+        given: cfg.gyro_bias_sigma_rad_per_s.is_some(),
+    };
+    let db0 = Assumed {
+        value: cfg.accel_bias_sigma_mps2.unwrap_or_else(|| assumed_accel_bias(vrw.value)),
+        given: cfg.accel_bias_sigma_mps2.is_some(),
+    };
     let cos_lat = cfg.latitude_rad.cos().max(1e-3);
     // What a coarse alignment can do about heading with this gyro (bias over the horizontal Earth
     // rate), at least a degree: the filter's prior.
@@ -409,7 +450,11 @@ pub fn fine(samples: &[Increment], cfg: &AlignConfig) -> Result<Alignment, Align
     let first = run_pass(samples, cfg, start.quaternion(), 0.01, noise, prior, heading_sigma);
     // The disturbance: innovations after the first fifth (the filter has settled).
     let settled = &first.innovations[first.innovations.len() / 5..];
-    let r = if settled.is_empty() { 0.01 } else { (settled.iter().map(|x| x * x).sum::<f64>() / settled.len() as f64).sqrt().max(1e-4) };
+    let r = if settled.is_empty() {
+        0.01
+    } else {
+        (settled.iter().map(|x| x * x).sum::<f64>() / settled.len() as f64).sqrt().max(1e-4)
+    };
     let second = run_pass(samples, cfg, start.quaternion(), r, noise, prior, heading_sigma);
     let rest = &second.innovations[second.innovations.len() / 5..];
     let rms = if rest.is_empty() { 0.0 } else { (rest.iter().map(|x| x * x).sum::<f64>() / rest.len() as f64).sqrt() };
@@ -468,19 +513,26 @@ pub struct ImpliedLatitude {
 
 /// See [`ImpliedLatitude`]; `gyro_bias_sigma` (rad/s) turns the gravity direction too.
 #[must_use]
-pub fn implied_latitude(samples: &[Increment], h: f64, site_latitude_rad: f64, gyro_bias_sigma: f64) -> Option<ImpliedLatitude> {
+pub fn implied_latitude(
+    samples: &[Increment],
+    h: f64,
+    site_latitude_rad: f64,
+    gyro_bias_sigma: f64,
+) -> Option<ImpliedLatitude> {
     let blocks = specific_force_blocks(samples, h);
     let n = blocks.len();
     if n < 10 {
         return None;
     }
-    let units: Vec<(f64, Vector3<f64>)> = blocks.iter().filter_map(|(t, f)| f.try_normalize(1e-9).map(|u| (*t, u))).collect();
+    let units: Vec<(f64, Vector3<f64>)> =
+        blocks.iter().filter_map(|(t, f)| f.try_normalize(1e-9).map(|u| (*t, u))).collect();
     let n = units.len() as f64;
     let t_mean = units.iter().map(|(t, _)| t).sum::<f64>() / n;
     let u_mean: Vector3<f64> = units.iter().map(|(_, u)| u).sum::<Vector3<f64>>() / n;
     let stt: f64 = units.iter().map(|(t, _)| (t - t_mean).powi(2)).sum();
     let slope: Vector3<f64> = units.iter().map(|(t, u)| (u - u_mean) * (t - t_mean)).sum::<Vector3<f64>>() / stt;
-    let resid: f64 = units.iter().map(|(t, u)| (u - u_mean - slope * (t - t_mean)).norm_squared()).sum::<f64>() / (2.0 * (n - 2.0)).max(1.0);
+    let resid: f64 = units.iter().map(|(t, u)| (u - u_mean - slope * (t - t_mean)).norm_squared()).sum::<f64>()
+        / (2.0 * (n - 2.0)).max(1.0);
     // The slope's 1σ per component; only the part across the gravity direction carries the rate.
     let slope_sigma = (resid / stt).sqrt();
     let rate = u_mean.normalize().cross(&slope).norm();
@@ -488,7 +540,10 @@ pub fn implied_latitude(samples: &[Increment], h: f64, site_latitude_rad: f64, g
     let lat = cos_l.acos() * if site_latitude_rad < 0.0 { -1.0 } else { 1.0 };
     let sigma_rate = (slope_sigma * slope_sigma * 2.0 + gyro_bias_sigma * gyro_bias_sigma).sqrt();
     let sin_l = lat.sin().abs().max(0.05);
-    Some(ImpliedLatitude { latitude_rad: lat, sigma_rad: (sigma_rate / (EARTH_RATE * sin_l)).min(std::f64::consts::FRAC_PI_2) })
+    Some(ImpliedLatitude {
+        latitude_rad: lat,
+        sigma_rad: (sigma_rate / (EARTH_RATE * sin_l)).min(std::f64::consts::FRAC_PI_2),
+    })
 }
 
 #[cfg(test)]

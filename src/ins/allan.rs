@@ -3,16 +3,20 @@
 //! table, a markdown table and JSON (docs/allan.md). `app::allan` gathers the log (simulated or
 //! read), `record::allan` draws it.
 
-use serde_json::{json, Map, Value};
+use serde_json::{Map, Value, json};
 
 use super::noise::IeeeTerms;
 use super::sensor::{AccelSpec, GyroSpec};
 use crate::math::allan::edf::alpha_code;
-use crate::math::allan::estimators::{deviation_curve, DeviationCurve, Estimator};
-use crate::math::allan::{analyze, averaging_factors, gauss_markov_avar, AllanError, AllanOptions, AllanReport, Estimate, NoiseTerm, Phase, SlopeReading, MIN_SAMPLES, TERMS};
+use crate::math::allan::estimators::{DeviationCurve, Estimator, deviation_curve};
+use crate::math::allan::{
+    AllanError, AllanOptions, AllanReport, Estimate, MIN_SAMPLES, NoiseTerm, Phase, SlopeReading, TERMS, analyze,
+    averaging_factors, gauss_markov_avar,
+};
 use crate::math::units::{
-    MPS2_PER_SQRT_S_PER_UG_PER_SQRT_H, MPS2_PER_UG, MPS3_PER_UG_PER_H, MPS_PER_SQRT_S_PER_UG_PER_SQRT_HZ, RAD_PER_ARCSEC, RAD_PER_S2_PER_DEG_PER_H2, RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H,
-    RAD_PER_S_PER_DEG_PER_H, RAD_PER_S_PER_SQRT_S_PER_DEG_PER_H_PER_SQRT_H,
+    MPS_PER_SQRT_S_PER_UG_PER_SQRT_HZ, MPS2_PER_SQRT_S_PER_UG_PER_SQRT_H, MPS2_PER_UG, MPS3_PER_UG_PER_H,
+    RAD_PER_ARCSEC, RAD_PER_S_PER_DEG_PER_H, RAD_PER_S_PER_SQRT_S_PER_DEG_PER_H_PER_SQRT_H, RAD_PER_S2_PER_DEG_PER_H2,
+    RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H,
 };
 
 /// The axis names, in channel order.
@@ -94,7 +98,9 @@ impl Sensor {
             (Self::Gyro, NoiseTerm::Quantization) => ("arcsec", "″", RAD_PER_ARCSEC),
             (Self::Gyro, NoiseTerm::RandomWalk) => ("deg_per_sqrt_h", "°/√h", RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H),
             (Self::Gyro, NoiseTerm::BiasInstability) => ("deg_per_h", "°/h", RAD_PER_S_PER_DEG_PER_H),
-            (Self::Gyro, NoiseTerm::RateRandomWalk) => ("deg_per_h_per_sqrt_h", "°/h/√h", RAD_PER_S_PER_SQRT_S_PER_DEG_PER_H_PER_SQRT_H),
+            (Self::Gyro, NoiseTerm::RateRandomWalk) => {
+                ("deg_per_h_per_sqrt_h", "°/h/√h", RAD_PER_S_PER_SQRT_S_PER_DEG_PER_H_PER_SQRT_H)
+            }
             (Self::Gyro, NoiseTerm::RateRamp) => ("deg_per_h2", "°/h²", RAD_PER_S2_PER_DEG_PER_H2),
             (Self::Accel, NoiseTerm::Quantization) => ("mps", "m/s", 1.0),
             (Self::Accel, NoiseTerm::RandomWalk) => ("ug_per_sqrt_hz", "µg/√Hz", MPS_PER_SQRT_S_PER_UG_PER_SQRT_HZ),
@@ -171,7 +177,8 @@ impl Truth {
     /// ([`IeeeTerms::model_avar`]) and the Gauss-Markov bias's.
     #[must_use]
     pub fn avar(&self, tau_s: f64) -> f64 {
-        let markov = if self.has_markov() { gauss_markov_avar(self.markov_sigma_si, self.correlation_s, tau_s) } else { 0.0 };
+        let markov =
+            if self.has_markov() { gauss_markov_avar(self.markov_sigma_si, self.correlation_s, tau_s) } else { 0.0 };
         self.terms.model_avar(tau_s) + markov
     }
 }
@@ -202,7 +209,10 @@ impl Channel {
     /// The fitted coefficient of `term` in its conventional unit (zero, not found, without a fit).
     #[must_use]
     pub fn fitted(&self, term: NoiseTerm) -> Estimate {
-        self.report.as_ref().map_or(Estimate { value: 0.0, sigma: 0.0, significant: false }, |r| r.fit.get(term)).scaled(1.0 / self.sensor.unit(term).si)
+        self.report
+            .as_ref()
+            .map_or(Estimate { value: 0.0, sigma: 0.0, significant: false }, |r| r.fit.get(term))
+            .scaled(1.0 / self.sensor.unit(term).si)
     }
 
     /// The configured coefficient of `term` in its conventional unit (None without a truth).
@@ -229,9 +239,18 @@ pub struct ChannelError {
 ///
 /// # Errors
 /// The first channel that cannot be analysed, named.
-pub fn analyze_imu(phases: &[Phase], tau0_s: f64, opts: &AllanOptions, estimators: &[Estimator], truth: Option<[Truth; 2]>, parallel: bool) -> Result<Vec<Channel>, ChannelError> {
+pub fn analyze_imu(
+    phases: &[Phase],
+    tau0_s: f64,
+    opts: &AllanOptions,
+    estimators: &[Estimator],
+    truth: Option<[Truth; 2]>,
+    parallel: bool,
+) -> Result<Vec<Channel>, ChannelError> {
     use rayon::prelude::*;
-    let one = |i: usize| analyze_channel(Sensor::ALL[i / 3], AXES[i % 3], &phases[i], tau0_s, opts, estimators, truth.map(|t| t[i / 3]));
+    let one = |i: usize| {
+        analyze_channel(Sensor::ALL[i / 3], AXES[i % 3], &phases[i], tau0_s, opts, estimators, truth.map(|t| t[i / 3]))
+    };
     let n = phases.len().min(6);
     if parallel { (0..n).into_par_iter().map(one).collect() } else { (0..n).map(one).collect() }
 }
@@ -243,12 +262,24 @@ pub fn analyze_imu(phases: &[Phase], tau0_s: f64, opts: &AllanOptions, estimator
 ///
 /// # Errors
 /// A non-finite sample, too few samples for any estimator, a bad option; named by channel.
-pub fn analyze_channel(sensor: Sensor, label: &str, phase: &Phase, tau0_s: f64, opts: &AllanOptions, estimators: &[Estimator], truth: Option<Truth>) -> Result<Channel, ChannelError> {
+pub fn analyze_channel(
+    sensor: Sensor,
+    label: &str,
+    phase: &Phase,
+    tau0_s: f64,
+    opts: &AllanOptions,
+    estimators: &[Estimator],
+    truth: Option<Truth>,
+) -> Result<Channel, ChannelError> {
     let fail = |error| ChannelError { channel: format!("{} {label}", sensor.name()), error };
     if let Some((index, value)) = phase.first_bad() {
         return Err(fail(AllanError::NonFinite { index, value }));
     }
-    let report = if sensor.is_inertial() && phase.len() >= MIN_SAMPLES.max(2 * opts.min_clusters) { Some(analyze(phase, tau0_s, opts).map_err(fail)?) } else { None };
+    let report = if sensor.is_inertial() && phase.len() >= MIN_SAMPLES.max(2 * opts.min_clusters) {
+        Some(analyze(phase, tau0_s, opts).map_err(fail)?)
+    } else {
+        None
+    };
     let x = phase.points();
     // Every curve at the spacing of the fit, up to N / min_clusters (each as far as it is defined).
     let m_max = phase.len() / opts.min_clusters.max(2);
@@ -321,14 +352,22 @@ impl ImuAllan {
     /// The shortest and the longest cluster time analysed, s.
     #[must_use]
     pub fn tau_range_s(&self) -> (f64, f64) {
-        let taus = self.channels.iter().flat_map(|c| c.report.iter().map(|r| r.taus_s.as_slice()).chain(c.curves.iter().map(|k| k.taus_s.as_slice())));
-        taus.fold((f64::INFINITY, 0.0), |(lo, hi), t| (lo.min(t.first().copied().unwrap_or(lo)), hi.max(t.last().copied().unwrap_or(hi))))
+        let taus = self.channels.iter().flat_map(|c| {
+            c.report.iter().map(|r| r.taus_s.as_slice()).chain(c.curves.iter().map(|k| k.taus_s.as_slice()))
+        });
+        taus.fold((f64::INFINITY, 0.0), |(lo, hi), t| {
+            (lo.min(t.first().copied().unwrap_or(lo)), hi.max(t.last().copied().unwrap_or(hi)))
+        })
     }
 
     /// Number of cluster times of the longest curve.
     #[must_use]
     pub fn tau_count(&self) -> usize {
-        self.channels.iter().flat_map(|c| c.report.iter().map(|r| r.taus_s.len()).chain(c.curves.iter().map(|k| k.taus_s.len()))).max().unwrap_or(0)
+        self.channels
+            .iter()
+            .flat_map(|c| c.report.iter().map(|r| r.taus_s.len()).chain(c.curves.iter().map(|k| k.taus_s.len())))
+            .max()
+            .unwrap_or(0)
     }
 
     /// The one-line heading.
@@ -361,14 +400,25 @@ impl ImuAllan {
         s.push_str(&self.heading());
         s.push('\n');
         for sensor in Sensor::ALL {
-            let chans: Vec<(&Channel, &AllanReport)> = self.channels.iter().filter(|c| c.sensor == sensor).filter_map(|c| c.report.as_ref().map(|r| (c, r))).collect();
+            let chans: Vec<(&Channel, &AllanReport)> = self
+                .channels
+                .iter()
+                .filter(|c| c.sensor == sensor)
+                .filter_map(|c| c.report.as_ref().map(|r| (c, r)))
+                .collect();
             if chans.is_empty() {
                 continue;
             }
             let truth = chans[0].0.truth;
-            let labels: Vec<String> = TERMS.iter().map(|t| format!("{} {} ({})", t.letter(), sensor.term_name(*t), sensor.unit(*t).text)).collect();
+            let labels: Vec<String> = TERMS
+                .iter()
+                .map(|t| format!("{} {} ({})", t.letter(), sensor.term_name(*t), sensor.unit(*t).text))
+                .collect();
             let w = labels.iter().map(|l| l.chars().count()).max().unwrap_or(0) + 2;
-            let cells: Vec<Vec<String>> = TERMS.iter().map(|t| chans.iter().map(|(c, _)| cell(c.fitted(*t), c.configured(*t))).collect()).collect();
+            let cells: Vec<Vec<String>> = TERMS
+                .iter()
+                .map(|t| chans.iter().map(|(c, _)| cell(c.fitted(*t), c.configured(*t))).collect())
+                .collect();
             let cw = cells.iter().flatten().map(|c| c.chars().count()).max().unwrap_or(0).max(4) + 2;
             s += &format!("\n{:<w$}", format!("{} (fit ±1σ, error)", sensor.name()));
             for (c, _) in &chans {
@@ -462,7 +512,12 @@ impl ImuAllan {
             }
         }
         if let Some(t) = chans.first().and_then(|c| c.truth).filter(Truth::has_markov) {
-            s += &format!("\nAlso configured: a Gauss-Markov bias, σ {} {}, T {} s.\n", sig(t.markov_sigma_si / sensor.adev_unit().si, 3), sensor.adev_unit().text, t.correlation_s);
+            s += &format!(
+                "\nAlso configured: a Gauss-Markov bias, σ {} {}, T {} s.\n",
+                sig(t.markov_sigma_si / sensor.adev_unit().si, 3),
+                sensor.adev_unit().text,
+                t.correlation_s
+            );
         }
         s
     }
@@ -519,13 +574,21 @@ fn curve_json(sensor: Sensor, k: &DeviationCurve) -> Value {
 /// A channel's curves as a terminal table: a row per τ, per estimator the deviation, its bounds
 /// and the noise type the EDF assumed.
 fn curve_table(c: &Channel, curves: &[DeviationCurve], ci_sigma: f64) -> String {
-    let mut taus: Vec<(usize, f64)> = curves.iter().flat_map(|k| k.m.iter().copied().zip(k.taus_s.iter().copied())).collect();
+    let mut taus: Vec<(usize, f64)> =
+        curves.iter().flat_map(|k| k.m.iter().copied().zip(k.taus_s.iter().copied())).collect();
     taus.sort_by_key(|(m, _)| *m);
     taus.dedup_by_key(|(m, _)| *m);
-    let heads: Vec<String> = curves.iter().map(|k| {
-        let u = c.sensor.deviation_unit(k.estimator);
-        format!("{}{} [±{ci_sigma}σ] noise", k.estimator.name().to_uppercase(), if u.text.is_empty() { String::new() } else { format!(" ({})", u.text) })
-    }).collect();
+    let heads: Vec<String> = curves
+        .iter()
+        .map(|k| {
+            let u = c.sensor.deviation_unit(k.estimator);
+            format!(
+                "{}{} [±{ci_sigma}σ] noise",
+                k.estimator.name().to_uppercase(),
+                if u.text.is_empty() { String::new() } else { format!(" ({})", u.text) }
+            )
+        })
+        .collect();
     let rows: Vec<Vec<String>> = taus
         .iter()
         .map(|(m, _)| {
@@ -534,13 +597,22 @@ fn curve_table(c: &Channel, curves: &[DeviationCurve], ci_sigma: f64) -> String 
                 .map(|k| {
                     let u = c.sensor.deviation_unit(k.estimator).si;
                     k.m.iter().position(|x| x == m).map_or_else(String::new, |j| {
-                        format!("{} [{}, {}] {}{}", sig(k.dev[j] / u, 4), sig(k.lower[j] / u, 3), sig(k.upper[j] / u, 3), alpha_code(k.alpha[j]), if k.alpha_identified[j] { "" } else { "*" })
+                        format!(
+                            "{} [{}, {}] {}{}",
+                            sig(k.dev[j] / u, 4),
+                            sig(k.lower[j] / u, 3),
+                            sig(k.upper[j] / u, 3),
+                            alpha_code(k.alpha[j]),
+                            if k.alpha_identified[j] { "" } else { "*" }
+                        )
                     })
                 })
                 .collect()
         })
         .collect();
-    let widths: Vec<usize> = (0..heads.len()).map(|i| rows.iter().map(|r| r[i].chars().count()).chain([heads[i].chars().count()]).max().unwrap_or(0) + 2).collect();
+    let widths: Vec<usize> = (0..heads.len())
+        .map(|i| rows.iter().map(|r| r[i].chars().count()).chain([heads[i].chars().count()]).max().unwrap_or(0) + 2)
+        .collect();
     let mut s = format!("\n{} — τ (s)", c.name());
     let tw = taus.iter().map(|(_, t)| sig(*t, 4).len()).max().unwrap_or(0).max(s.chars().count() - 1) + 2;
     s = format!("{:<tw$}", s);
@@ -578,7 +650,10 @@ fn channel_json(c: &Channel) -> Value {
     m.insert("dominant".into(), json!(r.dominant.iter().map(|t| t.letter()).collect::<Vec<_>>()));
     m.insert("fit_chi2_per_dof".into(), json!(r.fit_chi2_per_dof));
     // A fit is a claim: where the data contradict a term or the whole model, said in words.
-    m.insert("fit_warnings".into(), json!(r.fit_contradictions.iter().map(crate::math::allan::Contradiction::text).collect::<Vec<_>>()));
+    m.insert(
+        "fit_warnings".into(),
+        json!(r.fit_contradictions.iter().map(crate::math::allan::Contradiction::text).collect::<Vec<_>>()),
+    );
     let mut fitted = Map::new();
     let mut readings = Map::new();
     for term in TERMS {
@@ -601,7 +676,10 @@ fn channel_json(c: &Channel) -> Value {
             cfg.insert(format!("markov_sigma_{}", u.key), json!(t.markov_sigma_si / u.si));
             cfg.insert("correlation_time_s".into(), json!(t.correlation_s));
             m.insert("configured".into(), Value::Object(cfg));
-            m.insert(format!("configured_adev_{}", u.key), json!(r.taus_s.iter().map(|tau| t.avar(*tau).sqrt() / u.si).collect::<Vec<_>>()));
+            m.insert(
+                format!("configured_adev_{}", u.key),
+                json!(r.taus_s.iter().map(|tau| t.avar(*tau).sqrt() / u.si).collect::<Vec<_>>()),
+            );
         }
     }
     Value::Object(m)

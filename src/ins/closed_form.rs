@@ -152,7 +152,10 @@ impl ClosedForm {
     #[must_use]
     pub fn new(links: &[Link], omega_ie_n: Vector3<f64>, f_n: Vector3<f64>, t_anchor_s: f64) -> Option<Self> {
         // A cone turns its vectors through two links of rate ±Ω.
-        let rate_sum: f64 = links.iter().map(|l| l.rate_rad_per_s().abs() * if matches!(l, Link::Cone { .. }) { 2.0 } else { 1.0 }).sum();
+        let rate_sum: f64 = links
+            .iter()
+            .map(|l| l.rate_rad_per_s().abs() * if matches!(l, Link::Cone { .. }) { 2.0 } else { 1.0 })
+            .sum();
         // Frequencies are sums of the rates in different orders: equal to a few ulps.
         let tol = 8.0 * f64::EPSILON * rate_sum;
         let mut terms = vec![(0.0, CVec::real(omega_ie_n), CVec::real(f_n))];
@@ -166,15 +169,23 @@ impl ClosedForm {
                 Link::Cone { half_angle_rad, phase_rad, rate_rad_per_s } if rate_rad_per_s != 0.0 => {
                     // Kᵀ = Rz(φ)ᵀ... applied link by link: Rz(φ), Rx(α), Rz(−φ).
                     turn_back(&mut terms, &Vector3::z(), phase_rad, rate_rad_per_s, tol)?;
-                    rotate_back(&mut terms, &nalgebra::UnitQuaternion::from_axis_angle(&Vector3::x_axis(), half_angle_rad));
+                    rotate_back(
+                        &mut terms,
+                        &nalgebra::UnitQuaternion::from_axis_angle(&Vector3::x_axis(), half_angle_rad),
+                    );
                     turn_back(&mut terms, &Vector3::z(), -phase_rad, -rate_rad_per_s, tol)?;
                     // Its own rate, exact: Ω(−sin α sin φ, sin α cos φ, −2 sin²(α/2)) =
                     // Re(Ω sin α e^{iφ0} (i, 1, 0) e^{iΩτ}) + (0, 0, −2Ω sin²(α/2)).
                     let (w, (sa, sh)) = (rate_rad_per_s, (half_angle_rad.sin(), (0.5 * half_angle_rad).sin()));
                     let (s0, c0) = phase_rad.sin_cos();
-                    let spin = CVec { re: Vector3::new(-s0, c0, 0.0) * (w * sa), im: Vector3::new(c0, s0, 0.0) * (w * sa) };
+                    let spin =
+                        CVec { re: Vector3::new(-s0, c0, 0.0) * (w * sa), im: Vector3::new(c0, s0, 0.0) * (w * sa) };
                     terms.push((w, spin, CVec::real(Vector3::zeros())));
-                    terms.push((0.0, CVec::real(Vector3::new(0.0, 0.0, -2.0 * w * sh * sh)), CVec::real(Vector3::zeros())));
+                    terms.push((
+                        0.0,
+                        CVec::real(Vector3::new(0.0, 0.0, -2.0 * w * sh * sh)),
+                        CVec::real(Vector3::zeros()),
+                    ));
                 }
                 _ => rotate_back(&mut terms, &link.rotation(0.0)),
             }
@@ -199,7 +210,15 @@ impl ClosedForm {
                 out.push(Term { nu, omega: w, f, z: (1.0, 0.0), step: (1.0, 0.0), weight: 0.0, weight_dh: 0.0 });
             }
         }
-        (out.len() <= MAX_TERMS).then_some(Self { t_anchor_s, omega0, f0, terms: out, h_s: f64::NAN, tau_next: f64::NAN, since_anchor: 0 })
+        (out.len() <= MAX_TERMS).then_some(Self {
+            t_anchor_s,
+            omega0,
+            f0,
+            terms: out,
+            h_s: f64::NAN,
+            tau_next: f64::NAN,
+            since_anchor: 0,
+        })
     }
 
     /// Number of frequencies (ν > 0).
@@ -228,7 +247,8 @@ impl ClosedForm {
         // The caller's times carry rounding of ~ulp(t) (t = i·h): intervals and midpoints that differ
         // from the stepped ones by that much are still regular.
         let slack = 1e-8 * self.h_s + 16.0 * f64::EPSILON * t1_s.abs();
-        let regular = self.since_anchor < REANCHOR && (h - self.h_s).abs() <= slack && (tau - self.tau_next).abs() <= slack;
+        let regular =
+            self.since_anchor < REANCHOR && (h - self.h_s).abs() <= slack && (tau - self.tau_next).abs() <= slack;
         let (mut dtheta, mut dv) = (self.omega0 * h, self.f0 * h);
         if regular {
             // The interval and the midpoint differ from the stepped ones by that rounding: the phasor
@@ -332,7 +352,9 @@ mod tests {
         let first = rng.random_range(0..3usize);
         let unit = [Vector3::x(), Vector3::y(), Vector3::z()];
         let axes = (0..n_axes).map(|k| AxisGeometry::new(format!("a{k}"), unit[(first + k) % 3], 0.0)).collect();
-        let small = |rng: &mut ChaCha8Rng, s: f64| Vector3::new(rng.random_range(-s..s), rng.random_range(-s..s), rng.random_range(-s..s));
+        let small = |rng: &mut ChaCha8Rng, s: f64| {
+            Vector3::new(rng.random_range(-s..s), rng.random_range(-s..s), rng.random_range(-s..s))
+        };
         let mut truth = TableErrors::zero(n_axes);
         truth.installation_rad = small(rng, 1e-3);
         truth.imu_mount_rad = small(rng, 1e-3);
@@ -341,9 +363,14 @@ mod tests {
             e.swing_phase_rad = rng.random_range(-3.0..3.0);
             e.non_orthogonality_rad = if k > 0 { rng.random_range(-1e-4..1e-4) } else { 0.0 };
         }
-        let rates: Vec<f64> = (0..n_axes).map(|_| if rng.random_bool(0.3) { 0.0 } else { rng.random_range(-1.5..1.5) }).collect();
+        let rates: Vec<f64> =
+            (0..n_axes).map(|_| if rng.random_bool(0.3) { 0.0 } else { rng.random_range(-1.5..1.5) }).collect();
         let initial: Vec<f64> = (0..n_axes).map(|_| rng.random_range(-3.0..3.0)).collect();
-        let base = Attitude { pitch_rad: rng.random_range(-1.0..1.0), roll_rad: rng.random_range(-3.0..3.0), heading_rad: rng.random_range(-3.0..3.0) };
+        let base = Attitude {
+            pitch_rad: rng.random_range(-1.0..1.0),
+            roll_rad: rng.random_range(-3.0..3.0),
+            heading_rad: rng.random_range(-3.0..3.0),
+        };
         // Ramps from t = −1 s, far enough not to end before t = 14 s.
         let mut ramps = Vec::new();
         for angle in [AngleKind::Pitch, AngleKind::Roll, AngleKind::Heading] {
@@ -356,13 +383,24 @@ mod tests {
         let mut vehicle = VehicleMotion::new(base, ramps, vec![]).expect("ramps of different angles");
         let mut max_nu = 4.0 * rates.iter().fold(0.0f64, |m, r| m.max(r.abs())) + 1.0;
         if rng.random_bool(0.7) {
-            let coning = Coning { half_angle_rad: rng.random_range(1e-4..0.2), omega_rad_per_s: rng.random_range(-40.0..40.0) };
+            let coning =
+                Coning { half_angle_rad: rng.random_range(1e-4..0.2), omega_rad_per_s: rng.random_range(-40.0..40.0) };
             max_nu += 2.0 * coning.omega_rad_per_s.abs();
             vehicle = vehicle.with_coning(coning);
         }
         let chain = Chain::new(axes);
-        let table = TableParams { chain, vehicle, scheme: Scheme::continuous(initial, rates), truth, compensation: TableErrors::zero(n_axes) };
-        let site = Site { latitude_rad: rng.random_range(-1.5..1.5), longitude_rad: 0.0, height_m: rng.random_range(0.0..3000.0) };
+        let table = TableParams {
+            chain,
+            vehicle,
+            scheme: Scheme::continuous(initial, rates),
+            truth,
+            compensation: TableErrors::zero(n_axes),
+        };
+        let site = Site {
+            latitude_rad: rng.random_range(-1.5..1.5),
+            longitude_rad: 0.0,
+            height_m: rng.random_range(0.0..3000.0),
+        };
         (Model::new(&table, 0), Earth::at(site), max_nu)
     }
 

@@ -26,7 +26,8 @@ pub enum Algorithm {
 
 impl Algorithm {
     /// Every algorithm, in display order.
-    pub const ALL: [Self; 5] = [Self::SingleSample, Self::TwoSample, Self::TwoSampleP1, Self::TwoSampleP2, Self::ThreeSample];
+    pub const ALL: [Self; 5] =
+        [Self::SingleSample, Self::TwoSample, Self::TwoSampleP1, Self::TwoSampleP2, Self::ThreeSample];
 
     /// (N, P).
     #[must_use]

@@ -8,13 +8,13 @@
 
 use nalgebra::Vector3;
 
+use super::InsParams;
 use super::coning::Algorithm;
 use super::fir::Fir;
 use super::nav::{NavState, Navigator};
 use super::strapdown::AttitudeIntegrator;
-use super::InsParams;
 use crate::math::attitude::Attitude;
-use crate::math::frames::{Rot, B, N, S};
+use crate::math::frames::{B, N, Rot, S};
 use crate::math::rotvec;
 use crate::model::earth::{Earth, Site};
 
@@ -244,7 +244,12 @@ impl InsCore {
     pub fn push(&mut self, t1: f64, g_meas: Vector3<f64>, a_meas: Vector3<f64>) -> SampleOut {
         let g_filt = self.fir_g.push(g_meas);
         let a_filt = self.fir_a.push(a_meas);
-        let out = SampleOut { t_s: t1, updated: false, raw_rate_s: g_meas * self.inv_h, filtered_rate_s: g_filt * self.inv_h };
+        let out = SampleOut {
+            t_s: t1,
+            updated: false,
+            raw_rate_s: g_meas * self.inv_h,
+            filtered_rate_s: g_filt * self.inv_h,
+        };
         if self.cfg.decimation == 1 {
             // No sums to keep (written and read back through memory they stalled the update).
             return self.push_decimated(t1, g_filt, a_filt, out);
@@ -326,7 +331,12 @@ impl InsCore {
             let north = (s.latitude_rad - site.latitude_rad) * m_per_rad_north;
             let east = (s.longitude_rad - site.longitude_rad) * m_per_rad_east;
             // metres: no overflow for hypot to guard against (and it cost 2.5 % of a replay).
-            NavError { east_m: east, north_m: north, radial_m: (north * north + east * east).sqrt(), velocity_enu_mps: s.v_n }
+            NavError {
+                east_m: east,
+                north_m: north,
+                radial_m: (north * north + east * east).sqrt(),
+                velocity_enu_mps: s.v_n,
+            }
         })
     }
 
@@ -351,7 +361,10 @@ impl InsCore {
         let attitudes = self.history.iter().all(|h| h[1].1.quaternion().coords.iter().all(|x| x.is_finite()));
         let nav = self.nav.as_ref().is_none_or(|n| {
             let s = &n.state;
-            s.latitude_rad.is_finite() && s.longitude_rad.is_finite() && s.height_m.is_finite() && s.v_n.iter().all(|x| x.is_finite())
+            s.latitude_rad.is_finite()
+                && s.longitude_rad.is_finite()
+                && s.height_m.is_finite()
+                && s.v_n.iter().all(|x| x.is_finite())
         });
         attitudes && nav
     }

@@ -8,8 +8,9 @@ use nalgebra::Vector3;
 /// Li et al. 2014 §2.2, verbatim: 25 symmetric taps designed for 2 kHz data against the dither at 335.4,
 /// 375.5 and 425.7 Hz, 100 Hz bandwidth (the paper calls them notches; see the module docs).
 pub const SEED001_TAPS: [f64; 25] = [
-    -3.6162e-4, -5.5582e-5, -4.6181e-4, 1.3181e-3, 4.3263e-3, 1.1456e-2, 2.3008e-2, 3.9629e-2, 6.0210e-2, 8.2250e-2, 1.0213e-1, 1.1603e-1, 1.2103e-1,
-    1.1603e-1, 1.0213e-1, 8.2250e-2, 6.0210e-2, 3.9629e-2, 2.3008e-2, 1.1456e-2, 4.3263e-3, 1.3181e-3, -4.6181e-4, -5.5582e-5, -3.6162e-4,
+    -3.6162e-4, -5.5582e-5, -4.6181e-4, 1.3181e-3, 4.3263e-3, 1.1456e-2, 2.3008e-2, 3.9629e-2, 6.0210e-2, 8.2250e-2,
+    1.0213e-1, 1.1603e-1, 1.2103e-1, 1.1603e-1, 1.0213e-1, 8.2250e-2, 6.0210e-2, 3.9629e-2, 2.3008e-2, 1.1456e-2,
+    4.3263e-3, 1.3181e-3, -4.6181e-4, -5.5582e-5, -3.6162e-4,
 ];
 
 /// A FIR filter on 3-vectors. The taps are normalised to unit DC gain so that an increment stream
@@ -26,7 +27,8 @@ impl Fir {
     #[must_use]
     pub fn new(taps: &[f64]) -> Self {
         let sum: f64 = taps.iter().sum();
-        let taps: Vec<f64> = if taps.len() <= 1 || sum == 0.0 { vec![1.0] } else { taps.iter().map(|t| t / sum).collect() };
+        let taps: Vec<f64> =
+            if taps.len() <= 1 || sum == 0.0 { vec![1.0] } else { taps.iter().map(|t| t / sum).collect() };
         let n = taps.len();
         Self { taps, history: vec![Vector3::zeros(); n], head: 0 }
     }
@@ -93,7 +95,8 @@ mod tests {
         assert!((f.amplitude(0.5, 2000.0) - 1.0).abs() < 2e-5);
         assert!((20.0 * f.amplitude(100.0, 2000.0).log10() + 4.36).abs() < 0.05);
         // "extra attenuation at least 50 dB in the band 320-420 Hz" (Li et al. 2014 §2.2, about the new filter).
-        let worst = (320..=420).map(|f_hz| 20.0 * f.amplitude(f64::from(f_hz), 2000.0).log10()).fold(f64::MIN, f64::max);
+        let worst =
+            (320..=420).map(|f_hz| 20.0 * f.amplitude(f64::from(f_hz), 2000.0).log10()).fold(f64::MIN, f64::max);
         assert!(worst < -70.0, "worst in band {worst:.1} dB");
     }
 

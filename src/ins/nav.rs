@@ -4,9 +4,9 @@
 
 use nalgebra::Vector3;
 
-use crate::math::frames::{Rot, N, S};
+use crate::math::frames::{N, Rot, S};
 
-use crate::model::earth::{normal_gravity, omega_ie_n, Earth};
+use crate::model::earth::{Earth, normal_gravity, omega_ie_n};
 
 /// How the vertical channel is handled (it is unstable when free).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -110,7 +110,9 @@ impl LatitudeTerms {
     }
 
     fn refresh(&mut self, latitude_rad: f64, height_m: f64) {
-        if (latitude_rad - self.latitude_rad).abs() > REFRESH_LATITUDE_RAD || (height_m - self.height_m).abs() > REFRESH_HEIGHT_M {
+        if (latitude_rad - self.latitude_rad).abs() > REFRESH_LATITUDE_RAD
+            || (height_m - self.height_m).abs() > REFRESH_HEIGHT_M
+        {
             *self = Self::at(latitude_rad, height_m);
         }
     }
@@ -122,7 +124,12 @@ impl Navigator {
     pub fn new(earth: &Earth, options: NavOptions) -> Self {
         let s = earth.site;
         Self {
-            state: NavState { latitude_rad: s.latitude_rad, longitude_rad: s.longitude_rad, height_m: s.height_m, v_n: Vector3::zeros() },
+            state: NavState {
+                latitude_rad: s.latitude_rad,
+                longitude_rad: s.longitude_rad,
+                height_m: s.height_m,
+                v_n: Vector3::zeros(),
+            },
             options,
             height0: s.height_m,
             terms: LatitudeTerms::at(s.latitude_rad, s.height_m),
@@ -138,7 +145,14 @@ impl Navigator {
     /// One velocity/position update over `h` seconds from the sensor increments of the update (one
     /// entry per gyro/accel sample), with the attitude C_s^n at the start of the update and the
     /// navigation-frame rotation `zeta_n` over it.
-    pub fn update(&mut self, n_from_s_start: &Rot<N, S>, dtheta: &[Vector3<f64>], dv: &[Vector3<f64>], zeta_n: &Vector3<f64>, h: f64) {
+    pub fn update(
+        &mut self,
+        n_from_s_start: &Rot<N, S>,
+        dtheta: &[Vector3<f64>],
+        dv: &[Vector3<f64>],
+        zeta_n: &Vector3<f64>,
+        h: f64,
+    ) {
         let theta: Vector3<f64> = dtheta.iter().sum();
         let vel: Vector3<f64> = dv.iter().sum();
         // Rotation compensation and sculling (Savage's two- and three-sample forms).
@@ -147,7 +161,11 @@ impl Navigator {
             2 => dv_s += (2.0 / 3.0) * (dtheta[0].cross(&dv[1]) + dv[0].cross(&dtheta[1])),
             3 => {
                 dv_s += (33.0 / 80.0) * (dtheta[0].cross(&dv[2]) + dv[0].cross(&dtheta[2]))
-                    + (57.0 / 80.0) * (dtheta[0].cross(&dv[1]) + dtheta[1].cross(&dv[2]) + dv[0].cross(&dtheta[1]) + dv[1].cross(&dtheta[2]));
+                    + (57.0 / 80.0)
+                        * (dtheta[0].cross(&dv[1])
+                            + dtheta[1].cross(&dv[2])
+                            + dv[0].cross(&dtheta[1])
+                            + dv[1].cross(&dtheta[2]));
             }
             _ => {}
         }

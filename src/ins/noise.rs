@@ -27,7 +27,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 use std::f64::consts::{LN_10, PI};
 
-use crate::math::allan::{gauss_markov_avar, NoiseTerm};
+use crate::math::allan::{NoiseTerm, gauss_markov_avar};
 
 #[cfg(test)]
 mod tests;
@@ -73,7 +73,12 @@ impl IeeeTerms {
     /// True if any term is set (else the simulation does not build a generator at all).
     #[must_use]
     pub fn is_active(&self) -> bool {
-        self.quantization_si > 0.0 || self.random_walk_si > 0.0 || self.bias_instability_si > 0.0 || self.rate_random_walk_si > 0.0 || self.rate_ramp_si != 0.0 || self.saturation_si.is_some()
+        self.quantization_si > 0.0
+            || self.random_walk_si > 0.0
+            || self.bias_instability_si > 0.0
+            || self.rate_random_walk_si > 0.0
+            || self.rate_ramp_si != 0.0
+            || self.saturation_si.is_some()
     }
 
     /// The output pulse weight q = √12·Q (rad | m/s).
@@ -99,8 +104,15 @@ impl IeeeTerms {
     /// off outside it). Saturation is not modelled.
     #[must_use]
     pub fn model_avar(&self, tau_s: f64) -> f64 {
-        let laws: f64 = [NoiseTerm::Quantization, NoiseTerm::RandomWalk, NoiseTerm::RateRandomWalk, NoiseTerm::RateRamp].iter().map(|t| t.avar(self.coefficient(*t), tau_s)).sum();
-        let flicker: f64 = flicker_bank(self.bias_instability_si, self.flicker_range_s).iter().map(|g| gauss_markov_avar(g.sigma_si, g.correlation_time_s, tau_s)).sum();
+        let laws: f64 =
+            [NoiseTerm::Quantization, NoiseTerm::RandomWalk, NoiseTerm::RateRandomWalk, NoiseTerm::RateRamp]
+                .iter()
+                .map(|t| t.avar(self.coefficient(*t), tau_s))
+                .sum();
+        let flicker: f64 = flicker_bank(self.bias_instability_si, self.flicker_range_s)
+            .iter()
+            .map(|g| gauss_markov_avar(g.sigma_si, g.correlation_time_s, tau_s))
+            .sum();
         laws + flicker
     }
 }
@@ -178,7 +190,14 @@ impl GaussMarkov {
         let cov = s * s * t * one_minus_phi * one_minus_phi;
         let l11 = var1.sqrt();
         let l21 = if l11 > 0.0 { cov / l11 } else { 0.0 };
-        Self { phi: (-h).exp(), gain: t * one_minus_phi, l11, l21, l22: (var2 - l21 * l21).max(0.0).sqrt(), x: s * x0_normal }
+        Self {
+            phi: (-h).exp(),
+            gain: t * one_minus_phi,
+            l11,
+            l21,
+            l22: (var2 - l21 * l21).max(0.0).sqrt(),
+            x: s * x0_normal,
+        }
     }
 
     /// The integral of x over the next sample; advances x. `z1`, `z2` standard normal.
@@ -224,7 +243,14 @@ impl TriadNoise {
             let flicker = bank.iter().map(|t| GaussMarkov::new(*t, tau0_s, rng.sample(StandardNormal))).collect();
             AxisState { rng, flicker, rrw_rate: 0.0, carry: 0.0, pulses: 0, saturations: 0 }
         });
-        Self { terms: *terms, tau0_s, k: 0, white_sigma: terms.random_walk_si * tau0_s.sqrt(), pulse: terms.pulse_weight_si(), axes }
+        Self {
+            terms: *terms,
+            tau0_s,
+            k: 0,
+            white_sigma: terms.random_walk_si * tau0_s.sqrt(),
+            pulse: terms.pulse_weight_si(),
+            axes,
+        }
     }
 
     /// The additive error increments (rad | m/s) of the next sample: N, B, K, R (no quantization,

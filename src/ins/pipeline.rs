@@ -4,19 +4,19 @@
 
 use nalgebra::Vector3;
 
+use super::InsParams;
 use super::coning::Algorithm;
 use super::core::{InsCore, NavError, SampleOut};
 use super::nav::NavState;
 use super::sensor::Sensors;
 use super::truth::TruthImu;
-use super::InsParams;
 use crate::math::attitude::{Attitude, AttitudeError};
-use crate::math::frames::{Rot, B, N, S};
+use crate::math::frames::{B, N, Rot, S};
 use crate::math::rotvec;
 use crate::model::earth::{Earth, Site};
 use crate::model::gimbal::ChainMemo;
 use crate::model::scheme::AxisValues;
-use crate::sim::{demodulate, encoder_readings, DemodState, Model};
+use crate::sim::{DemodState, Model, demodulate, encoder_readings};
 
 /// The INS's view of the body at one output instant.
 #[derive(Debug, Clone)]
@@ -35,6 +35,9 @@ pub struct InsView {
     /// Navigation errors, when navigating.
     pub nav: Option<NavError>,
 }
+
+/// An algorithm's latest error and the (instant, attitude) it was computed for.
+type LastError = (f64, Rot<N, S>, AttitudeError);
 
 /// What [`InsRun::view`] computes once per output instant for the algorithms that share it.
 #[derive(Clone)]
@@ -59,7 +62,7 @@ pub struct InsRun {
     start: Rot<N, S>,
     /// Each algorithm's latest error and the (instant, attitude) it was computed for: an algorithm
     /// that has not updated since (more samples per update than the primary) is not recomputed.
-    last_error: Vec<Option<(f64, Rot<N, S>, AttitudeError)>>,
+    last_error: Vec<Option<LastError>>,
     /// The view's per-instant scratch, kept between views (no allocation per view).
     shared: Vec<Shared>,
     /// The compensated chain at the latest corrected angles, one per algorithm at most.
@@ -109,7 +112,23 @@ impl InsRun {
         let demod = vec![DemodState::default(); core.algorithms().len()];
         let demod_len = demod.len();
         let last_error = vec![None; demod_len];
-        Self { truth, sensors, core, h, index: 0, demod, pre_roll, start, last_error, shared: Vec::new(), chains: ChainMemo::new(demod_len), compensation: None, t0_s, site, seed }
+        Self {
+            truth,
+            sensors,
+            core,
+            h,
+            index: 0,
+            demod,
+            pre_roll,
+            start,
+            last_error,
+            shared: Vec::new(),
+            chains: ChainMemo::new(demod_len),
+            compensation: None,
+            t0_s,
+            site,
+            seed,
+        }
     }
 
     /// True when every algorithm has just completed an update: where the sample rate can change
@@ -129,7 +148,9 @@ impl InsRun {
     /// the old rate), with navigation (its state too), or with other algorithms.
     pub fn at_rate(&self, cfg: &InsParams) -> Result<Self, String> {
         if cfg.fir_taps.len() > 1 || cfg.decimation != 1 {
-            return Err("the sample rate of an IMU with a FIR or a decimation cannot change in a running session".into());
+            return Err(
+                "the sample rate of an IMU with a FIR or a decimation cannot change in a running session".into()
+            );
         }
         if cfg.navigation.is_some() {
             return Err("the sample rate of a navigating INS cannot change in a running session".into());
@@ -340,7 +361,8 @@ mod tests {
         crate::scenario::parse(&text, "test").expect("test scenario")
     }
 
-    const STATIC_TABLE: &str = "[turntable]\n[[turntable.axis]]\nname = \"table\"\naxis = \"z\"\n[scheme]\nkind = \"static\"\n";
+    const STATIC_TABLE: &str =
+        "[turntable]\n[[turntable.axis]]\nname = \"table\"\naxis = \"z\"\n[scheme]\nkind = \"static\"\n";
 
     fn run(p: &Params, seconds: f64, mut each_update: impl FnMut(&mut InsRun, f64)) -> InsRun {
         let mut ins = p.ins_run().expect("ins");
@@ -428,7 +450,12 @@ mod tests {
             }
         });
         let expected = 7.0 * RAD_PER_DEG * std::f64::consts::TAU * 0.5 * 6.25e-3;
-        assert!((peak / expected - 1.0).abs() < 1e-3, "peak {:.5}° vs {:.5}°", peak.to_degrees(), expected.to_degrees());
+        assert!(
+            (peak / expected - 1.0).abs() < 1e-3,
+            "peak {:.5}° vs {:.5}°",
+            peak.to_degrees(),
+            expected.to_degrees()
+        );
     }
 }
 
@@ -436,7 +463,7 @@ mod tests {
 mod bias_tests {
     use super::tests::params;
     use super::*;
-    use crate::model::earth::{normal_gravity, EARTH_RATE};
+    use crate::model::earth::{EARTH_RATE, normal_gravity};
 
     /// The textbook linear error model of a stationary INS (Titterton & Weston ch. 12, phi-angle form,
     /// ENU, vertical channel held), integrated with RK4 — an independent computation:
@@ -512,7 +539,10 @@ mod bias_tests {
         let peak_psi = model.iter().map(|m| m.2.abs()).fold(0.0f64, f64::max);
         assert!(peak_pos > 100.0, "the biases matter: {peak_pos} m");
         for ((e, n, psi), (me, mn, mpsi)) in got.iter().zip(&model) {
-            assert!((e - me).abs() < 0.02 * peak_pos && (n - mn).abs() < 0.02 * peak_pos, "position ({e:.1}, {n:.1}) vs model ({me:.1}, {mn:.1})");
+            assert!(
+                (e - me).abs() < 0.02 * peak_pos && (n - mn).abs() < 0.02 * peak_pos,
+                "position ({e:.1}, {n:.1}) vs model ({me:.1}, {mn:.1})"
+            );
             assert!((psi - mpsi).abs() < 0.02 * peak_psi, "heading {psi:e} vs model {mpsi:e}");
         }
     }

@@ -32,7 +32,8 @@ pub const PAPER_RADIAL_M: (f64, f64) = (100.0, 310.0);
 /// The strategies compared after the second fix.
 pub const BRANCHES: usize = 3;
 /// Their names.
-pub const BRANCH_NAMES: [&str; BRANCHES] = ["conventional reset", "TPR (Zheng et al. 2016 eq. 25)", "TPR + level errors from velocity"];
+pub const BRANCH_NAMES: [&str; BRANCHES] =
+    ["conventional reset", "TPR (Zheng et al. 2016 eq. 25)", "TPR + level errors from velocity"];
 
 /// One sample of every branch.
 #[derive(Debug, Clone, Copy, Default, Serialize)]
@@ -107,7 +108,10 @@ impl TprResult {
         let peak_h = self.peak_heading_after_arcsec();
         let mut s = String::new();
         if !self.complete {
-            s.push_str(&format!("INTERRUPTED at {:.2} h: the numbers below are over the simulated part only, not the run's\n", last.t_s / 3600.0));
+            s.push_str(&format!(
+                "INTERRUPTED at {:.2} h: the numbers below are over the simulated part only, not the run's\n",
+                last.t_s / 3600.0
+            ));
         }
         s += &format!(
             "position-fix resets of {}: fixes at {:.1} h and {:.1} h, {:.1} h simulated in {:.1} s\n",
@@ -130,8 +134,13 @@ impl TprResult {
             "heading error at the second fix {:+.2}″; estimated by TPR {:+.2}″, by TPR + level {:+.2}″\n",
             self.heading_at_second_fix_arcsec, self.tpr_heading_estimate_arcsec, self.level_heading_estimate_arcsec
         ));
-        s.push_str(&format!("  {:<42} {:>13} {:>10} {:>12} {:>18}\n", "", "conventional", "TPR", "TPR + level", "Zheng et al. 2016 (Fig. 9)"));
-        let row = |label: &str, v: [f64; BRANCHES], digits: usize, paper: &str| format!("  {label:<42} {:>13.digits$} {:>10.digits$} {:>12.digits$} {paper:>18}\n", v[0], v[1], v[2]);
+        s.push_str(&format!(
+            "  {:<42} {:>13} {:>10} {:>12} {:>18}\n",
+            "", "conventional", "TPR", "TPR + level", "Zheng et al. 2016 (Fig. 9)"
+        ));
+        let row = |label: &str, v: [f64; BRANCHES], digits: usize, paper: &str| {
+            format!("  {label:<42} {:>13.digits$} {:>10.digits$} {:>12.digits$} {paper:>18}\n", v[0], v[1], v[2])
+        };
         s.push_str(&row("peak radial error after the 2nd fix (m)", peak_r, 1, "> 310 / < 100"));
         s.push_str(&row("radial error at the end (m)", last.radial_m, 1, ""));
         s.push_str(&row("peak |heading error| after the 2nd fix (″)", peak_h, 2, ""));
@@ -150,7 +159,11 @@ impl TprResult {
     pub fn verdict(&self) -> String {
         let t_after = (self.duration_s - self.fixes_s[1]).max(0.0);
         let floor_m = crate::model::earth::EARTH_A * self.arw_rad_per_sqrt_s * t_after.sqrt();
-        let per_arcsec = crate::model::earth::EARTH_A * EARTH_RATE * self.latitude_rad.cos() * crate::math::units::RAD_PER_ARCSEC * 3600.0;
+        let per_arcsec = crate::model::earth::EARTH_A
+            * EARTH_RATE
+            * self.latitude_rad.cos()
+            * crate::math::units::RAD_PER_ARCSEC
+            * 3600.0;
         let tpr = self.peak_radial_after_m()[1];
         let verdict = if floor_m > 100.0 {
             "rinscope does not reproduce the paper's \"< 100 m\": the gyro noise it states puts the floor above it"
@@ -200,7 +213,13 @@ pub fn level_errors_from_velocity(v: [f64; 2], v_dot: [f64; 2], k: f64, latitude
 /// Returns φ_U(t2), rad (heading error = −φ_U). With `phi1 = phi2 = 0` it is
 /// [`azimuth_error_at_second_fix`] (0, …).
 #[must_use]
-pub fn azimuth_error_level_corrected(phi1: [f64; 2], phi2: [f64; 2], dlat2_rad: f64, dt_s: f64, latitude_rad: f64) -> f64 {
+pub fn azimuth_error_level_corrected(
+    phi1: [f64; 2],
+    phi2: [f64; 2],
+    dlat2_rad: f64,
+    dt_s: f64,
+    latitude_rad: f64,
+) -> f64 {
     let (s, c) = (EARTH_RATE * dt_s).sin_cos();
     let (sl, cl) = latitude_rad.sin_cos();
     // ψ^s(t1+) = C_n^s (φ_E1, φ_N1, φ_U1); its x part turns into ψ_x^s(t2) = φ_E2 − δL2.
@@ -236,7 +255,16 @@ pub struct SweepRow {
 pub fn sweep_text(rows: &[SweepRow]) -> String {
     let mut s = format!(
         "  {:>6} {:>11} {:>10} {:>10} {:>12} {:>8} {:>8} {:>11} {:>8} {:>8}\n",
-        "seed", "heading@t2″", "TPR est.″", "+level ″", "conv. peak m", "TPR m", "+level m", "conv. peak″", "TPR ″", "+level ″"
+        "seed",
+        "heading@t2″",
+        "TPR est.″",
+        "+level ″",
+        "conv. peak m",
+        "TPR m",
+        "+level m",
+        "conv. peak″",
+        "TPR ″",
+        "+level ″"
     );
     for r in rows {
         s.push_str(&format!(
@@ -256,7 +284,13 @@ pub fn sweep_text(rows: &[SweepRow]) -> String {
     let median = |f: &dyn Fn(&SweepRow) -> f64| {
         let mut v: Vec<f64> = rows.iter().map(f).collect();
         v.sort_by(f64::total_cmp);
-        if v.is_empty() { f64::NAN } else if v.len() % 2 == 1 { v[v.len() / 2] } else { 0.5 * (v[v.len() / 2 - 1] + v[v.len() / 2]) }
+        if v.is_empty() {
+            f64::NAN
+        } else if v.len() % 2 == 1 {
+            v[v.len() / 2]
+        } else {
+            0.5 * (v[v.len() / 2 - 1] + v[v.len() / 2])
+        }
     };
     let better = |b: usize| rows.iter().filter(|r| r.peak_radial_m[b] < r.peak_radial_m[0]).count();
     s.push_str(&format!(
@@ -268,7 +302,12 @@ pub fn sweep_text(rows: &[SweepRow]) -> String {
         median(&|r| r.peak_heading_arcsec[1]),
         median(&|r| r.peak_heading_arcsec[2]),
     ));
-    s.push_str(&format!("  smaller peak radial error than conventional: TPR in {} of {} seeds, TPR + level in {}\n", better(1), rows.len(), better(2)));
+    s.push_str(&format!(
+        "  smaller peak radial error than conventional: TPR in {} of {} seeds, TPR + level in {}\n",
+        better(1),
+        rows.len(),
+        better(2)
+    ));
     s
 }
 

@@ -20,8 +20,8 @@
 use nalgebra::{Matrix3, SMatrix, SVector, UnitQuaternion, Vector3};
 
 use crate::ins::align::Increment;
-use crate::math::rotvec;
 use crate::ins::sensor::{ImuErrorSpec, Spec};
+use crate::math::rotvec;
 use crate::math::units::{ARCSEC_PER_RAD, MPS2_PER_UG, RAD_PER_DEG, RAD_PER_S_PER_DEG_PER_H};
 use crate::model::earth::Earth;
 use crate::model::scheme::IndexedStep;
@@ -206,7 +206,8 @@ pub enum Sequence {
 
 impl Sequence {
     /// Every built-in, with its command-line name.
-    pub const ALL: [(Self, &'static str); 3] = [(Self::Positions19, "positions-19"), (Self::DualAxis29, "dual-axis-29"), (Self::AzimuthOnly, "azimuth-only")];
+    pub const ALL: [(Self, &'static str); 3] =
+        [(Self::Positions19, "positions-19"), (Self::DualAxis29, "dual-axis-29"), (Self::AzimuthOnly, "azimuth-only")];
 
     /// By its command-line name.
     #[must_use]
@@ -230,13 +231,23 @@ impl Sequence {
             Self::Positions19 => (
                 vec![
                     (o, 90.0), // z horizontal
-                    (z, 90.0), (z, 90.0), (z, 90.0), (z, 90.0), // about z, gravity sweeping the x-y plane
-                    (o, 90.0), (o, 90.0), (o, 90.0), // about y: z down, horizontal, up
+                    (z, 90.0),
+                    (z, 90.0),
+                    (z, 90.0),
+                    (z, 90.0), // about z, gravity sweeping the x-y plane
+                    (o, 90.0),
+                    (o, 90.0),
+                    (o, 90.0), // about y: z down, horizontal, up
                     (z, 90.0), // x onto the outer axis
-                    (o, 90.0), (o, 90.0), (o, 90.0), (o, 90.0), // about x
-                    (o, -180.0), (o, 180.0), // about x, back and forth
+                    (o, 90.0),
+                    (o, 90.0),
+                    (o, 90.0),
+                    (o, 90.0), // about x
+                    (o, -180.0),
+                    (o, 180.0), // about x, back and forth
                     (z, -90.0), // y onto the outer axis
-                    (o, -180.0), (o, 180.0), // about y, back and forth
+                    (o, -180.0),
+                    (o, 180.0), // about y, back and forth
                 ],
                 240.0,
             ),
@@ -256,10 +267,25 @@ impl Sequence {
                 m.push((z, -90.0));
                 (m, 160.0)
             }
-            Self::AzimuthOnly => (std::iter::repeat_n((z, 90.0), 4).chain(std::iter::repeat_n((z, -90.0), 4)).chain(std::iter::repeat_n((z, 90.0), 4)).collect(), 300.0),
+            Self::AzimuthOnly => (
+                std::iter::repeat_n((z, 90.0), 4)
+                    .chain(std::iter::repeat_n((z, -90.0), 4))
+                    .chain(std::iter::repeat_n((z, 90.0), 4))
+                    .collect(),
+                300.0,
+            ),
         };
         let rate = 10.0 * RAD_PER_DEG;
-        let steps = moves.into_iter().map(|(axis, deg)| IndexedStep { axis, angle_rad: deg * RAD_PER_DEG, rate_rad_per_s: rate, dwell_s: dwell, accel_rad_per_s2: rate }).collect();
+        let steps = moves
+            .into_iter()
+            .map(|(axis, deg)| IndexedStep {
+                axis,
+                angle_rad: deg * RAD_PER_DEG,
+                rate_rad_per_s: rate,
+                dwell_s: dwell,
+                accel_rad_per_s2: rate,
+            })
+            .collect();
         (INITIAL_DWELL_S, steps)
     }
 }
@@ -429,7 +455,21 @@ impl SelfCal {
         for k in 0..N_PARAMS {
             p[(6 + k, 6 + k)] = cfg.prior[k] * cfg.prior[k];
         }
-        Some(Self { cfg, q, v: Vector3::zeros(), x: Vec27::zeros(), p, f_nn, a, s: Block::zeros(), w: Block::zeros(), k: 0, t_s: 0.0, history: Vec::new(), next_history_s: 0.0 })
+        Some(Self {
+            cfg,
+            q,
+            v: Vector3::zeros(),
+            x: Vec27::zeros(),
+            p,
+            f_nn,
+            a,
+            s: Block::zeros(),
+            w: Block::zeros(),
+            k: 0,
+            t_s: 0.0,
+            history: Vec::new(),
+            next_history_s: 0.0,
+        })
     }
 
     /// Takes one sample's (Δθ, Δv).
@@ -565,7 +605,8 @@ pub struct Observability {
 #[must_use]
 pub fn observability(e: &Estimate) -> Observability {
     let ratio: [f64; N_PARAMS] = std::array::from_fn(|k| e.sigma[k] / e.prior[k]);
-    let observable_from_s = std::array::from_fn(|k| e.history.iter().find(|r| r.sigma[k] < 0.1 * e.prior[k]).map(|r| r.t_s));
+    let observable_from_s =
+        std::array::from_fn(|k| e.history.iter().find(|r| r.sigma[k] < 0.1 * e.prior[k]).map(|r| r.t_s));
     let unobservable = (0..N_PARAMS).filter(|&k| ratio[k] > 0.5).map(|k| param(k).1).collect();
     let weak = (0..N_PARAMS).filter(|&k| ratio[k] > 0.1 && ratio[k] <= 0.5).map(|k| param(k).1).collect();
     let mut aliased = Vec::new();
@@ -575,7 +616,13 @@ pub fn observability(e: &Estimate) -> Observability {
             if rho.abs() >= 0.9 {
                 // The combination with the smaller variance: x_i/σ_i ∓ x_j/σ_j.
                 let sign = if rho > 0.0 { "−" } else { "+" };
-                aliased.push(format!("{} and {} (correlation {rho:+.3}): the data see {}/σ {sign} {}/σ", param(i).1, param(j).1, param(i).1, param(j).1));
+                aliased.push(format!(
+                    "{} and {} (correlation {rho:+.3}): the data see {}/σ {sign} {}/σ",
+                    param(i).1,
+                    param(j).1,
+                    param(i).1,
+                    param(j).1
+                ));
             }
         }
     }
@@ -607,7 +654,11 @@ mod tests {
             assert!(total <= 2.0 * 3600.0, "{}: {total} s", s.name());
             for axis in 0..2 {
                 let turned: f64 = steps.iter().filter(|m| m.axis == axis).map(|m| m.angle_rad).sum();
-                assert!((turned / std::f64::consts::TAU).fract().abs() < 1e-9, "{}: axis {axis} ends at {turned} rad", s.name());
+                assert!(
+                    (turned / std::f64::consts::TAU).fract().abs() < 1e-9,
+                    "{}: axis {axis} ends at {turned} rad",
+                    s.name()
+                );
             }
         }
     }

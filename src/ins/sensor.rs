@@ -94,13 +94,27 @@ struct TriadErrors {
 
 impl From<&GyroSpec> for TriadErrors {
     fn from(g: &GyroSpec) -> Self {
-        Self { bias: g.bias_rad_per_s, scale: g.scale, misalignment_rad: g.misalignment_rad, white_per_sqrt_s: g.noise.random_walk_si, instability: g.markov_sigma_rad_per_s, correlation_s: g.correlation_s }
+        Self {
+            bias: g.bias_rad_per_s,
+            scale: g.scale,
+            misalignment_rad: g.misalignment_rad,
+            white_per_sqrt_s: g.noise.random_walk_si,
+            instability: g.markov_sigma_rad_per_s,
+            correlation_s: g.correlation_s,
+        }
     }
 }
 
 impl From<&AccelSpec> for TriadErrors {
     fn from(a: &AccelSpec) -> Self {
-        Self { bias: a.bias_mps2, scale: a.scale, misalignment_rad: a.misalignment_rad, white_per_sqrt_s: a.noise.random_walk_si, instability: a.markov_sigma_mps2, correlation_s: a.correlation_s }
+        Self {
+            bias: a.bias_mps2,
+            scale: a.scale,
+            misalignment_rad: a.misalignment_rad,
+            white_per_sqrt_s: a.noise.random_walk_si,
+            instability: a.markov_sigma_mps2,
+            correlation_s: a.correlation_s,
+        }
     }
 }
 
@@ -221,7 +235,19 @@ impl Sensors {
         // Streams 1-3 (gyros) and 4-6 (accelerometers) of the seed: stream 0 is `rng`'s.
         let gyro_ieee = ieee_generator(&spec.gyro.noise, h, seed, 1);
         let accel_ieee = ieee_generator(&spec.accel.noise, h, seed, 4);
-        let mut me = Self { gyro, accel, gyro_ieee, accel_ieee, g_sensitivity: spec.g_sensitivity, dither: spec.dither, dither_phase, dither_last: [0.0; 3], h, rng, drawn_bias };
+        let mut me = Self {
+            gyro,
+            accel,
+            gyro_ieee,
+            accel_ieee,
+            g_sensitivity: spec.g_sensitivity,
+            dither: spec.dither,
+            dither_phase,
+            dither_last: [0.0; 3],
+            h,
+            rng,
+            drawn_bias,
+        };
         me.dither_last = me.dither_angles(t0);
         me
     }
@@ -230,7 +256,8 @@ impl Sensors {
         let mut a = [0.0; 3];
         for j in 0..3 {
             if self.dither.amplitudes_rad[j] != 0.0 {
-                a[j] = self.dither.amplitudes_rad[j] * (std::f64::consts::TAU * self.dither.frequencies_hz[j] * t + self.dither_phase[j]).sin();
+                a[j] = self.dither.amplitudes_rad[j]
+                    * (std::f64::consts::TAU * self.dither.frequencies_hz[j] * t + self.dither_phase[j]).sin();
             }
         }
         a
@@ -288,7 +315,10 @@ mod tests {
     fn white_noise_has_the_specified_density() {
         // ARW 1e-3 rad/√s at 100 Hz: per-sample σ = 1e-3·√0.01 = 1e-4 rad (sample std over 2e5 draws
         // within 1%: the standard error of a std estimate is σ/√(2n) = 0.16%).
-        let spec = ImuErrorSpec { gyro: GyroSpec { noise: IeeeTerms { random_walk_si: 1e-3, ..IeeeTerms::default() }, ..Default::default() }, ..Default::default() };
+        let spec = ImuErrorSpec {
+            gyro: GyroSpec { noise: IeeeTerms { random_walk_si: 1e-3, ..IeeeTerms::default() }, ..Default::default() },
+            ..Default::default()
+        };
         let mut s = Sensors::new(&spec, 0.01, 7, 0.0);
         let n = 200_000;
         let mut sum_sq = 0.0;
@@ -305,7 +335,12 @@ mod tests {
         let spec = ImuErrorSpec {
             gyro: GyroSpec {
                 bias_rad_per_s: Spec::Sigma(1e-6),
-                noise: IeeeTerms { random_walk_si: 1e-5, bias_instability_si: 1e-7, rate_random_walk_si: 1e-8, ..IeeeTerms::default() },
+                noise: IeeeTerms {
+                    random_walk_si: 1e-5,
+                    bias_instability_si: 1e-7,
+                    rate_random_walk_si: 1e-8,
+                    ..IeeeTerms::default()
+                },
                 markov_sigma_rad_per_s: 1e-7,
                 correlation_s: 100.0,
                 ..Default::default()
@@ -314,7 +349,9 @@ mod tests {
         };
         let run = |seed| {
             let mut s = Sensors::new(&spec, 0.005, seed, 0.0);
-            (0..100).map(|i| s.measure(&Vector3::zeros(), &Vector3::zeros(), f64::from(i) * 0.005).0.x).collect::<Vec<_>>()
+            (0..100)
+                .map(|i| s.measure(&Vector3::zeros(), &Vector3::zeros(), f64::from(i) * 0.005).0.x)
+                .collect::<Vec<_>>()
         };
         assert_eq!(run(3), run(3));
         assert_ne!(run(3), run(4));
@@ -323,7 +360,11 @@ mod tests {
     #[test]
     fn fixed_bias_and_scale_act_as_specified() {
         let spec = ImuErrorSpec {
-            gyro: GyroSpec { bias_rad_per_s: Spec::Fixed([1e-5, 0.0, 0.0]), scale: Spec::Fixed([1e-3, 0.0, 0.0]), ..Default::default() },
+            gyro: GyroSpec {
+                bias_rad_per_s: Spec::Fixed([1e-5, 0.0, 0.0]),
+                scale: Spec::Fixed([1e-3, 0.0, 0.0]),
+                ..Default::default()
+            },
             ..Default::default()
         };
         let mut s = Sensors::new(&spec, 0.01, 1, 0.0);
@@ -334,7 +375,10 @@ mod tests {
     #[test]
     fn dither_integrates_to_the_dither_angle() {
         // The sum of dither increments is the change of the dither angle: bounded, zero mean.
-        let spec = ImuErrorSpec { dither: DitherSpec { frequencies_hz: [335.4, 375.5, 425.7], amplitudes_rad: [5e-4; 3], coupling: 0.2 }, ..Default::default() };
+        let spec = ImuErrorSpec {
+            dither: DitherSpec { frequencies_hz: [335.4, 375.5, 425.7], amplitudes_rad: [5e-4; 3], coupling: 0.2 },
+            ..Default::default()
+        };
         let mut s = Sensors::new(&spec, 0.0005, 1, 0.0);
         let mut total = Vector3::zeros();
         let mut peak = 0.0f64;
@@ -358,7 +402,13 @@ mod tests {
             correlation_s: 100.0,
             ..Default::default()
         };
-        let extra = IeeeTerms { random_walk_si: 1e-5, bias_instability_si: 3e-6, rate_random_walk_si: 1e-7, rate_ramp_si: 1e-9, ..IeeeTerms::default() };
+        let extra = IeeeTerms {
+            random_walk_si: 1e-5,
+            bias_instability_si: 3e-6,
+            rate_random_walk_si: 1e-7,
+            rate_ramp_si: 1e-9,
+            ..IeeeTerms::default()
+        };
         let plain = ImuErrorSpec { gyro: base, ..Default::default() };
         let full = ImuErrorSpec { gyro: GyroSpec { noise: extra, ..base }, ..Default::default() };
         let (mut a, mut b) = (Sensors::new(&plain, 0.005, 9, 0.0), Sensors::new(&full, 0.005, 9, 0.0));

@@ -5,10 +5,10 @@
 
 use nalgebra::{UnitQuaternion, Vector3};
 
-use crate::math::frames::{Rot, N, S};
+use crate::math::frames::{N, Rot, S};
 use crate::math::rotvec;
 
-use super::coning::{coefficients, Algorithm};
+use super::coning::{Algorithm, coefficients};
 
 /// One attitude integrator (one algorithm) fed gyro increments of the sensor frame s.
 ///
@@ -55,7 +55,20 @@ impl AttitudeIntegrator {
             }
         }
         let zero = Vector3::zeros();
-        Self { algorithm, n, p, k_cur, k_prev, sum: zero, weighted: zero, last_in: zero, prev: [zero; 2], filled: 0, n_from_s, updates: 0 }
+        Self {
+            algorithm,
+            n,
+            p,
+            k_cur,
+            k_prev,
+            sum: zero,
+            weighted: zero,
+            last_in: zero,
+            prev: [zero; 2],
+            filled: 0,
+            n_from_s,
+            updates: 0,
+        }
     }
 
     /// Sets the previous samples (oldest first) as if the integrator had been running: the
@@ -119,7 +132,11 @@ impl AttitudeIntegrator {
         }
         self.start_update();
         let n_from_s = *self.n_from_s.quaternion();
-        let q = if *zeta_n == Vector3::zeros() { n_from_s * rotvec::exp(&phi) } else { rotvec::exp(&-*zeta_n) * n_from_s * rotvec::exp(&phi) };
+        let q = if *zeta_n == Vector3::zeros() {
+            n_from_s * rotvec::exp(&phi)
+        } else {
+            rotvec::exp(&-*zeta_n) * n_from_s * rotvec::exp(&phi)
+        };
         // Renormalise: |q|² = 1 + ε after the products (ε ~ 1e-16); q·(3 − |q|²)/2 has norm
         // 1 + O(ε²), the same as dividing by |q| to machine precision, without a square root.
         let q = q.into_inner();
@@ -135,8 +152,8 @@ impl AttitudeIntegrator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::Quaternion;
     use crate::ins::coning::coning_drift_rate;
+    use nalgebra::Quaternion;
 
     /// Pure coning about z (docs/coning.md): ω_b = Ω(−sin α sin Ωt, sin α cos Ωt, −2 sin²(α/2)),
     /// true attitude q(t) = (cos α/2, sin α/2 cos Ωt, sin α/2 sin Ωt, 0). Gyro increments are the
@@ -177,7 +194,8 @@ mod tests {
                     let (t0, t1) = (i as f64 * dt, (i + 1) as f64 * dt);
                     if integ.push(coning_increment(alpha, omega, t0, t1), &Vector3::zeros()).is_some() {
                         // Error rotation in the body frame; its z-component is the drift about the cone axis.
-                        let err = (coning_truth(alpha, omega, t1).inverse() * integ.n_from_s.quaternion()).scaled_axis();
+                        let err =
+                            (coning_truth(alpha, omega, t1).inverse() * integ.n_from_s.quaternion()).scaled_axis();
                         // Express along the cone axis: the body z axis tilted by α; for small α, z.
                         let about_axis = err.z;
                         if first.is_none() && t1 > 0.1 {
@@ -190,7 +208,12 @@ mod tests {
                 let measured = (last.1 - e_a) / (last.0 - t_a);
                 // The computed attitude lags the truth: its error about the axis is -ε per update.
                 let rel = (measured + expected).abs() / expected.abs();
-                assert!(rel < 0.02, "{alg:?} at {freq} Hz: measured {measured:.4e} rad/s, formula {:.4e} rad/s ({:.2}% off)", -expected, rel * 100.0);
+                assert!(
+                    rel < 0.02,
+                    "{alg:?} at {freq} Hz: measured {measured:.4e} rad/s, formula {:.4e} rad/s ({:.2}% off)",
+                    -expected,
+                    rel * 100.0
+                );
             }
         }
     }

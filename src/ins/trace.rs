@@ -34,4 +34,3 @@ impl NavTrace {
         self.samples.iter().map(|s| s.heading_arcsec.abs()).fold(0.0, f64::max)
     }
 }
-

@@ -5,9 +5,9 @@
 use nalgebra::{UnitQuaternion, Vector3};
 
 use super::closed_form::ClosedForm;
-use crate::model::earth::Earth;
-use crate::math::frames::{Rot, N, S};
 use crate::math::frames::axis_angle;
+use crate::math::frames::{N, Rot, S};
+use crate::model::earth::Earth;
 use crate::model::gimbal::ShaftRotations;
 use crate::model::scheme::{AxisValues, MAX_AXES};
 use crate::sim::Model;
@@ -108,7 +108,17 @@ impl TruthImu {
     #[must_use]
     pub fn new(model: Model, earth: Earth, t0_s: f64) -> Self {
         let max_omega = model.vehicle.max_angular_frequency().max(model.scheme.max_rate());
-        let mut me = Self { t_last_s: t0_s, last: None, model, earth, next_break: 0.0, closed: None, max_omega, memo: None, shafts: ShaftCache::new() };
+        let mut me = Self {
+            t_last_s: t0_s,
+            last: None,
+            model,
+            earth,
+            next_break: 0.0,
+            closed: None,
+            max_omega,
+            memo: None,
+            shafts: ShaftCache::new(),
+        };
         me.start_piece(t0_s);
         me
     }
@@ -252,7 +262,11 @@ impl TruthImu {
         for p in 1..=panels {
             let t_end = t0 + p as f64 * hp;
             let mid = self.eval(t_end - 0.5 * hp);
-            let right = if p == panels && at_break { self.eval(end - 1e-9f64.min(0.25 * hp)) } else { self.eval(if p == panels { end } else { t_end }) };
+            let right = if p == panels && at_break {
+                self.eval(end - 1e-9f64.min(0.25 * hp))
+            } else {
+                self.eval(if p == panels { end } else { t_end })
+            };
             dtheta += (left.omega_is_s + 4.0 * mid.omega_is_s + right.omega_is_s) * (hp / 6.0);
             dv += (left.f_s + 4.0 * mid.f_s + right.f_s) * (hp / 6.0);
             left = right;
@@ -330,12 +344,22 @@ mod tests {
         use crate::model::motion::{Coning, VehicleMotion};
         use crate::model::scheme::Scheme;
         use crate::sim::TableParams;
-        let vehicle = VehicleMotion::fixed(Attitude::default()).with_coning(Coning { half_angle_rad: alpha, omega_rad_per_s: std::f64::consts::TAU * freq_hz });
+        let vehicle = VehicleMotion::fixed(Attitude::default())
+            .with_coning(Coning { half_angle_rad: alpha, omega_rad_per_s: std::f64::consts::TAU * freq_hz });
         let chain = Chain::new(vec![AxisGeometry::new("mount".into(), Vector3::z(), 0.0)]);
-        let table = TableParams { chain, vehicle, scheme: Scheme::continuous(vec![0.0], vec![0.0]), truth: TableErrors::zero(1), compensation: TableErrors::zero(1) };
+        let table = TableParams {
+            chain,
+            vehicle,
+            scheme: Scheme::continuous(vec![0.0], vec![0.0]),
+            truth: TableErrors::zero(1),
+            compensation: TableErrors::zero(1),
+        };
         // Without the Earth's rate: its coupling with the cone is not in the formula, and the
         // high-order algorithms' drifts are as small as 1e-13 rad/s.
-        let earth = Earth { omega_ie_n: Vector3::zeros(), ..Earth::at(Site { latitude_rad: 34f64.to_radians(), longitude_rad: 0.0, height_m: 0.0 }) };
+        let earth = Earth {
+            omega_ie_n: Vector3::zeros(),
+            ..Earth::at(Site { latitude_rad: 34f64.to_radians(), longitude_rad: 0.0, height_m: 0.0 })
+        };
         let mut imu = TruthImu::new(Model::new(&table, 0), earth, 0.0);
         let mut integ = AttitudeIntegrator::new(alg, imu.eval(0.0).n_from_s);
         let zeta = earth.omega_ie_n * (integ.samples_per_update() as f64 / rate_hz);
@@ -366,12 +390,22 @@ mod tests {
         // closed form, 0.160 %). The `pure-coning` preset's 1° cone (5 Hz at 100 Hz) for the
         // single- and two-sample algorithms; for the others at 1° the formula's O(α⁴) remainder
         // dominates (measured 0.47 %, 17.8 % and 1.16 % off, the same with either truth).
-        let cases = [(1.0, 5.0, &Algorithm::ALL[..2]), (0.05, 4.0, &Algorithm::ALL[..]), (0.05, 7.0, &Algorithm::ALL[..]), (0.05, 10.0, &Algorithm::ALL[..])];
+        let cases = [
+            (1.0, 5.0, &Algorithm::ALL[..2]),
+            (0.05, 4.0, &Algorithm::ALL[..]),
+            (0.05, 7.0, &Algorithm::ALL[..]),
+            (0.05, 10.0, &Algorithm::ALL[..]),
+        ];
         for (alpha_deg, freq_hz, algorithms) in cases {
             for alg in algorithms {
                 let (measured, analytic) = coning_drift(*alg, f64::to_radians(alpha_deg), freq_hz, 100.0);
                 let rel = (measured / analytic - 1.0).abs();
-                assert!(rel < 2e-3, "{alpha_deg}° at {freq_hz} Hz, {}: {measured:.6e} rad/s vs {analytic:.6e} ({:.3} %)", alg.name(), rel * 100.0);
+                assert!(
+                    rel < 2e-3,
+                    "{alpha_deg}° at {freq_hz} Hz, {}: {measured:.6e} rad/s vs {analytic:.6e} ({:.3} %)",
+                    alg.name(),
+                    rel * 100.0
+                );
             }
         }
     }

@@ -43,44 +43,23 @@ impl<'a> Cursor<'a> {
     fn take(&mut self, n: usize, what: &str) -> Result<&'a [u8], String> {
         let end = self.pos.checked_add(n).filter(|&e| e <= self.data.len());
         let Some(end) = end else {
-            return Err(format!(
-                "message ends inside {what} (byte {} of {})",
-                self.pos + 4,
-                self.data.len() + 4
-            ));
+            return Err(format!("message ends inside {what} (byte {} of {})", self.pos + 4, self.data.len() + 4));
         };
-        let bytes = self
-            .data
-            .get(self.pos..end)
-            .ok_or_else(|| format!("message ends inside {what}"))?;
+        let bytes = self.data.get(self.pos..end).ok_or_else(|| format!("message ends inside {what}"))?;
         self.pos = end;
         Ok(bytes)
     }
 
     fn u32(&mut self, what: &str) -> Result<u32, String> {
         self.align(4);
-        let b: [u8; 4] = self
-            .take(4, what)?
-            .try_into()
-            .map_err(|_| what.to_owned())?;
-        Ok(if self.little {
-            u32::from_le_bytes(b)
-        } else {
-            u32::from_be_bytes(b)
-        })
+        let b: [u8; 4] = self.take(4, what)?.try_into().map_err(|_| what.to_owned())?;
+        Ok(if self.little { u32::from_le_bytes(b) } else { u32::from_be_bytes(b) })
     }
 
     fn f64(&mut self, what: &str) -> Result<f64, String> {
         self.align(8);
-        let b: [u8; 8] = self
-            .take(8, what)?
-            .try_into()
-            .map_err(|_| what.to_owned())?;
-        Ok(if self.little {
-            f64::from_le_bytes(b)
-        } else {
-            f64::from_be_bytes(b)
-        })
+        let b: [u8; 8] = self.take(8, what)?.try_into().map_err(|_| what.to_owned())?;
+        Ok(if self.little { f64::from_le_bytes(b) } else { f64::from_be_bytes(b) })
     }
 
     fn f64s<const N: usize>(&mut self, what: &str) -> Result<[f64; N], String> {
@@ -95,10 +74,7 @@ impl<'a> Cursor<'a> {
 /// Decodes a CDR-encoded `sensor_msgs/msg/Imu`; the error says what is wrong.
 pub(crate) fn decode_imu(message: &[u8]) -> Result<ImuMessage, String> {
     let (Some(header), Some(data)) = (message.get(..4), message.get(4..)) else {
-        return Err(format!(
-            "{} bytes: shorter than the 4-byte CDR encapsulation header",
-            message.len()
-        ));
+        return Err(format!("{} bytes: shorter than the 4-byte CDR encapsulation header", message.len()));
     };
     let little = match header {
         [0, 1, _, _] => true,
@@ -110,11 +86,7 @@ pub(crate) fn decode_imu(message: &[u8]) -> Result<ImuMessage, String> {
             ));
         }
     };
-    let mut c = Cursor {
-        data,
-        pos: 0,
-        little,
-    };
+    let mut c = Cursor { data, pos: 0, little };
     let stamp_sec = c.u32("header.stamp.sec")?.cast_signed();
     let stamp_nanosec = c.u32("header.stamp.nanosec")?;
     let frame_len = c.u32("header.frame_id length")? as usize;
@@ -126,27 +98,15 @@ pub(crate) fn decode_imu(message: &[u8]) -> Result<ImuMessage, String> {
     let linear_acceleration: [f64; 3] = c.f64s("linear_acceleration")?;
     let linear_acceleration_cov: [f64; 9] = c.f64s("linear_acceleration_covariance")?;
     if angular_velocity_cov[0] == -1.0 {
-        return Err(
-            "angular_velocity_covariance[0] is -1: the message has no angular velocity".into(),
-        );
+        return Err("angular_velocity_covariance[0] is -1: the message has no angular velocity".into());
     }
     if linear_acceleration_cov[0] == -1.0 {
-        return Err(
-            "linear_acceleration_covariance[0] is -1: the message has no linear acceleration"
-                .into(),
-        );
+        return Err("linear_acceleration_covariance[0] is -1: the message has no linear acceleration".into());
     }
     if stamp_nanosec >= 1_000_000_000 {
-        return Err(format!(
-            "header.stamp.nanosec = {stamp_nanosec} is not below 1e9"
-        ));
+        return Err(format!("header.stamp.nanosec = {stamp_nanosec} is not below 1e9"));
     }
-    Ok(ImuMessage {
-        stamp_sec,
-        stamp_nanosec,
-        angular_velocity,
-        linear_acceleration,
-    })
+    Ok(ImuMessage { stamp_sec, stamp_nanosec, angular_velocity, linear_acceleration })
 }
 
 #[cfg(test)]

@@ -110,9 +110,7 @@ impl Clock {
     pub(crate) fn start(&self) -> Option<StartTime> {
         match (self.first_ns, self.first) {
             (Some(ns), _) => Some(StartTime::Nanoseconds(ns)),
-            (None, Some(v)) if self.unit == TimeUnit::GpsSecondsOfWeek => {
-                Some(StartTime::GpsSecondsOfWeek(v))
-            }
+            (None, Some(v)) if self.unit == TimeUnit::GpsSecondsOfWeek => Some(StartTime::GpsSecondsOfWeek(v)),
             (None, Some(v)) => Some(StartTime::Seconds(v * self.unit.to_s())),
             (None, None) => None,
         }

@@ -38,17 +38,13 @@ pub enum FrameError {
         name: String,
     },
     /// The letters do not span three perpendicular axes (e.g. "ffd").
-    #[error(
-        "frame {name:?} names the same axis twice: each of forward/back, right/left, up/down must appear once"
-    )]
+    #[error("frame {name:?} names the same axis twice: each of forward/back, right/left, up/down must appear once")]
     RepeatedAxis {
         /// The name given.
         name: String,
     },
     /// The axes form a left-handed triad, which no IMU reports.
-    #[error(
-        "frame {name:?} is left-handed (x × y points {z_would_be}, not along z): an IMU frame is right-handed"
-    )]
+    #[error("frame {name:?} is left-handed (x × y points {z_would_be}, not along z): an IMU frame is right-handed")]
     LeftHanded {
         /// The name given.
         name: String,
@@ -301,11 +297,7 @@ pub enum LogError {
 }
 
 fn list(items: &[String]) -> String {
-    if items.is_empty() {
-        "none".to_owned()
-    } else {
-        items.join(", ")
-    }
+    if items.is_empty() { "none".to_owned() } else { items.join(", ") }
 }
 
 impl LogError {
@@ -338,18 +330,11 @@ impl LogError {
     }
 
     pub(crate) fn io(file: &std::path::Path, action: &'static str, source: std::io::Error) -> Self {
-        Self::Io {
-            file: file.to_path_buf(),
-            action,
-            source,
-        }
+        Self::Io { file: file.to_path_buf(), action, source }
     }
 
     pub(crate) fn corrupt(file: &std::path::Path, detail: impl Into<String>) -> Self {
-        Self::Corrupt {
-            file: file.to_path_buf(),
-            detail: detail.into(),
-        }
+        Self::Corrupt { file: file.to_path_buf(), detail: detail.into() }
     }
 }
 

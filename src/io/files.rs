@@ -114,7 +114,8 @@ pub enum OutputError {
 /// name the path: the caller's error does.
 pub fn open_input(path: &Path) -> std::io::Result<File> {
     use std::os::unix::fs::FileTypeExt as _;
-    let file = OpenOptions::new().read(true).custom_flags(libc::O_NONBLOCK | libc::O_NOCTTY | libc::O_CLOEXEC).open(path)?;
+    let file =
+        OpenOptions::new().read(true).custom_flags(libc::O_NONBLOCK | libc::O_NOCTTY | libc::O_CLOEXEC).open(path)?;
     let kind = file.metadata()?.file_type();
     if !kind.is_file() {
         let what = if kind.is_fifo() {
@@ -130,7 +131,9 @@ pub fn open_input(path: &Path) -> std::io::Result<File> {
         };
         return Err(std::io::Error::new(
             std::io::ErrorKind::InvalidInput,
-            format!("not a regular file but {what}; give a file (an input is never read from a pipe, a device or a directory)"),
+            format!(
+                "not a regular file but {what}; give a file (an input is never read from a pipe, a device or a directory)"
+            ),
         ));
     }
     note_input(path);
@@ -244,7 +247,8 @@ fn writable(path: &Path, dir: &Path) -> Result<(), OutputError> {
     static PROBES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
     let n = PROBES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let probe = dir.join(format!(".rinscope-write-test-{}-{n}", std::process::id()));
-    match OpenOptions::new().write(true).create_new(true).custom_flags(libc::O_NOFOLLOW | libc::O_CLOEXEC).open(&probe) {
+    match OpenOptions::new().write(true).create_new(true).custom_flags(libc::O_NOFOLLOW | libc::O_CLOEXEC).open(&probe)
+    {
         Ok(_) => {
             std::fs::remove_file(&probe).ok();
             Ok(())
@@ -263,7 +267,10 @@ pub fn create_output_dir(flag: &str, dir: &Path) -> Result<(), OutputRefused> {
     match std::fs::create_dir(dir) {
         Ok(()) => Ok(()),
         Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && dir.is_dir() => Ok(()),
-        Err(source) => Err(OutputRefused { flag: flag.to_owned(), error: OutputError::Io { path: dir.to_path_buf(), action: "create the folder", source } }),
+        Err(source) => Err(OutputRefused {
+            flag: flag.to_owned(),
+            error: OutputError::Io { path: dir.to_path_buf(), action: "create the folder", source },
+        }),
     }
 }
 
@@ -382,7 +389,8 @@ pub fn create_partial_dir(path: &Path) -> Result<File, OutputError> {
         // Left by a run that died: ours now, started afresh.
         for entry in std::fs::read_dir(&partial).map_err(|e| io("empty", e))? {
             let p = entry.map_err(|e| io("empty", e))?.path();
-            let removed = if p.is_dir() && !p.is_symlink() { std::fs::remove_dir_all(&p) } else { std::fs::remove_file(&p) };
+            let removed =
+                if p.is_dir() && !p.is_symlink() { std::fs::remove_dir_all(&p) } else { std::fs::remove_file(&p) };
             removed.map_err(|e| io("empty", e))?;
         }
     }
@@ -430,7 +438,9 @@ impl PartialFile {
         }
         match file.try_lock() {
             Ok(()) => {}
-            Err(std::fs::TryLockError::WouldBlock) => return Err(OutputError::Busy { path: path.to_path_buf(), partial }),
+            Err(std::fs::TryLockError::WouldBlock) => {
+                return Err(OutputError::Busy { path: path.to_path_buf(), partial });
+            }
             Err(std::fs::TryLockError::Error(e)) => return Err(io("lock", e)),
         }
         // Ours now: a partial a crashed run left is started afresh.
@@ -507,7 +517,11 @@ pub fn rewrite_input(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
 }
 
 fn write_through(out: PartialFile, bytes: &[u8]) -> Result<(), OutputError> {
-    out.file().write_all(bytes).map_err(|e| OutputError::Io { path: out.partial().to_path_buf(), action: "write", source: e })?;
+    out.file().write_all(bytes).map_err(|e| OutputError::Io {
+        path: out.partial().to_path_buf(),
+        action: "write",
+        source: e,
+    })?;
     out.commit().map(|_| ())
 }
 
@@ -526,7 +540,10 @@ mod tests {
         if made {
             let e = write_atomically(&fifo, b"{}").expect_err("a FIFO");
             assert!(e.to_string().contains("FIFO"), "{e}");
-            assert!(std::fs::symlink_metadata(&fifo).is_ok_and(|m| special_kind(&m.file_type()).is_some()), "the FIFO is still there");
+            assert!(
+                std::fs::symlink_metadata(&fifo).is_ok_and(|m| special_kind(&m.file_type()).is_some()),
+                "the FIFO is still there"
+            );
         }
         std::fs::remove_dir_all(&d).ok();
     }
@@ -621,7 +638,10 @@ mod tests {
             let e = check_output(flag, &path, kind).expect_err(says).to_string();
             assert!(e.starts_with(flag) && e.contains(says), "{flag} {}: {e}", path.display());
         }
-        assert!(check_output("--export", &d.join("new"), D).is_ok() && !d.join("new").exists(), "a new folder in a writable one; nothing left");
+        assert!(
+            check_output("--export", &d.join("new"), D).is_ok() && !d.join("new").exists(),
+            "a new folder in a writable one; nothing left"
+        );
         assert!(check_output("--export", &d, D).is_ok());
         assert!(check_output("--json", &d.join("x.json"), F).is_ok());
         assert_eq!(std::fs::read_dir(&d).expect("dir").count(), 4, "no probe left behind");

@@ -42,11 +42,11 @@ impl Frame {
                 let orthonormality_error = (m.transpose() * m - Matrix3::identity()).abs().max();
                 let determinant = m.determinant();
                 // Written so that a NaN anywhere fails too.
-                if !(m.iter().all(|x| x.is_finite()) && orthonormality_error <= 1e-6 && (determinant - 1.0).abs() <= 1e-6) {
-                    return Err(FrameError::NotARotation {
-                        orthonormality_error,
-                        determinant,
-                    });
+                if !(m.iter().all(|x| x.is_finite())
+                    && orthonormality_error <= 1e-6
+                    && (determinant - 1.0).abs() <= 1e-6)
+                {
+                    return Err(FrameError::NotARotation { orthonormality_error, determinant });
                 }
                 Ok(*m)
             }
@@ -76,10 +76,7 @@ fn direction_word(v: &Vector3<f64>) -> &'static str {
         ("up", [0.0, 0.0, 1.0]),
         ("down", [0.0, 0.0, -1.0]),
     ];
-    WORDS
-        .iter()
-        .find(|(_, d)| (Vector3::from(*d) - v).norm() < 1e-9)
-        .map_or("nowhere", |(w, _)| *w)
+    WORDS.iter().find(|(_, d)| (Vector3::from(*d) - v).norm() < 1e-9).map_or("nowhere", |(w, _)| *w)
 }
 
 /// The matrix `C` that maps a vector in the named frame onto rinscope's RFU frame, `v_rfu = C · v`.
@@ -97,9 +94,7 @@ pub fn frame_matrix(name: &str) -> Result<Matrix3<f64>, FrameError> {
         "nwu" => "flu",
         other => other,
     };
-    let unknown = || FrameError::UnknownName {
-        name: name.to_owned(),
-    };
+    let unknown = || FrameError::UnknownName { name: name.to_owned() };
     let mut cols = [Vector3::zeros(); 3];
     let mut count = 0;
     for (i, c) in letters.chars().enumerate() {
@@ -115,18 +110,13 @@ pub fn frame_matrix(name: &str) -> Result<Matrix3<f64>, FrameError> {
     for i in 0..3 {
         for j in (i + 1)..3 {
             if cols[i].dot(&cols[j]).abs() > 0.5 {
-                return Err(FrameError::RepeatedAxis {
-                    name: name.to_owned(),
-                });
+                return Err(FrameError::RepeatedAxis { name: name.to_owned() });
             }
         }
     }
     let cross = cols[0].cross(&cols[1]);
     if cross.dot(&cols[2]) < 0.0 {
-        return Err(FrameError::LeftHanded {
-            name: name.to_owned(),
-            z_would_be: direction_word(&cross),
-        });
+        return Err(FrameError::LeftHanded { name: name.to_owned(), z_would_be: direction_word(&cross) });
     }
     Ok(Matrix3::from_columns(&cols))
 }
@@ -156,38 +146,14 @@ mod tests {
 
     #[test]
     fn errors() {
-        assert!(matches!(
-            frame_matrix("xyz"),
-            Err(FrameError::UnknownName { .. })
-        ));
-        assert!(matches!(
-            frame_matrix("frdu"),
-            Err(FrameError::UnknownName { .. })
-        ));
-        assert!(matches!(
-            frame_matrix("fr"),
-            Err(FrameError::UnknownName { .. })
-        ));
-        assert!(matches!(
-            frame_matrix("ffd"),
-            Err(FrameError::RepeatedAxis { .. })
-        ));
-        assert!(matches!(
-            frame_matrix("fbd"),
-            Err(FrameError::RepeatedAxis { .. })
-        ));
+        assert!(matches!(frame_matrix("xyz"), Err(FrameError::UnknownName { .. })));
+        assert!(matches!(frame_matrix("frdu"), Err(FrameError::UnknownName { .. })));
+        assert!(matches!(frame_matrix("fr"), Err(FrameError::UnknownName { .. })));
+        assert!(matches!(frame_matrix("ffd"), Err(FrameError::RepeatedAxis { .. })));
+        assert!(matches!(frame_matrix("fbd"), Err(FrameError::RepeatedAxis { .. })));
         // F × R = down in a right-handed world, so "fru" is left-handed.
-        assert!(matches!(
-            frame_matrix("fru"),
-            Err(FrameError::LeftHanded {
-                z_would_be: "down",
-                ..
-            })
-        ));
+        assert!(matches!(frame_matrix("fru"), Err(FrameError::LeftHanded { z_would_be: "down", .. })));
         let shear = Matrix3::new(1.0, 0.1, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
-        assert!(matches!(
-            Frame::Matrix(shear).to_rfu(),
-            Err(FrameError::NotARotation { .. })
-        ));
+        assert!(matches!(Frame::Matrix(shear).to_rfu(), Err(FrameError::NotARotation { .. })));
     }
 }

@@ -30,21 +30,34 @@ pub fn guess_layout(path: &Path) -> Result<&'static str> {
     let Some(first) = data.first() else {
         return Err(layout_error(path, "it has no data lines to tell its layout from".into()));
     };
-    let fields = |l: &str| -> Vec<f64> { l.split(|c: char| c == ',' || c.is_whitespace()).filter(|f| !f.is_empty()).filter_map(|f| f.parse().ok()).collect() };
+    let fields = |l: &str| -> Vec<f64> {
+        l.split(|c: char| c == ',' || c.is_whitespace())
+            .filter(|f| !f.is_empty())
+            .filter_map(|f| f.parse().ok())
+            .collect()
+    };
     let lower = first.to_ascii_lowercase();
     if lower.starts_with("#timestamp") || lower.starts_with("timestamp") {
         return Ok("kalibr");
     }
-    if lower.starts_with('#') || fields(first).len() < first.split(|c: char| c == ',' || c.is_whitespace()).filter(|f| !f.is_empty()).count() {
+    if lower.starts_with('#')
+        || fields(first).len() < first.split(|c: char| c == ',' || c.is_whitespace()).filter(|f| !f.is_empty()).count()
+    {
         // A header of names: rinscope's own units-in-names layout (its reader lists what it lacks).
         return Ok("rinscope");
     }
     let rows: Vec<Vec<f64>> = data.iter().take(12).map(|l| fields(l)).collect();
     let n = rows[0].len();
     if n < 7 {
-        return Err(layout_error(path, format!("its first data line has {n} numbers; the headerless layouts have 7: [wm vm t] (psins), [t dθ dv] (kf-gins, npy7), [t_ns ω α] (kalibr)")));
+        return Err(layout_error(
+            path,
+            format!(
+                "its first data line has {n} numbers; the headerless layouts have 7: [wm vm t] (psins), [t dθ dv] (kf-gins, npy7), [t_ns ω α] (kalibr)"
+            ),
+        ));
     }
-    let increasing = |k: usize| rows.len() > 2 && rows.windows(2).all(|w| w[0].len() > k && w[1].len() > k && w[1][k] > w[0][k]);
+    let increasing =
+        |k: usize| rows.len() > 2 && rows.windows(2).all(|w| w[0].len() > k && w[1].len() > k && w[1][k] > w[0][k]);
     let (time_first, time_last) = (increasing(0), increasing(6));
     match (time_first, time_last) {
         (true, false) if rows[0][0] > 1e15 => Ok("kalibr"),
@@ -58,7 +71,12 @@ pub fn guess_layout(path: &Path) -> Result<&'static str> {
 }
 
 fn layout_error(path: &Path, why: String) -> LogError {
-    LogError::Layout { file: path.to_path_buf(), problem: format!("cannot tell the layout: {why}; set imu.layout (--imu-layout) to one of rinscope, psins, psins-imu, kf-gins, kalibr, npy7, ros2") }
+    LogError::Layout {
+        file: path.to_path_buf(),
+        problem: format!(
+            "cannot tell the layout: {why}; set imu.layout (--imu-layout) to one of rinscope, psins, psins-imu, kf-gins, kalibr, npy7, ros2"
+        ),
+    }
 }
 
 fn read_head(path: &Path) -> Result<String> {

@@ -114,7 +114,7 @@ pub enum Layout {
     /// MCAP with ROS 2 `sensor_msgs/msg/Imu`.
     Ros2,
     /// Any table, its columns described one by one (`[imu.columns]` of a log set).
-    Columns(ColumnMap),
+    Columns(Box<ColumnMap>),
 }
 
 /// The columns of a foreign or headerless file, as a log set's `[imu.columns]` describes them:
@@ -263,10 +263,7 @@ const BLOCK_ROWS: usize = 4096;
 
 impl std::fmt::Debug for ImuReader {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("ImuReader")
-            .field("path", &self.path)
-            .field("kind", &self.kind)
-            .finish_non_exhaustive()
+        f.debug_struct("ImuReader").field("path", &self.path).field("kind", &self.kind).finish_non_exhaustive()
     }
 }
 
@@ -281,10 +278,7 @@ impl ImuReader {
         if let Some(check) = &options.static_check {
             let report = crate::io::plausibility::check_static(path, options, check)?;
             if !report.problems.is_empty() {
-                return Err(LogError::Implausible {
-                    file: path.to_path_buf(),
-                    message: report.problems.join("; "),
-                });
+                return Err(LogError::Implausible { file: path.to_path_buf(), message: report.problems.join("; ") });
             }
         }
         let plan = plan_for(path, options)?;
@@ -301,10 +295,7 @@ impl ImuReader {
                 });
             }
         };
-        let c = frame.to_rfu().map_err(|source| LogError::Frame {
-            file: path.to_path_buf(),
-            source,
-        })?;
+        let c = frame.to_rfu().map_err(|source| LogError::Frame { file: path.to_path_buf(), source })?;
         let reader = ColumnReader::open(path, &plan.cols, &read_options(options, plan.header))?;
         let time_column = reader.columns().first().cloned().unwrap_or_default();
         let psins = reader.psins_header().cloned();
@@ -533,12 +524,7 @@ impl ImuReader {
                     }
                     GapPolicy::Split => {
                         self.held = Some(p.sample);
-                        return Ok(Some(ImuEvent::Gap {
-                            at,
-                            t_before_s: t_prev,
-                            t_after_s: t,
-                            nominal_s: nominal,
-                        }));
+                        return Ok(Some(ImuEvent::Gap { at, t_before_s: t_prev, t_after_s: t, nominal_s: nominal }));
                     }
                 }
             }

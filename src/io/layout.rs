@@ -21,21 +21,8 @@ pub(crate) struct Plan {
     pub header: HeaderMode,
 }
 
-fn fixed(
-    time: TimeUnit,
-    kind: SampleKind,
-    order: [usize; 7],
-    frame: Option<&'static str>,
-    header: HeaderMode,
-) -> Plan {
-    Plan {
-        cols: order.map(Col::Index),
-        time,
-        scale: [1.0; 6],
-        kind,
-        frame,
-        header,
-    }
+fn fixed(time: TimeUnit, kind: SampleKind, order: [usize; 7], frame: Option<&'static str>, header: HeaderMode) -> Plan {
+    Plan { cols: order.map(Col::Index), time, scale: [1.0; 6], kind, frame, header }
 }
 
 impl Layout {
@@ -58,10 +45,7 @@ impl Layout {
 /// A PSINS SIMU file is read by the psins-imu layout only, and that layout reads nothing else.
 fn check_psins(path: &Path, layout: &Layout) -> Result<()> {
     let format = detect_format(path)?;
-    let layout_error = |problem: String| LogError::Layout {
-        file: path.to_path_buf(),
-        problem,
-    };
+    let layout_error = |problem: String| LogError::Layout { file: path.to_path_buf(), problem };
     match (layout, format) {
         (Layout::PsinsImu, Format::PsinsImu) => Ok(()),
         (Layout::PsinsImu, Format::Text) => Err(not_psins(path, first_line(path)?.as_deref())),
@@ -136,27 +120,11 @@ pub(crate) fn plan_for(path: &Path, options: &ImuOptions) -> Result<Plan> {
     }
     Ok(match &options.layout {
         // imufile.m's [wm vm t], decoded by the PSINS source (`psins_imu`).
-        Layout::Psins | Layout::PsinsImu => fixed(
-            TimeUnit::Seconds,
-            Increments,
-            [6, 0, 1, 2, 3, 4, 5],
-            Some("rfu"),
-            Auto,
-        ),
-        Layout::KfGins => fixed(
-            TimeUnit::GpsSecondsOfWeek,
-            Increments,
-            [0, 1, 2, 3, 4, 5, 6],
-            Some("frd"),
-            Absent,
-        ),
-        Layout::Kalibr => fixed(
-            TimeUnit::Nanoseconds,
-            Rates,
-            [0, 1, 2, 3, 4, 5, 6],
-            None,
-            Auto,
-        ),
+        Layout::Psins | Layout::PsinsImu => {
+            fixed(TimeUnit::Seconds, Increments, [6, 0, 1, 2, 3, 4, 5], Some("rfu"), Auto)
+        }
+        Layout::KfGins => fixed(TimeUnit::GpsSecondsOfWeek, Increments, [0, 1, 2, 3, 4, 5, 6], Some("frd"), Absent),
+        Layout::Kalibr => fixed(TimeUnit::Nanoseconds, Rates, [0, 1, 2, 3, 4, 5, 6], None, Auto),
         Layout::Npy7 { time } => fixed(*time, Increments, [0, 1, 2, 3, 4, 5, 6], None, Auto),
         Layout::Columns(map) => columns_plan(path, map)?,
         Layout::Rinscope | Layout::Ros2 => {
@@ -185,20 +153,11 @@ pub(crate) fn plan_for(path: &Path, options: &ImuOptions) -> Result<Plan> {
 }
 
 pub(crate) fn read_options(options: &ImuOptions, header: HeaderMode) -> ReadOptions {
-    ReadOptions {
-        header,
-        topic: options.topic.clone(),
-        allow_non_finite: false,
-    }
+    ReadOptions { header, topic: options.topic.clone(), allow_non_finite: false }
 }
 
 /// Finds `<base>_<unit>` among `names`; the unit must measure `quantity`.
-fn find_unit_column(
-    path: &Path,
-    names: &[String],
-    base: &str,
-    quantity: Quantity,
-) -> Result<Option<(String, f64)>> {
+fn find_unit_column(path: &Path, names: &[String], base: &str, quantity: Quantity) -> Result<Option<(String, f64)>> {
     let prefix = format!("{base}_");
     let hits: Vec<&String> = names.iter().filter(|n| n.starts_with(&prefix)).collect();
     let [name] = hits[..] else {
@@ -210,15 +169,9 @@ fn find_unit_column(
         }
         return Ok(None);
     };
-    let unit_error = |problem: String| LogError::Unit {
-        file: path.to_path_buf(),
-        column: name.clone(),
-        problem,
-    };
+    let unit_error = |problem: String| LogError::Unit { file: path.to_path_buf(), column: name.clone(), problem };
     match split_unit(name) {
-        Some((b, unit)) if b == base && unit.quantity == quantity => {
-            Ok(Some((name.clone(), unit.to_si)))
-        }
+        Some((b, unit)) if b == base && unit.quantity == quantity => Ok(Some((name.clone(), unit.to_si))),
         Some((b, unit)) if b == base => Err(unit_error(format!(
             "{base} is {}, but _{} is a unit of {}; use one of {}",
             quantity_phrase(quantity),
@@ -258,15 +211,32 @@ fn columns_plan(path: &Path, map: &ColumnMap) -> Result<Plan> {
     let mut kinds = [SampleKind::Rates; 6];
     for (i, (_, suffix)) in map.sensors.iter().enumerate() {
         let gyro = i < 3;
-        let (rate, increment) = if gyro { (Quantity::AngularRate, Quantity::Angle) } else { (Quantity::Acceleration, Quantity::Velocity) };
+        let (rate, increment) =
+            if gyro { (Quantity::AngularRate, Quantity::Angle) } else { (Quantity::Acceleration, Quantity::Velocity) };
         let Some((_, unit)) = split_unit(&format!("x_{suffix}")).filter(|(b, _)| *b == "x") else {
-            return Err(unit_error(i, format!("unknown unit {suffix:?}; use one of {} (rates) or {} (increments)", suffixes_for(rate), suffixes_for(increment))));
+            return Err(unit_error(
+                i,
+                format!(
+                    "unknown unit {suffix:?}; use one of {} (rates) or {} (increments)",
+                    suffixes_for(rate),
+                    suffixes_for(increment)
+                ),
+            ));
         };
         kinds[i] = match unit.quantity {
             q if q == rate => SampleKind::Rates,
             q if q == increment => SampleKind::Increments,
             _ => {
-                return Err(unit_error(i, format!("{suffix:?} is {}; a {} column takes one of {} (rates) or {} (increments)", quantity_phrase(unit.quantity), if gyro { "gyro" } else { "accelerometer" }, suffixes_for(rate), suffixes_for(increment))));
+                return Err(unit_error(
+                    i,
+                    format!(
+                        "{suffix:?} is {}; a {} column takes one of {} (rates) or {} (increments)",
+                        quantity_phrase(unit.quantity),
+                        if gyro { "gyro" } else { "accelerometer" },
+                        suffixes_for(rate),
+                        suffixes_for(increment)
+                    ),
+                ));
             }
         };
         scale[i] = unit.to_si;
@@ -274,12 +244,23 @@ fn columns_plan(path: &Path, map: &ColumnMap) -> Result<Plan> {
     if kinds.iter().any(|k| *k != kinds[0]) {
         return Err(LogError::Layout {
             file: path.to_path_buf(),
-            problem: format!("[imu.columns] mixes rates and increments ({}): give all six as rates (deg_per_s, mps2, ...) or all as increments (rad, mps, ...)", NAMES.iter().zip(kinds).map(|(n, k)| format!("{n} {k:?}")).collect::<Vec<_>>().join(", ")),
+            problem: format!(
+                "[imu.columns] mixes rates and increments ({}): give all six as rates (deg_per_s, mps2, ...) or all as increments (rad, mps, ...)",
+                NAMES.iter().zip(kinds).map(|(n, k)| format!("{n} {k:?}")).collect::<Vec<_>>().join(", ")
+            ),
         });
     }
-    let by_name = std::iter::once(&map.time.0).chain(map.sensors.iter().map(|(c, _)| c)).any(|c| matches!(c, Col::Name(_)));
+    let by_name =
+        std::iter::once(&map.time.0).chain(map.sensors.iter().map(|(c, _)| c)).any(|c| matches!(c, Col::Name(_)));
     let [a, b, c, d, e, f] = map.sensors.clone().map(|(col, _)| col);
-    Ok(Plan { cols: [map.time.0.clone(), a, b, c, d, e, f], time: map.time.1, scale, kind: kinds[0], frame: None, header: if by_name { HeaderMode::Present } else { HeaderMode::Auto } })
+    Ok(Plan {
+        cols: [map.time.0.clone(), a, b, c, d, e, f],
+        time: map.time.1,
+        scale,
+        kind: kinds[0],
+        frame: None,
+        header: if by_name { HeaderMode::Present } else { HeaderMode::Auto },
+    })
 }
 
 fn rinscope_plan(path: &Path, names: &[String]) -> Result<Plan> {
@@ -297,18 +278,13 @@ fn rinscope_plan(path: &Path, names: &[String]) -> Result<Plan> {
             Some((n, unit))
         })
         .collect();
-    let layout_error = |problem: String| LogError::Layout {
-        file: path.to_path_buf(),
-        problem,
-    };
+    let layout_error = |problem: String| LogError::Layout { file: path.to_path_buf(), problem };
     let (time_name, time) = match times[..] {
         [(n, u)] => (n.clone(), u),
         [] => {
             return Err(LogError::MissingColumn {
                 file: path.to_path_buf(),
-                column:
-                    "t_s, t_ms, t_us, t_ns or gps_sow_s (the time column of the rinscope layout)"
-                        .into(),
+                column: "t_s, t_ms, t_us, t_ns or gps_sow_s (the time column of the rinscope layout)".into(),
                 available: names.to_vec(),
             });
         }
@@ -321,28 +297,14 @@ fn rinscope_plan(path: &Path, names: &[String]) -> Result<Plan> {
     };
     let mut families = Vec::new();
     for (gyro, q_gyro, accel, q_accel, kind) in [
-        (
-            "gyro",
-            Quantity::AngularRate,
-            "accel",
-            Quantity::Acceleration,
-            SampleKind::Rates,
-        ),
-        (
-            "dtheta",
-            Quantity::Angle,
-            "dv",
-            Quantity::Velocity,
-            SampleKind::Increments,
-        ),
+        ("gyro", Quantity::AngularRate, "accel", Quantity::Acceleration, SampleKind::Rates),
+        ("dtheta", Quantity::Angle, "dv", Quantity::Velocity, SampleKind::Increments),
     ] {
         let mut found = Vec::new();
         for (family, q) in [(gyro, q_gyro), (accel, q_accel)] {
             for axis in ["x", "y", "z"] {
-                found.push((
-                    format!("{family}_{axis}"),
-                    find_unit_column(path, names, &format!("{family}_{axis}"), q)?,
-                ));
+                found
+                    .push((format!("{family}_{axis}"), find_unit_column(path, names, &format!("{family}_{axis}"), q)?));
             }
         }
         if found.iter().any(|(_, c)| c.is_some()) {
@@ -359,8 +321,7 @@ fn rinscope_plan(path: &Path, names: &[String]) -> Result<Plan> {
         }
         _ => {
             return Err(layout_error(
-                "both rate (gyro_*/accel_*) and increment (dtheta_*/dv_*) columns: keep one kind"
-                    .into(),
+                "both rate (gyro_*/accel_*) and increment (dtheta_*/dv_*) columns: keep one kind".into(),
             ));
         }
     };
@@ -379,15 +340,6 @@ fn rinscope_plan(path: &Path, names: &[String]) -> Result<Plan> {
         }
         cols.push(Col::Name(name));
     }
-    let cols: [Col; 7] = cols
-        .try_into()
-        .map_err(|_| layout_error("internal: column plan".into()))?;
-    Ok(Plan {
-        cols,
-        time,
-        scale,
-        kind,
-        frame: Some("rfu"),
-        header: HeaderMode::Auto,
-    })
+    let cols: [Col; 7] = cols.try_into().map_err(|_| layout_error("internal: column plan".into()))?;
+    Ok(Plan { cols, time, scale, kind, frame: Some("rfu"), header: HeaderMode::Auto })
 }

@@ -58,11 +58,7 @@ impl ChannelInfo {
         format!(
             "{} ({}, {})",
             self.topic,
-            if self.schema.is_empty() {
-                "no schema"
-            } else {
-                &self.schema
-            },
+            if self.schema.is_empty() { "no schema" } else { &self.schema },
             self.encoding
         )
     }
@@ -85,35 +81,17 @@ struct Records {
 
 impl Records {
     fn new(file: File) -> Self {
-        let options = LinearReaderOptions::default()
-            .with_record_length_limit(RECORD_LIMIT)
-            .with_emit_chunks(true);
-        Self {
-            file,
-            reader: LinearReader::new_with_options(options),
-            chunk: Vec::new(),
-            chunk_pos: 0,
-            fed: 0,
-        }
+        let options = LinearReaderOptions::default().with_record_length_limit(RECORD_LIMIT).with_emit_chunks(true);
+        Self { file, reader: LinearReader::new_with_options(options), chunk: Vec::new(), chunk_pos: 0, fed: 0 }
     }
 
     /// Calls `on_record` for each record until it returns `true` (then `Ok(true)`), or the file ends (`Ok(false)`).
-    fn until(
-        &mut self,
-        path: &Path,
-        mut on_record: impl FnMut(u8, &[u8]) -> Result<bool>,
-    ) -> Result<bool> {
+    fn until(&mut self, path: &Path, mut on_record: impl FnMut(u8, &[u8]) -> Result<bool>) -> Result<bool> {
         loop {
             while self.chunk_pos < self.chunk.len() {
                 let rest = self.chunk.get(self.chunk_pos..).unwrap_or(&[]);
                 let (opcode, body, used) = split_record(rest).ok_or_else(|| {
-                    mcap_error(
-                        path,
-                        format!(
-                            "a record inside a chunk overruns the chunk ({} bytes left)",
-                            rest.len()
-                        ),
-                    )
+                    mcap_error(path, format!("a record inside a chunk overruns the chunk ({} bytes left)", rest.len()))
                 })?;
                 self.chunk_pos += used;
                 if on_record(opcode, body)? {
@@ -129,7 +107,10 @@ impl Records {
                 if more > 0 {
                     return Err(mcap_error(
                         path,
-                        format!("bytes follow the recording's closing magic at byte {}: a second file appended, or garbage (an MCAP ends with its magic)", self.fed),
+                        format!(
+                            "bytes follow the recording's closing magic at byte {}: a second file appended, or garbage (an MCAP ends with its magic)",
+                            self.fed
+                        ),
                     ));
                 }
                 return Ok(false);
@@ -137,17 +118,11 @@ impl Records {
             match event.map_err(|e| mcap_error(path, e))? {
                 LinearReadEvent::ReadRequest(need) => {
                     let buf = self.reader.insert(need.clamp(1, READ_BYTES));
-                    let n = self
-                        .file
-                        .read(buf)
-                        .map_err(|e| LogError::io(path, "cannot read", e))?;
+                    let n = self.file.read(buf).map_err(|e| LogError::io(path, "cannot read", e))?;
                     self.reader.notify_read(n);
                     self.fed += n as u64;
                 }
-                LinearReadEvent::Record {
-                    opcode: op::CHUNK,
-                    data,
-                } => {
+                LinearReadEvent::Record { opcode: op::CHUNK, data } => {
                     self.chunk = decompress_chunk(path, data)?;
                     self.chunk_pos = 0;
                 }
@@ -171,52 +146,31 @@ fn split_record(buf: &[u8]) -> Option<(u8, &[u8], usize)> {
 
 /// The records of a chunk record, decompressed and CRC-checked.
 fn decompress_chunk(path: &Path, data: &[u8]) -> Result<Vec<u8>> {
-    let Record::Chunk { header, data } =
-        mcap::parse_record(op::CHUNK, data).map_err(|e| mcap_error(path, e))?
-    else {
+    let Record::Chunk { header, data } = mcap::parse_record(op::CHUNK, data).map_err(|e| mcap_error(path, e))? else {
         return Err(mcap_error(path, "a chunk record that does not parse"));
     };
-    let size = usize::try_from(header.uncompressed_size)
-        .ok()
-        .filter(|&n| n <= RECORD_LIMIT)
-        .ok_or_else(|| {
-            mcap_error(
-                path,
-                format!(
-                    "a chunk claims {} uncompressed bytes (more than {RECORD_LIMIT})",
-                    header.uncompressed_size
-                ),
-            )
-        })?;
-    let bad = |what: String| {
+    let size = usize::try_from(header.uncompressed_size).ok().filter(|&n| n <= RECORD_LIMIT).ok_or_else(|| {
         mcap_error(
             path,
-            format!("chunk at log time {}: {what}", header.message_start_time),
+            format!("a chunk claims {} uncompressed bytes (more than {RECORD_LIMIT})", header.uncompressed_size),
         )
-    };
+    })?;
+    let bad = |what: String| mcap_error(path, format!("chunk at log time {}: {what}", header.message_start_time));
     let records = match header.compression.as_str() {
         "" => data.to_vec(),
         "zstd" => zstd::bulk::decompress(&data, size).map_err(|e| bad(format!("zstd: {e}")))?,
         "lz4" => {
             let mut out = Vec::with_capacity(size);
             let decoder = lz4::Decoder::new(&data[..]).map_err(|e| bad(format!("lz4: {e}")))?;
-            decoder
-                .take(size as u64 + 1)
-                .read_to_end(&mut out)
-                .map_err(|e| bad(format!("lz4: {e}")))?;
+            decoder.take(size as u64 + 1).read_to_end(&mut out).map_err(|e| bad(format!("lz4: {e}")))?;
             out
         }
         other => {
-            return Err(bad(format!(
-                "compression {other:?} is not zstd, lz4 or none"
-            )));
+            return Err(bad(format!("compression {other:?} is not zstd, lz4 or none")));
         }
     };
     if records.len() != size {
-        return Err(bad(format!(
-            "decompresses to {} bytes, the header says {size}",
-            records.len()
-        )));
+        return Err(bad(format!("decompresses to {} bytes, the header says {size}", records.len())));
     }
     if header.uncompressed_crc != 0 && crc32fast::hash(&records) != header.uncompressed_crc {
         return Err(bad("CRC mismatch: the chunk is corrupt".into()));
@@ -226,28 +180,19 @@ fn decompress_chunk(path: &Path, data: &[u8]) -> Result<Vec<u8>> {
 
 /// Channels from the summary section, if the file has one.
 fn summary_channels(path: &Path, file: &mut File) -> Result<Option<BTreeMap<u16, ChannelInfo>>> {
-    let len = file
-        .metadata()
-        .map_err(|e| LogError::io(path, "cannot read", e))?
-        .len();
+    let len = file.metadata().map_err(|e| LogError::io(path, "cannot read", e))?.len();
     let mut reader = SummaryReader::new_with_options(
-        SummaryReaderOptions::default()
-            .with_file_size(len)
-            .with_record_length_limit(RECORD_LIMIT),
+        SummaryReaderOptions::default().with_file_size(len).with_record_length_limit(RECORD_LIMIT),
     );
     while let Some(event) = reader.next_event() {
         match event.map_err(|e| mcap_error(path, e))? {
             SummaryReadEvent::ReadRequest(need) => {
                 let buf = reader.insert(need.clamp(1, READ_BYTES));
-                let n = file
-                    .read(buf)
-                    .map_err(|e| LogError::io(path, "cannot read", e))?;
+                let n = file.read(buf).map_err(|e| LogError::io(path, "cannot read", e))?;
                 reader.notify_read(n);
             }
             SummaryReadEvent::SeekRequest(to) => {
-                let pos = file
-                    .seek(to)
-                    .map_err(|e| LogError::io(path, "cannot seek", e))?;
+                let pos = file.seek(to).map_err(|e| LogError::io(path, "cannot seek", e))?;
                 reader.notify_seeked(pos);
             }
         }
@@ -263,19 +208,8 @@ fn summary_channels(path: &Path, file: &mut File) -> Result<Option<BTreeMap<u16,
             .channels
             .iter()
             .map(|(&id, c)| {
-                let schema = c
-                    .schema
-                    .as_ref()
-                    .map(|s| s.name.clone())
-                    .unwrap_or_default();
-                (
-                    id,
-                    ChannelInfo {
-                        topic: c.topic.clone(),
-                        schema,
-                        encoding: c.message_encoding.clone(),
-                    },
-                )
+                let schema = c.schema.as_ref().map(|s| s.name.clone()).unwrap_or_default();
+                (id, ChannelInfo { topic: c.topic.clone(), schema, encoding: c.message_encoding.clone() })
             })
             .collect(),
     ))
@@ -283,11 +217,8 @@ fn summary_channels(path: &Path, file: &mut File) -> Result<Option<BTreeMap<u16,
 
 /// Channels from a pass over all records (files without a summary).
 fn scan_channels(path: &Path, file: &File) -> Result<BTreeMap<u16, ChannelInfo>> {
-    let mut file = file
-        .try_clone()
-        .map_err(|e| LogError::io(path, "cannot read", e))?;
-    file.rewind()
-        .map_err(|e| LogError::io(path, "cannot seek", e))?;
+    let mut file = file.try_clone().map_err(|e| LogError::io(path, "cannot read", e))?;
+    file.rewind().map_err(|e| LogError::io(path, "cannot seek", e))?;
     let mut schemas: BTreeMap<u16, String> = BTreeMap::new();
     let mut channels: BTreeMap<u16, (u16, String, String)> = BTreeMap::new();
     let mut records = Records::new(file);
@@ -301,9 +232,7 @@ fn scan_channels(path: &Path, file: &File) -> Result<BTreeMap<u16, ChannelInfo>>
                 }
             }
             op::CHANNEL => {
-                if let Record::Channel(c) =
-                    mcap::parse_record(opcode, data).map_err(|e| mcap_error(path, e))?
-                {
+                if let Record::Channel(c) = mcap::parse_record(opcode, data).map_err(|e| mcap_error(path, e))? {
                     channels.insert(c.id, (c.schema_id, c.topic, c.message_encoding));
                 }
             }
@@ -322,14 +251,7 @@ fn scan_channels(path: &Path, file: &File) -> Result<BTreeMap<u16, ChannelInfo>>
         .into_iter()
         .map(|(id, (schema_id, topic, encoding))| {
             let schema = schemas.get(&schema_id).cloned().unwrap_or_default();
-            (
-                id,
-                ChannelInfo {
-                    topic,
-                    schema,
-                    encoding,
-                },
-            )
+            (id, ChannelInfo { topic, schema, encoding })
         })
         .collect())
 }
@@ -354,15 +276,11 @@ impl McapImuSource {
             Err(e) => return Err(e),
         };
         let topics: Vec<String> = channels.values().map(ChannelInfo::describe).collect();
-        let topic_error = |problem: String| LogError::Topic {
-            file: path.to_path_buf(),
-            problem,
-            topics: topics.clone(),
-        };
+        let topic_error =
+            |problem: String| LogError::Topic { file: path.to_path_buf(), problem, topics: topics.clone() };
         let chosen: String = match topic {
             Some(t) => {
-                let on_topic: Vec<&ChannelInfo> =
-                    channels.values().filter(|c| c.topic == t).collect();
+                let on_topic: Vec<&ChannelInfo> = channels.values().filter(|c| c.topic == t).collect();
                 if on_topic.is_empty() {
                     return Err(topic_error(format!("no topic {t:?}")));
                 }
@@ -375,11 +293,8 @@ impl McapImuSource {
                 t.to_owned()
             }
             None => {
-                let imu_topics: BTreeSet<&str> = channels
-                    .values()
-                    .filter(|c| c.is_imu())
-                    .map(|c| c.topic.as_str())
-                    .collect();
+                let imu_topics: BTreeSet<&str> =
+                    channels.values().filter(|c| c.is_imu()).map(|c| c.topic.as_str()).collect();
                 match imu_topics.len() {
                     0 => return Err(topic_error(format!("no {IMU_SCHEMA} topic in cdr"))),
                     1 => imu_topics.into_iter().next().unwrap_or_default().to_owned(),
@@ -392,13 +307,8 @@ impl McapImuSource {
                 }
             }
         };
-        let channel_ids = channels
-            .iter()
-            .filter(|(_, c)| c.topic == chosen)
-            .map(|(&id, _)| id)
-            .collect();
-        file.rewind()
-            .map_err(|e| LogError::io(path, "cannot seek", e))?;
+        let channel_ids = channels.iter().filter(|(_, c)| c.topic == chosen).map(|(&id, _)| id).collect();
+        file.rewind().map_err(|e| LogError::io(path, "cannot seek", e))?;
         Ok(Self {
             path: path.to_path_buf(),
             records: Records::new(file),
@@ -429,8 +339,7 @@ impl Source for McapImuSource {
             if opcode != op::MESSAGE {
                 return Ok(false);
             }
-            let Record::Message { header, data } =
-                mcap::parse_record(opcode, data).map_err(|e| mcap_error(path, e))?
+            let Record::Message { header, data } = mcap::parse_record(opcode, data).map_err(|e| mcap_error(path, e))?
             else {
                 return Ok(false);
             };
@@ -440,17 +349,12 @@ impl Source for McapImuSource {
             let bad = |detail: String| {
                 LogError::corrupt(
                     path,
-                    format!(
-                        "Imu message {} on {topic} (log_time {} ns): {detail}",
-                        row + 1,
-                        header.log_time
-                    ),
+                    format!("Imu message {} on {topic} (log_time {} ns): {detail}", row + 1, header.log_time),
                 )
             };
             let m = decode_imu(&data).map_err(bad)?;
             t_ns = if m.stamp_sec == 0 && m.stamp_nanosec == 0 {
-                i64::try_from(header.log_time)
-                    .map_err(|_| bad("log_time beyond year 2262".into()))?
+                i64::try_from(header.log_time).map_err(|_| bad("log_time beyond year 2262".into()))?
             } else {
                 i64::from(m.stamp_sec) * 1_000_000_000 + i64::from(m.stamp_nanosec)
             };
@@ -483,9 +387,6 @@ impl Source for McapImuSource {
     }
 
     fn location(&self) -> Location {
-        Location {
-            row: self.row,
-            line: None,
-        }
+        Location { row: self.row, line: None }
     }
 }

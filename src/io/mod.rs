@@ -15,10 +15,10 @@
 //! Every error ([`LogError`]) names the file, and where it applies the row, line, column, value
 //! and unit. No input makes these functions panic.
 
-pub mod files;
 mod cdr;
 mod clock;
 mod error;
+pub mod files;
 mod frames;
 mod guess;
 mod imu;
@@ -40,8 +40,8 @@ pub use error::{FrameError, Location, LogError, Result, fixed_number, short_numb
 pub use frames::{Frame, frame_matrix};
 pub use guess::guess_layout;
 pub use imu::{
-    BlockEnd, ColumnMap, GPS_WEEK_S, GapPolicy, RATE_TOLERANCE, ImuEvent, ImuOptions, ImuReader, ImuSample, Layout, SampleKind,
-    StartTime, StaticCheck, TimeUnit,
+    BlockEnd, ColumnMap, GPS_WEEK_S, GapPolicy, ImuEvent, ImuOptions, ImuReader, ImuSample, Layout, RATE_TOLERANCE,
+    SampleKind, StartTime, StaticCheck, TimeUnit,
 };
 pub use mcap_imu::MCAP_IMU_COLUMNS;
 pub use plausibility::{EARTH_RATE_RAD_PER_S, StaticReport, check_static};

@@ -57,10 +57,7 @@ impl PyParser<'_> {
             self.i += 1;
             Ok(())
         } else {
-            Err(format!(
-                "expected '{}' at byte {} of the header",
-                c as char, self.i
-            ))
+            Err(format!("expected '{}' at byte {} of the header", c as char, self.i))
         }
     }
 
@@ -75,10 +72,7 @@ impl PyParser<'_> {
                 while self.s.get(self.i).is_some_and(|&c| c != q) {
                     self.i += 1;
                 }
-                let text = self
-                    .s
-                    .get(start..self.i)
-                    .ok_or("unterminated string in header")?;
+                let text = self.s.get(start..self.i).ok_or("unterminated string in header")?;
                 self.expect(q)?;
                 Ok(Py::Str(String::from_utf8_lossy(text).into_owned()))
             }
@@ -120,11 +114,7 @@ impl PyParser<'_> {
             }
             Some(c) if c.is_ascii_alphanumeric() => {
                 let start = self.i;
-                while self
-                    .s
-                    .get(self.i)
-                    .is_some_and(|c| c.is_ascii_alphanumeric() || *c == b'_')
-                {
+                while self.s.get(self.i).is_some_and(|c| c.is_ascii_alphanumeric() || *c == b'_') {
                     self.i += 1;
                 }
                 let word = self.s.get(start..self.i).unwrap_or(&[]);
@@ -139,9 +129,7 @@ impl PyParser<'_> {
                             .ok()
                             .and_then(|d| d.parse::<u64>().ok())
                             .map(Py::Int)
-                            .ok_or_else(|| {
-                                format!("unexpected {:?} in header", String::from_utf8_lossy(word))
-                            })
+                            .ok_or_else(|| format!("unexpected {:?} in header", String::from_utf8_lossy(word)))
                     }
                 }
             }
@@ -170,20 +158,12 @@ impl Dtype {
             Self::F64 { little } => {
                 let mut b = [0u8; 8];
                 b.copy_from_slice(bytes.get(..8).unwrap_or(&[0; 8]));
-                if little {
-                    f64::from_le_bytes(b)
-                } else {
-                    f64::from_be_bytes(b)
-                }
+                if little { f64::from_le_bytes(b) } else { f64::from_be_bytes(b) }
             }
             Self::F32 { little } => {
                 let mut b = [0u8; 4];
                 b.copy_from_slice(bytes.get(..4).unwrap_or(&[0; 4]));
-                f64::from(if little {
-                    f32::from_le_bytes(b)
-                } else {
-                    f32::from_be_bytes(b)
-                })
+                f64::from(if little { f32::from_le_bytes(b) } else { f32::from_be_bytes(b) })
             }
         }
     }
@@ -201,8 +181,7 @@ struct Header {
 fn parse_header(path: &Path, file: &mut impl Read, file_len: u64) -> Result<Header> {
     let corrupt = |d: String| LogError::corrupt(path, format!("not a valid .npy file: {d}"));
     let mut pre = [0u8; 8];
-    file.read_exact(&mut pre)
-        .map_err(|_| corrupt("shorter than the 8-byte preamble".into()))?;
+    file.read_exact(&mut pre).map_err(|_| corrupt("shorter than the 8-byte preamble".into()))?;
     if !pre.starts_with(NPY_MAGIC) {
         return Err(corrupt("no \\x93NUMPY magic".into()));
     }
@@ -210,40 +189,28 @@ fn parse_header(path: &Path, file: &mut impl Read, file_len: u64) -> Result<Head
     let header_len = match major {
         1 => {
             let mut b = [0u8; 2];
-            file.read_exact(&mut b)
-                .map_err(|_| corrupt("truncated in the header length".into()))?;
+            file.read_exact(&mut b).map_err(|_| corrupt("truncated in the header length".into()))?;
             usize::from(u16::from_le_bytes(b))
         }
         2 | 3 => {
             let mut b = [0u8; 4];
-            file.read_exact(&mut b)
-                .map_err(|_| corrupt("truncated in the header length".into()))?;
+            file.read_exact(&mut b).map_err(|_| corrupt("truncated in the header length".into()))?;
             usize::try_from(u32::from_le_bytes(b)).unwrap_or(usize::MAX)
         }
         _ => {
-            return Err(corrupt(format!(
-                "format version {major}.{minor} is not 1.0, 2.0 or 3.0"
-            )));
+            return Err(corrupt(format!("format version {major}.{minor} is not 1.0, 2.0 or 3.0")));
         }
     };
     if header_len > MAX_HEADER_BYTES {
-        return Err(corrupt(format!(
-            "header of {header_len} bytes (more than {MAX_HEADER_BYTES})"
-        )));
+        return Err(corrupt(format!("header of {header_len} bytes (more than {MAX_HEADER_BYTES})")));
     }
     let mut text = vec![0u8; header_len];
-    file.read_exact(&mut text)
-        .map_err(|_| corrupt(format!("truncated inside its {header_len}-byte header")))?;
+    file.read_exact(&mut text).map_err(|_| corrupt(format!("truncated inside its {header_len}-byte header")))?;
     let mut parser = PyParser { s: &text, i: 0 };
     let Py::Dict(items) = parser.value(0).map_err(corrupt)? else {
         return Err(corrupt("the header is not a dict".into()));
     };
-    let get = |key: &str| {
-        items
-            .iter()
-            .find(|(k, _)| *k == Py::Str(key.into()))
-            .map(|(_, v)| v)
-    };
+    let get = |key: &str| items.iter().find(|(k, _)| *k == Py::Str(key.into())).map(|(_, v)| v);
     let descr = match get("descr") {
         Some(Py::Str(s)) => s.clone(),
         Some(other) => {
@@ -260,53 +227,37 @@ fn parse_header(path: &Path, file: &mut impl Read, file_len: u64) -> Result<Head
         "<f4" => Dtype::F32 { little: true },
         ">f4" => Dtype::F32 { little: false },
         _ => {
-            return Err(LogError::NpyDtype {
-                file: path.to_path_buf(),
-                dtype: descr,
-            });
+            return Err(LogError::NpyDtype { file: path.to_path_buf(), dtype: descr });
         }
     };
     let fortran = match get("fortran_order") {
         Some(Py::Bool(b)) => *b,
         _ => return Err(corrupt("the header has no boolean 'fortran_order'".into())),
     };
-    let dims: Vec<u64> = match get("shape") {
-        Some(Py::Seq(items)) => items
-            .iter()
-            .map(|d| {
-                if let Py::Int(n) = d {
-                    Ok(*n)
-                } else {
-                    Err(corrupt("a non-integer dimension in 'shape'".into()))
-                }
-            })
-            .collect::<Result<_>>()?,
-        _ => return Err(corrupt("the header has no tuple 'shape'".into())),
-    };
-    let shape_text = format!(
-        "({})",
-        dims.iter()
-            .map(u64::to_string)
-            .collect::<Vec<_>>()
-            .join(", ")
-    );
+    let dims: Vec<u64> =
+        match get("shape") {
+            Some(Py::Seq(items)) => items
+                .iter()
+                .map(|d| {
+                    if let Py::Int(n) = d { Ok(*n) } else { Err(corrupt("a non-integer dimension in 'shape'".into())) }
+                })
+                .collect::<Result<_>>()?,
+            _ => return Err(corrupt("the header has no tuple 'shape'".into())),
+        };
+    let shape_text = format!("({})", dims.iter().map(u64::to_string).collect::<Vec<_>>().join(", "));
     let shape_err = |expected: &str| LogError::Shape {
         file: path.to_path_buf(),
         shape: shape_text.clone(),
         expected: expected.into(),
     };
     let &[rows, cols] = dims.as_slice() else {
-        return Err(shape_err(
-            "expected a 2-D array (N rows, C columns); reshape with a.reshape(len(a), -1)",
-        ));
+        return Err(shape_err("expected a 2-D array (N rows, C columns); reshape with a.reshape(len(a), -1)"));
     };
     if cols == 0 {
         return Err(shape_err("the array has no columns"));
     }
     if fortran && rows > 1 && cols > 1 {
-        return Err(shape_err(
-            "the array is stored in Fortran (column-major) order; save np.ascontiguousarray(a)",
-        ));
+        return Err(shape_err("the array is stored in Fortran (column-major) order; save np.ascontiguousarray(a)"));
     }
     let prefix = if major == 1 { 10 } else { 12 };
     let data_offset = prefix + header_len as u64;
@@ -316,21 +267,12 @@ fn parse_header(path: &Path, file: &mut impl Read, file_len: u64) -> Result<Head
         .ok_or_else(|| shape_err("the shape is too large to exist"))?;
     let present = file_len.saturating_sub(data_offset);
     if present != needed {
-        let what = if present < needed {
-            "the file is truncated"
-        } else {
-            "extra bytes follow the array"
-        };
+        let what = if present < needed { "the file is truncated" } else { "extra bytes follow the array" };
         return Err(corrupt(format!(
             "{what}: shape {shape_text} of {descr} needs {needed} data bytes, the file has {present} after its header"
         )));
     }
-    Ok(Header {
-        dtype,
-        rows,
-        cols: usize::try_from(cols).map_err(|_| shape_err("too many columns"))?,
-        data_offset,
-    })
+    Ok(Header { dtype, rows, cols: usize::try_from(cols).map_err(|_| shape_err("too many columns"))?, data_offset })
 }
 
 pub(crate) struct NpySource {
@@ -348,13 +290,9 @@ pub(crate) struct NpySource {
 impl NpySource {
     pub(crate) fn open(path: &Path) -> Result<Self> {
         let mut file = crate::io::files::open_input(path).map_err(|e| LogError::io(path, "cannot open", e))?;
-        let len = file
-            .metadata()
-            .map_err(|e| LogError::io(path, "cannot read", e))?
-            .len();
+        let len = file.metadata().map_err(|e| LogError::io(path, "cannot read", e))?.len();
         let header = parse_header(path, &mut BufReader::new(&mut file), len)?;
-        file.seek(SeekFrom::Start(header.data_offset))
-            .map_err(|e| LogError::io(path, "cannot read", e))?;
+        file.seek(SeekFrom::Start(header.data_offset)).map_err(|e| LogError::io(path, "cannot read", e))?;
         if header.cols > 1 << 20 {
             return Err(LogError::Shape {
                 file: path.to_path_buf(),
@@ -390,9 +328,7 @@ impl Source for NpySource {
             return Ok(false);
         }
         self.row += 1;
-        self.reader
-            .read_exact(&mut self.buf)
-            .map_err(|e| LogError::io(&self.path, "cannot read", e))?;
+        self.reader.read_exact(&mut self.buf).map_err(|e| LogError::io(&self.path, "cannot read", e))?;
         let size = self.header.dtype.size();
         for (k, &col) in self.selected.iter().enumerate() {
             let bytes = self.buf.get(col * size..(col + 1) * size).unwrap_or(&[]);
@@ -438,10 +374,7 @@ impl Source for NpySource {
     }
 
     fn location(&self) -> Location {
-        Location {
-            row: self.row,
-            line: None,
-        }
+        Location { row: self.row, line: None }
     }
 }
 
@@ -469,10 +402,7 @@ fn header_bytes(rows: u64, cols: usize, total: usize) -> Vec<u8> {
 impl NpyWriter {
     pub(crate) fn new(path: &Path, file: File, cols: usize) -> Result<Self> {
         // Room for the largest u64 row count; the total is a multiple of 64 as the format asks.
-        let widest = format!(
-            "{{'descr': '<f8', 'fortran_order': False, 'shape': ({}, {cols}), }}",
-            u64::MAX
-        );
+        let widest = format!("{{'descr': '<f8', 'fortran_order': False, 'shape': ({}, {cols}), }}", u64::MAX);
         let header_len = (10 + widest.len() + 1).div_ceil(64) * 64;
         if header_len - 10 > usize::from(u16::MAX) {
             return Err(LogError::Output {
@@ -481,22 +411,14 @@ impl NpyWriter {
             });
         }
         let mut out = BufWriter::with_capacity(1 << 16, file);
-        out.write_all(&header_bytes(0, cols, header_len))
-            .map_err(|e| LogError::io(path, "cannot write", e))?;
-        Ok(Self {
-            out,
-            cols,
-            rows: 0,
-            header_len,
-        })
+        out.write_all(&header_bytes(0, cols, header_len)).map_err(|e| LogError::io(path, "cannot write", e))?;
+        Ok(Self { out, cols, rows: 0, header_len })
     }
 
     pub(crate) fn write_row(&mut self, path: &Path, row: &[f64]) -> Result<()> {
         debug_assert_eq!(row.len(), self.cols);
         for v in row {
-            self.out
-                .write_all(&v.to_le_bytes())
-                .map_err(|e| LogError::io(path, "cannot write", e))?;
+            self.out.write_all(&v.to_le_bytes()).map_err(|e| LogError::io(path, "cannot write", e))?;
         }
         self.rows += 1;
         Ok(())
@@ -505,13 +427,9 @@ impl NpyWriter {
     pub(crate) fn finish(mut self, path: &Path) -> Result<File> {
         let io = |e| LogError::io(path, "cannot write", e);
         self.out.flush().map_err(io)?;
-        let mut file = self
-            .out
-            .into_inner()
-            .map_err(|e| LogError::io(path, "cannot write", e.into_error()))?;
+        let mut file = self.out.into_inner().map_err(|e| LogError::io(path, "cannot write", e.into_error()))?;
         file.seek(SeekFrom::Start(0)).map_err(io)?;
-        file.write_all(&header_bytes(self.rows, self.cols, self.header_len))
-            .map_err(io)?;
+        file.write_all(&header_bytes(self.rows, self.cols, self.header_len)).map_err(io)?;
         Ok(file)
     }
 }
@@ -528,27 +446,16 @@ mod tests {
         let mut data = h.clone();
         data.extend(std::iter::repeat_n(0u8, 123 * 7 * 8));
         let header = parse_header(Path::new("x.npy"), &mut &data[..], data.len() as u64).unwrap();
-        assert_eq!(
-            (header.rows, header.cols, header.data_offset),
-            (123, 7, 128)
-        );
+        assert_eq!((header.rows, header.cols, header.data_offset), (123, 7, 128));
     }
 
     #[test]
     fn python_literals() {
-        let mut p = PyParser {
-            s: b"{'descr': '<f4', 'fortran_order': False, 'shape': (10L, 3), }",
-            i: 0,
-        };
-        let Py::Dict(items) = p.value(0).unwrap() else {
-            panic!()
-        };
+        let mut p = PyParser { s: b"{'descr': '<f4', 'fortran_order': False, 'shape': (10L, 3), }", i: 0 };
+        let Py::Dict(items) = p.value(0).unwrap() else { panic!() };
         assert_eq!(items.len(), 3);
         assert_eq!(items[2].1, Py::Seq(vec![Py::Int(10), Py::Int(3)]));
-        let mut deep = PyParser {
-            s: &[b'('; 100],
-            i: 0,
-        };
+        let mut deep = PyParser { s: &[b'('; 100], i: 0 };
         assert!(deep.value(0).is_err());
     }
 }

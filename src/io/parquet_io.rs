@@ -15,16 +15,15 @@ use crate::io::error::{Location, LogError, Result};
 use crate::io::table::Source;
 use arrow_array::cast::AsArray;
 use arrow_array::types::{
-    Float32Type, Float64Type, Int32Type, Int64Type, TimestampMicrosecondType,
-    TimestampMillisecondType, TimestampNanosecondType, TimestampSecondType, UInt32Type,
+    Float32Type, Float64Type, Int32Type, Int64Type, TimestampMicrosecondType, TimestampMillisecondType,
+    TimestampNanosecondType, TimestampSecondType, UInt32Type,
 };
 use arrow_array::{Array, ArrayRef, Float64Array, RecordBatch};
 use arrow_schema::{DataType, Field, Schema, SchemaRef, TimeUnit};
 use parquet::arrow::ArrowWriter;
 use parquet::arrow::ProjectionMask;
 use parquet::arrow::arrow_reader::{
-    ArrowReaderMetadata, ArrowReaderOptions, ParquetRecordBatchReader,
-    ParquetRecordBatchReaderBuilder,
+    ArrowReaderMetadata, ArrowReaderOptions, ParquetRecordBatchReader, ParquetRecordBatchReaderBuilder,
 };
 use parquet::basic::Compression;
 use parquet::file::properties::WriterProperties;
@@ -67,10 +66,7 @@ fn cell(array: &ArrayRef, kind: Kind, i: usize) -> Option<(f64, Option<i64>)> {
     let int = |v: i64| (v as f64, Some(v));
     Some(match (kind, array.data_type()) {
         (_, DataType::Float64) => (array.as_primitive::<Float64Type>().value(i), None),
-        (_, DataType::Float32) => (
-            f64::from(array.as_primitive::<Float32Type>().value(i)),
-            None,
-        ),
+        (_, DataType::Float32) => (f64::from(array.as_primitive::<Float32Type>().value(i)), None),
         (_, DataType::Int64) => int(array.as_primitive::<Int64Type>().value(i)),
         (_, DataType::Int32) => int(i64::from(array.as_primitive::<Int32Type>().value(i))),
         (_, DataType::UInt32) => int(i64::from(array.as_primitive::<UInt32Type>().value(i))),
@@ -94,9 +90,7 @@ fn cell(array: &ArrayRef, kind: Kind, i: usize) -> Option<(f64, Option<i64>)> {
 fn check_chunk_ranges(path: &Path, metadata: &ArrowReaderMetadata, file_len: u64) -> Result<()> {
     for (g, group) in metadata.metadata().row_groups().iter().enumerate() {
         for column in group.columns() {
-            let start = column
-                .dictionary_page_offset()
-                .unwrap_or_else(|| column.data_page_offset());
+            let start = column.dictionary_page_offset().unwrap_or_else(|| column.data_page_offset());
             let len = column.compressed_size();
             let inside = u64::try_from(start)
                 .ok()
@@ -124,7 +118,9 @@ fn check_unreferenced(path: &Path, metadata: &ArrowReaderMetadata, file: &File, 
     use std::io::{Read, Seek, SeekFrom};
     let mut tail = [0u8; 8];
     let mut f = file.try_clone().map_err(|e| LogError::io(path, "cannot read", e))?;
-    f.seek(SeekFrom::End(-8)).and_then(|_| f.read_exact(&mut tail)).map_err(|e| LogError::io(path, "cannot read", e))?;
+    f.seek(SeekFrom::End(-8))
+        .and_then(|_| f.read_exact(&mut tail))
+        .map_err(|e| LogError::io(path, "cannot read", e))?;
     let footer_len = u64::from(u32::from_le_bytes([tail[0], tail[1], tail[2], tail[3]]));
     let Some(footer_start) = file_len.checked_sub(8 + footer_len) else {
         return Err(LogError::corrupt(path, "Parquet footer longer than the file"));
@@ -174,20 +170,12 @@ pub(crate) struct ParquetSource {
 impl ParquetSource {
     pub(crate) fn open(path: &Path) -> Result<Self> {
         let file = crate::io::files::open_input(path).map_err(|e| LogError::io(path, "cannot open", e))?;
-        let metadata = ArrowReaderMetadata::load(
-            &file,
-            ArrowReaderOptions::new().with_skip_arrow_metadata(true),
-        )
-        .map_err(|e| LogError::corrupt(path, format!("not a readable Parquet file: {e}")))?;
+        let metadata = ArrowReaderMetadata::load(&file, ArrowReaderOptions::new().with_skip_arrow_metadata(true))
+            .map_err(|e| LogError::corrupt(path, format!("not a readable Parquet file: {e}")))?;
         let file_len = file.metadata().map_err(|e| LogError::io(path, "cannot read", e))?.len();
         check_chunk_ranges(path, &metadata, file_len)?;
         check_unreferenced(path, &metadata, &file, file_len)?;
-        let names = metadata
-            .schema()
-            .fields()
-            .iter()
-            .map(|f| f.name().clone())
-            .collect();
+        let names = metadata.schema().fields().iter().map(|f| f.name().clone()).collect();
         Ok(Self {
             path: path.to_path_buf(),
             file,
@@ -204,10 +192,7 @@ impl ParquetSource {
     }
 
     fn parquet_error(&self, e: impl std::fmt::Display) -> LogError {
-        LogError::corrupt(
-            &self.path,
-            format!("Parquet read error near data row {}: {e}", self.row + 1),
-        )
+        LogError::corrupt(&self.path, format!("Parquet read error near data row {}: {e}", self.row + 1))
     }
 
     /// Makes sure a batch with an unread row is loaded; `false` at the end of the file.
@@ -222,9 +207,7 @@ impl ParquetSource {
             if let Some(reader) = &mut self.reader {
                 match reader.next() {
                     Some(Ok(batch)) => {
-                        if batch.num_columns()
-                            < self.selected.iter().map(|s| s.2 + 1).max().unwrap_or(0)
-                        {
+                        if batch.num_columns() < self.selected.iter().map(|s| s.2 + 1).max().unwrap_or(0) {
                             return Err(self.parquet_error("a batch is missing projected columns"));
                         }
                         self.batch = Some(batch);
@@ -240,14 +223,10 @@ impl ParquetSource {
             }
             let group = self.next_group;
             self.next_group += 1;
-            let file = self
-                .file
-                .try_clone()
-                .map_err(|e| LogError::io(&self.path, "cannot read", e))?;
-            let mut builder =
-                ParquetRecordBatchReaderBuilder::new_with_metadata(file, self.metadata.clone())
-                    .with_row_groups(vec![group])
-                    .with_batch_size(BATCH_ROWS);
+            let file = self.file.try_clone().map_err(|e| LogError::io(&self.path, "cannot read", e))?;
+            let mut builder = ParquetRecordBatchReaderBuilder::new_with_metadata(file, self.metadata.clone())
+                .with_row_groups(vec![group])
+                .with_batch_size(BATCH_ROWS);
             if let Some(mask) = &self.mask {
                 builder = builder.with_projection(mask.clone());
             }
@@ -295,10 +274,7 @@ impl Source for ParquetSource {
             let Some((value, integer)) = cell(array, kind, i) else {
                 return Err(LogError::NonFinite {
                     file: self.path.clone(),
-                    at: Location {
-                        row: self.row,
-                        line: None,
-                    },
+                    at: Location { row: self.row, line: None },
                     column: self.names.get(field).cloned().unwrap_or_default(),
                     value: "null".into(),
                 });
@@ -317,10 +293,7 @@ impl Source for ParquetSource {
     }
 
     fn location(&self) -> Location {
-        Location {
-            row: self.row,
-            line: None,
-        }
+        Location { row: self.row, line: None }
     }
 }
 
@@ -333,42 +306,25 @@ pub(crate) struct ParquetWriter {
 
 impl ParquetWriter {
     pub(crate) fn new(path: &Path, file: File, names: &[String]) -> Result<Self> {
-        let schema: SchemaRef = Arc::new(Schema::new(
-            names
-                .iter()
-                .map(|n| Field::new(n, DataType::Float64, false))
-                .collect::<Vec<_>>(),
-        ));
+        let schema: SchemaRef =
+            Arc::new(Schema::new(names.iter().map(|n| Field::new(n, DataType::Float64, false)).collect::<Vec<_>>()));
         let props = WriterProperties::builder()
             .set_compression(Compression::SNAPPY)
             .set_max_row_group_row_count(Some(ROW_GROUP_ROWS))
             .set_created_by(format!("rinscope {}", env!("CARGO_PKG_VERSION")))
             .build();
-        let writer = ArrowWriter::try_new(file, schema.clone(), Some(props)).map_err(|e| {
-            LogError::Output {
-                file: path.to_path_buf(),
-                problem: format!("cannot start Parquet: {e}"),
-            }
+        let writer = ArrowWriter::try_new(file, schema.clone(), Some(props)).map_err(|e| LogError::Output {
+            file: path.to_path_buf(),
+            problem: format!("cannot start Parquet: {e}"),
         })?;
-        Ok(Self {
-            writer,
-            schema,
-            columns: names
-                .iter()
-                .map(|_| Vec::with_capacity(ROW_GROUP_ROWS))
-                .collect(),
-        })
+        Ok(Self { writer, schema, columns: names.iter().map(|_| Vec::with_capacity(ROW_GROUP_ROWS)).collect() })
     }
 
     pub(crate) fn write_row(&mut self, path: &Path, row: &[f64]) -> Result<()> {
         for (column, &v) in self.columns.iter_mut().zip(row) {
             column.push(v);
         }
-        if self
-            .columns
-            .first()
-            .is_some_and(|c| c.len() >= ROW_GROUP_ROWS)
-        {
+        if self.columns.first().is_some_and(|c| c.len() >= ROW_GROUP_ROWS) {
             self.flush_group(path)?;
         }
         Ok(())
@@ -381,31 +337,22 @@ impl ParquetWriter {
         let arrays: Vec<ArrayRef> = self
             .columns
             .iter_mut()
-            .map(|c| {
-                Arc::new(Float64Array::from(std::mem::replace(
-                    c,
-                    Vec::with_capacity(ROW_GROUP_ROWS),
-                ))) as ArrayRef
-            })
+            .map(|c| Arc::new(Float64Array::from(std::mem::replace(c, Vec::with_capacity(ROW_GROUP_ROWS)))) as ArrayRef)
             .collect();
         let fail = |e: parquet::errors::ParquetError| LogError::Output {
             file: path.to_path_buf(),
             problem: format!("Parquet write failed: {e}"),
         };
-        let batch =
-            RecordBatch::try_new(self.schema.clone(), arrays).map_err(|e| LogError::Output {
-                file: path.to_path_buf(),
-                problem: format!("Parquet batch: {e}"),
-            })?;
+        let batch = RecordBatch::try_new(self.schema.clone(), arrays)
+            .map_err(|e| LogError::Output { file: path.to_path_buf(), problem: format!("Parquet batch: {e}") })?;
         self.writer.write(&batch).map_err(fail)?;
         self.writer.flush().map_err(fail)
     }
 
     pub(crate) fn finish(mut self, path: &Path) -> Result<File> {
         self.flush_group(path)?;
-        self.writer.into_inner().map_err(|e| LogError::Output {
-            file: path.to_path_buf(),
-            problem: format!("Parquet footer: {e}"),
-        })
+        self.writer
+            .into_inner()
+            .map_err(|e| LogError::Output { file: path.to_path_buf(), problem: format!("Parquet footer: {e}") })
     }
 }

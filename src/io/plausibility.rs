@@ -44,26 +44,13 @@ fn kind_fix(layout: &Layout, want: SampleKind) -> String {
             "set kind = increments: name the columns dtheta_{x,y,z}_rad and dv_{x,y,z}_mps".into()
         }
         (Layout::Rinscope, SampleKind::Rates) => {
-            "set kind = rates: name the columns gyro_{x,y,z}_rad_per_s and accel_{x,y,z}_mps2"
-                .into()
+            "set kind = rates: name the columns gyro_{x,y,z}_rad_per_s and accel_{x,y,z}_mps2".into()
         }
         (other, want) => format!(
             "the {other:?} layout is fixed to {}; this file holds {}: convert it, or write it in the rinscope layout with {} columns",
-            if want == SampleKind::Rates {
-                "increments"
-            } else {
-                "rates"
-            },
-            if want == SampleKind::Rates {
-                "rates"
-            } else {
-                "increments"
-            },
-            if want == SampleKind::Rates {
-                "gyro_*/accel_*"
-            } else {
-                "dtheta_*/dv_*"
-            },
+            if want == SampleKind::Rates { "increments" } else { "rates" },
+            if want == SampleKind::Rates { "rates" } else { "increments" },
+            if want == SampleKind::Rates { "gyro_*/accel_*" } else { "dtheta_*/dv_*" },
         ),
     }
 }
@@ -74,11 +61,7 @@ fn kind_fix(layout: &Layout, want: SampleKind) -> String {
 ///
 /// # Errors
 /// Only what reading the file reports; implausible data are [`StaticReport::problems`].
-pub fn check_static(
-    path: impl AsRef<Path>,
-    options: &ImuOptions,
-    check: &StaticCheck,
-) -> Result<StaticReport> {
+pub fn check_static(path: impl AsRef<Path>, options: &ImuOptions, check: &StaticCheck) -> Result<StaticReport> {
     let path = path.as_ref();
     let mut opts = options.clone();
     opts.static_check = None;
@@ -110,16 +93,8 @@ pub fn check_static(
     let mut dts: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
     dts.sort_by(f64::total_cmp);
     let dt = dts.get(dts.len() / 2).copied().unwrap_or(f64::NAN);
-    let mean_g = if n > 0 {
-        sum_g / n as f64
-    } else {
-        Vector3::zeros()
-    };
-    let mean_a = if n > 0 {
-        sum_a / n as f64
-    } else {
-        Vector3::zeros()
-    };
+    let mean_g = if n > 0 { sum_g / n as f64 } else { Vector3::zeros() };
+    let mean_a = if n > 0 { sum_a / n as f64 } else { Vector3::zeros() };
     let (rate_g, rate_a) = match kind {
         SampleKind::Rates => (mean_g, mean_a),
         SampleKind::Increments => (mean_g / dt, mean_a / dt),
@@ -133,10 +108,9 @@ pub fn check_static(
         problems: Vec::new(),
     };
     if n < 10 || dt.is_nan() || dt <= 0.0 {
-        report.problems.push(format!(
-            "only {n} samples in the first {} s: too few to check the static segment",
-            check.duration_s
-        ));
+        report
+            .problems
+            .push(format!("only {n} samples in the first {} s: too few to check the static segment", check.duration_s));
         return Ok(report);
     }
     let accel_cols = columns.get(4..7).map_or_else(String::new, |c| c.join(", "));
@@ -145,11 +119,7 @@ pub fn check_static(
     let tol = check.gravity_tolerance;
     let a = if n > 0 { sum_a_norm / n as f64 } else { 0.0 };
     let per = |x: f64| {
-        if kind == SampleKind::Rates {
-            format!("{x:.4} m/s²")
-        } else {
-            format!("{x:.4} m/s per sample")
-        }
+        if kind == SampleKind::Rates { format!("{x:.4} m/s²") } else { format!("{x:.4} m/s per sample") }
     };
     let lead = format!(
         "accelerometer columns {accel_cols}: the mean magnitude over the first {:.1} s is {}",
@@ -192,11 +162,7 @@ pub fn check_static(
         _ => (
             Some(format!(
                 "{lead}, {} as specific force, not the ~{G0} m/s² of gravity: the segment is not static, or the units or kind are wrong",
-                if kind == SampleKind::Rates {
-                    format!("{a:.4} m/s²")
-                } else {
-                    format!("{:.4} m/s²", a / dt)
-                }
+                if kind == SampleKind::Rates { format!("{a:.4} m/s²") } else { format!("{:.4} m/s²", a / dt) }
             )),
             false,
         ),

@@ -36,15 +36,7 @@ use crate::io::text::{Delimiter, Line, LineReader, field, is_blank, split};
 use std::path::{Path, PathBuf};
 
 /// The columns of the stream: `imufile.m`'s `[wm vm t]` in SI units.
-const COLUMNS: [&str; 7] = [
-    "dtheta_x_rad",
-    "dtheta_y_rad",
-    "dtheta_z_rad",
-    "dv_x_mps",
-    "dv_y_mps",
-    "dv_z_mps",
-    "t_s",
-];
+const COLUMNS: [&str; 7] = ["dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad", "dv_x_mps", "dv_y_mps", "dv_z_mps", "t_s"];
 
 /// The header fields, named as the file's own comment lines name them.
 const HEADER_FIELDS: [[&str; 6]; 3] = [
@@ -225,13 +217,29 @@ fn read_header(path: &Path, lines: &mut LineReader) -> Result<PsinsHeader> {
             let column = || format!("{name} (header row {}, field {})", r + 1, k + 1);
             let value = std::str::from_utf8(text).ok().and_then(|s| s.parse::<f64>().ok());
             let Some(value) = value else {
-                return Err(LogError::NonNumeric { file: path.to_path_buf(), at, column: column(), value: cell_text(text) });
+                return Err(LogError::NonNumeric {
+                    file: path.to_path_buf(),
+                    at,
+                    column: column(),
+                    value: cell_text(text),
+                });
             };
             if !value.is_finite() {
-                return Err(LogError::NonFinite { file: path.to_path_buf(), at, column: column(), value: cell_text(text) });
+                return Err(LogError::NonFinite {
+                    file: path.to_path_buf(),
+                    at,
+                    column: column(),
+                    value: cell_text(text),
+                });
             }
             if let Some(problem) = header_problem(r, k, value) {
-                return Err(LogError::BadValue { file: path.to_path_buf(), at, column: column(), value: cell_text(text), problem });
+                return Err(LogError::BadValue {
+                    file: path.to_path_buf(),
+                    at,
+                    column: column(),
+                    value: cell_text(text),
+                    problem,
+                });
             }
             if let Some(v) = values.get_mut(k) {
                 *v = value;
@@ -379,7 +387,8 @@ impl PsinsSource {
                 at,
                 column,
                 value,
-                problem: "is not an integer: a PSINS SIMU data row holds whole counts (imufile.m writes them with %d)".into(),
+                problem: "is not an integer: a PSINS SIMU data row holds whole counts (imufile.m writes them with %d)"
+                    .into(),
             }),
             Some(v) => Ok(v),
         }
@@ -501,7 +510,16 @@ mod tests {
             has_dither: false,
         };
         // yaw counter-clockwise from North: 90° is West (heading 270°), -90° is East (90°).
-        for (yaw, heading) in [(0.0, 0.0), (90.0, 270.0), (-90.0, 90.0), (180.0, 180.0), (-180.0, 180.0), (1e-20, 0.0), (360.0, 0.0), (-450.0, 90.0)] {
+        for (yaw, heading) in [
+            (0.0, 0.0),
+            (90.0, 270.0),
+            (-90.0, 90.0),
+            (180.0, 180.0),
+            (-180.0, 180.0),
+            (1e-20, 0.0),
+            (360.0, 0.0),
+            (-450.0, 90.0),
+        ] {
             h.yaw_deg = yaw;
             assert_eq!(h.heading_deg().to_bits(), f64::to_bits(heading), "yaw {yaw}");
         }

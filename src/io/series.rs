@@ -15,7 +15,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::io::error::{Location, LogError};
 use crate::io::table::{Col, ColumnReader, ReadOptions};
-use crate::io::units::{unit_named, units_for, Quantity, Unit};
+use crate::io::units::{Quantity, Unit, unit_named, units_for};
 
 /// What the values of a column are.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -31,7 +31,8 @@ pub enum SeriesKind {
 }
 
 impl SeriesKind {
-    const ALL: [(Self, &'static str); 4] = [(Self::Rate, "rate"), (Self::Increment, "increment"), (Self::Phase, "phase"), (Self::Frequency, "frequency")];
+    const ALL: [(Self, &'static str); 4] =
+        [(Self::Rate, "rate"), (Self::Increment, "increment"), (Self::Phase, "phase"), (Self::Frequency, "frequency")];
 
     /// The name on the command line.
     #[must_use]
@@ -87,10 +88,19 @@ impl SeriesColumn {
                 // `a:b:c` whose middle is not a kind: the column name may hold a colon.
                 match kind_of(u) {
                     Some(kind) => (&spec[..spec.len() - u.len() - 1], Some(kind), None),
-                    None => return Err(format!("--column {spec:?}: {k:?} (after column {c:?}) is not a kind ({}); expected COLUMN:KIND[:UNIT], e.g. gyro_z:rate:deg/s", kinds())),
+                    None => {
+                        return Err(format!(
+                            "--column {spec:?}: {k:?} (after column {c:?}) is not a kind ({}); expected COLUMN:KIND[:UNIT], e.g. gyro_z:rate:deg/s",
+                            kinds()
+                        ));
+                    }
                 }
             }
-            _ => return Err(format!("--column {spec:?}: expected COLUMN:KIND[:UNIT], e.g. gyro_z:rate:deg/s, 2:frequency, x:phase:ns")),
+            _ => {
+                return Err(format!(
+                    "--column {spec:?}: expected COLUMN:KIND[:UNIT], e.g. gyro_z:rate:deg/s, 2:frequency, x:phase:ns"
+                ));
+            }
         };
         let Some(kind) = kind else {
             return Err(format!("--column {spec:?}: the kind must be one of {}", kinds()));
@@ -105,7 +115,11 @@ impl SeriesColumn {
         let unit = unit_named(unit_text).ok_or_else(|| format!("--column {spec:?}: unknown unit {unit_text:?}"))?;
         if !kind.quantities().contains(&unit.quantity) {
             let q: Vec<String> = kind.quantities().iter().map(|q| units_for(*q)).collect();
-            return Err(format!("--column {spec:?}: {unit_text:?} is not a unit of a {} (use {})", kind.name(), q.join("; ")));
+            return Err(format!(
+                "--column {spec:?}: {unit_text:?} is not a unit of a {} (use {})",
+                kind.name(),
+                q.join("; ")
+            ));
         }
         let col = column.trim().parse::<usize>().map_or_else(|_| Col::Name(column.trim().to_owned()), Col::Index);
         Ok(Self { col, kind, unit })
@@ -198,7 +212,12 @@ pub fn read_series(path: &Path, columns: &[SeriesColumn], sampling: &Sampling) -
 ///
 /// # Errors
 /// As [`read_series`]; [`SeriesError::Interrupted`] when stopped before two rows.
-pub fn read_series_until(path: &Path, columns: &[SeriesColumn], sampling: &Sampling, stop: &AtomicBool) -> Result<Series, SeriesError> {
+pub fn read_series_until(
+    path: &Path,
+    columns: &[SeriesColumn],
+    sampling: &Sampling,
+    stop: &AtomicBool,
+) -> Result<Series, SeriesError> {
     let bad = |what: String| SeriesError::Series(format!("{}: {what}", path.display()));
     // A declared rate is checked before the file is read (the one number rule: a rate of 1e-308
     // Hz gave infinite increments and NaN deviations).
@@ -252,22 +271,41 @@ pub fn read_series_until(path: &Path, columns: &[SeriesColumn], sampling: &Sampl
         (None, Sampling::RateHz(hz)) => tau0_of_rate(*hz, "--rate-hz").map_err(bad)?,
         (None, Sampling::TimeColumn(..)) => match even_step(&steps) {
             Ok(()) => (t_prev - t_first.unwrap_or(0.0)) / (rows - 1) as f64,
-            Err(Uneven::Stalled(median)) => return Err(bad(format!("the time column does not advance (median step {} s)", crate::io::short_number(median)))),
+            Err(Uneven::Stalled(median)) => {
+                return Err(bad(format!(
+                    "the time column does not advance (median step {} s)",
+                    crate::io::short_number(median)
+                )));
+            }
             Err(Uneven::Step { k, step, median }) => {
                 // Step k ends at data row k + 2 (1-based).
                 let at = Location { row: k as u64 + 2, line: None };
                 let time_col = &reader.columns()[columns.len()];
-                return Err(SeriesError::Log(LogError::BadValue { file: path.to_owned(), at, column: time_col.clone(), value: format!("step {} s", crate::io::short_number(step)), problem: uneven_problem(median) }));
+                return Err(SeriesError::Log(LogError::BadValue {
+                    file: path.to_owned(),
+                    at,
+                    column: time_col.clone(),
+                    value: format!("step {} s", crate::io::short_number(step)),
+                    problem: uneven_problem(median),
+                }));
             }
         },
     };
-    Ok(Series { names, columns: columns.to_vec(), increments: increments(columns, values, tau0_s), tau0_s, rows, interrupted })
+    Ok(Series {
+        names,
+        columns: columns.to_vec(),
+        increments: increments(columns, values, tau0_s),
+        tau0_s,
+        rows,
+        interrupted,
+    })
 }
 
 /// The sample interval of a rate given as `name`, s (the one number rule,
 /// [`crate::io::validity::SERIES_RATE_HZ`]).
 fn tau0_of_rate(hz: f64, name: &str) -> Result<f64, String> {
-    let hz = crate::io::validity::check_number(hz, &crate::io::validity::SERIES_RATE_HZ).map_err(|e| format!("{name} {e}"))?;
+    let hz = crate::io::validity::check_number(hz, &crate::io::validity::SERIES_RATE_HZ)
+        .map_err(|e| format!("{name} {e}"))?;
     Ok(1.0 / hz)
 }
 
@@ -324,7 +362,12 @@ fn increments(columns: &[SeriesColumn], values: Vec<Vec<f64>>, tau0_s: f64) -> V
 ///
 /// # Errors
 /// Which column, index and value, or why the sampling is refused.
-pub fn series_in_memory(columns: &[SeriesColumn], values: Vec<Vec<f64>>, rate_hz: Option<f64>, times_s: Option<&[f64]>) -> Result<Series, SeriesError> {
+pub fn series_in_memory(
+    columns: &[SeriesColumn],
+    values: Vec<Vec<f64>>,
+    rate_hz: Option<f64>,
+    times_s: Option<&[f64]>,
+) -> Result<Series, SeriesError> {
     let names: Vec<String> = columns
         .iter()
         .map(|c| match &c.col {
@@ -335,7 +378,10 @@ pub fn series_in_memory(columns: &[SeriesColumn], values: Vec<Vec<f64>>, rate_hz
     let rows = values.first().map_or(0, Vec::len);
     for (name, v) in names.iter().zip(&values) {
         if v.len() != rows {
-            return Err(SeriesError::Series(format!("column {name}: {} samples where the first column has {rows}", v.len())));
+            return Err(SeriesError::Series(format!(
+                "column {name}: {} samples where the first column has {rows}",
+                v.len()
+            )));
         }
         if let Some((i, x)) = v.iter().enumerate().find(|(_, x)| !x.is_finite()) {
             return Err(SeriesError::Series(format!("column {name}, sample {i}: {x} is not a finite number")));
@@ -356,13 +402,31 @@ pub fn series_in_memory(columns: &[SeriesColumn], values: Vec<Vec<f64>>, rate_hz
             let steps: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
             match even_step(&steps) {
                 Ok(()) => (t[rows - 1] - t[0]) / (rows - 1) as f64,
-                Err(Uneven::Stalled(median)) => return Err(SeriesError::Series(format!("time_s does not advance (median step {} s)", crate::io::short_number(median)))),
-                Err(Uneven::Step { k, step, median }) => return Err(SeriesError::Series(format!("time_s, from sample {k} to {}: step {step} s {}", k + 1, uneven_problem(median)))),
+                Err(Uneven::Stalled(median)) => {
+                    return Err(SeriesError::Series(format!(
+                        "time_s does not advance (median step {} s)",
+                        crate::io::short_number(median)
+                    )));
+                }
+                Err(Uneven::Step { k, step, median }) => {
+                    return Err(SeriesError::Series(format!(
+                        "time_s, from sample {k} to {}: step {step} s {}",
+                        k + 1,
+                        uneven_problem(median)
+                    )));
+                }
             }
         }
         _ => return Err(SeriesError::Series("give the sampling: rate_hz or time_s (not both)".into())),
     };
-    Ok(Series { names, columns: columns.to_vec(), increments: increments(columns, values, tau0_s), tau0_s, rows, interrupted: false })
+    Ok(Series {
+        names,
+        columns: columns.to_vec(),
+        increments: increments(columns, values, tau0_s),
+        tau0_s,
+        rows,
+        interrupted: false,
+    })
 }
 
 #[cfg(test)]
@@ -390,7 +454,9 @@ mod tests {
             let e = read_series(&path, &col, &Sampling::RateHz(hz)).expect_err("refused").to_string();
             assert!(e.contains("--rate-hz") && e.contains("Hz") && e.len() < 200, "{hz}: {e}");
         }
-        assert!(read_series(&path, &col, &Sampling::RateHz(1e-308)).expect_err("1e-308").to_string().contains("1e-308 Hz"));
+        assert!(
+            read_series(&path, &col, &Sampling::RateHz(1e-308)).expect_err("1e-308").to_string().contains("1e-308 Hz")
+        );
         let s = read_series(&path, &col, &Sampling::RateHz(100.0)).expect("a good rate");
         assert!(!s.interrupted && s.rows == 10 && s.increments[0].iter().all(|x| x.is_finite()));
     }
@@ -415,8 +481,17 @@ mod tests {
         assert_eq!((c.col, c.kind, c.unit.suffix), (Col::Index(2), SeriesKind::Frequency, "1"));
         let c = SeriesColumn::parse("x:phase:ns").expect("valid");
         assert_eq!((c.kind, c.unit.to_si), (SeriesKind::Phase, 1e-9));
-        assert_eq!(SeriesColumn::parse("a:accel:rate:m/s^2").expect("a colon in the name").col, Col::Name("a:accel".into()));
-        for (spec, says) in [("gx:rate", "needs a unit"), ("gx:speed:deg/s", "kind"), ("gx:rate:furlong", "unknown unit"), ("gx:rate:ns", "not a unit of a rate"), ("gx", "expected COLUMN:KIND")] {
+        assert_eq!(
+            SeriesColumn::parse("a:accel:rate:m/s^2").expect("a colon in the name").col,
+            Col::Name("a:accel".into())
+        );
+        for (spec, says) in [
+            ("gx:rate", "needs a unit"),
+            ("gx:speed:deg/s", "kind"),
+            ("gx:rate:furlong", "unknown unit"),
+            ("gx:rate:ns", "not a unit of a rate"),
+            ("gx", "expected COLUMN:KIND"),
+        ] {
             let e = SeriesColumn::parse(spec).expect_err(spec);
             assert!(e.contains(says) && e.contains(spec), "{spec}: {e}");
         }

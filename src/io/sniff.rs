@@ -57,22 +57,13 @@ impl Format {
 /// What the first bytes of a file look like.
 fn classify(head: &[u8]) -> (Option<Format>, String) {
     if head.starts_with(NPY_MAGIC) {
-        return (
-            Some(Format::Npy),
-            "its content starts with the NumPy magic \\x93NUMPY".into(),
-        );
+        return (Some(Format::Npy), "its content starts with the NumPy magic \\x93NUMPY".into());
     }
     if head.starts_with(PARQUET_MAGIC) {
-        return (
-            Some(Format::Parquet),
-            "its content starts with the Parquet magic PAR1".into(),
-        );
+        return (Some(Format::Parquet), "its content starts with the Parquet magic PAR1".into());
     }
     if head.starts_with(MCAP_MAGIC) {
-        return (
-            Some(Format::Mcap),
-            "its content starts with the MCAP magic \\x89MCAP0\\r\\n".into(),
-        );
+        return (Some(Format::Mcap), "its content starts with the MCAP magic \\x89MCAP0\\r\\n".into());
     }
     if head.is_empty() {
         return (None, "it is empty".into());
@@ -85,30 +76,17 @@ fn classify(head: &[u8]) -> (Option<Format>, String) {
         };
     if text_like {
         let line = head.split(|&b| b == b'\n').next().unwrap_or(head);
-        let first_line: String = String::from_utf8_lossy(line)
-            .trim_end_matches('\r')
-            .chars()
-            .take(60)
-            .collect();
+        let first_line: String = String::from_utf8_lossy(line).trim_end_matches('\r').chars().take(60).collect();
         if crate::io::psins_imu::names_psins_simu(line) {
             return (
                 Some(Format::PsinsImu),
                 format!("its first line {first_line:?} is a PSINS SIMU file's (imufile.m)"),
             );
         }
-        return (
-            Some(Format::Text),
-            format!("its content is text (first line {first_line:?})"),
-        );
+        return (Some(Format::Text), format!("its content is text (first line {first_line:?})"));
     }
     let hex: Vec<String> = head.iter().take(8).map(|b| format!("{b:02x}")).collect();
-    (
-        None,
-        format!(
-            "its content is binary of no known format (first bytes {})",
-            hex.join(" ")
-        ),
-    )
+    (None, format!("its content is binary of no known format (first bytes {})", hex.join(" ")))
 }
 
 /// The format of `path`: from its extension, checked against its first bytes.
@@ -122,10 +100,7 @@ fn classify(head: &[u8]) -> (Option<Format>, String) {
 pub fn detect_format(path: &Path) -> Result<Format> {
     let mut file = crate::io::files::open_input(path).map_err(|e| LogError::io(path, "cannot open", e))?;
     let mut head = Vec::with_capacity(512);
-    (&mut file)
-        .take(512)
-        .read_to_end(&mut head)
-        .map_err(|e| LogError::io(path, "cannot read", e))?;
+    (&mut file).take(512).read_to_end(&mut head).map_err(|e| LogError::io(path, "cannot read", e))?;
     let (found, description) = classify(&head);
     let expected = Format::from_extension(path);
     let not_the_format = |expected: &str, found: String| LogError::NotTheFormat {
@@ -150,10 +125,7 @@ pub fn detect_format(path: &Path) -> Result<Format> {
 
 fn check_parquet_footer(path: &Path, file: &mut std::fs::File) -> Result<()> {
     use std::io::{Seek, SeekFrom};
-    let len = file
-        .metadata()
-        .map_err(|e| LogError::io(path, "cannot read", e))?
-        .len();
+    let len = file.metadata().map_err(|e| LogError::io(path, "cannot read", e))?.len();
     let mut tail = [0u8; 4];
     let ok = len >= 12
         && file.seek(SeekFrom::End(-4)).is_ok()
@@ -180,10 +152,7 @@ mod tests {
         assert_eq!(classify(b"\x93NUMPY\x01\x00").0, Some(Format::Npy));
         assert_eq!(classify(b"PAR1....").0, Some(Format::Parquet));
         assert_eq!(classify(b"\x89MCAP0\r\n").0, Some(Format::Mcap));
-        assert_eq!(
-            classify(b"t_s,gyro_x_rad_per_s\n0,1\n").0,
-            Some(Format::Text)
-        );
+        assert_eq!(classify(b"t_s,gyro_x_rad_per_s\n0,1\n").0, Some(Format::Text));
         assert_eq!(classify(b"\x00\x01\x02\xff").0, None);
         assert_eq!(classify(b"").0, None);
         // "é" (c3 a9) cut after its first byte is still text.

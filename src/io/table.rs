@@ -131,7 +131,10 @@ fn guarded<T>(path: &Path, format: Format, f: impl FnOnce() -> Result<T>) -> Res
             .map(|s| (*s).to_owned())
             .or_else(|| payload.downcast_ref::<String>().cloned())
             .unwrap_or_default();
-        Err(LogError::corrupt(path, format!("the {format:?} decoder gave up on this file (a corrupt file; internal panic: {what})")))
+        Err(LogError::corrupt(
+            path,
+            format!("the {format:?} decoder gave up on this file (a corrupt file; internal panic: {what})"),
+        ))
     })
 }
 
@@ -161,15 +164,13 @@ impl ColumnReader {
         let format = detect_format(path)?;
         let mut source: Box<dyn Source + Send> = guarded(path, format, || {
             Ok(match format {
-                Format::Text => Box::new(crate::io::text::TextSource::open(path, options.header)?)
-                    as Box<dyn Source + Send>,
+                Format::Text => {
+                    Box::new(crate::io::text::TextSource::open(path, options.header)?) as Box<dyn Source + Send>
+                }
                 Format::Npy => Box::new(crate::io::npy::NpySource::open(path)?),
                 Format::Parquet => Box::new(crate::io::parquet_io::ParquetSource::open(path)?),
                 Format::PsinsImu => Box::new(crate::io::psins_imu::PsinsSource::open(path)?),
-                Format::Mcap => Box::new(crate::io::mcap_imu::McapImuSource::open(
-                    path,
-                    options.topic.as_deref(),
-                )?),
+                Format::Mcap => Box::new(crate::io::mcap_imu::McapImuSource::open(path, options.topic.as_deref())?),
             })
         })?;
         let all = source.all_columns();
@@ -183,19 +184,12 @@ impl ColumnReader {
                 return Err(LogError::MissingColumn {
                     file: path.to_path_buf(),
                     column: col.to_string(),
-                    available: all
-                        .iter()
-                        .enumerate()
-                        .map(|(i, n)| format!("{n:?} (index {i})"))
-                        .collect(),
+                    available: all.iter().enumerate().map(|(i, n)| format!("{n:?} (index {i})")).collect(),
                 });
             };
             indices.push(index);
         }
-        let names = indices
-            .iter()
-            .filter_map(|&i| all.get(i).cloned())
-            .collect();
+        let names = indices.iter().filter_map(|&i| all.get(i).cloned()).collect();
         guarded(path, format, || source.select(&indices))?;
         Ok(Self {
             path: path.to_path_buf(),
@@ -254,15 +248,11 @@ impl ColumnReader {
             });
         }
         if self.poisoned {
-            return Err(LogError::corrupt(
-                &self.path,
-                "the decoder failed earlier on this file",
-            ));
+            return Err(LogError::corrupt(&self.path, "the decoder failed earlier on this file"));
         }
         let (source, exact) = (&mut self.source, &mut self.exact);
         let more = guarded(&self.path, self.format, || source.next_row(row, exact));
-        if matches!(&more, Err(LogError::Corrupt { detail, .. }) if detail.contains("internal panic"))
-        {
+        if matches!(&more, Err(LogError::Corrupt { detail, .. }) if detail.contains("internal panic")) {
             self.poisoned = true;
         }
         if !more? {

@@ -88,11 +88,7 @@ impl LineReader {
                 bytes.drain(..3);
             }
         }
-        Ok(Some(Line {
-            bytes,
-            number: self.line_number,
-            terminated,
-        }))
+        Ok(Some(Line { bytes, number: self.line_number, terminated }))
     }
 
     /// The number of the last line read (0 before the first).
@@ -120,14 +116,8 @@ pub(crate) fn is_blank(s: &[u8]) -> bool {
 }
 
 fn trim(s: &[u8]) -> &[u8] {
-    let start = s
-        .iter()
-        .position(|b| !matches!(b, b' ' | b'\t'))
-        .unwrap_or(s.len());
-    let end = s
-        .iter()
-        .rposition(|b| !matches!(b, b' ' | b'\t'))
-        .map_or(start, |e| e + 1);
+    let start = s.iter().position(|b| !matches!(b, b' ' | b'\t')).unwrap_or(s.len());
+    let end = s.iter().rposition(|b| !matches!(b, b' ' | b'\t')).map_or(start, |e| e + 1);
     s.get(start..end).unwrap_or(&[])
 }
 
@@ -137,11 +127,7 @@ pub(crate) fn split(line: &[u8], delimiter: Delimiter, spans: &mut Vec<(usize, u
     match delimiter {
         Delimiter::Comma => {
             let mut start = 0;
-            for (i, &b) in line
-                .iter()
-                .enumerate()
-                .chain(std::iter::once((line.len(), &b',')))
-            {
+            for (i, &b) in line.iter().enumerate().chain(std::iter::once((line.len(), &b','))) {
                 if b == b',' {
                     let (mut s, mut e) = (start, i);
                     while s < e && matches!(line[s], b' ' | b'\t') {
@@ -185,10 +171,7 @@ fn is_number(s: &[u8]) -> bool {
 
 fn header_name(s: &[u8]) -> String {
     let s = trim(s);
-    let s = s
-        .strip_prefix(b"\"")
-        .and_then(|t| t.strip_suffix(b"\""))
-        .unwrap_or(s);
+    let s = s.strip_prefix(b"\"").and_then(|t| t.strip_suffix(b"\"")).unwrap_or(s);
     String::from_utf8_lossy(s).trim().to_owned()
 }
 
@@ -215,11 +198,7 @@ impl TextSource {
             has_header: false,
             field_count: 0,
             pending: None,
-            current: Line {
-                bytes: Vec::new(),
-                number: 0,
-                terminated: true,
-            },
+            current: Line { bytes: Vec::new(), number: 0, terminated: true },
             spans: Vec::new(),
             selected: Vec::new(),
             row: 0,
@@ -246,36 +225,18 @@ impl TextSource {
         let Some(first) = first else {
             // No table line: a header-only file (possibly in a comment) has zero rows.
             if let (Some(comment), false) = (last_comment, mode == HeaderMode::Absent) {
-                self.delimiter = if comment.contains(&b',') {
-                    Delimiter::Comma
-                } else {
-                    Delimiter::Whitespace
-                };
+                self.delimiter = if comment.contains(&b',') { Delimiter::Comma } else { Delimiter::Whitespace };
                 split(&comment, self.delimiter, &mut self.spans);
-                self.names = self
-                    .spans
-                    .iter()
-                    .map(|&s| header_name(field(&comment, s)))
-                    .collect();
+                self.names = self.spans.iter().map(|&s| header_name(field(&comment, s))).collect();
                 self.has_header = true;
                 self.field_count = self.names.len();
                 return Ok(());
             }
-            return Err(LogError::corrupt(
-                &self.path,
-                "the file has no table: no header and no data rows",
-            ));
+            return Err(LogError::corrupt(&self.path, "the file has no table: no header and no data rows"));
         };
-        self.delimiter = if first.bytes.contains(&b',') {
-            Delimiter::Comma
-        } else {
-            Delimiter::Whitespace
-        };
+        self.delimiter = if first.bytes.contains(&b',') { Delimiter::Comma } else { Delimiter::Whitespace };
         split(&first.bytes, self.delimiter, &mut self.spans);
-        let all_numbers = self
-            .spans
-            .iter()
-            .all(|&s| is_number(field(&first.bytes, s)));
+        let all_numbers = self.spans.iter().all(|&s| is_number(field(&first.bytes, s)));
         let count = self.spans.len();
         let comment_header = last_comment.filter(|c| {
             let mut spans = Vec::new();
@@ -284,9 +245,7 @@ impl TextSource {
         });
         let header_line: Option<Vec<u8>> = match mode {
             HeaderMode::Absent => None,
-            HeaderMode::Auto | HeaderMode::Present if all_numbers && comment_header.is_some() => {
-                comment_header
-            }
+            HeaderMode::Auto | HeaderMode::Present if all_numbers && comment_header.is_some() => comment_header,
             HeaderMode::Auto if all_numbers => None,
             HeaderMode::Auto | HeaderMode::Present => Some(first.bytes.clone()),
         };
@@ -294,11 +253,7 @@ impl TextSource {
             Some(h) => {
                 let is_first = h == first.bytes;
                 split(&h, self.delimiter, &mut self.spans);
-                self.names = self
-                    .spans
-                    .iter()
-                    .map(|&s| header_name(field(&h, s)))
-                    .collect();
+                self.names = self.spans.iter().map(|&s| header_name(field(&h, s))).collect();
                 self.has_header = true;
                 self.field_count = self.names.len();
                 if !is_first {
@@ -350,13 +305,8 @@ impl Source for TextSource {
                 at: self.location(),
                 expected: self.field_count,
                 found: self.spans.len(),
-                reference: if self.has_header {
-                    "header"
-                } else {
-                    "first data row"
-                },
-                truncated_last_line: !self.current.terminated
-                    && self.spans.len() < self.field_count,
+                reference: if self.has_header { "header" } else { "first data row" },
+                truncated_last_line: !self.current.terminated && self.spans.len() < self.field_count,
             });
         }
         if !self.current.terminated {
@@ -386,10 +336,7 @@ impl Source for TextSource {
     }
 
     fn location(&self) -> Location {
-        Location {
-            row: self.row,
-            line: Some(self.current.number),
-        }
+        Location { row: self.row, line: Some(self.current.number) }
     }
 }
 
@@ -400,28 +347,20 @@ mod tests {
     fn spans(line: &str, d: Delimiter) -> Vec<String> {
         let mut s = Vec::new();
         split(line.as_bytes(), d, &mut s);
-        s.iter()
-            .map(|&sp| String::from_utf8_lossy(field(line.as_bytes(), sp)).into_owned())
-            .collect()
+        s.iter().map(|&sp| String::from_utf8_lossy(field(line.as_bytes(), sp)).into_owned()).collect()
     }
 
     #[test]
     fn splitting() {
         assert_eq!(spans(" a , b,c ", Delimiter::Comma), ["a", "b", "c"]);
         assert_eq!(spans("1,,3", Delimiter::Comma), ["1", "", "3"]);
-        assert_eq!(
-            spans("  1.0\t2  3,4 ", Delimiter::Whitespace),
-            ["1.0", "2", "3", "4"]
-        );
+        assert_eq!(spans("  1.0\t2  3,4 ", Delimiter::Whitespace), ["1.0", "2", "3", "4"]);
         assert_eq!(spans("", Delimiter::Whitespace), Vec::<String>::new());
     }
 
     #[test]
     fn cells() {
-        assert_eq!(
-            parse_cell(b"1403715273262142976"),
-            Some((1403715273262142976.0, Some(1403715273262142976)))
-        );
+        assert_eq!(parse_cell(b"1403715273262142976"), Some((1403715273262142976.0, Some(1403715273262142976))));
         assert_eq!(parse_cell(b"+12"), Some((12.0, Some(12))));
         assert_eq!(parse_cell(b"-1.5e-3"), Some((-1.5e-3, None)));
         assert!(parse_cell(b"abc").is_none());

@@ -67,141 +67,33 @@ pub struct Unit {
 const ARCSEC: f64 = PI / 648_000.0;
 
 const UNITS: &[Unit] = &[
-    Unit {
-        suffix: "rad",
-        quantity: Quantity::Angle,
-        to_si: 1.0,
-    },
-    Unit {
-        suffix: "mrad",
-        quantity: Quantity::Angle,
-        to_si: 1e-3,
-    },
-    Unit {
-        suffix: "urad",
-        quantity: Quantity::Angle,
-        to_si: 1e-6,
-    },
-    Unit {
-        suffix: "deg",
-        quantity: Quantity::Angle,
-        to_si: PI / 180.0,
-    },
-    Unit {
-        suffix: "arcsec",
-        quantity: Quantity::Angle,
-        to_si: ARCSEC,
-    },
-    Unit {
-        suffix: "arcmin",
-        quantity: Quantity::Angle,
-        to_si: ARCSEC * 60.0,
-    },
-    Unit {
-        suffix: "rad_per_s",
-        quantity: Quantity::AngularRate,
-        to_si: 1.0,
-    },
-    Unit {
-        suffix: "deg_per_s",
-        quantity: Quantity::AngularRate,
-        to_si: PI / 180.0,
-    },
-    Unit {
-        suffix: "deg_per_h",
-        quantity: Quantity::AngularRate,
-        to_si: ARCSEC,
-    },
-    Unit {
-        suffix: "mps",
-        quantity: Quantity::Velocity,
-        to_si: 1.0,
-    },
-    Unit {
-        suffix: "m_per_s",
-        quantity: Quantity::Velocity,
-        to_si: 1.0,
-    },
-    Unit {
-        suffix: "mps2",
-        quantity: Quantity::Acceleration,
-        to_si: 1.0,
-    },
-    Unit {
-        suffix: "m_per_s2",
-        quantity: Quantity::Acceleration,
-        to_si: 1.0,
-    },
-    Unit {
-        suffix: "g",
-        quantity: Quantity::Acceleration,
-        to_si: STANDARD_GRAVITY_MPS2,
-    },
-    Unit {
-        suffix: "mg",
-        quantity: Quantity::Acceleration,
-        to_si: 1e-3 * STANDARD_GRAVITY_MPS2,
-    },
-    Unit {
-        suffix: "ug",
-        quantity: Quantity::Acceleration,
-        to_si: 1e-6 * STANDARD_GRAVITY_MPS2,
-    },
-    Unit {
-        suffix: "s",
-        quantity: Quantity::Time,
-        to_si: 1.0,
-    },
-    Unit {
-        suffix: "ms",
-        quantity: Quantity::Time,
-        to_si: 1e-3,
-    },
-    Unit {
-        suffix: "us",
-        quantity: Quantity::Time,
-        to_si: 1e-6,
-    },
-    Unit {
-        suffix: "ns",
-        quantity: Quantity::Time,
-        to_si: 1e-9,
-    },
-    Unit {
-        suffix: "ps",
-        quantity: Quantity::Time,
-        to_si: 1e-12,
-    },
-    Unit {
-        suffix: "m",
-        quantity: Quantity::Length,
-        to_si: 1.0,
-    },
-    Unit {
-        suffix: "ppm",
-        quantity: Quantity::Dimensionless,
-        to_si: 1e-6,
-    },
-    Unit {
-        suffix: "ppb",
-        quantity: Quantity::Dimensionless,
-        to_si: 1e-9,
-    },
-    Unit {
-        suffix: "ppt",
-        quantity: Quantity::Dimensionless,
-        to_si: 1e-12,
-    },
-    Unit {
-        suffix: "1",
-        quantity: Quantity::Dimensionless,
-        to_si: 1.0,
-    },
-    Unit {
-        suffix: "count",
-        quantity: Quantity::Dimensionless,
-        to_si: 1.0,
-    },
+    Unit { suffix: "rad", quantity: Quantity::Angle, to_si: 1.0 },
+    Unit { suffix: "mrad", quantity: Quantity::Angle, to_si: 1e-3 },
+    Unit { suffix: "urad", quantity: Quantity::Angle, to_si: 1e-6 },
+    Unit { suffix: "deg", quantity: Quantity::Angle, to_si: PI / 180.0 },
+    Unit { suffix: "arcsec", quantity: Quantity::Angle, to_si: ARCSEC },
+    Unit { suffix: "arcmin", quantity: Quantity::Angle, to_si: ARCSEC * 60.0 },
+    Unit { suffix: "rad_per_s", quantity: Quantity::AngularRate, to_si: 1.0 },
+    Unit { suffix: "deg_per_s", quantity: Quantity::AngularRate, to_si: PI / 180.0 },
+    Unit { suffix: "deg_per_h", quantity: Quantity::AngularRate, to_si: ARCSEC },
+    Unit { suffix: "mps", quantity: Quantity::Velocity, to_si: 1.0 },
+    Unit { suffix: "m_per_s", quantity: Quantity::Velocity, to_si: 1.0 },
+    Unit { suffix: "mps2", quantity: Quantity::Acceleration, to_si: 1.0 },
+    Unit { suffix: "m_per_s2", quantity: Quantity::Acceleration, to_si: 1.0 },
+    Unit { suffix: "g", quantity: Quantity::Acceleration, to_si: STANDARD_GRAVITY_MPS2 },
+    Unit { suffix: "mg", quantity: Quantity::Acceleration, to_si: 1e-3 * STANDARD_GRAVITY_MPS2 },
+    Unit { suffix: "ug", quantity: Quantity::Acceleration, to_si: 1e-6 * STANDARD_GRAVITY_MPS2 },
+    Unit { suffix: "s", quantity: Quantity::Time, to_si: 1.0 },
+    Unit { suffix: "ms", quantity: Quantity::Time, to_si: 1e-3 },
+    Unit { suffix: "us", quantity: Quantity::Time, to_si: 1e-6 },
+    Unit { suffix: "ns", quantity: Quantity::Time, to_si: 1e-9 },
+    Unit { suffix: "ps", quantity: Quantity::Time, to_si: 1e-12 },
+    Unit { suffix: "m", quantity: Quantity::Length, to_si: 1.0 },
+    Unit { suffix: "ppm", quantity: Quantity::Dimensionless, to_si: 1e-6 },
+    Unit { suffix: "ppb", quantity: Quantity::Dimensionless, to_si: 1e-9 },
+    Unit { suffix: "ppt", quantity: Quantity::Dimensionless, to_si: 1e-12 },
+    Unit { suffix: "1", quantity: Quantity::Dimensionless, to_si: 1.0 },
+    Unit { suffix: "count", quantity: Quantity::Dimensionless, to_si: 1.0 },
 ];
 
 /// Splits a column name into its base and unit: `"gyro_x_deg_per_h"` → `("gyro_x", deg_per_h)`.
@@ -244,18 +136,18 @@ pub fn unit_named(text: &str) -> Option<Unit> {
 /// Every unit of `quantity` as a user writes it (`deg/h`), for error messages.
 #[must_use]
 pub fn units_for(quantity: Quantity) -> String {
-    UNITS.iter().filter(|u| u.quantity == quantity).map(|u| u.suffix.replace("_per_", "/")).collect::<Vec<_>>().join(", ")
+    UNITS
+        .iter()
+        .filter(|u| u.quantity == quantity)
+        .map(|u| u.suffix.replace("_per_", "/"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// The list of accepted suffixes for a quantity, for error messages.
 #[must_use]
 pub fn suffixes_for(quantity: Quantity) -> String {
-    UNITS
-        .iter()
-        .filter(|u| u.quantity == quantity)
-        .map(|u| format!("_{}", u.suffix))
-        .collect::<Vec<_>>()
-        .join(", ")
+    UNITS.iter().filter(|u| u.quantity == quantity).map(|u| format!("_{}", u.suffix)).collect::<Vec<_>>().join(", ")
 }
 
 #[cfg(test)]
@@ -265,10 +157,7 @@ mod tests {
     #[test]
     fn longest_suffix_wins() {
         let (base, unit) = split_unit("gyro_x_rad_per_s").unwrap();
-        assert_eq!(
-            (base, unit.suffix, unit.quantity),
-            ("gyro_x", "rad_per_s", Quantity::AngularRate)
-        );
+        assert_eq!((base, unit.suffix, unit.quantity), ("gyro_x", "rad_per_s", Quantity::AngularRate));
         let (base, unit) = split_unit("accel_z_mps2").unwrap();
         assert_eq!((base, unit.suffix), ("accel_z", "mps2"));
         let (base, unit) = split_unit("t_ns").unwrap();

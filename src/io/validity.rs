@@ -42,7 +42,15 @@ pub(crate) enum Sensor {
 
 /// Checks one IMU value `si` (SI units, rate or increment; `interval_s`: the interval an increment
 /// covers, None for a rate) read as `cell` from `column` at `at`.
-pub(crate) fn check_imu_value(file: &Path, at: Location, column: &str, cell: f64, si: f64, sensor: Sensor, interval_s: Option<f64>) -> Result<(), LogError> {
+pub(crate) fn check_imu_value(
+    file: &Path,
+    at: Location,
+    column: &str,
+    cell: f64,
+    si: f64,
+    sensor: Sensor,
+    interval_s: Option<f64>,
+) -> Result<(), LogError> {
     let (rate_bound, unit, what) = match sensor {
         Sensor::Gyro => (MAX_RATE_RAD_PER_S, "rad", "gyro"),
         Sensor::Accel => (MAX_SPECIFIC_FORCE_MPS2, "m/s", "accelerometer"),
@@ -56,10 +64,24 @@ pub(crate) fn check_imu_value(file: &Path, at: Location, column: &str, cell: f64
         Sensor::Accel => "1000 g = 9806.65 m/s²",
     };
     let (value, bound_text) = match interval_s {
-        Some(dt) => (format!("{} {unit} in {} s", short_number(si), fixed_number(dt, 6)), format!("{limit}: {} {unit} in {} s", fixed_number(bound, 4), fixed_number(dt, 6))),
-        None => (format!("{} {}", short_number(si), if sensor == Sensor::Gyro { "rad/s" } else { "m/s²" }), limit.to_owned()),
+        Some(dt) => (
+            format!("{} {unit} in {} s", short_number(si), fixed_number(dt, 6)),
+            format!("{limit}: {} {unit} in {} s", fixed_number(bound, 4), fixed_number(dt, 6)),
+        ),
+        None => (
+            format!("{} {}", short_number(si), if sensor == Sensor::Gyro { "rad/s" } else { "m/s²" }),
+            limit.to_owned(),
+        ),
     };
-    Err(bad_value(file, at, column, cell, format!("({value}) is beyond what any {what} measures (at most {bound_text}): a damaged file, or a unit other than the column's")))
+    Err(bad_value(
+        file,
+        at,
+        column,
+        cell,
+        format!(
+            "({value}) is beyond what any {what} measures (at most {bound_text}): a damaged file, or a unit other than the column's"
+        ),
+    ))
 }
 
 /// The one refusal of the rule: `cell` as read from `column` at `at` of `file`, in short form, and why.
@@ -75,7 +97,16 @@ pub fn check_angle(file: &Path, at: Location, column: &str, cell: f64, si: f64) 
     if si.abs() <= MAX_ANGLE_RAD {
         return Ok(());
     }
-    Err(bad_value(file, at, column, cell, format!("({} rad) is not an angle a table or a reference gives: beyond ±1e8 rad (16 million turns) an f64 no longer resolves 0.01″; a damaged file?", short_number(si))))
+    Err(bad_value(
+        file,
+        at,
+        column,
+        cell,
+        format!(
+            "({} rad) is not an angle a table or a reference gives: beyond ±1e8 rad (16 million turns) an f64 no longer resolves 0.01″; a damaged file?",
+            short_number(si)
+        ),
+    ))
 }
 
 /// Checks a time stamp `t_s` (s after the log's first) read as `cell` from `column` at `at`.
@@ -86,7 +117,16 @@ pub fn check_span(file: &Path, at: Location, column: &str, cell: f64, t_s: f64) 
     if t_s.abs() <= MAX_LOG_SPAN_S {
         return Ok(());
     }
-    Err(bad_value(file, at, column, cell, format!("is {} s from the IMU's first stamp: not a time on the same clock (a log spans at most 1e9 s); a damaged file?", short_number(t_s))))
+    Err(bad_value(
+        file,
+        at,
+        column,
+        cell,
+        format!(
+            "is {} s from the IMU's first stamp: not a time on the same clock (a log spans at most 1e9 s); a damaged file?",
+            short_number(t_s)
+        ),
+    ))
 }
 
 /// The physical range of one number a user gives — an option on the command line, a field of a
@@ -208,8 +248,15 @@ mod tests {
             assert!(e.len() < 120 && e.contains("Hz") && e.contains("1e9"), "{v}: {e}");
         }
         assert!(check_number(1e-308, &SERIES_RATE_HZ).expect_err("1e-308").starts_with("1e-308 Hz"));
-        assert!(check_number(1e300, &PITCH_DEG).expect_err("1e300").starts_with("1e300 deg is out of range for a pitch: it must be within ±90 deg"));
-        assert!(check_number(-90.0, &PITCH_DEG).is_ok() && check_number(0.0, &Range::positive(1.0, "s", "a duration")).is_err());
+        assert!(
+            check_number(1e300, &PITCH_DEG)
+                .expect_err("1e300")
+                .starts_with("1e300 deg is out of range for a pitch: it must be within ±90 deg")
+        );
+        assert!(
+            check_number(-90.0, &PITCH_DEG).is_ok()
+                && check_number(0.0, &Range::positive(1.0, "s", "a duration")).is_err()
+        );
     }
 
     #[test]
@@ -218,11 +265,20 @@ mod tests {
         let at = Location { row: 12, line: Some(13) };
         assert!(check_imu_value(f, at, "gyro_x_rad_per_s", 600.0, 600.0, Sensor::Gyro, None).is_ok());
         assert!(check_imu_value(f, at, "dv_z_mps", 0.049, 0.049, Sensor::Accel, Some(0.005)).is_ok());
-        let e = check_imu_value(f, at, "dtheta_x_rad", 1e300, 1e300, Sensor::Gyro, Some(0.005)).expect_err("1e300 rad").to_string();
-        assert!(e.contains("data row 12 (line 13), column dtheta_x_rad: \"1e300\"") && e.contains("gyro") && e.len() < 300, "{e}");
-        let e = check_imu_value(f, at, "accel_x_g", 2000.0, 19_613.3, Sensor::Accel, None).expect_err("2000 g").to_string();
+        let e = check_imu_value(f, at, "dtheta_x_rad", 1e300, 1e300, Sensor::Gyro, Some(0.005))
+            .expect_err("1e300 rad")
+            .to_string();
+        assert!(
+            e.contains("data row 12 (line 13), column dtheta_x_rad: \"1e300\"") && e.contains("gyro") && e.len() < 300,
+            "{e}"
+        );
+        let e =
+            check_imu_value(f, at, "accel_x_g", 2000.0, 19_613.3, Sensor::Accel, None).expect_err("2000 g").to_string();
         assert!(e.contains("1000 g") && e.contains("m/s²"), "{e}");
-        assert!(check_imu_value(f, at, "gyro_x_rad_per_s", 1.0, f64::NAN, Sensor::Gyro, None).is_err(), "NaN fails every bound");
+        assert!(
+            check_imu_value(f, at, "gyro_x_rad_per_s", 1.0, f64::NAN, Sensor::Gyro, None).is_err(),
+            "NaN fails every bound"
+        );
         assert!(check_angle(f, at, "outer_rad", 6.0e7, 6.0e7).is_ok());
         let e = check_angle(f, at, "outer_deg", 1e300, 1e300f64.to_radians()).expect_err("1e300 deg").to_string();
         assert!(e.contains("\"1e300\"") && e.len() < 300, "{e}");

@@ -64,11 +64,8 @@ enum Shape {
 }
 
 fn check_columns(path: &Path, columns: &[&str], shape: Shape) -> Result<()> {
-    let bad = |column: &str, problem: String| LogError::Unit {
-        file: path.to_path_buf(),
-        column: column.to_owned(),
-        problem,
-    };
+    let bad =
+        |column: &str, problem: String| LogError::Unit { file: path.to_path_buf(), column: column.to_owned(), problem };
     if columns.is_empty() || (shape == Shape::TimeSeries && columns.first() != Some(&"t_s")) {
         return Err(LogError::Layout {
             file: path.to_path_buf(),
@@ -77,13 +74,13 @@ fn check_columns(path: &Path, columns: &[&str], shape: Shape) -> Result<()> {
     }
     for (i, c) in columns.iter().enumerate() {
         if c.is_empty() || !c.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_') {
-            return Err(bad(
-                c,
-                "a column name is ASCII letters, digits and _".into(),
-            ));
+            return Err(bad(c, "a column name is ASCII letters, digits and _".into()));
         }
         if shape == Shape::TimeSeries && split_unit(c).is_none() {
-            return Err(bad(c, "the name carries no unit: end it with _<unit>, e.g. _rad, _deg_per_h, _mps2, _m, _s".into()));
+            return Err(bad(
+                c,
+                "the name carries no unit: end it with _<unit>, e.g. _rad, _deg_per_h, _mps2, _m, _s".into(),
+            ));
         }
         if columns.get(..i).is_some_and(|before| before.contains(c)) {
             return Err(bad(c, "the column appears twice".into()));
@@ -96,11 +93,8 @@ fn check_columns(path: &Path, columns: &[&str], shape: Shape) -> Result<()> {
 fn push_f64(out: &mut String, v: f64) {
     use std::fmt::Write as _;
     let a = v.abs();
-    let _ = if v == 0.0 || (1e-5..1e16).contains(&a) || !v.is_finite() {
-        write!(out, "{v}")
-    } else {
-        write!(out, "{v:e}")
-    };
+    let _ =
+        if v == 0.0 || (1e-5..1e16).contains(&a) || !v.is_finite() { write!(out, "{v}") } else { write!(out, "{v:e}") };
 }
 
 impl TableWriter {
@@ -125,16 +119,11 @@ impl TableWriter {
 
     fn create_shaped(path: &Path, columns: &[&str], shape: Shape) -> Result<Self> {
         let format = Format::from_extension(path);
-        let output = |problem: String| LogError::Output {
-            file: path.to_path_buf(),
-            problem,
-        };
+        let output = |problem: String| LogError::Output { file: path.to_path_buf(), problem };
         let format = match format {
             Some(f @ (Format::Text | Format::Parquet | Format::Npy)) => f,
             _ => {
-                return Err(output(
-                    "the extension must be .csv, .parquet or .npy".into(),
-                ));
+                return Err(output("the extension must be .csv, .parquet or .npy".into()));
             }
         };
         check_columns(path, columns, shape)?;
@@ -153,8 +142,9 @@ impl TableWriter {
             line: String::new(),
         };
         let backend = match format {
-            Format::Parquet => ParquetWriter::new(&this.path, file, &this.columns)
-                .map(|w| Backend::Parquet(Box::new(w))),
+            Format::Parquet => {
+                ParquetWriter::new(&this.path, file, &this.columns).map(|w| Backend::Parquet(Box::new(w)))
+            }
             Format::Npy => NpyWriter::new(&this.path, file, columns.len()).map(Backend::Npy),
             _ => {
                 let mut out = BufWriter::with_capacity(1 << 16, file);
@@ -196,10 +186,7 @@ impl TableWriter {
             });
         }
         let result = match &mut self.backend {
-            None => Err(LogError::Output {
-                file: self.path.clone(),
-                problem: "the writer failed earlier".into(),
-            }),
+            None => Err(LogError::Output { file: self.path.clone(), problem: "the writer failed earlier".into() }),
             Some(Backend::Csv(out)) => {
                 self.line.clear();
                 for (i, &v) in row.iter().enumerate() {
@@ -209,8 +196,7 @@ impl TableWriter {
                     push_f64(&mut self.line, v);
                 }
                 self.line.push('\n');
-                out.write_all(self.line.as_bytes())
-                    .map_err(|e| LogError::io(&self.path, "cannot write", e))
+                out.write_all(self.line.as_bytes()).map_err(|e| LogError::io(&self.path, "cannot write", e))
             }
             Some(Backend::Parquet(w)) => w.write_row(&self.path, row),
             Some(Backend::Npy(w)) => w.write_row(&self.path, row),
@@ -236,10 +222,7 @@ impl TableWriter {
         let io = |e| LogError::io(&self.path, "cannot write", e);
         let file = match self.backend.take() {
             None => {
-                return Err(LogError::Output {
-                    file: self.path.clone(),
-                    problem: "the writer failed earlier".into(),
-                });
+                return Err(LogError::Output { file: self.path.clone(), problem: "the writer failed earlier".into() });
             }
             Some(Backend::Csv(mut out)) => {
                 out.flush().map_err(io)?;
@@ -249,7 +232,10 @@ impl TableWriter {
             Some(Backend::Npy(w)) => w.finish(&self.path)?,
         };
         drop(file);
-        let out = self.out.take().ok_or_else(|| LogError::Output { file: self.path.clone(), problem: "already finished".into() })?;
+        let out = self
+            .out
+            .take()
+            .ok_or_else(|| LogError::Output { file: self.path.clone(), problem: "already finished".into() })?;
         out.commit().map_err(|e| LogError::Output { file: self.path.clone(), problem: e.to_string() })?;
         Ok(self.rows)
     }
@@ -261,19 +247,7 @@ mod tests {
 
     #[test]
     fn shortest_text_round_trips() {
-        for v in [
-            0.0,
-            -0.0,
-            1.0,
-            0.1,
-            1e-7,
-            123456.789,
-            1e300,
-            -2.5e-310,
-            f64::MAX,
-            f64::MIN_POSITIVE,
-            1.0 / 3.0,
-        ] {
+        for v in [0.0, -0.0, 1.0, 0.1, 1e-7, 123456.789, 1e300, -2.5e-310, f64::MAX, f64::MIN_POSITIVE, 1.0 / 3.0] {
             let mut s = String::new();
             push_f64(&mut s, v);
             assert_eq!(s.parse::<f64>().unwrap().to_bits(), v.to_bits(), "{s}");

@@ -29,7 +29,10 @@ mod fit;
 #[cfg(test)]
 mod tests;
 
-pub use fit::{check_claims, fit_noise_model, slope_readings, Contradiction, NoiseFit, CLAIM_Z, SlopeReading, SlopeReadings, SIGNIFICANCE_Z, SLOPE_MATCH_TOLERANCE};
+pub use fit::{
+    CLAIM_Z, Contradiction, NoiseFit, SIGNIFICANCE_Z, SLOPE_MATCH_TOLERANCE, SlopeReading, SlopeReadings, check_claims,
+    fit_noise_model, slope_readings,
+};
 
 /// Fewest samples [`allan_curve`] accepts.
 pub const MIN_SAMPLES: usize = 16;
@@ -211,12 +214,20 @@ pub fn cluster_sizes(n_samples: usize, spacing: &TauSpacing, min_clusters: usize
 pub fn averaging_factors(m_max: usize, spacing: &TauSpacing) -> Result<Vec<usize>, AllanError> {
     let mut ms: Vec<usize> = match spacing {
         TauSpacing::All => (1..=m_max).collect(),
-        TauSpacing::Octave => std::iter::successors(Some(1usize), |&m| m.checked_mul(2)).take_while(|&m| m <= m_max).collect(),
-        TauSpacing::Decade => std::iter::successors(Some(1usize), |&d| d.checked_mul(10)).take_while(|&d| d <= m_max).flat_map(|d| [d, 2 * d, 4 * d]).filter(|&m| m <= m_max).collect(),
-        TauSpacing::PerDecade(0) => return Err(AllanError::BadOption("points per decade must be >= 1")),
-        TauSpacing::PerDecade(n) => {
-            (0u32..).map(|i| 10f64.powf(f64::from(i) / f64::from(*n)).round()).take_while(|&m| m <= m_max as f64).map(|m| m as usize).collect()
+        TauSpacing::Octave => {
+            std::iter::successors(Some(1usize), |&m| m.checked_mul(2)).take_while(|&m| m <= m_max).collect()
         }
+        TauSpacing::Decade => std::iter::successors(Some(1usize), |&d| d.checked_mul(10))
+            .take_while(|&d| d <= m_max)
+            .flat_map(|d| [d, 2 * d, 4 * d])
+            .filter(|&m| m <= m_max)
+            .collect(),
+        TauSpacing::PerDecade(0) => return Err(AllanError::BadOption("points per decade must be >= 1")),
+        TauSpacing::PerDecade(n) => (0u32..)
+            .map(|i| 10f64.powf(f64::from(i) / f64::from(*n)).round())
+            .take_while(|&m| m <= m_max as f64)
+            .map(|m| m as usize)
+            .collect(),
         TauSpacing::Explicit(v) => v.iter().copied().filter(|&m| m >= 1 && m <= m_max).collect(),
     };
     ms.sort_unstable();
@@ -274,7 +285,9 @@ fn second_difference_sums(theta: &[f64], ms: &[usize]) -> Vec<(f64, usize)> {
     const FUSED_MAX_M: usize = 2048;
     let terms = |m: usize| theta.len() - 2 * m;
     let mut out: Vec<(f64, usize)> = ms.iter().map(|&m| (0.0, terms(m))).collect();
-    let block_sum = |m: usize, k0: usize, k1: usize| sum_sq_second_diff(&theta[k0..k1], &theta[k0 + m..k1 + m], &theta[k0 + 2 * m..k1 + 2 * m]);
+    let block_sum = |m: usize, k0: usize, k1: usize| {
+        sum_sq_second_diff(&theta[k0..k1], &theta[k0 + m..k1 + m], &theta[k0 + 2 * m..k1 + 2 * m])
+    };
     let most = ms.iter().map(|&m| terms(m)).max().unwrap_or(0);
     for k0 in (0..most).step_by(BLOCK) {
         for (o, &m) in out.iter_mut().zip(ms).filter(|(_, m)| **m <= FUSED_MAX_M) {
@@ -309,7 +322,8 @@ pub fn allan_curve(phase: &Phase, tau0_s: f64, opts: &AllanOptions) -> Result<Al
         return Err(AllanError::TooFewSamples { got: n, min });
     }
     let ms = cluster_sizes(n, &opts.spacing, opts.min_clusters)?;
-    let mut curve = AllanCurve { tau0_s, n_samples: n, m: ms.clone(), taus_s: vec![], avar_si: vec![], n_terms: vec![] };
+    let mut curve =
+        AllanCurve { tau0_s, n_samples: n, m: ms.clone(), taus_s: vec![], avar_si: vec![], n_terms: vec![] };
     for (&m, (s, terms)) in ms.iter().zip(second_difference_sums(&phase.theta, &ms)) {
         let tau = m as f64 * tau0_s;
         curve.taus_s.push(tau);
@@ -349,10 +363,14 @@ pub fn edf_overlapping(n_samples: usize, m: usize, noise: NoiseType) -> f64 {
             let p = ((n - 1.0) / (2.0 * mf)).ln() * ((2.0 * mf + 1.0) * (n - 1.0) / 4.0).ln();
             if p > 0.0 { p.sqrt().exp() } else { 1.0 }
         }
-        NoiseType::WhiteRate => (3.0 * (n - 1.0) / (2.0 * mf) - 2.0 * (n - 2.0) / n) * (4.0 * mf * mf / (4.0 * mf * mf + 5.0)),
+        NoiseType::WhiteRate => {
+            (3.0 * (n - 1.0) / (2.0 * mf) - 2.0 * (n - 2.0) / n) * (4.0 * mf * mf / (4.0 * mf * mf + 5.0))
+        }
         NoiseType::FlickerRate if m == 1 => 2.0 * (n - 2.0) * (n - 2.0) / (2.3 * n - 4.9),
         NoiseType::FlickerRate => 5.0 * n * n / (4.0 * mf * (n + 3.0 * mf)),
-        NoiseType::RandomWalkRate => (n - 2.0) / mf * ((n - 1.0).powi(2) - 3.0 * mf * (n - 1.0) + 4.0 * mf * mf) / (n - 3.0).powi(2),
+        NoiseType::RandomWalkRate => {
+            (n - 2.0) / mf * ((n - 1.0).powi(2) - 3.0 * mf * (n - 1.0) + 4.0 * mf * mf) / (n - 3.0).powi(2)
+        }
     };
     let max = (n - 2.0 * mf).max(1.0);
     if edf.is_finite() { edf.clamp(1.0, max) } else { 1.0 }
@@ -416,7 +434,13 @@ pub enum NoiseTerm {
 }
 
 /// All terms, in order of increasing τ exponent.
-pub const TERMS: [NoiseTerm; 5] = [NoiseTerm::Quantization, NoiseTerm::RandomWalk, NoiseTerm::BiasInstability, NoiseTerm::RateRandomWalk, NoiseTerm::RateRamp];
+pub const TERMS: [NoiseTerm; 5] = [
+    NoiseTerm::Quantization,
+    NoiseTerm::RandomWalk,
+    NoiseTerm::BiasInstability,
+    NoiseTerm::RateRandomWalk,
+    NoiseTerm::RateRamp,
+];
 
 impl NoiseTerm {
     /// Exponent p of τ in σ²(τ) (−2..=2); the ADEV slope is p/2.
@@ -434,7 +458,13 @@ impl NoiseTerm {
     /// The noise type whose EDF applies where this term dominates.
     #[must_use]
     pub fn noise_type(self) -> NoiseType {
-        [NoiseType::WhitePhase, NoiseType::WhiteRate, NoiseType::FlickerRate, NoiseType::RandomWalkRate, NoiseType::RandomWalkRate][self as usize]
+        [
+            NoiseType::WhitePhase,
+            NoiseType::WhiteRate,
+            NoiseType::FlickerRate,
+            NoiseType::RandomWalkRate,
+            NoiseType::RandomWalkRate,
+        ][self as usize]
     }
 
     /// Contribution a·c²·τ^p of the coefficient c (SI) to σ² at τ (s).
@@ -551,7 +581,8 @@ pub fn analyze(phase: &Phase, tau0_s: f64, opts: &AllanOptions) -> Result<AllanR
     let curve = allan_curve(phase, tau0_s, opts)?;
     let fit = fit_noise_model(&curve);
     let adev_si: Vec<f64> = curve.avar_si.iter().map(|v| v.sqrt()).collect();
-    let (lo, hi): (Vec<f64>, Vec<f64>) = adev_si.iter().zip(&fit.edf).map(|(&s, &e)| adev_confidence(s, e, opts.ci_sigma)).unzip();
+    let (lo, hi): (Vec<f64>, Vec<f64>) =
+        adev_si.iter().zip(&fit.edf).map(|(&s, &e)| adev_confidence(s, e, opts.ci_sigma)).unzip();
     let slope = slope_readings(&curve.taus_s, &adev_si, &lo, &hi);
     Ok(AllanReport {
         tau0_s,

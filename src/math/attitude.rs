@@ -8,7 +8,7 @@
 
 use nalgebra::{UnitQuaternion, Vector3};
 
-use crate::math::frames::{axis_angle, Rot, B, N, V3};
+use crate::math::frames::{B, N, Rot, V3, axis_angle};
 use crate::math::units::wrap_pi;
 
 /// Pitch, roll and heading, in radians.

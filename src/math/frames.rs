@@ -35,13 +35,7 @@ impl<To, From> Clone for Rot<To, From> {
 impl<To, From> Copy for Rot<To, From> {}
 impl<To, From> fmt::Debug for Rot<To, From> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "Rot<{}, {}>({:?})",
-            short_type_name::<To>(),
-            short_type_name::<From>(),
-            self.q
-        )
+        write!(f, "Rot<{}, {}>({:?})", short_type_name::<To>(), short_type_name::<From>(), self.q)
     }
 }
 

@@ -32,7 +32,11 @@ pub fn exp(phi: &Vector3<f64>) -> UnitQuaternion<f64> {
 pub fn log(q: &UnitQuaternion<f64>) -> Vector3<f64> {
     let v = if q.w < 0.0 { -q.imag() } else { q.imag() };
     let s2 = v.norm_squared();
-    if s2 < 1e-4 { v * (2.0 * (1.0 + s2 * (1.0 / 6.0 + s2 * (3.0 / 40.0 + s2 * (5.0 / 112.0))))) } else { q.scaled_axis() }
+    if s2 < 1e-4 {
+        v * (2.0 * (1.0 + s2 * (1.0 / 6.0 + s2 * (3.0 / 40.0 + s2 * (5.0 / 112.0)))))
+    } else {
+        q.scaled_axis()
+    }
 }
 
 #[cfg(test)]

@@ -19,7 +19,7 @@
 
 use nalgebra::{UnitQuaternion, Vector3};
 
-use crate::math::frames::{axis_angle, Rot, B, S, V3};
+use crate::math::frames::{B, Rot, S, V3, axis_angle};
 use crate::math::rotvec;
 use crate::model::scheme::{AxisValues, MAX_AXES};
 use crate::model::turning::Link;
@@ -119,7 +119,11 @@ impl TableErrors {
     /// No error at all on `n_axes` axes.
     #[must_use]
     pub fn zero(n_axes: usize) -> Self {
-        Self { installation_rad: Vector3::zeros(), imu_mount_rad: Vector3::zeros(), axes: vec![AxisErrors::default(); n_axes] }
+        Self {
+            installation_rad: Vector3::zeros(),
+            imu_mount_rad: Vector3::zeros(),
+            axes: vec![AxisErrors::default(); n_axes],
+        }
     }
 
     /// Every geometric error angle multiplied by its class's factor (encoder errors dropped): what
@@ -314,7 +318,12 @@ impl Chain {
     /// [`Self::b_from_s_with`] and the angular rate of s relative to b, in s, for gimbal rates
     /// `rates_rad_per_s`: `ω_bs^s = Σ_k λ̇_k Q_kᵀ a_k` with Q_k everything in the chain after shaft k.
     #[must_use]
-    pub fn b_from_s_and_rate(&self, err: &ErrorRotations, shafts: &ShaftRotations, rates_rad_per_s: &AxisValues) -> (Rot<B, S>, V3<S>) {
+    pub fn b_from_s_and_rate(
+        &self,
+        err: &ErrorRotations,
+        shafts: &ShaftRotations,
+        rates_rad_per_s: &AxisValues,
+    ) -> (Rot<B, S>, V3<S>) {
         let n = self.axes.len();
         let mut suffix = err.between[n];
         let mut omega = Vector3::zeros();
@@ -333,7 +342,11 @@ impl Chain {
         let n = self.axes.len();
         let mut links = vec![Link::Fixed(err.between[0])];
         for k in 0..n {
-            links.push(Link::Turning { axis: self.axes[k].axis, angle_rad: angles_rad[k], rate_rad_per_s: rates_rad_per_s[k] });
+            links.push(Link::Turning {
+                axis: self.axes[k].axis,
+                angle_rad: angles_rad[k],
+                rate_rad_per_s: rates_rad_per_s[k],
+            });
             links.push(Link::Fixed(err.between[k + 1]));
         }
         links
@@ -375,8 +388,19 @@ impl Chain {
     /// with P_k the nominal rotation of the axes before k, ι the installation vector, t_k the tilt
     /// vector, m the mounting vector, and the encoder error λ̂_k - λ_k ≈ b_k + s_k λ_k - λ̇_k τ_k.
     #[must_use]
-    pub fn first_order_phi_b(&self, errors: &TableErrors, angles_rad: &AxisValues, rates_rad_per_s: &AxisValues) -> V3<B> {
-        self.first_order_phi_b_with(errors, &self.error_rotations(errors), angles_rad, rates_rad_per_s, &self.shaft_rotations(angles_rad))
+    pub fn first_order_phi_b(
+        &self,
+        errors: &TableErrors,
+        angles_rad: &AxisValues,
+        rates_rad_per_s: &AxisValues,
+    ) -> V3<B> {
+        self.first_order_phi_b_with(
+            errors,
+            &self.error_rotations(errors),
+            angles_rad,
+            rates_rad_per_s,
+            &self.shaft_rotations(angles_rad),
+        )
     }
 
     /// [`Self::first_order_phi_b`] with the shaft rotations of `angles_rad` and the error rotations of
@@ -394,7 +418,8 @@ impl Chain {
         let mut prefix = UnitQuaternion::identity();
         for (k, (g, e)) in self.axes.iter().zip(&errors.axes).enumerate() {
             let lambda = angles_rad[k];
-            let encoder_error = e.encoder_offset_rad + e.encoder_scale * lambda - rates_rad_per_s[k] * e.encoder_delay_s;
+            let encoder_error =
+                e.encoder_offset_rad + e.encoder_scale * lambda - rates_rad_per_s[k] * e.encoder_delay_s;
             let mut local = self.tilt_vector(k, e) - g.axis * encoder_error;
             if e.swing_half_angle_rad != 0.0 {
                 // sin λ, cos λ from the shaft quaternion (cos λ/2, sin λ/2 · a), then λ + φ by addition.
@@ -551,7 +576,8 @@ mod tests {
             for (k, ax) in e.axes.iter().enumerate() {
                 readings[k] = ax.encoder_reading(angles[k]);
             }
-            let exact = chain.b_from_s(&chain.error_rotations(&e), &angles) * chain.b_from_s_nominal(&readings).inverse();
+            let exact =
+                chain.b_from_s(&chain.error_rotations(&e), &angles) * chain.b_from_s_nominal(&readings).inverse();
             let exact_vec = exact.quaternion().scaled_axis();
             let linear = chain.first_order_phi_b(&e, &angles, &[0.0; 3]).v;
             ((exact_vec - linear).norm(), exact_vec.norm())

@@ -5,7 +5,7 @@
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 use crate::math::attitude::Attitude;
-use crate::math::frames::{axis_angle, Rot, B, N};
+use crate::math::frames::{B, N, Rot, axis_angle};
 use crate::model::turning::Link;
 
 /// Which Euler angle a ramp or a wobble drives.
@@ -197,7 +197,10 @@ impl VehicleMotion {
             if let Some(&t_last) = k.t_s.last()
                 && r.start_s < t_last
             {
-                return Err(format!("a {:?} ramp starts at {} s, before the previous {:?} ramp ends at {} s", r.angle, r.start_s, r.angle, t_last));
+                return Err(format!(
+                    "a {:?} ramp starts at {} s, before the previous {:?} ramp ends at {} s",
+                    r.angle, r.start_s, r.angle, t_last
+                ));
             }
             let duration = (r.target_rad - current).abs() / r.rate_rad_per_s;
             k.t_s.push(r.start_s);
@@ -205,13 +208,33 @@ impl VehicleMotion {
             k.t_s.push(r.start_s + duration);
             k.value_rad.push(r.target_rad);
         }
-        Ok(Self { base, knots, wobble_ramps: vec![None; wobble.len()], wobble, coning: None, cone_constants: [1.0, 0.0, 0.0, 0.0], cone_continuation: None, euler_fixed: None }.with_constants())
+        Ok(Self {
+            base,
+            knots,
+            wobble_ramps: vec![None; wobble.len()],
+            wobble,
+            coning: None,
+            cone_constants: [1.0, 0.0, 0.0, 0.0],
+            cone_continuation: None,
+            euler_fixed: None,
+        }
+        .with_constants())
     }
 
     /// A vehicle at rest at `base`.
     #[must_use]
     pub fn fixed(base: Attitude) -> Self {
-        Self { base, knots: Default::default(), wobble: Vec::new(), wobble_ramps: Vec::new(), coning: None, cone_constants: [1.0, 0.0, 0.0, 0.0], cone_continuation: None, euler_fixed: None }.with_constants()
+        Self {
+            base,
+            knots: Default::default(),
+            wobble: Vec::new(),
+            wobble_ramps: Vec::new(),
+            coning: None,
+            cone_constants: [1.0, 0.0, 0.0, 0.0],
+            cone_continuation: None,
+            euler_fixed: None,
+        }
+        .with_constants()
     }
 
     /// Computes the constant rotations and trigonometry once.
@@ -249,7 +272,13 @@ impl VehicleMotion {
             }
             let (amplitude, _, phase, omega) = old.wobble_state(i, t_s);
             let w = &self.wobble[i];
-            self.wobble_ramps[i] = Some(Transition { start_s: t_s, end_s: t_s + CONE_RAMP_S, phase_rad: phase, from: (amplitude, omega), to: (w.amplitude_rad, w.omega_rad_per_s) });
+            self.wobble_ramps[i] = Some(Transition {
+                start_s: t_s,
+                end_s: t_s + CONE_RAMP_S,
+                phase_rad: phase,
+                from: (amplitude, omega),
+                to: (w.amplitude_rad, w.omega_rad_per_s),
+            });
         }
         if old.coning.is_none() && self.coning.is_none() {
             return self;
@@ -257,7 +286,8 @@ impl VehicleMotion {
         let (alpha, _, phase, omega) = old.cone_state_full(t_s);
         let to = self.coning.map_or((0.0, omega), |c| (c.half_angle_rad, c.omega_rad_per_s));
         self.coning = Some(Coning { half_angle_rad: to.0, omega_rad_per_s: to.1 });
-        self.cone_continuation = Some(Transition { start_s: t_s, end_s: t_s + CONE_RAMP_S, phase_rad: phase, from: (alpha, omega), to });
+        self.cone_continuation =
+            Some(Transition { start_s: t_s, end_s: t_s + CONE_RAMP_S, phase_rad: phase, from: (alpha, omega), to });
         self.with_constants()
     }
 
@@ -305,7 +335,10 @@ impl VehicleMotion {
 
     /// Whether a cone or wobble is changing at `t_s` (inside a [`Transition`]).
     fn in_transition(&self, t_s: f64) -> bool {
-        self.cone_continuation.iter().chain(self.wobble_ramps.iter().flatten()).any(|k| t_s >= k.start_s && t_s < k.end_s)
+        self.cone_continuation
+            .iter()
+            .chain(self.wobble_ramps.iter().flatten())
+            .any(|k| t_s >= k.start_s && t_s < k.end_s)
     }
 
     /// True when the vehicle never moves (no ramp, no wobble, no coning).
@@ -380,14 +413,23 @@ impl VehicleMotion {
         }
         let a = self.euler(t_s);
         let [dp, dr, dh] = self.euler_rates(rates_at_s);
-        let turning = |axis: Vector3<f64>, angle_rad: f64, rate_rad_per_s: f64| Link::Turning { axis, angle_rad, rate_rad_per_s };
-        let mut links = vec![turning(Vector3::z(), -a.heading_rad, -dh), turning(Vector3::x(), a.pitch_rad, dp), turning(Vector3::y(), a.roll_rad, dr)];
+        let turning =
+            |axis: Vector3<f64>, angle_rad: f64, rate_rad_per_s: f64| Link::Turning { axis, angle_rad, rate_rad_per_s };
+        let mut links = vec![
+            turning(Vector3::z(), -a.heading_rad, -dh),
+            turning(Vector3::x(), a.pitch_rad, dp),
+            turning(Vector3::y(), a.roll_rad, dr),
+        ];
         if let Some(c) = self.coning {
             // A cone changing is not a link turning at a constant rate.
             if self.in_transition(rates_at_s) {
                 return None;
             }
-            links.push(Link::Cone { half_angle_rad: c.half_angle_rad, phase_rad: self.cone_state(t_s).1, rate_rad_per_s: c.omega_rad_per_s });
+            links.push(Link::Cone {
+                half_angle_rad: c.half_angle_rad,
+                phase_rad: self.cone_state(t_s).1,
+                rate_rad_per_s: c.omega_rad_per_s,
+            });
         }
         Some(links)
     }
@@ -409,14 +451,25 @@ impl VehicleMotion {
     pub fn max_angular_frequency(&self) -> f64 {
         let w = self.wobble.iter().map(|w| w.omega_rad_per_s).fold(0.0, f64::max);
         // A transition passes through the frequencies between its ends.
-        let changing = self.cone_continuation.iter().chain(self.wobble_ramps.iter().flatten()).map(|k| k.from.1.abs().max(k.to.1.abs())).fold(0.0, f64::max);
+        let changing = self
+            .cone_continuation
+            .iter()
+            .chain(self.wobble_ramps.iter().flatten())
+            .map(|k| k.from.1.abs().max(k.to.1.abs()))
+            .fold(0.0, f64::max);
         w.max(self.coning.map_or(0.0, |c| c.omega_rad_per_s.abs())).max(changing)
     }
 
     /// First time after `t_s` where a rate jumps (a ramp starts or ends).
     #[must_use]
     pub fn next_breakpoint_after(&self, t_s: f64) -> f64 {
-        let ramp = self.cone_continuation.iter().chain(self.wobble_ramps.iter().flatten()).flat_map(|k| [k.start_s, k.end_s]).filter(|b| *b > t_s).fold(f64::INFINITY, f64::min);
+        let ramp = self
+            .cone_continuation
+            .iter()
+            .chain(self.wobble_ramps.iter().flatten())
+            .flat_map(|k| [k.start_s, k.end_s])
+            .filter(|b| *b > t_s)
+            .fold(f64::INFINITY, f64::min);
         self.knots.iter().map(|k| k.next_after(t_s)).fold(ramp, f64::min)
     }
 
@@ -451,7 +504,12 @@ mod tests {
     /// The rotary-table paper section 5: roll to 30 deg at 6 deg/s at 500 s, pitch to 30 deg at 1100 s,
     /// pitch back at 1700 s, roll back at 2300 s.
     fn seed004_profile() -> VehicleMotion {
-        let ramp = |angle, start_s, target_deg: f64| Ramp { angle, start_s, target_rad: target_deg * RAD_PER_DEG, rate_rad_per_s: 6.0 * RAD_PER_DEG };
+        let ramp = |angle, start_s, target_deg: f64| Ramp {
+            angle,
+            start_s,
+            target_rad: target_deg * RAD_PER_DEG,
+            rate_rad_per_s: 6.0 * RAD_PER_DEG,
+        };
         VehicleMotion::new(
             Attitude::default(),
             vec![
@@ -513,7 +571,10 @@ mod tests {
         // A live session's cone 1° at 5 Hz changed to 2° at 10 Hz at t = 3.217 s: the attitude is
         // the same on both sides of the change (no jump the INS does not feel), and the rate is the
         // attitude's derivative (finite differences, as above) inside the ramp and after it.
-        let cone = |deg: f64, hz: f64| VehicleMotion::fixed(Attitude::default()).with_coning(Coning { half_angle_rad: deg * RAD_PER_DEG, omega_rad_per_s: std::f64::consts::TAU * hz });
+        let cone = |deg: f64, hz: f64| {
+            VehicleMotion::fixed(Attitude::default())
+                .with_coning(Coning { half_angle_rad: deg * RAD_PER_DEG, omega_rad_per_s: std::f64::consts::TAU * hz })
+        };
         let (old, t_c) = (cone(1.0, 5.0), 3.217);
         let new = cone(2.0, 10.0).continuing_from(&old, t_c);
         let jump = (old.n_from_b(t_c).inverse() * new.n_from_b(t_c)).quaternion().angle();
@@ -540,8 +601,18 @@ mod tests {
         // Li et al. 2014's two-axis wobble (6°, 1 Hz, 90° apart) changed to 3° at 2 Hz at t = 1.3 s:
         // no jump in the attitude, the rate its derivative inside the ramp and after.
         let wobble = |deg: f64, hz: f64| {
-            let w = |angle, phase_rad| Wobble { angle, amplitude_rad: deg * RAD_PER_DEG, omega_rad_per_s: std::f64::consts::TAU * hz, phase_rad };
-            VehicleMotion::new(Attitude::default(), vec![], vec![w(AngleKind::Heading, 0.0), w(AngleKind::Roll, std::f64::consts::FRAC_PI_2)]).expect("valid")
+            let w = |angle, phase_rad| Wobble {
+                angle,
+                amplitude_rad: deg * RAD_PER_DEG,
+                omega_rad_per_s: std::f64::consts::TAU * hz,
+                phase_rad,
+            };
+            VehicleMotion::new(
+                Attitude::default(),
+                vec![],
+                vec![w(AngleKind::Heading, 0.0), w(AngleKind::Roll, std::f64::consts::FRAC_PI_2)],
+            )
+            .expect("valid")
         };
         let (old, t_c) = (wobble(6.0, 1.0), 1.3);
         let new = wobble(3.0, 2.0).continuing_from(&old, t_c);

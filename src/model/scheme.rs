@@ -89,8 +89,17 @@ fn move_duration(step: &IndexedStep) -> f64 {
 
 #[derive(Debug, Clone)]
 enum Kind {
-    Continuous { rates: AxisValues },
-    Indexed { initial_dwell_s: f64, period_s: f64, repeat: bool, net_rad: AxisValues, moves: Vec<Vec<Move>>, breakpoints: Vec<f64> },
+    Continuous {
+        rates: AxisValues,
+    },
+    Indexed {
+        initial_dwell_s: f64,
+        period_s: f64,
+        repeat: bool,
+        net_rad: AxisValues,
+        moves: Vec<Vec<Move>>,
+        breakpoints: Vec<f64>,
+    },
 }
 
 /// Gimbal angles over time.
@@ -115,7 +124,12 @@ impl Scheme {
     #[must_use]
     pub fn continuous(initial_rad: Vec<f64>, rates_rad_per_s: Vec<f64>) -> Self {
         assert!(initial_rad.len() <= MAX_AXES && initial_rad.len() == rates_rad_per_s.len());
-        Self { n_axes: initial_rad.len(), initial: to_values(&initial_rad), kind: Kind::Continuous { rates: to_values(&rates_rad_per_s) }, steps: Vec::new() }
+        Self {
+            n_axes: initial_rad.len(),
+            initial: to_values(&initial_rad),
+            kind: Kind::Continuous { rates: to_values(&rates_rad_per_s) },
+            steps: Vec::new(),
+        }
     }
 
     /// An indexed sequence: dwell `initial_dwell_s`, then the moves in order, each followed by its dwell.
@@ -130,7 +144,11 @@ impl Scheme {
         for s in &steps {
             let duration_s = move_duration(s);
             // Where the rate jumps or its slope changes: start, end of acceleration, start of braking, end.
-            let t_acc = if s.accel_rad_per_s2 > 0.0 { (s.rate_rad_per_s / s.accel_rad_per_s2).min(0.5 * duration_s) } else { 0.0 };
+            let t_acc = if s.accel_rad_per_s2 > 0.0 {
+                (s.rate_rad_per_s / s.accel_rad_per_s2).min(0.5 * duration_s)
+            } else {
+                0.0
+            };
             breakpoints.extend([t, t + t_acc, t + duration_s - t_acc, t + duration_s]);
             moves[s.axis].push(Move {
                 t0_s: t,
@@ -146,11 +164,18 @@ impl Scheme {
         Self {
             n_axes,
             initial: to_values(&initial_rad),
-            kind: Kind::Indexed { initial_dwell_s, period_s: t, repeat, net_rad: rel, moves, breakpoints: {
-                breakpoints.sort_by(f64::total_cmp);
-                breakpoints.dedup();
-                breakpoints
-            } },
+            kind: Kind::Indexed {
+                initial_dwell_s,
+                period_s: t,
+                repeat,
+                net_rad: rel,
+                moves,
+                breakpoints: {
+                    breakpoints.sort_by(f64::total_cmp);
+                    breakpoints.dedup();
+                    breakpoints
+                },
+            },
             steps,
         }
     }
@@ -323,7 +348,13 @@ mod tests {
 
     /// The rotary-table paper section 5: 0/90/180/270 deg, 10 deg/s, 290 s dwell, back to 0 (docs/schemes.md).
     fn four_position() -> Scheme {
-        let step = |deg: f64| IndexedStep { axis: 0, angle_rad: deg * RAD_PER_DEG, rate_rad_per_s: 10.0 * RAD_PER_DEG, dwell_s: 290.0, accel_rad_per_s2: 0.0 };
+        let step = |deg: f64| IndexedStep {
+            axis: 0,
+            angle_rad: deg * RAD_PER_DEG,
+            rate_rad_per_s: 10.0 * RAD_PER_DEG,
+            dwell_s: 290.0,
+            accel_rad_per_s2: 0.0,
+        };
         Scheme::indexed(vec![0.0], 290.0, vec![step(90.0), step(90.0), step(90.0), step(-270.0)], true)
     }
 

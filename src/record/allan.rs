@@ -11,11 +11,11 @@ use rerun::{RecordingStreamResult, TimeColumn};
 use super::export::Exporter;
 use super::layout::{self, LegendCorner, Node};
 use super::palette::rgb;
-use super::{Stream, APPLICATION_ID};
+use super::{APPLICATION_ID, Stream};
 use crate::ins::allan::{Channel, ImuAllan, Sensor};
-use crate::math::allan::estimators::Estimator;
 use crate::io::LogError;
 use crate::math::allan::TERMS;
+use crate::math::allan::estimators::Estimator;
 
 /// The x axis: a duration timeline whose value in seconds is log10(τ / 1 s).
 pub const LOG10_TAU_TIMELINE: &str = "log10_tau_s";
@@ -32,23 +32,45 @@ const LINE_POINTS_PER_DECADE: f64 = 20.0;
 /// The channel's entity: `allan/gyro_x`, `allan/clock_<column>` (the column name reduced to
 /// letters, digits and `_`).
 fn path(c: &Channel) -> String {
-    let label: String = c.label.chars().map(|ch| if ch.is_ascii_alphanumeric() || ch == '_' { ch } else { '_' }).collect();
+    let label: String =
+        c.label.chars().map(|ch| if ch.is_ascii_alphanumeric() || ch == '_' { ch } else { '_' }).collect();
     format!("allan/{}_{label}", c.sensor.name())
 }
 
 /// Colours of the other estimators' curves, in `Estimator::ALL` order.
-const ESTIMATOR_COLORS: [[u8; 3]; 7] = [[250, 160, 60], [235, 235, 235], [90, 200, 250], [250, 120, 200], [150, 230, 120], [200, 160, 250], [250, 210, 90]];
+const ESTIMATOR_COLORS: [[u8; 3]; 7] = [
+    [250, 160, 60],
+    [235, 235, 235],
+    [90, 200, 250],
+    [250, 120, 200],
+    [150, 230, 120],
+    [200, 160, 250],
+    [250, 210, 90],
+];
 
 /// One curve on the log10 τ timeline.
-fn send(stream: &Stream, entity: &str, log10_tau: &[f64], log10_value: &[f64], drawn: &mut Vec<(f64, f64)>) -> RecordingStreamResult<()> {
+fn send(
+    stream: &Stream,
+    entity: &str,
+    log10_tau: &[f64],
+    log10_value: &[f64],
+    drawn: &mut Vec<(f64, f64)>,
+) -> RecordingStreamResult<()> {
     drawn.extend(log10_tau.iter().copied().zip(log10_value.iter().copied()));
     let time = TimeColumn::new_duration_secs(LOG10_TAU_TIMELINE, log10_tau.iter().copied());
-    stream.rec().send_columns(entity, [time], rerun::Scalars::new(log10_value.iter().copied()).columns(std::iter::repeat_n(1, log10_tau.len()))?)?;
+    stream.rec().send_columns(
+        entity,
+        [time],
+        rerun::Scalars::new(log10_value.iter().copied()).columns(std::iter::repeat_n(1, log10_tau.len()))?,
+    )?;
     Ok(())
 }
 
 fn line_style(stream: &Stream, entity: &str, color: [u8; 3], width: f32, name: &str) -> RecordingStreamResult<()> {
-    stream.rec().log_static(entity, &rerun::SeriesLines::new().with_colors([rgb(color)]).with_widths([width]).with_names([name]))
+    stream.rec().log_static(
+        entity,
+        &rerun::SeriesLines::new().with_colors([rgb(color)]).with_widths([width]).with_names([name]),
+    )
 }
 
 /// A dense log-spaced grid over [lo, hi] (log10 values).
@@ -80,7 +102,13 @@ fn log_channel(stream: &Stream, c: &Channel, ci_sigma: f64) -> RecordingStreamRe
         measured.as_str(),
         &rerun::SeriesLines::new().with_colors([rgb(MEASURED)]).with_widths([2.0]).with_names(["ADEV (measured)"]),
     )?;
-    stream.rec().log_static(measured.as_str(), &rerun::SeriesPoints::new().with_colors([rgb(MEASURED)]).with_marker_sizes([2.5]).with_names(["ADEV (measured)"]))?;
+    stream.rec().log_static(
+        measured.as_str(),
+        &rerun::SeriesPoints::new()
+            .with_colors([rgb(MEASURED)])
+            .with_marker_sizes([2.5])
+            .with_names(["ADEV (measured)"]),
+    )?;
     send(stream, &measured, &x, &y, &mut drawn)?;
     let (mut y_min, mut y_max) = (f64::INFINITY, f64::NEG_INFINITY);
     for (name, bound, sign) in [("ci_upper", &r.adev_upper_si, "+"), ("ci_lower", &r.adev_lower_si, "−")] {
@@ -105,13 +133,24 @@ fn log_channel(stream: &Stream, c: &Channel, ci_sigma: f64) -> RecordingStreamRe
         // a tenth of the fitted variance, inside the plot.
         let (p, a0) = (f64::from(term.exponent()) / 2.0, lg(term.avar(est.value, 1.0).sqrt()));
         let share = |lt: f64| term.avar(est.value, 10f64.powf(lt)) / fit.avar(10f64.powf(lt));
-        let pts: Vec<(f64, f64)> = dense.iter().filter(|lt| share(**lt) >= 0.1).map(|lt| (*lt, a0 + p * lt)).filter(|(_, v)| (y_lo..=y_hi).contains(v)).collect();
+        let pts: Vec<(f64, f64)> = dense
+            .iter()
+            .filter(|lt| share(**lt) >= 0.1)
+            .map(|lt| (*lt, a0 + p * lt))
+            .filter(|(_, v)| (y_lo..=y_hi).contains(v))
+            .collect();
         if pts.len() < 2 {
             continue;
         }
         let e = format!("{dir}/slope_{}", term.letter());
         let unit = c.sensor.unit(term);
-        let label = format!("{} {} {} ({})", term.letter(), crate::ins::allan::sig(est.value / unit.si, 3), unit.text, term.slope_text());
+        let label = format!(
+            "{} {} {} ({})",
+            term.letter(),
+            crate::ins::allan::sig(est.value / unit.si, 3),
+            unit.text,
+            term.slope_text()
+        );
         line_style(stream, &e, TERM_COLORS[term as usize], 1.5, &label)?;
         let (xs, ys): (Vec<f64>, Vec<f64>) = pts.into_iter().unzip();
         send(stream, &e, &xs, &ys, &mut drawn)?;
@@ -120,7 +159,11 @@ fn log_channel(stream: &Stream, c: &Channel, ci_sigma: f64) -> RecordingStreamRe
         let e = format!("{dir}/configured");
         stream.rec().log_static(
             e.as_str(),
-            &rerun::SeriesPoints::new().with_colors([rgb(TRUTH)]).with_marker_sizes([1.2]).with_markers([rerun::components::MarkerShape::Circle]).with_names(["configured"]),
+            &rerun::SeriesPoints::new()
+                .with_colors([rgb(TRUTH)])
+                .with_marker_sizes([1.2])
+                .with_markers([rerun::components::MarkerShape::Circle])
+                .with_names(["configured"]),
         )?;
         let yt: Vec<f64> = dense.iter().map(|lt| lg(t.avar(10f64.powf(*lt)).sqrt().max(f64::MIN_POSITIVE))).collect();
         for v in &yt {
@@ -144,7 +187,13 @@ fn range_of(drawn: &[(f64, f64)]) -> PlotRange {
 
 /// Logs the curves of `c.curves` that `keep` selects under `base`, each with its bounds, in its
 /// estimator's colour.
-fn log_curves(stream: &Stream, c: &Channel, base: &str, keep: impl Fn(Estimator) -> bool, drawn: &mut Vec<(f64, f64)>) -> RecordingStreamResult<()> {
+fn log_curves(
+    stream: &Stream,
+    c: &Channel,
+    base: &str,
+    keep: impl Fn(Estimator) -> bool,
+    drawn: &mut Vec<(f64, f64)>,
+) -> RecordingStreamResult<()> {
     for k in c.curves.iter().filter(|k| keep(k.estimator)) {
         let u = c.sensor.deviation_unit(k.estimator);
         let js: Vec<usize> = (0..k.dev.len()).filter(|&j| k.dev[j] > 0.0).collect();
@@ -156,13 +205,28 @@ fn log_curves(stream: &Stream, c: &Channel, base: &str, keep: impl Fn(Estimator)
         let dir = format!("{base}/log10_{name}{}", if u.key == "frac" { String::new() } else { format!("_{}", u.key) });
         let x: Vec<f64> = js.iter().map(|&j| k.taus_s[j].log10()).collect();
         let e = format!("{dir}/measured");
-        stream.rec().log_static(e.as_str(), &rerun::SeriesLines::new().with_colors([rgb(color)]).with_widths([1.5]).with_names([name.to_uppercase()]))?;
-        stream.rec().log_static(e.as_str(), &rerun::SeriesPoints::new().with_colors([rgb(color)]).with_marker_sizes([2.5]).with_names([name.to_uppercase()]))?;
+        stream.rec().log_static(
+            e.as_str(),
+            &rerun::SeriesLines::new().with_colors([rgb(color)]).with_widths([1.5]).with_names([name.to_uppercase()]),
+        )?;
+        stream.rec().log_static(
+            e.as_str(),
+            &rerun::SeriesPoints::new()
+                .with_colors([rgb(color)])
+                .with_marker_sizes([2.5])
+                .with_names([name.to_uppercase()]),
+        )?;
         send(stream, &e, &x, &js.iter().map(|&j| (k.dev[j] / u.si).log10()).collect::<Vec<_>>(), drawn)?;
         for (side, bound) in [("ci_upper", &k.upper), ("ci_lower", &k.lower)] {
             let e = format!("{dir}/{side}");
             line_style(stream, &e, color.map(|v| v / 2 + 40), 1.0, &format!("{} bound", name.to_uppercase()))?;
-            send(stream, &e, &x, &js.iter().map(|&j| (bound[j].max(f64::MIN_POSITIVE) / u.si).log10()).collect::<Vec<_>>(), drawn)?;
+            send(
+                stream,
+                &e,
+                &x,
+                &js.iter().map(|&j| (bound[j].max(f64::MIN_POSITIVE) / u.si).log10()).collect::<Vec<_>>(),
+                drawn,
+            )?;
         }
     }
     Ok(())
@@ -184,7 +248,12 @@ fn plot_range(drawn: &[(f64, f64)], x: (f64, f64)) -> PlotRange {
         })
     };
     let x_r = (x.0 - 0.02 * sx, x.1 + 0.02 * sx);
-    let corners = [(true, true, LegendCorner::RightBottom), (false, true, LegendCorner::LeftBottom), (true, false, LegendCorner::RightTop), (false, false, LegendCorner::LeftTop)];
+    let corners = [
+        (true, true, LegendCorner::RightBottom),
+        (false, true, LegendCorner::LeftBottom),
+        (true, false, LegendCorner::RightTop),
+        (false, false, LegendCorner::LeftTop),
+    ];
     if let Some((_, _, corner)) = corners.iter().find(|(r, b, _)| free(x_r, y_r, *r, *b)) {
         return PlotRange { x: x_r, y: y_r, legend: *corner };
     }
@@ -210,12 +279,18 @@ struct PlotRange {
     legend: LegendCorner,
 }
 
-
-
 fn about(r: &ImuAllan, description: &str) -> String {
     let terms: String = TERMS
         .iter()
-        .map(|t| format!("| {} | {} / {} | {} |\n", t.letter(), crate::ins::allan::Sensor::Gyro.term_name(*t), crate::ins::allan::Sensor::Accel.term_name(*t), t.slope_text()))
+        .map(|t| {
+            format!(
+                "| {} | {} / {} | {} |\n",
+                t.letter(),
+                crate::ins::allan::Sensor::Gyro.term_name(*t),
+                crate::ins::allan::Sensor::Accel.term_name(*t),
+                t.slope_text()
+            )
+        })
         .collect();
     let mut notes: String = r.notes.iter().map(|n| format!("\n*Note:* {n}\n")).collect();
     // A fit is a claim: where the data contradict a term or every IEEE combination, said here too.
@@ -250,22 +325,40 @@ pub fn log(stream: &Stream, r: &ImuAllan, description: &str) -> RecordingStreamR
     rec.send_recording_name(format!("rinscope allan: {}", r.source))?;
     rec.log_static("docs/allan", &rerun::TextDocument::from_markdown(about(r, description)))?;
     for sensor in Sensor::ALL.into_iter().filter(|s| r.channels.iter().any(|c| c.sensor == *s && c.report.is_some())) {
-        rec.log_static(format!("docs/coefficients_{}", sensor.name()), &rerun::TextDocument::from_markdown(r.markdown(sensor)))?;
+        rec.log_static(
+            format!("docs/coefficients_{}", sensor.name()),
+            &rerun::TextDocument::from_markdown(r.markdown(sensor)),
+        )?;
     }
     // One plot per channel of the rate deviations; TDEV (of the phase, another unit) beside it.
     let mut views: Vec<(Sensor, Node)> = Vec::new();
     for c in &r.channels {
         let range = log_channel(stream, c, r.ci_sigma)?;
         let u = c.sensor.adev_unit();
-        let unit = if u.text.is_empty() { "log10 fractional frequency".to_owned() } else { format!("log10 {}", u.text) };
+        let unit =
+            if u.text.is_empty() { "log10 fractional frequency".to_owned() } else { format!("log10 {}", u.text) };
         let what = if c.report.is_some() { "ADEV" } else { "deviation" };
-        views.push((c.sensor, plot_view(format!("{}: log10 {what} [{unit}] vs log10 τ — the axis's \"+1s\" is τ = 10 s", c.name()), path(c), &range)));
+        views.push((
+            c.sensor,
+            plot_view(
+                format!("{}: log10 {what} [{unit}] vs log10 τ — the axis's \"+1s\" is τ = 10 s", c.name()),
+                path(c),
+                &range,
+            ),
+        ));
         if c.curves.iter().any(|k| k.estimator.is_of_phase()) {
             let base = format!("{}_tdev", path(c));
             let mut drawn = Vec::new();
             log_curves(stream, c, &base, Estimator::is_of_phase, &mut drawn)?;
             let pu = c.sensor.phase_unit();
-            views.push((c.sensor, plot_view(format!("{}: log10 TDEV [log10 {}] vs log10 τ — the axis's \"+1s\" is τ = 10 s", c.name(), pu.text), base, &range_of(&drawn))));
+            views.push((
+                c.sensor,
+                plot_view(
+                    format!("{}: log10 TDEV [log10 {}] vs log10 τ — the axis's \"+1s\" is τ = 10 s", c.name(), pu.text),
+                    base,
+                    &range_of(&drawn),
+                ),
+            ));
         }
     }
     let mut rows: Vec<Node> = Vec::new();
@@ -278,14 +371,21 @@ pub fn log(stream: &Stream, r: &ImuAllan, description: &str) -> RecordingStreamR
     let mut tabs: Vec<Node> = Sensor::ALL
         .iter()
         .filter(|s| r.channels.iter().any(|c| c.sensor == **s && c.report.is_some()))
-        .map(|s| Node::view("TextDocument", format!("{} coefficients", s.name()), format!("docs/coefficients_{}", s.name())))
+        .map(|s| {
+            Node::view("TextDocument", format!("{} coefficients", s.name()), format!("docs/coefficients_{}", s.name()))
+        })
         .collect();
     tabs.push(Node::view("TextDocument", "how to read the plots", "docs/allan"));
     let mut shares: Vec<f32> = vec![1.0; rows.len()];
     rows.push(Node::container(ContainerKind::Tabs, tabs, &[]));
     shares.push(0.62);
     let root = Node::container(ContainerKind::Vertical, rows, &shares);
-    layout::send(rec, APPLICATION_ID, &root, &layout::Playback { timeline: LOG10_TAU_TIMELINE, speed: 1.0, follow: true })
+    layout::send(
+        rec,
+        APPLICATION_ID,
+        &root,
+        &layout::Playback { timeline: LOG10_TAU_TIMELINE, speed: 1.0, follow: true },
+    )
 }
 
 /// `allan --export`: per channel (`allan__gyro_x`, ...) its curve against `tau_s` — the Allan
@@ -302,15 +402,42 @@ pub fn export(exporter: &mut Exporter, r: &ImuAllan) -> Result<(), LogError> {
     for c in &r.channels {
         for k in &c.curves {
             let u = c.sensor.deviation_unit(k.estimator);
-            let columns: Vec<String> = ["tau_s".to_owned(), "m".to_owned(), format!("dev_{}", u.key), format!("lower_{}", u.key), format!("upper_{}", u.key), "edf".to_owned(), "alpha".to_owned(), "alpha_identified".to_owned(), "terms_count".to_owned()].into();
+            let columns: Vec<String> = [
+                "tau_s".to_owned(),
+                "m".to_owned(),
+                format!("dev_{}", u.key),
+                format!("lower_{}", u.key),
+                format!("upper_{}", u.key),
+                "edf".to_owned(),
+                "alpha".to_owned(),
+                "alpha_identified".to_owned(),
+                "terms_count".to_owned(),
+            ]
+            .into();
             let rows: Vec<Vec<f64>> = (0..k.m.len())
-                .map(|j| vec![k.taus_s[j], k.m[j] as f64, k.dev[j] / u.si, k.lower[j] / u.si, k.upper[j] / u.si, k.edf[j], f64::from(k.alpha[j]), f64::from(u8::from(k.alpha_identified[j])), k.n_terms[j] as f64])
+                .map(|j| {
+                    vec![
+                        k.taus_s[j],
+                        k.m[j] as f64,
+                        k.dev[j] / u.si,
+                        k.lower[j] / u.si,
+                        k.upper[j] / u.si,
+                        k.edf[j],
+                        f64::from(k.alpha[j]),
+                        f64::from(u8::from(k.alpha_identified[j])),
+                        k.n_terms[j] as f64,
+                    ]
+                })
                 .collect();
             exporter.write_table(&format!("{}_{}", path(c), k.estimator.name()), &columns, &rows)?;
         }
         let u = c.sensor.adev_unit();
         let Some(rep) = &c.report else { continue };
-        let mut columns: Vec<String> = ["tau_s", "adev", "adev_lower", "adev_upper", "fit_adev"].iter().enumerate().map(|(i, n)| if i == 0 { (*n).to_owned() } else { format!("{n}_{}", u.key) }).collect();
+        let mut columns: Vec<String> = ["tau_s", "adev", "adev_lower", "adev_upper", "fit_adev"]
+            .iter()
+            .enumerate()
+            .map(|(i, n)| if i == 0 { (*n).to_owned() } else { format!("{n}_{}", u.key) })
+            .collect();
         columns.extend(["edf".to_owned(), "second_differences_count".to_owned()]);
         if c.truth.is_some() {
             columns.push(format!("configured_adev_{}", u.key));
@@ -318,7 +445,15 @@ pub fn export(exporter: &mut Exporter, r: &ImuAllan) -> Result<(), LogError> {
         let rows: Vec<Vec<f64>> = (0..rep.taus_s.len())
             .map(|j| {
                 let tau = rep.taus_s[j];
-                let mut row = vec![tau, rep.adev_si[j] / u.si, rep.adev_lower_si[j] / u.si, rep.adev_upper_si[j] / u.si, rep.fit.avar(tau).sqrt() / u.si, rep.edf[j], rep.n_terms[j] as f64];
+                let mut row = vec![
+                    tau,
+                    rep.adev_si[j] / u.si,
+                    rep.adev_lower_si[j] / u.si,
+                    rep.adev_upper_si[j] / u.si,
+                    rep.fit.avar(tau).sqrt() / u.si,
+                    rep.edf[j],
+                    rep.n_terms[j] as f64,
+                ];
                 if let Some(t) = c.truth {
                     row.push(t.avar(tau).sqrt() / u.si);
                 }
@@ -328,8 +463,13 @@ pub fn export(exporter: &mut Exporter, r: &ImuAllan) -> Result<(), LogError> {
         exporter.write_table(&path(c), &columns, &rows)?;
     }
     for sensor in Sensor::ALL {
-        let chans: Vec<(usize, &Channel, &crate::math::allan::AllanReport)> =
-            r.channels.iter().filter(|c| c.sensor == sensor).enumerate().filter_map(|(i, c)| c.report.as_ref().map(|rep| (i, c, rep))).collect();
+        let chans: Vec<(usize, &Channel, &crate::math::allan::AllanReport)> = r
+            .channels
+            .iter()
+            .filter(|c| c.sensor == sensor)
+            .enumerate()
+            .filter_map(|(i, c)| c.report.as_ref().map(|rep| (i, c, rep)))
+            .collect();
         if chans.is_empty() {
             continue;
         }

@@ -4,7 +4,7 @@
 use rerun::RecordingStreamResult;
 
 use super::palette::{colors, rgb, rgba};
-use super::{to_rerun_quaternion, Recorder, Stream};
+use super::{Recorder, Stream, to_rerun_quaternion};
 use crate::ins::pipeline::InsView;
 
 /// The INS's body axes.
@@ -40,7 +40,11 @@ impl BodyScene {
         let reference = self.reference.as_mut().map(std::mem::take);
         for (path, q) in [(INS_BODY, Some(std::mem::take(&mut self.ins))), (REFERENCE_BODY, reference)] {
             let Some(q) = q.filter(|q| !q.is_empty()) else { continue };
-            stream.rec().send_columns(path, stream.time_columns(times), rerun::Transform3D::update_fields().with_many_quaternion(q).columns_of_unit_batches()?)?;
+            stream.rec().send_columns(
+                path,
+                stream.time_columns(times),
+                rerun::Transform3D::update_fields().with_many_quaternion(q).columns_of_unit_batches()?,
+            )?;
         }
         Ok(())
     }
@@ -55,21 +59,38 @@ impl Recorder {
         rec.log_static(INS_BODY, &rerun::Transform3D::IDENTITY)?;
         rec.log_static(
             format!("{INS_BODY}/case"),
-            &rerun::Boxes3D::from_half_sizes([[0.3, 0.45, 0.15]]).with_colors([rgba([200, 200, 210], 90)]).with_fill_mode(rerun::FillMode::Solid),
+            &rerun::Boxes3D::from_half_sizes([[0.3, 0.45, 0.15]])
+                .with_colors([rgba([200, 200, 210], 90)])
+                .with_fill_mode(rerun::FillMode::Solid),
         )?;
         let tips = [[0.8, 0.0, 0.0], [0.0, 1.1, 0.0], [0.0, 0.0, 0.7]];
-        rec.log_static(format!("{INS_BODY}/axes"), &rerun::Arrows3D::from_vectors(tips).with_colors(colors::SENSOR.map(rgb)).with_radii([0.02]))?;
+        rec.log_static(
+            format!("{INS_BODY}/axes"),
+            &rerun::Arrows3D::from_vectors(tips).with_colors(colors::SENSOR.map(rgb)).with_radii([0.02]),
+        )?;
         // Labels beyond the tips (an arrow's own label sits at its middle, inside the case).
         let at = tips.map(|[x, y, z]| [x * 1.12, y * 1.1, z * 1.15]);
         let names = ["x right", "y forward", "z up"];
-        rec.log_static(format!("{INS_BODY}/axes/labels"), &rerun::Points3D::new(at).with_labels(names).with_colors(colors::SENSOR.map(super::palette::label)).with_radii([0.002]))?;
+        rec.log_static(
+            format!("{INS_BODY}/axes/labels"),
+            &rerun::Points3D::new(at)
+                .with_labels(names)
+                .with_colors(colors::SENSOR.map(super::palette::label))
+                .with_radii([0.002]),
+        )?;
         if body.reference.is_some() {
             rec.log_static(REFERENCE_BODY, &rerun::Transform3D::IDENTITY)?;
             let longer = tips.map(|[x, y, z]| [x * 1.3, y * 1.3, z * 1.3]);
-            rec.log_static(format!("{REFERENCE_BODY}/axes"), &rerun::Arrows3D::from_vectors(longer).with_colors([rgba([170, 170, 170], 200); 3]).with_radii([0.008]))?;
+            rec.log_static(
+                format!("{REFERENCE_BODY}/axes"),
+                &rerun::Arrows3D::from_vectors(longer).with_colors([rgba([170, 170, 170], 200); 3]).with_radii([0.008]),
+            )?;
             rec.log_static(
                 format!("{REFERENCE_BODY}/axes/label"),
-                &rerun::Points3D::new([[0.0, 1.3 * 1.1 * 1.1, 0.08]]).with_labels(["reference"]).with_colors([super::palette::label([190, 190, 190])]).with_radii([0.002]),
+                &rerun::Points3D::new([[0.0, 1.3 * 1.1 * 1.1, 0.08]])
+                    .with_labels(["reference"])
+                    .with_colors([super::palette::label([190, 190, 190])])
+                    .with_radii([0.002]),
             )?;
         }
         Ok(())

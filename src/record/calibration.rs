@@ -3,8 +3,8 @@
 //! ±3σ band beside the true value, and the attitude error before and after compensation.
 
 use nalgebra::Vector3;
-use rerun::blueprint::components::ContainerKind;
 use rerun::RecordingStreamResult;
+use rerun::blueprint::components::ContainerKind;
 
 use super::layout::{self, Node};
 use super::palette::{albedo, p3, rgb, rgba};
@@ -13,7 +13,7 @@ use super::{CustomLayout, Recorder, Stream, TIMELINE};
 use crate::calib::report::Report;
 use crate::calib::{Calibration, Param};
 use crate::math::rotvec;
-use crate::math::units::{fmt_angle, ARCSEC_PER_RAD};
+use crate::math::units::{ARCSEC_PER_RAD, fmt_angle};
 use crate::scenario::Params;
 use crate::sim::ERROR_AXES;
 
@@ -30,18 +30,27 @@ pub type ErrorTraces = crate::calib::Thinned<Vec<[f64; 3]>>;
 /// Writes the calibration's recording into `rec`: layout, documents, the filter over time, the
 /// before/after errors and the ghost cones. Returns the table's recorder, into which the caller
 /// streams the table's motion (as in any run) and finishes.
-pub fn log(stream: Stream, params: &Params, cal: &Calibration, report: &Report, traces: &ErrorTraces) -> RecordingStreamResult<Recorder> {
+pub fn log(
+    stream: Stream,
+    params: &Params,
+    cal: &Calibration,
+    report: &Report,
+    traces: &ErrorTraces,
+) -> RecordingStreamResult<Recorder> {
     let chain = &params.table.chain;
     let set = &cal.set;
     let table: Vec<(usize, Param)> = set.params.iter().copied().enumerate().filter(|(_, p)| p.is_table()).collect();
-    let plot = |name: String, origin: String| Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::whole_run_time_axis());
+    let plot = |name: String, origin: String| {
+        Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::whole_run_time_axis())
+    };
     // Each state's plot is framed on where the filter ends: the final estimate ± 4 × its 3σ band
     // (at least ±1″), widened to include the true value; the prior's ±3σ start falls off the top.
     let truth = set.values(&params.table.truth);
     let states: Vec<Node> = table
         .iter()
         .map(|(i, p)| {
-            let (x, sd, t) = (cal.kf.theta[*i] * ARCSEC_PER_RAD, cal.kf.sigma(*i) * ARCSEC_PER_RAD, truth[*i] * ARCSEC_PER_RAD);
+            let (x, sd, t) =
+                (cal.kf.theta[*i] * ARCSEC_PER_RAD, cal.kf.sigma(*i) * ARCSEC_PER_RAD, truth[*i] * ARCSEC_PER_RAD);
             // On the viewer's power-of-ten grid: a centre on a tick and ±1.25 × a 1-2-3 half range,
             // so that the plot labels 3-7 ticks (layout::symmetric_range).
             let h = crate::math::units::nice_half_range((12.0 * sd).max(1.0).max(1.5 * (x - t).abs()));
@@ -58,11 +67,18 @@ pub fn log(stream: Stream, params: &Params, cal: &Calibration, report: &Report, 
     let errors: Vec<Node> = ERROR_AXES
         .iter()
         .map(|a| {
-            plot(format!("{a} error (″) — red before, yellow (wide) after static KF, blue after exact LSQ"), format!("calibration/error_arcsec/{a}"))
-                .with_property("PlotLegend", &layout::no_legend())
+            plot(
+                format!("{a} error (″) — red before, yellow (wide) after static KF, blue after exact LSQ"),
+                format!("calibration/error_arcsec/{a}"),
+            )
+            .with_property("PlotLegend", &layout::no_legend())
         })
         .collect();
-    let right = Node::container(ContainerKind::Vertical, vec![Node::container(ContainerKind::Grid, states, &[]), Node::container(ContainerKind::Tabs, errors, &[])], &[1.6, 1.0]);
+    let right = Node::container(
+        ContainerKind::Vertical,
+        vec![Node::container(ContainerKind::Grid, states, &[]), Node::container(ContainerKind::Tabs, errors, &[])],
+        &[1.6, 1.0],
+    );
     let custom = CustomLayout { right, docs: vec![Node::view("TextDocument", "calibration", "docs/calibration")] };
     // The table scene of the ideal demodulation; the INS is the calibration's business here.
     let mut drawing = params.clone();
@@ -99,7 +115,10 @@ pub fn log(stream: Stream, params: &Params, cal: &Calibration, report: &Report, 
     for a in ERROR_AXES {
         rec.log_static(
             format!("calibration/error_arcsec/{a}"),
-            &rerun::SeriesLines::new().with_colors(ERROR_COLORS.map(rgb)).with_names(ERROR_NAMES).with_widths([1.5, 4.0, 1.5]),
+            &rerun::SeriesLines::new()
+                .with_colors(ERROR_COLORS.map(rgb))
+                .with_names(ERROR_NAMES)
+                .with_widths([1.5, 4.0, 1.5]),
         )?;
     }
 
@@ -109,15 +128,34 @@ pub fn log(stream: Stream, params: &Params, cal: &Calibration, report: &Report, 
         let mut values = Vec::with_capacity(5 * times.len());
         for s in &cal.history {
             let (x, sd) = (s.theta[*i] * ARCSEC_PER_RAD, s.sigma[*i] * ARCSEC_PER_RAD);
-            values.extend([x, x + 3.0 * sd, x - 3.0 * sd, truth[*i] * ARCSEC_PER_RAD, cal.nls.theta[*i] * ARCSEC_PER_RAD]);
+            values.extend([
+                x,
+                x + 3.0 * sd,
+                x - 3.0 * sd,
+                truth[*i] * ARCSEC_PER_RAD,
+                cal.nls.theta[*i] * ARCSEC_PER_RAD,
+            ]);
         }
-        stream.send_series(&format!("calibration/state_arcsec/{}", p.key(chain)), &STATE_NAMES.map(String::from), &times, values, 5)?;
+        stream.send_series(
+            &format!("calibration/state_arcsec/{}", p.key(chain)),
+            &STATE_NAMES.map(String::from),
+            &times,
+            values,
+            5,
+        )?;
     }
 
     // Before / after (the trace is kept at the series rate, thinned over long tests).
     for (a, name) in ERROR_AXES.iter().enumerate() {
-        let values: Vec<f64> = traces.rows.iter().flat_map(|row| row.iter().map(move |e| e[a] * ARCSEC_PER_RAD)).collect();
-        stream.send_series(&format!("calibration/error_arcsec/{name}"), &ERROR_NAMES.map(String::from), &traces.t_s, values, 3)?;
+        let values: Vec<f64> =
+            traces.rows.iter().flat_map(|row| row.iter().map(move |e| e[a] * ARCSEC_PER_RAD)).collect();
+        stream.send_series(
+            &format!("calibration/error_arcsec/{name}"),
+            &ERROR_NAMES.map(String::from),
+            &traces.t_s,
+            values,
+            3,
+        )?;
     }
 
     // Ghost cones and estimated rotor axes, once per second of the test.
@@ -150,28 +188,47 @@ pub fn log(stream: Stream, params: &Params, cal: &Calibration, report: &Report, 
             }
             let (mesh, rims) = cone(g.axis, g.e1, g.e2, alpha * x, half * 1.02);
             let mount = &recorder.paths.mounts[k];
-            rec.log(format!("{mount}/estimated_cone"), &rerun::Mesh3D::new(mesh.0).with_triangle_indices(mesh.1).with_albedo_factor(albedo(GHOST, 35)))?;
-            rec.log(format!("{mount}/estimated_cone/rims"), &rerun::LineStrips3D::new(rims).with_colors([rgba(GHOST, 230)]).with_radii([0.003]))?;
+            rec.log(
+                format!("{mount}/estimated_cone"),
+                &rerun::Mesh3D::new(mesh.0).with_triangle_indices(mesh.1).with_albedo_factor(albedo(GHOST, 35)),
+            )?;
+            rec.log(
+                format!("{mount}/estimated_cone/rims"),
+                &rerun::LineStrips3D::new(rims).with_colors([rgba(GHOST, 230)]).with_radii([0.003]),
+            )?;
             // The estimated rotor axis, drawn in the (truly tilted) rotor frame: W_trueᵀ W_est a.
             let w_true = rotvec::exp(&(chain.swing_vector(k, &params.table.truth.axes[k], 0.0) * x));
             let w_est = rotvec::exp(&(chain.swing_vector(k, &est.axes[k], 0.0) * x));
             let dir: Vector3<f64> = (w_true.inverse() * w_est) * g.axis;
             rec.log(
                 format!("{}/estimated_axis", recorder.paths.gimbals[k]),
-                &rerun::LineStrips3D::new([[p3(-dir * half * 1.1), p3(dir * half * 1.1)]]).with_colors([rgb(GHOST)]).with_radii([0.006]),
+                &rerun::LineStrips3D::new([[p3(-dir * half * 1.1), p3(dir * half * 1.1)]])
+                    .with_colors([rgb(GHOST)])
+                    .with_radii([0.006]),
             )?;
             // At the true cone's label's end (the other end carries the η label), across the rim
             // from it.
             let tip = -g.axis * half * 1.05 + g.e1 * (half * (alpha * x).tan() + 0.18);
             // What the data do not determine is said where the number is shown.
-            let undetermined = |what: &str| report.angles.iter().any(|r| r.key == format!("{}.{what}", g.name) && !r.flag.is_empty());
+            let undetermined =
+                |what: &str| report.angles.iter().any(|r| r.key == format!("{}.{what}", g.name) && !r.flag.is_empty());
             let note = match (undetermined("swing_half_angle"), undetermined("swing_phase")) {
                 (true, _) => " (not determined by the data)",
                 (false, true) => " (φ not determined by the data)",
                 _ => "",
             };
-            let label = format!("estimate: α = {}, φ = {:.2}°{note}", fmt_angle(alpha), est.axes[k].swing_phase_rad.to_degrees());
-            rec.log(format!("{mount}/estimated_cone/label"), &rerun::Points3D::new([p3(tip)]).with_labels([label]).with_radii([0.002]).with_colors([super::palette::label(GHOST)]))?;
+            let label = format!(
+                "estimate: α = {}, φ = {:.2}°{note}",
+                fmt_angle(alpha),
+                est.axes[k].swing_phase_rad.to_degrees()
+            );
+            rec.log(
+                format!("{mount}/estimated_cone/label"),
+                &rerun::Points3D::new([p3(tip)])
+                    .with_labels([label])
+                    .with_radii([0.002])
+                    .with_colors([super::palette::label(GHOST)]),
+            )?;
         }
     }
 

@@ -7,10 +7,10 @@ use std::collections::VecDeque;
 use nalgebra::{UnitQuaternion, Vector3};
 use rerun::{RecordingStream, RecordingStreamResult};
 
-use super::palette::{albedo, rgb, rgba};
 use super::TIMELINE;
-use crate::math::frames::{Rot, B, N};
-use crate::math::units::{fmt_angle, RAD_PER_DEG};
+use super::palette::{albedo, rgb, rgba};
+use crate::math::frames::{B, N, Rot};
+use crate::math::units::{RAD_PER_DEG, fmt_angle};
 
 /// Where the gizmo stands: beside the table, towards the default camera.
 const OFFSET: [f32; 3] = [1.0, -0.9, 0.5];
@@ -40,7 +40,12 @@ impl ConeGizmo {
     pub(crate) fn new(rec: &RecordingStream, alpha_rad: f64, at_s: Option<f64>) -> RecordingStreamResult<Self> {
         let gain = Self::gain_for(alpha_rad);
         rec.log_static("world/cone", &rerun::Transform3D::from_translation(OFFSET))?;
-        rec.log_static("world/cone/nominal", &rerun::LineStrips3D::new([[[0.0, 0.0, -0.7f32], [0.0, 0.0, 0.7]]]).with_colors([rgb([150, 150, 150])]).with_radii([0.005]))?;
+        rec.log_static(
+            "world/cone/nominal",
+            &rerun::LineStrips3D::new([[[0.0, 0.0, -0.7f32], [0.0, 0.0, 0.7]]])
+                .with_colors([rgb([150, 150, 150])])
+                .with_radii([0.005]),
+        )?;
         // The trail's colours and widths; its lines go on the timeline.
         let colors = (0..TRAIL).map(|i| rgba([255, 230, 120], (230.0 * (1.0 - i as f64 / TRAIL as f64)) as u8));
         let radii = (0..TRAIL).map(|i| if i == 0 { 0.012f32 } else { 0.007 });
@@ -56,13 +61,21 @@ impl ConeGizmo {
 
     /// The drawn cone and its label for half-angle `alpha_rad`: static, or in live mode at `at_s`.
     fn log_cone(&self, rec: &RecordingStream, alpha_rad: f64, at_s: Option<f64>) -> RecordingStreamResult<()> {
-        let (mesh, rims) = super::scene::cone(Vector3::z(), Vector3::x(), Vector3::y(), (alpha_rad * self.gain).min(1.4), HALF);
+        let (mesh, rims) =
+            super::scene::cone(Vector3::z(), Vector3::x(), Vector3::y(), (alpha_rad * self.gain).min(1.4), HALF);
         let color = [120, 200, 255];
-        let label = if alpha_rad > 0.0 { format!("body z on its {} cone, tilt ×{}", fmt_angle(alpha_rad), self.gain) } else { "body z: no cone (half-angle 0)".to_owned() };
+        let label = if alpha_rad > 0.0 {
+            format!("body z on its {} cone, tilt ×{}", fmt_angle(alpha_rad), self.gain)
+        } else {
+            "body z: no cone (half-angle 0)".to_owned()
+        };
         let surface = rerun::Mesh3D::new(mesh.0).with_triangle_indices(mesh.1).with_albedo_factor(albedo(color, 35));
         let rims = rerun::LineStrips3D::new(rims).with_colors([rgba(color, 160)]).with_radii([0.004]);
         // Above the cone (below it, it sat on the table's deck, where no colour reads).
-        let label = rerun::Points3D::new([[0.0f32, 0.0, 0.85]]).with_labels([label]).with_radii([0.002]).with_colors([super::palette::label(color)]);
+        let label = rerun::Points3D::new([[0.0f32, 0.0, 0.85]])
+            .with_labels([label])
+            .with_radii([0.002])
+            .with_colors([super::palette::label(color)]);
         match at_s {
             None => {
                 rec.log_static("world/cone/surface", &surface)?;
@@ -113,7 +126,13 @@ impl ConeGizmo {
     pub(crate) fn flush(&mut self, stream: &super::Stream, times: &[f64]) -> RecordingStreamResult<()> {
         let frames = std::mem::take(&mut self.strips);
         let strips = frames.iter().flat_map(|f| f.chunks(2).map(<[[f32; 3]]>::to_vec));
-        stream.rec().send_columns(AXIS_PATH, stream.time_columns(times), rerun::LineStrips3D::update_fields().with_strips(strips).columns(std::iter::repeat_n(TRAIL, frames.len()))?)?;
+        stream.rec().send_columns(
+            AXIS_PATH,
+            stream.time_columns(times),
+            rerun::LineStrips3D::update_fields()
+                .with_strips(strips)
+                .columns(std::iter::repeat_n(TRAIL, frames.len()))?,
+        )?;
         Ok(())
     }
 }

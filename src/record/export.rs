@@ -142,7 +142,12 @@ impl Exporter {
     /// Why the folder cannot be used.
     pub fn new(dir: &Path, format: ExportFormat) -> Result<Self, crate::io::files::OutputError> {
         crate::io::files::create_output_dir("--export", dir).map_err(|e| e.error)?;
-        Ok(Self { target: Target::Files { dir: dir.to_path_buf(), format }, tables: BTreeMap::new(), failed: None, file_clock_s: None })
+        Ok(Self {
+            target: Target::Files { dir: dir.to_path_buf(), format },
+            tables: BTreeMap::new(),
+            failed: None,
+            file_clock_s: None,
+        })
     }
 
     /// Tables kept in memory, taken with [`Self::finish`].
@@ -155,9 +160,20 @@ impl Exporter {
     fn open(&self, entity: &str, columns: &[String], keyed: bool) -> Result<Open, LogError> {
         let refs: Vec<&str> = columns.iter().map(String::as_str).collect();
         Ok(match &self.target {
-            Target::Files { dir, format } if keyed => Open::File(TableWriter::create_keyed(dir.join(format!("{}.{}", table_name(entity), format.extension())), &refs)?),
-            Target::Files { dir, format } => Open::File(TableWriter::create(dir.join(format!("{}.{}", table_name(entity), format.extension())), &refs)?),
-            Target::Memory => Open::Memory(Table { name: table_name(entity), entity: entity.to_owned(), columns: columns.to_vec(), values: vec![Vec::new(); columns.len()] }),
+            Target::Files { dir, format } if keyed => Open::File(TableWriter::create_keyed(
+                dir.join(format!("{}.{}", table_name(entity), format.extension())),
+                &refs,
+            )?),
+            Target::Files { dir, format } => Open::File(TableWriter::create(
+                dir.join(format!("{}.{}", table_name(entity), format.extension())),
+                &refs,
+            )?),
+            Target::Memory => Open::Memory(Table {
+                name: table_name(entity),
+                entity: entity.to_owned(),
+                columns: columns.to_vec(),
+                values: vec![Vec::new(); columns.len()],
+            }),
         })
     }
 
@@ -180,7 +196,14 @@ impl Exporter {
 
     /// Appends rows to the table of `entity`: `times` (s) and `values` row-major, one column per
     /// name, in `unit`.
-    pub fn try_write(&mut self, entity: &str, unit: &str, names: &[String], times: &[f64], values: &[f64]) -> Result<(), LogError> {
+    pub fn try_write(
+        &mut self,
+        entity: &str,
+        unit: &str,
+        names: &[String],
+        times: &[f64],
+        values: &[f64],
+    ) -> Result<(), LogError> {
         let width = names.len();
         if !self.tables.contains_key(entity) {
             let mut columns = vec!["t_s".to_owned()];
@@ -292,7 +315,8 @@ mod tests {
             e.set_file_clock(100.0);
             e.write("attitude_error_arcsec/heading", "arcsec", &names, &[0.0, 0.5], &[1.0, 2.0, 3.0, 4.0]);
             e.write("attitude_error_arcsec/heading", "arcsec", &names, &[1.0], &[5.0, 6.0]);
-            e.write_table("allan/gyro_fit", &["axis".to_owned(), "n_deg_per_sqrt_h".to_owned()], &[vec![0.0, 0.01]]).expect("table");
+            e.write_table("allan/gyro_fit", &["axis".to_owned(), "n_deg_per_sqrt_h".to_owned()], &[vec![0.0, 0.01]])
+                .expect("table");
         }
         let written = file.finish().expect("files");
         assert!(written.tables.is_empty());

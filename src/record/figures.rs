@@ -113,16 +113,37 @@ impl Axes {
 fn axes(plot: &Plot) -> Axes {
     let log_x = plot.series.iter().all(|s| s.timeline == super::allan::LOG10_TAU_TIMELINE);
     let log_y = plot.series.iter().all(|s| is_log10(&s.entity));
-    let span = plot.series.iter().flat_map(|s| s.t.iter()).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), t| (a.min(*t), b.max(*t)));
+    let span = plot
+        .series
+        .iter()
+        .flat_map(|s| s.t.iter())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), t| (a.min(*t), b.max(*t)));
     let hours = !log_x && span.1 - span.0 > 3.0 * 3600.0;
-    let x_label = if log_x { "τ (s)".into() } else if hours { "time (h)".into() } else { "time (s)".into() };
-    let unit = readable(plot.series.iter().find_map(|s| super::export::unit_of(&s.entity)).or_else(|| super::export::unit_of(&plot.origin)).unwrap_or(""));
+    let x_label = if log_x {
+        "τ (s)".into()
+    } else if hours {
+        "time (h)".into()
+    } else {
+        "time (s)".into()
+    };
+    let unit = readable(
+        plot.series
+            .iter()
+            .find_map(|s| super::export::unit_of(&s.entity))
+            .or_else(|| super::export::unit_of(&plot.origin))
+            .unwrap_or(""),
+    );
     Axes { log_x, log_y, hours, x_label, y_label: unit }
 }
 
 /// A unit suffix as a reader writes it: `deg_per_sqrt_h` → `°/√h`, `mps2` → `m/s²`.
 fn readable(suffix: &str) -> String {
-    let s = suffix.replace("_per_", "/").replace("sqrt_", "√").replace("mps2", "m/s²").replace("mps", "m/s").replace("ug", "µg");
+    let s = suffix
+        .replace("_per_", "/")
+        .replace("sqrt_", "√")
+        .replace("mps2", "m/s²")
+        .replace("mps", "m/s")
+        .replace("ug", "µg");
     if s.starts_with("arc") { s } else { s.replace("deg", "°") }
 }
 
@@ -157,7 +178,10 @@ fn points(s: &PlotSeries, a: &Axes, x_window: Option<(f64, f64)>) -> Vec<Vec<(f6
         }
     }
     segments.retain(|s| !s.is_empty());
-    segments.into_iter().map(|seg| if seg.len() > MAX_LINE_POINTS { reduce(&seg, MAX_LINE_POINTS / 4) } else { seg }).collect()
+    segments
+        .into_iter()
+        .map(|seg| if seg.len() > MAX_LINE_POINTS { reduce(&seg, MAX_LINE_POINTS / 4) } else { seg })
+        .collect()
 }
 
 /// Each of `buckets` consecutive pieces of `seg` as its first, smallest, largest and last point
@@ -264,7 +288,11 @@ fn tick(v: f64) -> String {
     } else {
         let e = a.log10().floor();
         let m = v / 10f64.powf(e);
-        if (m.abs() - 1.0).abs() < 1e-9 { format!("{}1e{e}", if v < 0.0 { "-" } else { "" }) } else { format!("{m:.2}e{e}").replace(".00e", "e") }
+        if (m.abs() - 1.0).abs() < 1e-9 {
+            format!("{}1e{e}", if v < 0.0 { "-" } else { "" })
+        } else {
+            format!("{m:.2}e{e}").replace(".00e", "e")
+        }
     }
 }
 
@@ -295,13 +323,18 @@ fn svg(plot: &Plot) -> anyhow::Result<String> {
     let x_window = plot.time_range.map(|r| (a.x_of(r[0]), a.x_of(r[1])));
     let drawn: Drawn<'_> = plot.series.iter().map(|s| (s, points(s, &a, x_window))).collect();
     let extent = |f: &dyn Fn(&(f64, f64)) -> f64| {
-        drawn.iter().flat_map(|(_, segs)| segs.iter().flatten()).map(f).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)))
+        drawn
+            .iter()
+            .flat_map(|(_, segs)| segs.iter().flatten())
+            .map(f)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)))
     };
     let xr = range(extent(&|p| p.0), x_window, a.log_x);
     let layout_y = plot.range.map(|r| (a.y_of(r[0]), a.y_of(r[1])));
     let yr = range(extent(&|p| p.1), layout_y, a.log_y);
     // What leaves the visible box is cut at its edge, not drawn along it.
-    let drawn: Drawn<'_> = drawn.into_iter().map(|(s, segs)| (s, segs.iter().flat_map(|seg| clip(seg, xr, yr, &a)).collect())).collect();
+    let drawn: Drawn<'_> =
+        drawn.into_iter().map(|(s, segs)| (s, segs.iter().flat_map(|seg| clip(seg, xr, yr, &a)).collect())).collect();
     let mut out = String::new();
     {
         let root = SVGBackend::with_string(&mut out, SIZE).into_drawing_area();
@@ -311,9 +344,11 @@ fn svg(plot: &Plot) -> anyhow::Result<String> {
             Some((t, k)) => (t, Some(k)),
             None => (full.as_str(), None),
         };
-        root.draw_text(title, &("sans-serif", 19 * K).into_font().color(&BLACK), (16 * K, 10 * K)).map_err(draw_error)?;
+        root.draw_text(title, &("sans-serif", 19 * K).into_font().color(&BLACK), (16 * K, 10 * K))
+            .map_err(draw_error)?;
         if let Some(k) = key {
-            root.draw_text(k, &("sans-serif", 13 * K).into_font().color(&RGBColor(80, 80, 80)), (16 * K, 34 * K)).map_err(draw_error)?;
+            root.draw_text(k, &("sans-serif", 13 * K).into_font().color(&RGBColor(80, 80, 80)), (16 * K, 34 * K))
+                .map_err(draw_error)?;
         }
         let body = root.margin(K * if key.is_some() { 54 } else { 38 }, 8 * K, 8 * K, 12 * K);
         let mut legend: Vec<(String, RGBAColor, bool)> = Vec::new();
@@ -339,7 +374,8 @@ fn svg(plot: &Plot) -> anyhow::Result<String> {
             for (i, (name, color, line)) in legend.iter().enumerate() {
                 let y = K * (30 + 20 * i as i32);
                 if *line {
-                    area.draw(&PathElement::new(vec![(10 * K, y), (34 * K, y)], color.stroke_width(3 * K as u32))).map_err(draw_error)?;
+                    area.draw(&PathElement::new(vec![(10 * K, y), (34 * K, y)], color.stroke_width(3 * K as u32)))
+                        .map_err(draw_error)?;
                 } else {
                     area.draw(&Circle::new((22 * K, y), 4 * K, color.filled())).map_err(draw_error)?;
                 }
@@ -356,14 +392,24 @@ fn draw_error<E: std::fmt::Debug>(e: E) -> anyhow::Error {
 }
 
 /// The chart of `drawn` in `area` on the axes `x`, `y` (linear or logarithmic).
-fn chart<X, Y>(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, x: X, y: Y, a: &Axes, drawn: &Drawn<'_>) -> anyhow::Result<()>
+fn chart<X, Y>(
+    area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
+    x: X,
+    y: Y,
+    a: &Axes,
+    drawn: &Drawn<'_>,
+) -> anyhow::Result<()>
 where
     X: AsRangedCoord<Value = f64>,
     Y: AsRangedCoord<Value = f64>,
     X::CoordDescType: ValueFormatter<f64>,
     Y::CoordDescType: ValueFormatter<f64>,
 {
-    let mut c = ChartBuilder::on(area).x_label_area_size(40 * K).y_label_area_size(70 * K).build_cartesian_2d(x, y).map_err(draw_error)?;
+    let mut c = ChartBuilder::on(area)
+        .x_label_area_size(40 * K)
+        .y_label_area_size(70 * K)
+        .build_cartesian_2d(x, y)
+        .map_err(draw_error)?;
     c.configure_mesh()
         .x_desc(a.x_label.as_str())
         .y_desc(a.y_label.as_str())
@@ -384,7 +430,11 @@ where
             }
             match s.markers.as_deref() {
                 Some("down") => {
-                    c.draw_series(seg.iter().map(|p| EmptyElement::at(*p) + Polygon::new(vec![(-6 * K, -10 * K), (6 * K, -10 * K), (0, 0)], color.filled()))).map_err(draw_error)?;
+                    c.draw_series(seg.iter().map(|p| {
+                        EmptyElement::at(*p)
+                            + Polygon::new(vec![(-6 * K, -10 * K), (6 * K, -10 * K), (0, 0)], color.filled())
+                    }))
+                    .map_err(draw_error)?;
                 }
                 Some(_) => {
                     c.draw_series(seg.iter().map(|p| Circle::new(*p, 2 * K, color.filled()))).map_err(draw_error)?;
@@ -402,8 +452,17 @@ fn fonts() -> (resvg::usvg::Options<'static>, Option<String>) {
     let db = opt.fontdb_mut();
     db.load_system_fonts();
     let families: Vec<String> = db.faces().flat_map(|f| f.families.iter().map(|(n, _)| n.clone())).collect();
-    let warning = if families.is_empty() { Some("no system font found: the PNG figures have no text (the SVGs do); install one, e.g. Debian's fonts-dejavu-core".to_owned()) } else { None };
-    if let Some(f) = ["DejaVu Sans", "Liberation Sans", "Noto Sans", "Arial", "Helvetica"].iter().find(|f| families.iter().any(|n| n == *f)).map(|f| (*f).to_owned()).or_else(|| families.first().cloned()) {
+    let warning = if families.is_empty() {
+        Some("no system font found: the PNG figures have no text (the SVGs do); install one, e.g. Debian's fonts-dejavu-core".to_owned())
+    } else {
+        None
+    };
+    if let Some(f) = ["DejaVu Sans", "Liberation Sans", "Noto Sans", "Arial", "Helvetica"]
+        .iter()
+        .find(|f| families.iter().any(|n| n == *f))
+        .map(|f| (*f).to_owned())
+        .or_else(|| families.first().cloned())
+    {
         db.set_sans_serif_family(f);
     }
     (opt, warning)
@@ -413,7 +472,8 @@ fn fonts() -> (resvg::usvg::Options<'static>, Option<String>) {
 fn png(svg: &str, opt: &resvg::usvg::Options<'_>) -> anyhow::Result<Vec<u8>> {
     let tree = resvg::usvg::Tree::from_str(svg, opt).map_err(|e| anyhow::anyhow!("the figure's SVG: {e}"))?;
     let size = tree.size().to_int_size();
-    let mut pixmap = resvg::tiny_skia::Pixmap::new(size.width(), size.height()).ok_or_else(|| anyhow::anyhow!("figure size"))?;
+    let mut pixmap =
+        resvg::tiny_skia::Pixmap::new(size.width(), size.height()).ok_or_else(|| anyhow::anyhow!("figure size"))?;
     resvg::render(&tree, resvg::tiny_skia::Transform::identity(), &mut pixmap.as_mut());
     pixmap.encode_png().map_err(|e| anyhow::anyhow!("PNG: {e}"))
 }
@@ -434,7 +494,9 @@ mod tests {
 
     #[test]
     fn long_lines_keep_their_extremes() {
-        let seg: Vec<(f64, f64)> = (0..100_000).map(|i| (f64::from(i), if i == 77_777 { 50.0 } else { (f64::from(i) * 0.01).sin() })).collect();
+        let seg: Vec<(f64, f64)> = (0..100_000)
+            .map(|i| (f64::from(i), if i == 77_777 { 50.0 } else { (f64::from(i) * 0.01).sin() }))
+            .collect();
         let r = reduce(&seg, 1000);
         assert!(r.len() <= 4000);
         assert!(r.iter().any(|p| p.1 == 50.0), "the spike survives");

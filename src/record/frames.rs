@@ -5,8 +5,8 @@ use std::collections::BTreeMap;
 
 use rerun::RecordingStreamResult;
 
-use super::rows;
 use super::Recorder;
+use super::rows;
 
 /// Every plot framed on its data: each series' extent as it grows. A run's layout, sent once its
 /// data are in, and a saved live session's final layout take each plot's range from it ([`frame`],
@@ -38,7 +38,10 @@ impl Frames {
 /// Whether a plot of `what` is framed symmetrically about zero (an error).
 fn symmetric(what: rows::Quantity) -> bool {
     use rows::Quantity as Q;
-    matches!(what, Q::TableError(_) | Q::InsError(_) | Q::ClosedForm | Q::PositionError | Q::VelocityError | Q::Swing(_))
+    matches!(
+        what,
+        Q::TableError(_) | Q::InsError(_) | Q::ClosedForm | Q::PositionError | Q::VelocityError | Q::Swing(_)
+    )
 }
 
 /// The value range a plot of `what` shows for data in `[lo, hi]`: error plots symmetric about
@@ -76,9 +79,18 @@ impl Recorder {
         for (path, (lo, hi)) in moved {
             let entity = format!("{path}/{FRAME_SLUG}");
             if !self.frames.held.contains_key(&path) {
-                self.rec.log_static(entity.as_str(), &rerun::SeriesPoints::new().with_marker_sizes([0.0]).with_colors([rerun::Color::from_unmultiplied_rgba(0, 0, 0, 0)]))?;
+                self.rec.log_static(
+                    entity.as_str(),
+                    &rerun::SeriesPoints::new()
+                        .with_marker_sizes([0.0])
+                        .with_colors([rerun::Color::from_unmultiplied_rgba(0, 0, 0, 0)]),
+                )?;
             }
-            self.rec.send_columns(entity, self.stream.time_columns(&[t_s, t_s]), rerun::Scalars::new([lo, hi]).columns_of_unit_batches()?)?;
+            self.rec.send_columns(
+                entity,
+                self.stream.time_columns(&[t_s, t_s]),
+                rerun::Scalars::new([lo, hi]).columns_of_unit_batches()?,
+            )?;
             self.frames.held.insert(path, (lo, hi));
         }
         Ok(())

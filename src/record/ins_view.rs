@@ -5,7 +5,7 @@
 use rerun::RecordingStreamResult;
 
 use super::palette::{colors, rgb, rgba};
-use super::{rows, Recorder, SERIES_CHUNK_ROWS};
+use super::{Recorder, SERIES_CHUNK_ROWS, rows};
 use crate::ins::core::SampleOut;
 use crate::math::units::DEG_PER_RAD;
 use crate::sim::ERROR_AXES;
@@ -78,10 +78,21 @@ impl ConingLines {
 
 /// Each algorithm's analytic drift rate about the cone axis for the pure cone of `params` at its
 /// step rate, arcsec/s (None without one).
-pub(crate) fn coning_rates(params: &crate::scenario::Params, algorithms: &[crate::ins::coning::Algorithm]) -> Option<Vec<f64>> {
+pub(crate) fn coning_rates(
+    params: &crate::scenario::Params,
+    algorithms: &[crate::ins::coning::Algorithm],
+) -> Option<Vec<f64>> {
     let cone = params.table.vehicle.pure_coning()?;
     let freq_hz = cone.omega_rad_per_s / std::f64::consts::TAU;
-    Some(algorithms.iter().map(|a| crate::ins::coning::coning_drift_rate(*a, cone.half_angle_rad, freq_hz, 1.0 / params.step_hz).abs() * crate::math::units::ARCSEC_PER_RAD).collect())
+    Some(
+        algorithms
+            .iter()
+            .map(|a| {
+                crate::ins::coning::coning_drift_rate(*a, cone.half_angle_rad, freq_hz, 1.0 / params.step_hz).abs()
+                    * crate::math::units::ARCSEC_PER_RAD
+            })
+            .collect(),
+    )
 }
 
 /// Frames per second of the drift dial, at most.
@@ -166,10 +177,16 @@ impl Recorder {
         let Some(layout) = &self.ins else { return Ok(()) };
         let shown: Vec<bool> = layout.algorithms.iter().map(|a| !layout.hidden.contains(a)).collect();
         for axis in ERROR_AXES.iter().filter(|_| layout.errors && layout.algorithms.len() > 1) {
-            self.rec.log_static(format!("ins/attitude_error_arcsec/{axis}"), &rerun::SeriesLines::update_fields().with_visible_series(shown.iter().copied()))?;
+            self.rec.log_static(
+                format!("ins/attitude_error_arcsec/{axis}"),
+                &rerun::SeriesLines::update_fields().with_visible_series(shown.iter().copied()),
+            )?;
         }
         if layout.coning_log.is_some() {
-            self.rec.log_static(CONING_LOG_PATH, &rerun::SeriesLines::update_fields().with_visible_series(shown.iter().flat_map(|v| [*v; 2])))?;
+            self.rec.log_static(
+                CONING_LOG_PATH,
+                &rerun::SeriesLines::update_fields().with_visible_series(shown.iter().flat_map(|v| [*v; 2])),
+            )?;
         }
         Ok(())
     }
@@ -179,26 +196,54 @@ impl Recorder {
         let Some(layout) = &self.ins else { return Ok(()) };
         let rec = &self.rec;
         // Each algorithm keeps its colour in every recording (by identity, not by position).
-        let algo_colors: Vec<rerun::Color> = layout.algorithms.iter().map(|name| rgb(colors::algorithm(name))).collect();
+        let algo_colors: Vec<rerun::Color> =
+            layout.algorithms.iter().map(|name| rgb(colors::algorithm(name))).collect();
         for axis in ERROR_AXES.iter().filter(|_| layout.errors) {
             let path = format!("ins/attitude_error_arcsec/{axis}");
-            rec.log_static(path.as_str(), &rerun::SeriesLines::new().with_colors(algo_colors.clone()).with_names(self.series_names(&path)))?;
+            rec.log_static(
+                path.as_str(),
+                &rerun::SeriesLines::new().with_colors(algo_colors.clone()).with_names(self.series_names(&path)),
+            )?;
         }
         if layout.coning_log.is_some() {
             // Measured: the algorithm's colour, wide; analytic: the same colour, thin.
-            let colors: Vec<rerun::Color> = layout.algorithms.iter().flat_map(|name| [rgb(colors::algorithm(name)); 2]).collect();
+            let colors: Vec<rerun::Color> =
+                layout.algorithms.iter().flat_map(|name| [rgb(colors::algorithm(name)); 2]).collect();
             let widths: Vec<f32> = layout.algorithms.iter().flat_map(|_| [2.5, 1.0]).collect();
-            rec.log_static(CONING_LOG_PATH, &rerun::SeriesLines::new().with_colors(colors).with_widths(widths).with_names(self.series_names(CONING_LOG_PATH)))?;
+            rec.log_static(
+                CONING_LOG_PATH,
+                &rerun::SeriesLines::new()
+                    .with_colors(colors)
+                    .with_widths(widths)
+                    .with_names(self.series_names(CONING_LOG_PATH)),
+            )?;
         }
         self.log_shown_algorithms()?;
         // Pitch/roll/heading and east/north/up: red, green, blue.
-        let three = ["ins/position_error_m", "ins/velocity_error_mps", rows::BODY_ATTITUDE_PATH, rows::VELOCITY_PATH, rows::POSITION_PATH, rows::LAT_LON_PATH, rows::HEIGHT_PATH];
+        let three = [
+            "ins/position_error_m",
+            "ins/velocity_error_mps",
+            rows::BODY_ATTITUDE_PATH,
+            rows::VELOCITY_PATH,
+            rows::POSITION_PATH,
+            rows::LAT_LON_PATH,
+            rows::HEIGHT_PATH,
+        ];
         for path in three.into_iter().filter(|p| self.has_series(p)) {
             let names = self.series_names(path);
-            rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors::EULER[..names.len()].iter().map(|c| rgb(*c))).with_names(names))?;
+            rec.log_static(
+                path,
+                &rerun::SeriesLines::new()
+                    .with_colors(colors::EULER[..names.len()].iter().map(|c| rgb(*c)))
+                    .with_names(names),
+            )?;
         }
-        for path in [GYRO_RAW_PATH, GYRO_FILTERED_PATH].into_iter().take(if layout.fir_taps.len() > 1 { 2 } else { 1 }) {
-            rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors::SENSOR.map(rgb)).with_names(GYRO_NAMES))?;
+        for path in [GYRO_RAW_PATH, GYRO_FILTERED_PATH].into_iter().take(if layout.fir_taps.len() > 1 { 2 } else { 1 })
+        {
+            rec.log_static(
+                path,
+                &rerun::SeriesLines::new().with_colors(colors::SENSOR.map(rgb)).with_names(GYRO_NAMES),
+            )?;
         }
         // FIR amplitude response, dB, drawn in a 2D view: x = frequency (Hz), y = 5 × dB (so that
         // 0..-150 dB spans a readable height next to 0..1000 Hz).
@@ -212,30 +257,52 @@ impl Recorder {
                     [f as f32, (-5.0 * db) as f32]
                 })
                 .collect();
-            rec.log_static("ins/fir_response/curve", &rerun::LineStrips2D::new([curve]).with_colors([rgb([90, 200, 250])]).with_radii([1.5]))?;
+            rec.log_static(
+                "ins/fir_response/curve",
+                &rerun::LineStrips2D::new([curve]).with_colors([rgb([90, 200, 250])]).with_radii([1.5]),
+            )?;
             let mut grid = Vec::new();
             for db in [0.0f32, -50.0, -100.0, -150.0] {
                 grid.push(vec![[0.0, -5.0 * db], [nyquist as f32, -5.0 * db]]);
             }
-            rec.log_static("ins/fir_response/grid", &rerun::LineStrips2D::new(grid).with_colors([rgba([120, 120, 120], 120)]).with_radii([0.8]).with_labels(["0 dB", "-50 dB", "-100 dB", "-150 dB"]))?;
+            rec.log_static(
+                "ins/fir_response/grid",
+                &rerun::LineStrips2D::new(grid)
+                    .with_colors([rgba([120, 120, 120], 120)])
+                    .with_radii([0.8])
+                    .with_labels(["0 dB", "-50 dB", "-100 dB", "-150 dB"]),
+            )?;
             let tones: Vec<[f32; 2]> = [335.4f64, 375.5, 425.7]
                 .iter()
                 .filter(|f| **f < nyquist)
                 .map(|f| [*f as f32, (-5.0 * (20.0 * fir.amplitude(*f, layout.rate_hz).log10()).max(-160.0)) as f32])
                 .collect();
-            let labels: Vec<String> = [335.4f64, 375.5, 425.7].iter().filter(|f| **f < nyquist).map(|f| format!("{f} Hz dither")).collect();
-            rec.log_static("ins/fir_response/dither", &rerun::Points2D::new(tones).with_labels(labels).with_radii([6.0]).with_colors([rgb([240, 90, 90])]))?;
+            let labels: Vec<String> =
+                [335.4f64, 375.5, 425.7].iter().filter(|f| **f < nyquist).map(|f| format!("{f} Hz dither")).collect();
+            rec.log_static(
+                "ins/fir_response/dither",
+                &rerun::Points2D::new(tones).with_labels(labels).with_radii([6.0]).with_colors([rgb([240, 90, 90])]),
+            )?;
         }
         // The drift dial: a student sees the heading error of each algorithm accumulate, ×N, and
         // why a higher-order algorithm helps (the needles of the good ones barely move).
         if layout.dial_on {
-            let circle: Vec<[f32; 3]> = (0..=72).map(|i| {
-                let a = f64::from(i) * std::f64::consts::TAU / 72.0;
-                [(0.45 * a.cos()) as f32, (0.45 * a.sin()) as f32, 0.0]
-            }).collect();
+            let circle: Vec<[f32; 3]> = (0..=72)
+                .map(|i| {
+                    let a = f64::from(i) * std::f64::consts::TAU / 72.0;
+                    [(0.45 * a.cos()) as f32, (0.45 * a.sin()) as f32, 0.0]
+                })
+                .collect();
             rec.log_static("world/drift_dial", &rerun::Transform3D::from_translation(DIAL_OFFSET))?;
-            rec.log_static("world/drift_dial/rim", &rerun::LineStrips3D::new([circle]).with_colors([rgba([200, 200, 200], 160)]).with_radii([0.004]))?;
-            let title = format!("attitude error per algorithm, clockwise ×{} (a turn: {:.0}″)", layout.exaggeration, 360.0 * 3600.0 / layout.exaggeration);
+            rec.log_static(
+                "world/drift_dial/rim",
+                &rerun::LineStrips3D::new([circle]).with_colors([rgba([200, 200, 200], 160)]).with_radii([0.004]),
+            )?;
+            let title = format!(
+                "attitude error per algorithm, clockwise ×{} (a turn: {:.0}″)",
+                layout.exaggeration,
+                360.0 * 3600.0 / layout.exaggeration
+            );
             // The title above the dial (below it, it met the compass's E), the names in a column
             // to its right, spaced for their boxes, on points too small to cover a neighbour.
             let mut items: Vec<([f32; 3], String)> = vec![([0.0, 0.8, 0.0], title)];
@@ -243,11 +310,21 @@ impl Recorder {
                 items.push(([0.7, 0.0, 0.5 - 0.14 * k as f32], name.clone()));
             }
             // The needles' colours and widths; their directions go on the timeline.
-            rec.log_static(DIAL_NEEDLES_PATH, &rerun::Arrows3D::update_fields().with_colors(layout.algorithms.iter().map(|n| rgb(colors::algorithm(n)))).with_radii([0.01]))?;
-            let colors: Vec<rerun::Color> = std::iter::once(super::palette::label([230, 230, 230])).chain(layout.algorithms.iter().map(|n| super::palette::label(colors::algorithm(n)))).collect();
+            rec.log_static(
+                DIAL_NEEDLES_PATH,
+                &rerun::Arrows3D::update_fields()
+                    .with_colors(layout.algorithms.iter().map(|n| rgb(colors::algorithm(n))))
+                    .with_radii([0.01]),
+            )?;
+            let colors: Vec<rerun::Color> = std::iter::once(super::palette::label([230, 230, 230]))
+                .chain(layout.algorithms.iter().map(|n| super::palette::label(colors::algorithm(n))))
+                .collect();
             rec.log_static(
                 "world/drift_dial/labels",
-                &rerun::Points3D::new(items.iter().map(|(p, _)| *p)).with_labels(items.iter().map(|(_, t)| t.as_str())).with_colors(colors).with_radii([0.002]),
+                &rerun::Points3D::new(items.iter().map(|(p, _)| *p))
+                    .with_labels(items.iter().map(|(_, t)| t.as_str()))
+                    .with_colors(colors)
+                    .with_radii([0.002]),
             )?;
         }
         if !layout.trace {
@@ -257,13 +334,22 @@ impl Recorder {
         // as six arrows of one entity (their directions on the timeline).
         rec.log_static("world/ins_trace", &rerun::Transform3D::from_translation(TRACE_OFFSET))?;
         let trace_colors = [[170, 170, 170]; 3].into_iter().chain(colors::SENSOR).map(rgb);
-        rec.log_static(TRACE_AXES_PATH, &rerun::Arrows3D::update_fields().with_colors(trace_colors).with_radii([0.012]))?;
+        rec.log_static(
+            TRACE_AXES_PATH,
+            &rerun::Arrows3D::update_fields().with_colors(trace_colors).with_radii([0.012]),
+        )?;
         let ins_label = format!("INS IMU axes (error ×{})", layout.exaggeration);
         // In a frame that does not turn with the axes (turning, the two labels met).
-        let labels = [([0.0f32, 0.0, -0.3], "true IMU axes".to_owned(), [170, 170, 170]), ([0.0f32, 0.0, 0.8], ins_label, colors::SENSOR[0])];
+        let labels = [
+            ([0.0f32, 0.0, -0.3], "true IMU axes".to_owned(), [170, 170, 170]),
+            ([0.0f32, 0.0, 0.8], ins_label, colors::SENSOR[0]),
+        ];
         rec.log_static(
             "world/ins_trace/labels",
-            &rerun::Points3D::new(labels.iter().map(|(p, _, _)| *p)).with_labels(labels.iter().map(|(_, l, _)| l.as_str())).with_radii([0.002]).with_colors(labels.iter().map(|(_, _, c)| super::palette::label(*c))),
+            &rerun::Points3D::new(labels.iter().map(|(p, _, _)| *p))
+                .with_labels(labels.iter().map(|(_, l, _)| l.as_str()))
+                .with_radii([0.002])
+                .with_colors(labels.iter().map(|(_, _, c)| super::palette::label(*c))),
         )?;
         Ok(())
     }

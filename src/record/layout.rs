@@ -4,10 +4,10 @@
 
 use rerun::blueprint::components::{ContainerKind, PanelState, PlayState, RootContainer};
 use rerun::external::re_log_types::{BlueprintActivationCommand, LogMsg};
-use rerun::{AsComponents, RecordingStream, RecordingStreamBuilder, RecordingStreamResult};
 use rerun::external::re_sdk_types::blueprint::archetypes as bp;
 use rerun::external::re_sdk_types::blueprint::components as bpc;
 use rerun::external::re_sdk_types::datatypes;
+use rerun::{AsComponents, RecordingStream, RecordingStreamBuilder, RecordingStreamResult};
 
 /// A view or a container of the layout.
 #[derive(Clone)]
@@ -132,7 +132,11 @@ pub fn legend_at(corner: LegendCorner) -> bp::PlotLegend {
 /// A 3D eye looking at `target` from `position` with +z up.
 #[must_use]
 pub fn eye(position: [f32; 3], target: [f32; 3]) -> bp::EyeControls3D {
-    bp::EyeControls3D::new().with_kind(bpc::Eye3DKind::Orbital).with_position(position).with_look_target(target).with_eye_up([0.0, 0.0, 1.0])
+    bp::EyeControls3D::new()
+        .with_kind(bpc::Eye3DKind::Orbital)
+        .with_position(position)
+        .with_look_target(target)
+        .with_eye_up([0.0, 0.0, 1.0])
 }
 
 /// Deterministic UUID-shaped ids: the same scenario gives the same blueprint.
@@ -158,10 +162,15 @@ fn log_node(node: &Node, stream: &RecordingStream, ids: &mut Ids) -> RecordingSt
     match node {
         Node::View { class, name, origin, properties } => {
             let path = format!("view/{}", ids.next());
-            stream.log(format!("{path}/ViewContents"), &bp::ViewContents::new([bpc::QueryExpression("$origin/**".into())]))?;
+            stream.log(
+                format!("{path}/ViewContents"),
+                &bp::ViewContents::new([bpc::QueryExpression("$origin/**".into())]),
+            )?;
             stream.log(
                 path.as_str(),
-                &bp::ViewBlueprint::new(bpc::ViewClass((*class).into())).with_display_name(name.as_str()).with_space_origin(origin.as_str()),
+                &bp::ViewBlueprint::new(bpc::ViewClass((*class).into()))
+                    .with_display_name(name.as_str())
+                    .with_space_origin(origin.as_str()),
             )?;
             for (prop, batches) in properties {
                 stream.log_serialized_batches(format!("{path}/{prop}"), false, batches.iter().cloned())?;
@@ -174,7 +183,8 @@ fn log_node(node: &Node, stream: &RecordingStream, ids: &mut Ids) -> RecordingSt
                 child_paths.push(log_node(c, stream, ids)?);
             }
             let path = format!("container/{}", ids.next());
-            let mut arch = bp::ContainerBlueprint::new(*kind).with_contents(child_paths.iter().map(|p| bpc::IncludedContent(p.as_str().into())));
+            let mut arch = bp::ContainerBlueprint::new(*kind)
+                .with_contents(child_paths.iter().map(|p| bpc::IncludedContent(p.as_str().into())));
             if !shares.is_empty() {
                 let s = shares.iter().map(|&x| bpc::ColumnShare(datatypes::Float32(x)));
                 let r = shares.iter().map(|&x| bpc::RowShare(datatypes::Float32(x)));
@@ -200,7 +210,12 @@ pub struct Playback {
 }
 
 /// Sends `root` as the active and default layout of `rec`'s application.
-pub fn send(rec: &RecordingStream, application_id: &'static str, root: &Node, playback: &Playback) -> RecordingStreamResult<()> {
+pub fn send(
+    rec: &RecordingStream,
+    application_id: &'static str,
+    root: &Node,
+    playback: &Playback,
+) -> RecordingStreamResult<()> {
     let (bp_stream, storage) = RecordingStreamBuilder::new(application_id).blueprint().memory()?;
     bp_stream.set_time_sequence("blueprint", 0);
     let mut ids = Ids(0);
@@ -209,7 +224,10 @@ pub fn send(rec: &RecordingStream, application_id: &'static str, root: &Node, pl
     let root_uuid = datatypes::Uuid { bytes: ids.last_bytes() };
     bp_stream.log(
         "viewport",
-        &bp::ViewportBlueprint::new().with_root_container(RootContainer(root_uuid)).with_auto_layout(false).with_auto_views(false),
+        &bp::ViewportBlueprint::new()
+            .with_root_container(RootContainer(root_uuid))
+            .with_auto_layout(false)
+            .with_auto_views(false),
     )?;
     bp_stream.log("blueprint_panel", &bp::PanelBlueprint::new().with_state(PanelState::Collapsed))?;
     bp_stream.log("selection_panel", &bp::PanelBlueprint::new().with_state(PanelState::Collapsed))?;

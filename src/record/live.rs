@@ -3,7 +3,7 @@
 
 use rerun::RecordingStreamResult;
 
-use super::{drawing_factors, error_path, ins_view, Recorder, Stream};
+use super::{Recorder, Stream, drawing_factors, error_path, ins_view};
 use crate::scenario::Params;
 use crate::sim::ERROR_AXES;
 
@@ -31,7 +31,6 @@ impl LiveOutput {
     }
 }
 
-
 impl Recorder {
     /// A recorder for live mode feeding `output`: everything that a reload can change is logged
     /// on the timeline.
@@ -51,7 +50,8 @@ impl Recorder {
         self.truth = params.table.truth.clone();
         let factors = drawing_factors(&self.truth, params.recording.exaggeration);
         // The 3D view's title names each class's drawing factor: the layout follows a change of it.
-        let retitle = factors != self.factors || self.live_params.as_ref().is_some_and(|p| p.recording.exaggeration != params.recording.exaggeration);
+        let retitle = factors != self.factors
+            || self.live_params.as_ref().is_some_and(|p| p.recording.exaggeration != params.recording.exaggeration);
         self.factors = factors;
         self.drawing = self.chain.error_rotations(&self.truth.exaggerated(&self.factors));
         let old = self.live_params.replace(Box::new(params.clone()));
@@ -65,12 +65,14 @@ impl Recorder {
         }
         if let Some(layout) = self.ins.as_mut() {
             let algorithms = params.ins.as_ref().map(crate::ins::InsParams::algorithms).unwrap_or_default();
-            if let (Some(lines), Some(rates)) = (layout.coning_log.as_mut(), ins_view::coning_rates(params, &algorithms))
+            if let (Some(lines), Some(rates)) =
+                (layout.coning_log.as_mut(), ins_view::coning_rates(params, &algorithms))
                 && rates != lines.rates
             {
                 lines.change(t_s, rates);
             }
-            let hidden: Vec<String> = layout.algorithms.iter().filter(|a| !params.recording.shows(a)).cloned().collect();
+            let hidden: Vec<String> =
+                layout.algorithms.iter().filter(|a| !params.recording.shows(a)).cloned().collect();
             if hidden != layout.hidden {
                 layout.hidden = hidden;
                 self.log_shown_algorithms()?;
@@ -83,7 +85,13 @@ impl Recorder {
         for axis in ERROR_AXES {
             self.stream.mark_events(&error_path(self.error_unit, axis), "reloads", "config reloaded", &[t_s], 0.0)?;
             if self.ins.as_ref().is_some_and(|l| l.errors) {
-                self.stream.mark_events(&format!("ins/attitude_error_arcsec/{axis}"), "reloads", "config reloaded", &[t_s], 0.0)?;
+                self.stream.mark_events(
+                    &format!("ins/attitude_error_arcsec/{axis}"),
+                    "reloads",
+                    "config reloaded",
+                    &[t_s],
+                    0.0,
+                )?;
             }
         }
         self.log_error_geometry(params, self.geometry_at(t_s))
@@ -97,5 +105,4 @@ impl Recorder {
     pub fn flush_series_held(&mut self, hold: std::time::Duration) -> RecordingStreamResult<()> {
         self.flush_series_with(Some(hold))
     }
-
 }

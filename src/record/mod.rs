@@ -21,23 +21,23 @@ use layout::Node;
 pub mod allan;
 mod blueprint;
 mod body_view;
-mod cone;
 pub mod calibration;
+mod cone;
 pub mod export;
 pub mod figures;
 mod ins_view;
 mod layout;
 mod live;
 pub use live::LiveOutput;
+mod frames;
 pub mod modulation;
 mod palette;
 pub mod read;
-mod frames;
 use frames::Frames;
 mod rows;
 mod scene;
-pub mod sink;
 pub mod selfcal;
+pub mod sink;
 pub mod tpr;
 
 use crate::ins::pipeline::InsView;
@@ -45,11 +45,11 @@ use crate::math::rotvec;
 use crate::math::units::ARCSEC_PER_RAD;
 use crate::model::gimbal::{Chain, ClassFactors, ErrorRotations, TableErrors};
 use crate::scenario::Params;
-use crate::sim::{StepOutput, ERROR_AXES};
+use crate::sim::{ERROR_AXES, StepOutput};
+use export::SharedExporter;
 use ins_view::InsLayout;
 use rows::Series;
 pub use rows::Solution;
-use export::SharedExporter;
 use scene::ChainPaths;
 
 /// A recording stream and, with `--export`, the tables its series also go to: what the commands
@@ -98,27 +98,53 @@ impl Stream {
 
     /// Sends `width` series of `path` (values row-major, one row per time) to Rerun, and to the
     /// export tables with the series' `names` and the unit `path` states.
-    pub(crate) fn send_series(&self, path: &str, names: &[String], times: &[f64], values: Vec<f64>, width: usize) -> RecordingStreamResult<()> {
+    pub(crate) fn send_series(
+        &self,
+        path: &str,
+        names: &[String],
+        times: &[f64],
+        values: Vec<f64>,
+        width: usize,
+    ) -> RecordingStreamResult<()> {
         // A log10 plot is a picture of a series exported in its own unit, not a measurement.
         if let Some(export) = self.export.as_ref().filter(|_| !is_log_plot(path)) {
             let unit = export::unit_of(path).unwrap_or("1");
             let mut e = export.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
             e.write(path, unit, names, times, &values);
         }
-        self.rec.send_columns(path, self.time_columns(times), rerun::Scalars::new(values).columns(std::iter::repeat_n(width, times.len()))?)?;
+        self.rec.send_columns(
+            path,
+            self.time_columns(times),
+            rerun::Scalars::new(values).columns(std::iter::repeat_n(width, times.len()))?,
+        )?;
         Ok(())
     }
 
     /// Marks events on the plot of `plot_path` where they happen: ▼ markers named `label` at
     /// `times`, at height `y` (the top of the plot's data, or 0 when it is not known yet), in the
     /// child entity `<plot>/<slug>` the plot's view includes. Not exported (not a measurement).
-    pub(crate) fn mark_events(&self, plot_path: &str, slug: &str, label: &str, times: &[f64], y: f64) -> RecordingStreamResult<()> {
+    pub(crate) fn mark_events(
+        &self,
+        plot_path: &str,
+        slug: &str,
+        label: &str,
+        times: &[f64],
+        y: f64,
+    ) -> RecordingStreamResult<()> {
         let path = format!("{plot_path}/{slug}");
         self.rec.log_static(
             path.as_str(),
-            &rerun::SeriesPoints::new().with_markers([rerun::components::MarkerShape::Down]).with_marker_sizes([7.0]).with_colors([palette::rgb(palette::colors::EVENT)]).with_names([label]),
+            &rerun::SeriesPoints::new()
+                .with_markers([rerun::components::MarkerShape::Down])
+                .with_marker_sizes([7.0])
+                .with_colors([palette::rgb(palette::colors::EVENT)])
+                .with_names([label]),
         )?;
-        self.rec.send_columns(path, self.time_columns(times), rerun::Scalars::new(vec![y; times.len()]).columns_of_unit_batches()?)?;
+        self.rec.send_columns(
+            path,
+            self.time_columns(times),
+            rerun::Scalars::new(vec![y; times.len()]).columns_of_unit_batches()?,
+        )?;
         Ok(())
     }
 }
@@ -155,7 +181,12 @@ pub fn drawing_factors(truth: &TableErrors, x: f64) -> ClassFactors {
         crate::math::units::nice_at_least(MIN_DRAWN_RAD / a * (1.0 - 1e-12)).min(1e5).max(x)
     };
     let s = truth.class_sizes();
-    ClassFactors { swing: raise(s.swing), non_orthogonality: raise(s.non_orthogonality), installation: raise(s.installation), imu_mount: raise(s.imu_mount) }
+    ClassFactors {
+        swing: raise(s.swing),
+        non_orthogonality: raise(s.non_orthogonality),
+        installation: raise(s.installation),
+        imu_mount: raise(s.imu_mount),
+    }
 }
 
 /// Whether `path` is a log10 picture of another series (`…_log10_<unit>`): drawn, not exported.
@@ -286,11 +317,22 @@ impl Recorder {
         Self::build(stream, params, None, Some(custom))
     }
 
-    fn build(stream: Stream, params: &Params, live: Option<LiveOutput>, custom: Option<CustomLayout>) -> RecordingStreamResult<Self> {
+    fn build(
+        stream: Stream,
+        params: &Params,
+        live: Option<LiveOutput>,
+        custom: Option<CustomLayout>,
+    ) -> RecordingStreamResult<Self> {
         Self::build_with(stream, params, live, None, custom)
     }
 
-    fn build_with(stream: Stream, params: &Params, live: Option<LiveOutput>, replay: Option<ReplayKind>, custom: Option<CustomLayout>) -> RecordingStreamResult<Self> {
+    fn build_with(
+        stream: Stream,
+        params: &Params,
+        live: Option<LiveOutput>,
+        replay: Option<ReplayKind>,
+        custom: Option<CustomLayout>,
+    ) -> RecordingStreamResult<Self> {
         let rec = stream.rec.clone();
         let chain = params.table.chain.clone();
         let factors = drawing_factors(&params.table.truth, params.recording.exaggeration);
@@ -339,9 +381,15 @@ impl Recorder {
         me.send_blueprint(params, custom)?;
         let started = if live.is_some() {
             // A live session has no length of its own: it runs until it is stopped.
-            format!("live session started: {} at {} Hz, seed {} (it runs until stopped)", params.meta.name, params.step_hz, params.meta.seed)
+            format!(
+                "live session started: {} at {} Hz, seed {} (it runs until stopped)",
+                params.meta.name, params.step_hz, params.meta.seed
+            )
         } else {
-            format!("run started: {} ({} s at {} Hz, seed {})", params.meta.name, params.duration_s, params.step_hz, params.meta.seed)
+            format!(
+                "run started: {} ({} s at {} Hz, seed {})",
+                params.meta.name, params.duration_s, params.step_hz, params.meta.seed
+            )
         };
         me.event(0.0, &started, "INFO")?;
         Ok(me)
@@ -400,7 +448,13 @@ impl Recorder {
                 self.stream.mark_events(&error_path(self.error_unit, axis), "moves", "scheme moves", &starts, y)?;
             }
             if let Some(ins) = ranges.ins_peak_rad.filter(|_| self.ins.as_ref().is_some_and(|l| l.errors)) {
-                self.stream.mark_events(&format!("ins/attitude_error_arcsec/{axis}"), "moves", "scheme moves", &starts, top(ins, a, ARCSEC_PER_RAD))?;
+                self.stream.mark_events(
+                    &format!("ins/attitude_error_arcsec/{axis}"),
+                    "moves",
+                    "scheme moves",
+                    &starts,
+                    top(ins, a, ARCSEC_PER_RAD),
+                )?;
             }
         }
         Ok(())
@@ -442,11 +496,21 @@ impl Recorder {
 
     /// Buffers one row of a replay: the table's step (if it has a table), the INS's view and its
     /// own solution.
-    pub fn push_replay_row(&mut self, out: &StepOutput, ins: &InsView, solution: &Solution) -> RecordingStreamResult<()> {
+    pub fn push_replay_row(
+        &mut self,
+        out: &StepOutput,
+        ins: &InsView,
+        solution: &Solution,
+    ) -> RecordingStreamResult<()> {
         self.push_row_with(out, Some(ins), Some(solution))
     }
 
-    fn push_row_with(&mut self, out: &StepOutput, ins: Option<&InsView>, solution: Option<&Solution>) -> RecordingStreamResult<()> {
+    fn push_row_with(
+        &mut self,
+        out: &StepOutput,
+        ins: Option<&InsView>,
+        solution: Option<&Solution>,
+    ) -> RecordingStreamResult<()> {
         self.push_values(out, ins, solution);
         self.series_t.push(out.t_s);
         if self.series_t.len() >= SERIES_CHUNK_ROWS {
@@ -480,7 +544,9 @@ impl Recorder {
         if let Some(layout) = self.ins.as_mut().filter(|l| l.trace || l.dial_shown()) {
             // Without an INS view (or without its truth) the trace stands still at the identity.
             if layout.trace {
-                let (t, c) = ins.and_then(|v| Some((*v.imu_true?.quaternion(), *v.imu_ins.quaternion()))).unwrap_or((UnitQuaternion::identity(), UnitQuaternion::identity()));
+                let (t, c) = ins
+                    .and_then(|v| Some((*v.imu_true?.quaternion(), *v.imu_ins.quaternion())))
+                    .unwrap_or((UnitQuaternion::identity(), UnitQuaternion::identity()));
                 let err = rotvec::log(&(c * t.inverse())) * layout.exaggeration;
                 let ins_q = rotvec::exp(&err) * t;
                 // The true axes, then the computed ones, as arrows in the trace's (unturned) frame.
@@ -498,7 +564,10 @@ impl Recorder {
                 layout.dial_t.push(out.t_s);
                 layout.dial_next_t = out.t_s + 1.0 / ins_view::DIAL_HZ - 1e-9;
                 for (k, name) in layout.algorithms.iter().enumerate() {
-                    let size = ins.and_then(|v| v.errors.get(k)).filter(|_| !layout.hidden.contains(name)).map_or(0.0, |e| e.as_array().iter().map(|x| x * x).sum::<f64>().sqrt());
+                    let size = ins
+                        .and_then(|v| v.errors.get(k))
+                        .filter(|_| !layout.hidden.contains(name))
+                        .map_or(0.0, |e| e.as_array().iter().map(|x| x * x).sum::<f64>().sqrt());
                     layout.dial.push(ins_view::needle(-size * layout.exaggeration));
                 }
             }
@@ -554,7 +623,10 @@ impl Recorder {
                 // instead of sloping from the last row sent to the first new one.
                 (_, Some((row, _))) if s.held_until_s.is_some() => {
                     let held = s.held_until_s.unwrap_or_default();
-                    (std::iter::once(held).chain(times.iter().copied()).collect(), row.iter().copied().chain(values).collect())
+                    (
+                        std::iter::once(held).chain(times.iter().copied()).collect(),
+                        row.iter().copied().chain(values).collect(),
+                    )
                 }
                 _ => (times.clone(), values),
             };
@@ -569,7 +641,6 @@ impl Recorder {
             _ => Ok(()),
         }
     }
-
 
     /// Sends the buffered scene frames. A transform that has not moved since the frame last sent
     /// of it is not sent again (a vehicle at rest, a gimbal the scheme holds still).
@@ -587,22 +658,33 @@ impl Recorder {
             body.flush(&self.stream, &times)?;
             sent += 1;
         }
-        let motion = std::iter::once((self.paths.vehicle.as_str(), std::mem::take(&mut self.scene_vehicle)))
-            .chain(self.paths.gimbals.iter().map(String::as_str).zip(self.scene_gimbals.iter_mut().map(std::mem::take)));
+        let motion = std::iter::once((self.paths.vehicle.as_str(), std::mem::take(&mut self.scene_vehicle))).chain(
+            self.paths.gimbals.iter().map(String::as_str).zip(self.scene_gimbals.iter_mut().map(std::mem::take)),
+        );
         for ((path, q), last) in motion.zip(self.last_motion.iter_mut()) {
             let Some(newest) = q.last().copied() else { continue };
             if q.iter().all(|x| Some(*x) == *last) {
                 continue;
             }
             *last = Some(newest);
-            self.rec.send_columns(path, self.stream.time_columns(&times), rerun::Transform3D::update_fields().with_many_quaternion(q).columns_of_unit_batches()?)?;
+            self.rec.send_columns(
+                path,
+                self.stream.time_columns(&times),
+                rerun::Transform3D::update_fields().with_many_quaternion(q).columns_of_unit_batches()?,
+            )?;
             sent += 1;
         }
         if let Some(layout) = self.ins.as_mut() {
             let trace = std::mem::take(&mut layout.trace_axes);
             if !trace.is_empty() {
                 debug_assert_eq!(trace.len(), 6 * times.len());
-                self.rec.send_columns(ins_view::TRACE_AXES_PATH, self.stream.time_columns(&times), rerun::Arrows3D::update_fields().with_vectors(trace).columns(std::iter::repeat_n(6, times.len()))?)?;
+                self.rec.send_columns(
+                    ins_view::TRACE_AXES_PATH,
+                    self.stream.time_columns(&times),
+                    rerun::Arrows3D::update_fields()
+                        .with_vectors(trace)
+                        .columns(std::iter::repeat_n(6, times.len()))?,
+                )?;
                 sent += 1;
             }
         }
@@ -619,7 +701,11 @@ impl Recorder {
             return Ok(());
         }
         let k = layout.algorithms.len();
-        self.rec.send_columns(ins_view::DIAL_NEEDLES_PATH, self.stream.time_columns(&dial_t), rerun::Arrows3D::update_fields().with_vectors(needles).columns(std::iter::repeat_n(k, dial_t.len()))?)?;
+        self.rec.send_columns(
+            ins_view::DIAL_NEEDLES_PATH,
+            self.stream.time_columns(&dial_t),
+            rerun::Arrows3D::update_fields().with_vectors(needles).columns(std::iter::repeat_n(k, dial_t.len()))?,
+        )?;
         self.throttle(1);
         Ok(())
     }

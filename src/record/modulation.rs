@@ -1,11 +1,11 @@
 //! The recording of `rinscope modulation`: the three variants' position and heading errors overlaid.
 
-use rerun::blueprint::components::ContainerKind;
 use rerun::RecordingStreamResult;
+use rerun::blueprint::components::ContainerKind;
 
 use super::layout::{self, Node};
 use super::palette::rgb;
-use super::{Stream, APPLICATION_ID, TIMELINE};
+use super::{APPLICATION_ID, Stream, TIMELINE};
 use crate::ins::trace::{NavSample, NavTrace};
 
 const COLORS: [[u8; 3]; 3] = [[230, 76, 60], [240, 180, 40], [46, 170, 90]];
@@ -30,7 +30,13 @@ pub fn log(stream: &Stream, traces: &[NavTrace], table: &str) -> RecordingStream
     );
     rec.log_static("docs/modulation", &rerun::TextDocument::from_markdown(doc))?;
     let colors: Vec<rerun::Color> = COLORS.iter().map(|c| rgb(*c)).collect();
-    for path in ["modulation/radial_position_error_m", LOG_PATH, "modulation/east_error_m", "modulation/north_error_m", "modulation/heading_error_arcsec"] {
+    for path in [
+        "modulation/radial_position_error_m",
+        LOG_PATH,
+        "modulation/east_error_m",
+        "modulation/north_error_m",
+        "modulation/heading_error_arcsec",
+    ] {
         rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors.clone()).with_names(names.clone()))?;
     }
     let n = traces.iter().map(|t| t.samples.len()).min().unwrap_or(0);
@@ -57,7 +63,9 @@ pub fn log(stream: &Stream, traces: &[NavTrace], table: &str) -> RecordingStream
     // Legends would sit over the data: the first title gives the colours.
     let key = names.iter().zip(COLOR_NAMES).map(|(n, c)| format!("{c} {n}")).collect::<Vec<_>>().join(" · ");
     let plot = |name: &str, origin: &str| {
-        Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::whole_run_time_axis()).with_property("PlotLegend", &layout::no_legend())
+        Node::view("TimeSeries", name, origin)
+            .with_property("TimeAxis", &layout::whole_run_time_axis())
+            .with_property("PlotLegend", &layout::no_legend())
     };
     let root = Node::container(
         ContainerKind::Horizontal,

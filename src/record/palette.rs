@@ -40,7 +40,10 @@ pub(crate) mod colors {
 
     /// The colour of the coning algorithm named `name`, the same in every recording.
     pub fn algorithm(name: &str) -> [u8; 3] {
-        crate::ins::coning::Algorithm::ALL.iter().position(|a| a.name() == name).map_or([200, 200, 200], |k| ALGORITHMS[k])
+        crate::ins::coning::Algorithm::ALL
+            .iter()
+            .position(|a| a.name() == name)
+            .map_or([200, 200, 200], |k| ALGORITHMS[k])
     }
 }
 
@@ -84,7 +87,9 @@ pub(crate) fn label(c: [u8; 3]) -> rerun::Color {
     let grey = (f64::from(c[0]) + f64::from(c[1]) + f64::from(c[2])) / 3.0;
     let mut x = c.map(|v| (f64::from(v) + grey) / 2.0);
     // Bisection on a scale factor (towards black below 1, towards white above).
-    let at = |k: f64, x: [f64; 3]| x.map(|v| if k <= 1.0 { v * k } else { v + (255.0 - v) * (k - 1.0) }.round().clamp(0.0, 255.0) as u8);
+    let at = |k: f64, x: [f64; 3]| {
+        x.map(|v| if k <= 1.0 { v * k } else { v + (255.0 - v) * (k - 1.0) }.round().clamp(0.0, 255.0) as u8)
+    };
     let (mut lo, mut hi) = (0.0, 2.0);
     for _ in 0..40 {
         let k = (lo + hi) / 2.0;
@@ -115,7 +120,11 @@ mod tests {
             if v <= 0.040_45 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) }
         };
         let [r, g, b] = c.map(lin);
-        let (x, y, z) = (0.4124 * r + 0.3576 * g + 0.1805 * b, 0.2126 * r + 0.7152 * g + 0.0722 * b, 0.0193 * r + 0.1192 * g + 0.9505 * b);
+        let (x, y, z) = (
+            0.4124 * r + 0.3576 * g + 0.1805 * b,
+            0.2126 * r + 0.7152 * g + 0.0722 * b,
+            0.0193 * r + 0.1192 * g + 0.9505 * b,
+        );
         let f = |t: f64| if t > 216.0 / 24389.0 { t.cbrt() } else { (24389.0 / 27.0 * t + 16.0) / 116.0 };
         let (fx, fy, fz) = (f(x / 0.950_47), f(y), f(z / 1.088_83));
         [116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz)]
@@ -130,12 +139,29 @@ mod tests {
         let (c1, c2) = (a1.hypot(b1), a2.hypot(b2));
         let hue = |b: f64, a: f64| if a == 0.0 && b == 0.0 { 0.0 } else { b.atan2(a).to_degrees().rem_euclid(360.0) };
         let (h1, h2) = (hue(b1, a1), hue(b2, a2));
-        let dh = if c1 * c2 == 0.0 { 0.0 } else if (h2 - h1).abs() <= 180.0 { h2 - h1 } else if h2 <= h1 { h2 - h1 + 360.0 } else { h2 - h1 - 360.0 };
+        let dh = if c1 * c2 == 0.0 {
+            0.0
+        } else if (h2 - h1).abs() <= 180.0 {
+            h2 - h1
+        } else if h2 <= h1 {
+            h2 - h1 + 360.0
+        } else {
+            h2 - h1 - 360.0
+        };
         let (dl, dc, dhh) = (l2 - l1, c2 - c1, 2.0 * (c1 * c2).sqrt() * (dh / 2.0).to_radians().sin());
         let (l, c) = ((l1 + l2) / 2.0, (c1 + c2) / 2.0);
-        let h = if c1 * c2 == 0.0 { h1 + h2 } else if (h1 - h2).abs() <= 180.0 { (h1 + h2) / 2.0 } else if h1 + h2 < 360.0 { (h1 + h2 + 360.0) / 2.0 } else { (h1 + h2 - 360.0) / 2.0 };
+        let h = if c1 * c2 == 0.0 {
+            h1 + h2
+        } else if (h1 - h2).abs() <= 180.0 {
+            (h1 + h2) / 2.0
+        } else if h1 + h2 < 360.0 {
+            (h1 + h2 + 360.0) / 2.0
+        } else {
+            (h1 + h2 - 360.0) / 2.0
+        };
         let cos = |deg: f64| deg.to_radians().cos();
-        let t = 1.0 - 0.17 * cos(h - 30.0) + 0.24 * cos(2.0 * h) + 0.32 * cos(3.0 * h + 6.0) - 0.20 * cos(4.0 * h - 63.0);
+        let t =
+            1.0 - 0.17 * cos(h - 30.0) + 0.24 * cos(2.0 * h) + 0.32 * cos(3.0 * h + 6.0) - 0.20 * cos(4.0 * h - 63.0);
         let rc = 2.0 * (c.powi(7) / (c.powi(7) + 25f64.powi(7))).sqrt();
         let rt = -(2.0 * 30.0 * (-((h - 275.0) / 25.0).powi(2)).exp()).to_radians().sin() * rc;
         let sl = 1.0 + 0.015 * (l - 50.0).powi(2) / (20.0 + (l - 50.0).powi(2)).sqrt();

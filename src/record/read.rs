@@ -28,13 +28,16 @@ pub struct Event {
 /// (without the leading `/`); an unreadable file named in the error.
 fn chunks(path: &Path) -> anyhow::Result<impl Iterator<Item = anyhow::Result<(StoreId, String, Chunk)>> + '_> {
     let file = crate::io::files::open_input(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    let decoder = DecoderApp::decode_eager(BufReader::new(file)).map_err(|e| anyhow::anyhow!("{}: not a readable .rrd: {e}", path.display()))?;
+    let decoder = DecoderApp::decode_eager(BufReader::new(file))
+        .map_err(|e| anyhow::anyhow!("{}: not a readable .rrd: {e}", path.display()))?;
     Ok(decoder.filter_map(move |m| match m {
         Err(e) => Some(Err(anyhow::anyhow!("{}: {e}", path.display()))),
-        Ok(LogMsg::ArrowMsg(store_id, arrow_msg)) => Some(Chunk::from_arrow_msg(&arrow_msg).map_err(anyhow::Error::from).map(|chunk| {
-            let entity = chunk.entity_path().to_string().trim_start_matches('/').to_owned();
-            (store_id, entity, chunk)
-        })),
+        Ok(LogMsg::ArrowMsg(store_id, arrow_msg)) => {
+            Some(Chunk::from_arrow_msg(&arrow_msg).map_err(anyhow::Error::from).map(|chunk| {
+                let entity = chunk.entity_path().to_string().trim_start_matches('/').to_owned();
+                (store_id, entity, chunk)
+            }))
+        }
         Ok(_) => None,
     }))
 }
@@ -53,11 +56,20 @@ pub fn events(path: &Path) -> anyhow::Result<Vec<Event>> {
             .iter_component_indices(TIMELINE.into(), text_component)
             .map(|(t, _)| if t.is_static() { None } else { Some(t.as_i64() as f64 / 1e9) })
             .collect();
-        let texts: Vec<String> = chunk.iter_component::<rerun::components::Text>(text_component).map(|v| v.iter().map(|t| t.as_str().to_owned()).collect::<Vec<_>>().join("\n")).collect();
-        let levels: Vec<String> =
-            chunk.iter_component::<rerun::components::TextLogLevel>(level_component).map(|v| v.iter().map(|l| l.as_str().to_owned()).collect::<String>()).collect();
+        let texts: Vec<String> = chunk
+            .iter_component::<rerun::components::Text>(text_component)
+            .map(|v| v.iter().map(|t| t.as_str().to_owned()).collect::<Vec<_>>().join("\n"))
+            .collect();
+        let levels: Vec<String> = chunk
+            .iter_component::<rerun::components::TextLogLevel>(level_component)
+            .map(|v| v.iter().map(|l| l.as_str().to_owned()).collect::<String>())
+            .collect();
         for (i, text) in texts.into_iter().enumerate() {
-            out.push(Event { t_s: times.get(i).copied().flatten(), level: levels.get(i).cloned().unwrap_or_default(), text });
+            out.push(Event {
+                t_s: times.get(i).copied().flatten(),
+                level: levels.get(i).cloned().unwrap_or_default(),
+                text,
+            });
         }
     }
     out.sort_by(|a, b| a.t_s.unwrap_or(-1.0).total_cmp(&b.t_s.unwrap_or(-1.0)));
@@ -75,9 +87,15 @@ pub fn point_labels(path: &Path, entity: &str) -> anyhow::Result<Vec<(Option<f64
         if store_id.kind() != StoreKind::Recording || e != entity {
             continue;
         }
-        let times: Vec<Option<f64>> = chunk.iter_component_indices(TIMELINE.into(), labels).map(|(t, _)| if t.is_static() { None } else { Some(t.as_i64() as f64 / 1e9) }).collect();
+        let times: Vec<Option<f64>> = chunk
+            .iter_component_indices(TIMELINE.into(), labels)
+            .map(|(t, _)| if t.is_static() { None } else { Some(t.as_i64() as f64 / 1e9) })
+            .collect();
         for (i, v) in chunk.iter_component::<rerun::components::Text>(labels).enumerate() {
-            out.push((times.get(i).copied().flatten(), v.iter().map(|t| t.as_str().to_owned()).collect::<Vec<_>>().join("\n")));
+            out.push((
+                times.get(i).copied().flatten(),
+                v.iter().map(|t| t.as_str().to_owned()).collect::<Vec<_>>().join("\n"),
+            ));
         }
     }
     out.sort_by(|a, b| a.0.unwrap_or(-1.0).total_cmp(&b.0.unwrap_or(-1.0)));
@@ -98,7 +116,11 @@ impl Contents {
     /// The view origins under which the recording has no entity (a layout pointing at nothing).
     #[must_use]
     pub fn empty_views(&self) -> Vec<String> {
-        self.view_origins.iter().filter(|o| !self.entities.iter().any(|e| e == *o || e.starts_with(&format!("{o}/")))).cloned().collect()
+        self.view_origins
+            .iter()
+            .filter(|o| !self.entities.iter().any(|e| e == *o || e.starts_with(&format!("{o}/"))))
+            .cloned()
+            .collect()
     }
 }
 
@@ -148,7 +170,15 @@ pub fn plot_frames(path: &Path) -> anyhow::Result<Vec<PlotFrame>> {
     Ok(plots(path)?
         .into_iter()
         .map(|p| {
-            let mut f = PlotFrame { title: p.title, origin: p.origin, range: p.range, finite: 0, min: f64::INFINITY, max: f64::NEG_INFINITY, non_finite: 0 };
+            let mut f = PlotFrame {
+                title: p.title,
+                origin: p.origin,
+                range: p.range,
+                finite: 0,
+                min: f64::INFINITY,
+                max: f64::NEG_INFINITY,
+                non_finite: 0,
+            };
             for v in p.series.iter().flat_map(|s| s.y.iter()) {
                 if v.is_finite() {
                     (f.finite, f.min, f.max) = (f.finite + 1, f.min.min(*v), f.max.max(*v));
@@ -217,9 +247,21 @@ pub fn plots(path: &Path) -> anyhow::Result<Vec<Plot>> {
     use rerun::external::re_sdk_types::datatypes::TimeRangeBoundary;
     use std::collections::BTreeMap;
     let scalar = rerun::Scalars::descriptor_scalars().component;
-    let (l_names, l_colors, l_widths) = (rerun::SeriesLines::descriptor_names().component, rerun::SeriesLines::descriptor_colors().component, rerun::SeriesLines::descriptor_widths().component);
-    let (p_names, p_colors, p_markers) = (rerun::SeriesPoints::descriptor_names().component, rerun::SeriesPoints::descriptor_colors().component, rerun::SeriesPoints::descriptor_markers().component);
-    let (origin_c, class_c, name_c) = (ViewBlueprint::descriptor_space_origin().component, ViewBlueprint::descriptor_class_identifier().component, ViewBlueprint::descriptor_display_name().component);
+    let (l_names, l_colors, l_widths) = (
+        rerun::SeriesLines::descriptor_names().component,
+        rerun::SeriesLines::descriptor_colors().component,
+        rerun::SeriesLines::descriptor_widths().component,
+    );
+    let (p_names, p_colors, p_markers) = (
+        rerun::SeriesPoints::descriptor_names().component,
+        rerun::SeriesPoints::descriptor_colors().component,
+        rerun::SeriesPoints::descriptor_markers().component,
+    );
+    let (origin_c, class_c, name_c) = (
+        ViewBlueprint::descriptor_space_origin().component,
+        ViewBlueprint::descriptor_class_identifier().component,
+        ViewBlueprint::descriptor_display_name().component,
+    );
     let (range_c, time_c) = (ScalarAxis::descriptor_range().component, TimeAxis::descriptor_view_range().component);
     // Per entity: its style, and its rows (timeline, t, values).
     let mut styles: BTreeMap<String, Style> = BTreeMap::new();
@@ -239,11 +281,27 @@ pub fn plots(path: &Path) -> anyhow::Result<Vec<Plot>> {
         let (store_id, entity, chunk) = item?;
         match store_id.kind() {
             StoreKind::Recording => {
-                let texts = |c| chunk.iter_component::<rerun::components::Name>(c).flat_map(|v| v.iter().map(|n| n.as_str().to_owned()).collect::<Vec<_>>()).collect::<Vec<_>>();
-                let colors = |c| chunk.iter_component::<rerun::components::Color>(c).flat_map(|v| v.iter().map(|c| c.to_array()).collect::<Vec<_>>()).collect::<Vec<_>>();
+                let texts = |c| {
+                    chunk
+                        .iter_component::<rerun::components::Name>(c)
+                        .flat_map(|v| v.iter().map(|n| n.as_str().to_owned()).collect::<Vec<_>>())
+                        .collect::<Vec<_>>()
+                };
+                let colors = |c| {
+                    chunk
+                        .iter_component::<rerun::components::Color>(c)
+                        .flat_map(|v| v.iter().map(|c| c.to_array()).collect::<Vec<_>>())
+                        .collect::<Vec<_>>()
+                };
                 let (ln, lc, pn, pc) = (texts(l_names), colors(l_colors), texts(p_names), colors(p_colors));
-                let widths: Vec<f32> = chunk.iter_component::<rerun::components::StrokeWidth>(l_widths).flat_map(|v| v.iter().map(|w| w.0.0).collect::<Vec<_>>()).collect();
-                let markers: Vec<String> = chunk.iter_component::<rerun::components::MarkerShape>(p_markers).flat_map(|v| v.iter().map(|m| format!("{m:?}").to_lowercase()).collect::<Vec<_>>()).collect();
+                let widths: Vec<f32> = chunk
+                    .iter_component::<rerun::components::StrokeWidth>(l_widths)
+                    .flat_map(|v| v.iter().map(|w| w.0.0).collect::<Vec<_>>())
+                    .collect();
+                let markers: Vec<String> = chunk
+                    .iter_component::<rerun::components::MarkerShape>(p_markers)
+                    .flat_map(|v| v.iter().map(|m| format!("{m:?}").to_lowercase()).collect::<Vec<_>>())
+                    .collect();
                 let has_lines = !ln.is_empty() || !lc.is_empty() || !widths.is_empty();
                 let has_points = !pn.is_empty() || !pc.is_empty() || !markers.is_empty();
                 if has_lines || has_points {
@@ -269,8 +327,14 @@ pub fn plots(path: &Path) -> anyhow::Result<Vec<Plot>> {
                         s.marker = markers.into_iter().next().or(s.marker.take());
                     }
                 }
-                let Some(timeline) = [super::TIMELINE, super::allan::LOG10_TAU_TIMELINE].into_iter().find(|t| chunk.timelines().contains_key(&(*t).into())) else { continue };
-                let times: Vec<f64> = chunk.iter_component_indices(timeline.into(), scalar).map(|(t, _)| secs(t.as_i64())).collect();
+                let Some(timeline) = [super::TIMELINE, super::allan::LOG10_TAU_TIMELINE]
+                    .into_iter()
+                    .find(|t| chunk.timelines().contains_key(&(*t).into()))
+                else {
+                    continue;
+                };
+                let times: Vec<f64> =
+                    chunk.iter_component_indices(timeline.into(), scalar).map(|(t, _)| secs(t.as_i64())).collect();
                 let e = rows.entry(entity).or_default();
                 for (t, values) in times.into_iter().zip(chunk.iter_component::<rerun::components::Scalar>(scalar)) {
                     e.push((timeline.to_owned(), t, values.iter().map(|s| s.0.0).collect()));
@@ -290,14 +354,20 @@ pub fn plots(path: &Path) -> anyhow::Result<Vec<Plot>> {
                 let e = views.entry(view).or_default();
                 match property {
                     Some("ScalarAxis") => {
-                        if let Some(r) = chunk.iter_component::<rerun::components::Range1D>(range_c).filter_map(|r| r.first().copied()).last() {
+                        if let Some(r) = chunk
+                            .iter_component::<rerun::components::Range1D>(range_c)
+                            .filter_map(|r| r.first().copied())
+                            .last()
+                        {
                             e.range = Some(r.0.0);
                         }
                     }
                     Some(_) => {
                         use rerun::external::re_sdk_types::blueprint::components::TimeRange;
-                        if let Some(r) = chunk.iter_component::<TimeRange>(time_c).filter_map(|r| r.first().cloned()).last()
-                            && let (TimeRangeBoundary::Absolute(a), TimeRangeBoundary::Absolute(b)) = (r.0.start, r.0.end)
+                        if let Some(r) =
+                            chunk.iter_component::<TimeRange>(time_c).filter_map(|r| r.first().cloned()).last()
+                            && let (TimeRangeBoundary::Absolute(a), TimeRangeBoundary::Absolute(b)) =
+                                (r.0.start, r.0.end)
                         {
                             e.time_range = Some([secs(a.0), secs(b.0)]);
                         }
@@ -310,7 +380,10 @@ pub fn plots(path: &Path) -> anyhow::Result<Vec<Plot>> {
                             e.title = n.first().map(|n| n.as_str().to_owned()).unwrap_or_default();
                         }
                         for o in chunk.iter_component::<ViewOrigin>(origin_c) {
-                            e.origin = o.first().map(|o| o.0.0.as_str().trim_start_matches('/').to_owned()).unwrap_or_default();
+                            e.origin = o
+                                .first()
+                                .map(|o| o.0.0.as_str().trim_start_matches('/').to_owned())
+                                .unwrap_or_default();
                         }
                     }
                 }

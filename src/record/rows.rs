@@ -5,15 +5,15 @@
 use nalgebra::Vector3;
 
 use super::ins_view::{self, InsLayout};
-use super::{error_path, Recorder, ReplayKind, CLOSED_FORM_PATH};
+use super::{CLOSED_FORM_PATH, Recorder, ReplayKind, error_path};
 use crate::ins::core::NavError;
 use crate::ins::nav::{NavState, Vertical};
 use crate::ins::pipeline::InsView;
 use crate::math::attitude::Attitude;
-use crate::math::units::{AngleUnit, ARCSEC_PER_RAD, DEG_PER_RAD};
+use crate::math::units::{ARCSEC_PER_RAD, AngleUnit, DEG_PER_RAD};
 use crate::model::gimbal::Chain;
 use crate::scenario::Params;
-use crate::sim::{StepOutput, DEMODULATIONS, ERROR_AXES};
+use crate::sim::{DEMODULATIONS, ERROR_AXES, StepOutput};
 
 /// The INS's own solution at a recorded row of a replay (a simulation records the truth and the
 /// INS's errors instead).
@@ -75,7 +75,10 @@ pub(crate) struct Series {
 /// Whether two rows hold the same values to a part in 10⁹ (a NaN row repeats a NaN row): a zero
 /// error whose rounding flickers at 1e-13″ is a repeated row to a plot.
 pub(crate) fn same_row(a: &[f64], b: &[f64]) -> bool {
-    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits() || (x - y).abs() <= 1e-9 * x.abs().max(y.abs()).max(1.0))
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(x, y)| x.to_bits() == y.to_bits() || (x - y).abs() <= 1e-9 * x.abs().max(y.abs()).max(1.0))
 }
 
 impl Series {
@@ -114,7 +117,11 @@ pub(crate) fn table_series(chain: &Chain, replay: Option<ReplayKind>, unit: Angl
         // The compensated demodulation is the reference: its own error would be zero.
         Some(ReplayKind { reference: false, .. }) => names(&["nominal − compensated table"]),
     };
-    let mut series: Vec<Series> = ERROR_AXES.iter().enumerate().map(|(a, axis)| Series::new(error_path(unit, axis), demodulations.clone(), Quantity::TableError(a))).collect();
+    let mut series: Vec<Series> = ERROR_AXES
+        .iter()
+        .enumerate()
+        .map(|(a, axis)| Series::new(error_path(unit, axis), demodulations.clone(), Quantity::TableError(a)))
+        .collect();
     let axis_names: Vec<String> = chain.axes().iter().map(|a| a.name.clone()).collect();
     series.push(Series::new("gimbal_angle_deg", axis_names.clone(), Quantity::GimbalAngles));
     // A replay's "truth" is the reference (or the INS itself): the INS's attitude is its own series.
@@ -148,12 +155,24 @@ pub(crate) fn ins_layout(params: &Params, replay: Option<ReplayKind>, series: &m
     match (replay, cfg.navigation) {
         (_, None) => {}
         (None, Some(_)) => {
-            series.push(Series::new("ins/position_error_m", names(&["east", "north", "radial"]), Quantity::PositionError));
-            series.push(Series::new("ins/velocity_error_mps", names(&["east", "north", "up"]), Quantity::VelocityError));
+            series.push(Series::new(
+                "ins/position_error_m",
+                names(&["east", "north", "radial"]),
+                Quantity::PositionError,
+            ));
+            series.push(Series::new(
+                "ins/velocity_error_mps",
+                names(&["east", "north", "up"]),
+                Quantity::VelocityError,
+            ));
         }
         (Some(_), Some(nav)) => {
             let free = nav.vertical == Vertical::Free;
-            series.push(Series::new(VELOCITY_PATH, names(if free { &["east", "north", "up"] } else { &["east", "north"] }), Quantity::Velocity));
+            series.push(Series::new(
+                VELOCITY_PATH,
+                names(if free { &["east", "north", "up"] } else { &["east", "north"] }),
+                Quantity::Velocity,
+            ));
             series.push(Series::new(POSITION_PATH, names(&["east", "north"]), Quantity::PositionFromStart));
             series.push(Series::new(LAT_LON_PATH, names(&["latitude", "longitude"]), Quantity::LatitudeLongitude));
             if free {
@@ -166,11 +185,15 @@ pub(crate) fn ins_layout(params: &Params, replay: Option<ReplayKind>, series: &m
     }
     // Pure coning on a table at rest: the drifts span decades, a log10 plot with the
     // analytic rates shows each algorithm on its line.
-    let coning_log = params.table.vehicle.pure_coning().filter(|_| errors && params.table.scheme.max_rate() == 0.0).and_then(|_| {
-        let lines = algorithms.iter().flat_map(|a| [format!("{a}: log10 |heading error|"), format!("{a}: analytic coning drift")]).collect();
-        series.push(Series::new(ins_view::CONING_LOG_PATH, lines, Quantity::ConingLog));
-        ins_view::coning_rates(params, &cfg.algorithms()).map(ins_view::ConingLines::new)
-    });
+    let coning_log =
+        params.table.vehicle.pure_coning().filter(|_| errors && params.table.scheme.max_rate() == 0.0).and_then(|_| {
+            let lines = algorithms
+                .iter()
+                .flat_map(|a| [format!("{a}: log10 |heading error|"), format!("{a}: analytic coning drift")])
+                .collect();
+            series.push(Series::new(ins_view::CONING_LOG_PATH, lines, Quantity::ConingLog));
+            ins_view::coning_rates(params, &cfg.algorithms()).map(ins_view::ConingLines::new)
+        });
     // The INS trace and the drift dial draw the INS's error ×N: where the largest error of
     // the run is known in advance (pure coning: the analytic drifts), N is lowered to the
     // largest 1-2-5 factor that keeps it under 150°, so the picture never wraps round.
@@ -207,7 +230,12 @@ pub(crate) fn ins_layout(params: &Params, replay: Option<ReplayKind>, series: &m
 }
 
 /// What a row without a navigation view shows.
-const NO_NAV: NavError = NavError { east_m: f64::NAN, north_m: f64::NAN, radial_m: f64::NAN, velocity_enu_mps: Vector3::new(f64::NAN, f64::NAN, f64::NAN) };
+const NO_NAV: NavError = NavError {
+    east_m: f64::NAN,
+    north_m: f64::NAN,
+    radial_m: f64::NAN,
+    velocity_enu_mps: Vector3::new(f64::NAN, f64::NAN, f64::NAN),
+};
 
 impl Recorder {
     /// Buffers one row of every series from the table's step `out`, the INS's view `ins` (errors,
@@ -228,7 +256,9 @@ impl Recorder {
                     v.extend((0..3).map(|a| (closed[a] - exact[a]) * ARCSEC_PER_RAD));
                 }
                 Quantity::GimbalAngles => v.extend(out.gimbal_rad[..width].iter().map(|x| x * DEG_PER_RAD)),
-                Quantity::VehicleAttitude => v.extend([out.attitude.pitch_rad, out.attitude.roll_rad, out.attitude.heading_rad].map(|x| x * DEG_PER_RAD)),
+                Quantity::VehicleAttitude => v.extend(
+                    [out.attitude.pitch_rad, out.attitude.roll_rad, out.attitude.heading_rad].map(|x| x * DEG_PER_RAD),
+                ),
                 Quantity::Swing(k) => {
                     let g = &chain.axes()[k];
                     let sw = chain.swing_vector(k, &truth.axes[k], out.gimbal_rad[k]);
@@ -241,7 +271,8 @@ impl Recorder {
                 Quantity::ConingLog => {
                     let log10 = |x: f64| if x > 0.0 && x.is_finite() { x.log10() } else { f64::NAN };
                     for j in 0..lines.map_or(0, |l| l.rates.len()) {
-                        let measured = ins.map_or(f64::NAN, |view| log10(view.errors[j].heading_rad.abs() * ARCSEC_PER_RAD));
+                        let measured =
+                            ins.map_or(f64::NAN, |view| log10(view.errors[j].heading_rad.abs() * ARCSEC_PER_RAD));
                         v.extend([measured, log10(lines.map_or(f64::NAN, |l| l.at(j, out.t_s)))]);
                     }
                 }
@@ -249,12 +280,18 @@ impl Recorder {
                 Quantity::VelocityError => v.extend(nav.velocity_enu_mps.iter()),
                 Quantity::BodyAttitude => match solution {
                     // Heading in (−180°, 180°]: a vehicle pointing North (most tests) does not jump by 360°.
-                    Some(s) => v.extend([s.body.pitch_rad, s.body.roll_rad, s.body.heading_rad].map(|x| x * DEG_PER_RAD)),
+                    Some(s) => {
+                        v.extend([s.body.pitch_rad, s.body.roll_rad, s.body.heading_rad].map(|x| x * DEG_PER_RAD))
+                    }
                     None => v.extend([f64::NAN; 3]),
                 },
-                Quantity::Velocity => v.extend(state.map_or([f64::NAN; 3], |n| [n.v_n.x, n.v_n.y, n.v_n.z])[..width].iter()),
+                Quantity::Velocity => {
+                    v.extend(state.map_or([f64::NAN; 3], |n| [n.v_n.x, n.v_n.y, n.v_n.z])[..width].iter())
+                }
                 Quantity::PositionFromStart => v.extend([nav.east_m, nav.north_m]),
-                Quantity::LatitudeLongitude => v.extend(state.map_or([f64::NAN; 2], |n| [n.latitude_rad * DEG_PER_RAD, n.longitude_rad * DEG_PER_RAD])),
+                Quantity::LatitudeLongitude => v.extend(
+                    state.map_or([f64::NAN; 2], |n| [n.latitude_rad * DEG_PER_RAD, n.longitude_rad * DEG_PER_RAD]),
+                ),
                 Quantity::Height => v.push(state.map_or(f64::NAN, |n| n.height_m)),
             }
         }

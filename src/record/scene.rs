@@ -7,8 +7,8 @@ use rerun::RecordingStreamResult;
 
 use super::palette::{albedo, colors, p3, rgb, rgba};
 use super::rows::Quantity;
-use super::{to_rerun_quaternion, Recorder, ReplayKind, TIMELINE};
-use crate::math::units::{fmt_angle, ARCSEC_PER_RAD, DEG_PER_RAD};
+use super::{Recorder, ReplayKind, TIMELINE, to_rerun_quaternion};
+use crate::math::units::{ARCSEC_PER_RAD, DEG_PER_RAD, fmt_angle};
 use crate::model::gimbal::AxisGeometry;
 use crate::scenario::Params;
 
@@ -65,13 +65,30 @@ impl Recorder {
                     // both read where they coincide; their difference has its own plot.
                     let [u, c, f] = colors::VARIANT;
                     let n = names.len();
-                    rec.log_static(path, &rerun::SeriesLines::new().with_colors([rgba(u, 140), rgb(c), rgb(f)].into_iter().take(n)).with_names(names).with_widths([5.0, 2.0, 1.5].into_iter().take(n)))?;
+                    rec.log_static(
+                        path,
+                        &rerun::SeriesLines::new()
+                            .with_colors([rgba(u, 140), rgb(c), rgb(f)].into_iter().take(n))
+                            .with_names(names)
+                            .with_widths([5.0, 2.0, 1.5].into_iter().take(n)),
+                    )?;
                 }
-                Quantity::ClosedForm | Quantity::VehicleAttitude => rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors::EULER.map(rgb)).with_names(names))?,
-                Quantity::GimbalAngles => rec.log_static(path, &rerun::SeriesLines::new().with_colors(colors::AXES[..names.len()].iter().map(|c| rgb(*c))).with_names(names))?,
+                Quantity::ClosedForm | Quantity::VehicleAttitude => rec.log_static(
+                    path,
+                    &rerun::SeriesLines::new().with_colors(colors::EULER.map(rgb)).with_names(names),
+                )?,
+                Quantity::GimbalAngles => rec.log_static(
+                    path,
+                    &rerun::SeriesLines::new()
+                        .with_colors(colors::AXES[..names.len()].iter().map(|c| rgb(*c)))
+                        .with_names(names),
+                )?,
                 Quantity::Swing(k) => {
                     let light = colors::AXES[k].map(|c| c / 2 + 60);
-                    rec.log_static(path, &rerun::SeriesLines::new().with_colors([rgb(colors::AXES[k]), rgb(light)]).with_names(names))?;
+                    rec.log_static(
+                        path,
+                        &rerun::SeriesLines::new().with_colors([rgb(colors::AXES[k]), rgb(light)]).with_names(names),
+                    )?;
                 }
                 _ => {}
             }
@@ -115,11 +132,15 @@ impl Recorder {
             // Nominal axis (grey) in the mount frame; the rotor's own axis (coloured) in the rotor frame.
             rec.log_static(
                 format!("{}/nominal_axis", self.paths.mounts[k]),
-                &rerun::LineStrips3D::new([[p3(-g.axis * half), p3(g.axis * half)]]).with_colors([rgb(colors::NOMINAL)]).with_radii([0.006]),
+                &rerun::LineStrips3D::new([[p3(-g.axis * half), p3(g.axis * half)]])
+                    .with_colors([rgb(colors::NOMINAL)])
+                    .with_radii([0.006]),
             )?;
             rec.log_static(
                 format!("{}/actual_axis", self.paths.gimbals[k]),
-                &rerun::LineStrips3D::new([[p3(-g.axis * half * 1.05), p3(g.axis * half * 1.05)]]).with_colors([rgb(color)]).with_radii([0.012]),
+                &rerun::LineStrips3D::new([[p3(-g.axis * half * 1.05), p3(g.axis * half * 1.05)]])
+                    .with_colors([rgb(color)])
+                    .with_radii([0.012]),
             )?;
             // Ring of this gimbal: through its own axis and the next one; the last is a platform.
             rec.log_static(
@@ -130,11 +151,15 @@ impl Recorder {
         // The IMU: a box and its three sensor axes.
         rec.log_static(
             format!("{}/case", self.paths.imu),
-            &rerun::Boxes3D::from_half_sizes([[0.22, 0.22, 0.16]]).with_colors([rgba([200, 200, 210], 90)]).with_fill_mode(rerun::FillMode::Solid),
+            &rerun::Boxes3D::from_half_sizes([[0.22, 0.22, 0.16]])
+                .with_colors([rgba([200, 200, 210], 90)])
+                .with_fill_mode(rerun::FillMode::Solid),
         )?;
         rec.log_static(
             format!("{}/sensor_axes", self.paths.imu),
-            &rerun::Arrows3D::from_vectors([[0.45, 0.0, 0.0], [0.0, 0.45, 0.0], [0.0, 0.0, 0.45]]).with_colors(colors::SENSOR.map(rgb)).with_radii([0.015]),
+            &rerun::Arrows3D::from_vectors([[0.45, 0.0, 0.0], [0.0, 0.45, 0.0], [0.0, 0.0, 0.45]])
+                .with_colors(colors::SENSOR.map(rgb))
+                .with_radii([0.015]),
         )?;
         rec.log_static(
             format!("{}/sensor_axes/labels", self.paths.imu),
@@ -150,7 +175,12 @@ impl Recorder {
 
     /// Logs `arch` at `path`: static in a plain run (`at = None`), at simulated time `at` in live mode,
     /// where a reload can change it and the saved session must show the history.
-    pub(crate) fn put(&self, at: Option<f64>, path: impl Into<rerun::EntityPath>, arch: &dyn rerun::AsComponents) -> RecordingStreamResult<()> {
+    pub(crate) fn put(
+        &self,
+        at: Option<f64>,
+        path: impl Into<rerun::EntityPath>,
+        arch: &dyn rerun::AsComponents,
+    ) -> RecordingStreamResult<()> {
         match at {
             None => self.rec.log_static(path, arch),
             Some(t) => {
@@ -192,12 +222,18 @@ impl Recorder {
              and, navigating, `ins/velocity_enu_mps`, `ins/position_from_start_m` and `ins/latitude_longitude_deg`. \
              Time: seconds after the replay's start on `sim_time`, the IMU file's own clock on the timeline `file_clock` (docs/export.md).";
         let plots = match self.replay {
-            None => "Plots: red = uncompensated (nominal table model), green = compensated (`[compensation]` parameters), \
+            None => {
+                "Plots: red = uncompensated (nominal table model), green = compensated (`[compensation]` parameters), \
              blue = closed form (first-order theory, docs/closed-form.md)."
-                .to_owned(),
+                    .to_owned()
+            }
             Some(ReplayKind { table: false, reference }) => format!(
                 "A replayed **strapdown** IMU (no table): the 3D view shows its axes (= the body's: x right, y forward, z up) turning with the INS's attitude{}. {}",
-                if reference { ", the reference's in grey; the error plots are the INS's attitude against the reference, per algorithm" } else { " (no reference: nothing to compare it with)" },
+                if reference {
+                    ", the reference's in grey; the error plots are the INS's attitude against the reference, per algorithm"
+                } else {
+                    " (no reference: nothing to compare it with)"
+                },
                 replayed
             ),
             Some(ReplayKind { reference, .. }) => format!(
@@ -212,13 +248,20 @@ impl Recorder {
         if self.body.is_some() {
             doc.push_str(&format!("\n---\n{plots}\n"));
         } else {
-            doc.push_str(&format!("\n---\nError angles in the 3D view are drawn **×{}**. {plots} Seed {}.\n", p.recording.exaggeration, p.meta.seed));
+            doc.push_str(&format!(
+                "\n---\nError angles in the 3D view are drawn **×{}**. {plots} Seed {}.\n",
+                p.recording.exaggeration, p.meta.seed
+            ));
         }
         if self.replay.is_none() {
             doc.push_str(&errors_in_force(p, at));
         }
         self.put(at, "docs/scenario", &rerun::TextDocument::from_markdown(doc))?;
-        self.put(at, "docs/config", &rerun::TextDocument::from_markdown(format!("```toml\n{}\n```\n", p.resolved_toml)))?;
+        self.put(
+            at,
+            "docs/config",
+            &rerun::TextDocument::from_markdown(format!("```toml\n{}\n```\n", p.resolved_toml)),
+        )?;
         if self.body.is_some() {
             return Ok(());
         }
@@ -244,7 +287,16 @@ impl Recorder {
         // 1.1 long: at 1.5 the wedge and its label ran off the top of the default view.
         let mut key: Vec<(String, [u8; 3])> = Vec::new();
         let wedge = |radii: (f64, f64), both_ends: bool| Wedge { radii, both_ends };
-        key.extend(self.log_wedge(at, &format!("{}/installation", self.paths.vehicle), axes[0].axis, first_tilted, wedge((0.0, 1.1), false), installation, f.installation, "installation")?);
+        key.extend(self.log_wedge(
+            at,
+            &format!("{}/installation", self.paths.vehicle),
+            axes[0].axis,
+            first_tilted,
+            wedge((0.0, 1.1), false),
+            installation,
+            f.installation,
+            "installation",
+        )?);
         for (k, g) in axes.iter().enumerate() {
             let half = ring_radius(k, n) * 1.25;
             let color = colors::AXES[k];
@@ -253,8 +305,16 @@ impl Recorder {
             let cone_path = format!("{}/swing_cone", self.paths.mounts[k]);
             if alpha > 0.0 {
                 let (mesh, rims) = cone(g.axis, g.e1, g.e2, alpha, half);
-                self.put(at, cone_path.as_str(), &rerun::Mesh3D::new(mesh.0).with_triangle_indices(mesh.1).with_albedo_factor(albedo(color, 60)))?;
-                self.put(at, format!("{cone_path}/rims"), &rerun::LineStrips3D::new(rims).with_colors([rgba(color, 200)]).with_radii([0.004]))?;
+                self.put(
+                    at,
+                    cone_path.as_str(),
+                    &rerun::Mesh3D::new(mesh.0).with_triangle_indices(mesh.1).with_albedo_factor(albedo(color, 60)),
+                )?;
+                self.put(
+                    at,
+                    format!("{cone_path}/rims"),
+                    &rerun::LineStrips3D::new(rims).with_colors([rgba(color, 200)]).with_radii([0.004]),
+                )?;
                 let text = format!(
                     "{} cone: {} swing α = {}, φ = {:.1}°{}",
                     super::palette::colors::AXIS_COLOR_NAMES[k],
@@ -281,7 +341,16 @@ impl Recorder {
                 // Short: the key's line must stop short of the upper wedge (the inner axis's, from
                 // the default eye, passes just left of the key's middle).
                 let what = format!("{} η", g.name);
-                key.extend(self.log_wedge(at, &format!("{}/non_orthogonality", self.paths.gimbals[k - 1]), g.axis, tilted, wedge((from, from + 0.25), true), eta_arcsec, f.non_orthogonality, &what)?);
+                key.extend(self.log_wedge(
+                    at,
+                    &format!("{}/non_orthogonality", self.paths.gimbals[k - 1]),
+                    g.axis,
+                    tilted,
+                    wedge((from, from + 0.25), true),
+                    eta_arcsec,
+                    f.non_orthogonality,
+                    &what,
+                )?);
             }
         }
         self.log_key(at, &key)
@@ -290,7 +359,17 @@ impl Recorder {
     /// A translucent wedge from `ideal` to `tilted` (both unit, same frame) over `shape`'s radii;
     /// its line of the key (None when there is no wedge).
     #[allow(clippy::too_many_arguments)]
-    pub(crate) fn log_wedge(&self, at: Option<f64>, path: &str, ideal: Vector3<f64>, tilted: Vector3<f64>, shape: Wedge, true_arcsec: f64, x: f64, what: &str) -> RecordingStreamResult<Option<(String, [u8; 3])>> {
+    pub(crate) fn log_wedge(
+        &self,
+        at: Option<f64>,
+        path: &str,
+        ideal: Vector3<f64>,
+        tilted: Vector3<f64>,
+        shape: Wedge,
+        true_arcsec: f64,
+        x: f64,
+        what: &str,
+    ) -> RecordingStreamResult<Option<(String, [u8; 3])>> {
         if true_arcsec == 0.0 {
             self.clear(at, path)?;
             return Ok(None);
@@ -310,11 +389,23 @@ impl Recorder {
                 let (a, b) = (base + 2 * i, base + 2 * i + 2);
                 triangles.extend([[a, a + 1, b + 1], [a, b + 1, b]]);
             }
-            edges.extend([[p3(sign * ideal * r0), p3(sign * ideal * r1)], [p3(sign * tilted * r0), p3(sign * tilted * r1)]]);
+            edges.extend([
+                [p3(sign * ideal * r0), p3(sign * ideal * r1)],
+                [p3(sign * tilted * r0), p3(sign * tilted * r1)],
+            ]);
         }
-        self.put(at, format!("{path}/wedge"), &rerun::Mesh3D::new(positions).with_triangle_indices(triangles).with_albedo_factor(albedo(WEDGE, 110)))?;
-        let edge_colors: Vec<rerun::Color> = (0..edges.len()).map(|i| if i % 2 == 0 { rgb([255, 255, 255]) } else { rgb(WEDGE) }).collect();
-        self.put(at, format!("{path}/edges"), &rerun::LineStrips3D::new(edges).with_colors(edge_colors).with_radii([0.004]))?;
+        self.put(
+            at,
+            format!("{path}/wedge"),
+            &rerun::Mesh3D::new(positions).with_triangle_indices(triangles).with_albedo_factor(albedo(WEDGE, 110)),
+        )?;
+        let edge_colors: Vec<rerun::Color> =
+            (0..edges.len()).map(|i| if i % 2 == 0 { rgb([255, 255, 255]) } else { rgb(WEDGE) }).collect();
+        self.put(
+            at,
+            format!("{path}/edges"),
+            &rerun::LineStrips3D::new(edges).with_colors(edge_colors).with_radii([0.004]),
+        )?;
         let wedges = if shape.both_ends { "wedges" } else { "wedge" };
         Ok(Some((format!("yellow {wedges}: {what} = {} (drawn ×{x})", fmt_angle(true_arcsec / ARCSEC_PER_RAD)), WEDGE)))
     }
@@ -326,7 +417,8 @@ impl Recorder {
         if entries.is_empty() {
             return self.clear(at, KEY_PATH);
         }
-        let positions: Vec<[f32; 3]> = (0..entries.len()).map(|i| [KEY_AT[0], KEY_AT[1], KEY_AT[2] - KEY_STEP * i as f32]).collect();
+        let positions: Vec<[f32; 3]> =
+            (0..entries.len()).map(|i| [KEY_AT[0], KEY_AT[1], KEY_AT[2] - KEY_STEP * i as f32]).collect();
         self.put(
             at,
             KEY_PATH,
@@ -375,7 +467,9 @@ const WEDGE: [u8; 3] = [255, 200, 60];
 fn errors_in_force(p: &Params, at: Option<f64>) -> String {
     let t = &p.table.truth;
     let when = at.map_or(String::new(), |t_s| format!(" since t = {t_s:.1} s"));
-    let mut s = format!("\n**Errors in force{when}** (true values; `[compensation]` is what the compensated line assumes)\n\n| axis | swing α | swing φ | η | encoder offset | scale | delay | noise 1σ |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
+    let mut s = format!(
+        "\n**Errors in force{when}** (true values; `[compensation]` is what the compensated line assumes)\n\n| axis | swing α | swing φ | η | encoder offset | scale | delay | noise 1σ |\n|---|---:|---:|---:|---:|---:|---:|---:|\n"
+    );
     for (g, e) in p.table.chain.axes().iter().zip(&t.axes) {
         s.push_str(&format!(
             "| {} | {} | {:.1}° | {} | {} | {:.0} ppm | {:.2} ms | {} |\n",
@@ -389,8 +483,14 @@ fn errors_in_force(p: &Params, at: Option<f64>) -> String {
             fmt_angle(e.encoder_noise_rad)
         ));
     }
-    let v = |x: &nalgebra::Vector3<f64>| format!("({:.1}, {:.1}, {:.1})″", x.x * ARCSEC_PER_RAD, x.y * ARCSEC_PER_RAD, x.z * ARCSEC_PER_RAD);
-    s.push_str(&format!("\nInstallation about (x, y, z): {}; IMU mounting: {}.\n", v(&t.installation_rad), v(&t.imu_mount_rad)));
+    let v = |x: &nalgebra::Vector3<f64>| {
+        format!("({:.1}, {:.1}, {:.1})″", x.x * ARCSEC_PER_RAD, x.y * ARCSEC_PER_RAD, x.z * ARCSEC_PER_RAD)
+    };
+    s.push_str(&format!(
+        "\nInstallation about (x, y, z): {}; IMU mounting: {}.\n",
+        v(&t.installation_rad),
+        v(&t.imu_mount_rad)
+    ));
     s
 }
 
@@ -430,14 +530,25 @@ pub(crate) fn ring(axes: &[AxisGeometry], k: usize, radius: f64) -> Vec<Vec<[f32
             strips.push(vec![[0.0; 3], p3((u * t.cos() + w * t.sin()) * radius)]);
         }
         // A marker notch at e1 so the sense of rotation reads at a glance.
-        strips.push(vec![p3(u * radius * 1.12 + w * 0.05), p3(u * radius * 1.12 - w * 0.05), p3(u * radius * 0.95), p3(u * radius * 1.12 + w * 0.05)]);
+        strips.push(vec![
+            p3(u * radius * 1.12 + w * 0.05),
+            p3(u * radius * 1.12 - w * 0.05),
+            p3(u * radius * 0.95),
+            p3(u * radius * 1.12 + w * 0.05),
+        ]);
     }
     strips
 }
 
 /// A double cone of half-angle `alpha` around `axis` (length `half` each way): mesh and rim circles.
 #[allow(clippy::type_complexity)]
-pub(crate) fn cone(axis: Vector3<f64>, e1: Vector3<f64>, e2: Vector3<f64>, alpha: f64, half: f64) -> ((Vec<[f32; 3]>, Vec<[u32; 3]>), Vec<Vec<[f32; 3]>>) {
+pub(crate) fn cone(
+    axis: Vector3<f64>,
+    e1: Vector3<f64>,
+    e2: Vector3<f64>,
+    alpha: f64,
+    half: f64,
+) -> ((Vec<[f32; 3]>, Vec<[u32; 3]>), Vec<Vec<[f32; 3]>>) {
     let segments = 48u32;
     let r = half * alpha.tan();
     let mut positions = vec![[0.0f32; 3]];

@@ -5,13 +5,13 @@
 //! same IMU free-inertial afterwards, one plot per motion.
 
 use nalgebra::UnitQuaternion;
-use rerun::blueprint::components::ContainerKind;
 use rerun::RecordingStreamResult;
+use rerun::blueprint::components::ContainerKind;
 
 use super::layout::{self, Node};
 use super::palette::{self, rgb};
-use super::{to_rerun_quaternion, Stream, APPLICATION_ID, TIMELINE};
-use crate::ins::selfcal::{param, HistoryRow, N_PARAMS};
+use super::{APPLICATION_ID, Stream, TIMELINE, to_rerun_quaternion};
+use crate::ins::selfcal::{HistoryRow, N_PARAMS, param};
 
 /// What the recording shows.
 pub struct SelfcalView<'a> {
@@ -55,7 +55,8 @@ const GROUPS: [(&str, &str, &str); 4] = [
 /// The axes a parameter's name ends in (`bg_y`, `Kg_yx`), in the order of their line colours in
 /// [`palette::colors::DISTINCT`]: an axis, or a diagonal of K (a scale factor), in that axis's
 /// colour, as the IMU's axes in 3D; the misalignments in colours of their own.
-const LINE_AXES: [&[&str]; 9] = [&["x", "xx"], &["y", "yy"], &["z", "zz"], &["xy"], &["xz"], &["yz"], &["yx"], &["zx"], &["zy"]];
+const LINE_AXES: [&[&str]; 9] =
+    [&["x", "xx"], &["y", "yy"], &["z", "zz"], &["xy"], &["xz"], &["yz"], &["yx"], &["zx"], &["zy"]];
 
 /// A parameter's line colour in its group's plot: its index in [`palette::colors::DISTINCT`].
 fn line_colour(name: &str) -> usize {
@@ -80,7 +81,12 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
     let navigation = if motions.is_empty() {
         String::new()
     } else {
-        let compensations = v.navigation.iter().filter(|l| l.motion == motions[0]).enumerate().map(|(i, l)| format!("{} {}", nav_colour(i).0, l.compensation));
+        let compensations = v
+            .navigation
+            .iter()
+            .filter(|l| l.motion == motions[0])
+            .enumerate()
+            .map(|(i, l)| format!("{} {}", nav_colour(i).0, l.compensation));
         format!(
             "- right column: afterwards, the same IMU free-inertial from t = 0 ({}), the radial position error in log10 metres (1 = 10 m, 4 = 10 km); compensation {}\n",
             motions.join(", "),
@@ -97,21 +103,31 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
     );
     rec.log_static("docs/selfcal", &rerun::TextDocument::from_markdown(doc))?;
     // The IMU: a case and its axes, turned by its true attitude.
-    rec.log_static("world/imu/case", &rerun::Boxes3D::from_half_sizes([[0.25, 0.25, 0.18]]).with_colors([palette::rgba([150, 150, 160], 90)]))?;
+    rec.log_static(
+        "world/imu/case",
+        &rerun::Boxes3D::from_half_sizes([[0.25, 0.25, 0.18]]).with_colors([palette::rgba([150, 150, 160], 90)]),
+    )?;
     rec.log_static(
         "world/imu/axes",
-        &rerun::Arrows3D::from_vectors([[0.6, 0.0, 0.0], [0.0, 0.6, 0.0], [0.0, 0.0, 0.6]]).with_colors(palette::colors::SENSOR.map(rgb)).with_radii([0.02]),
+        &rerun::Arrows3D::from_vectors([[0.6, 0.0, 0.0], [0.0, 0.6, 0.0], [0.0, 0.0, 0.6]])
+            .with_colors(palette::colors::SENSOR.map(rgb))
+            .with_radii([0.02]),
     )?;
     rec.log_static(
         "world/imu/axes/labels",
-        &rerun::Points3D::new([[0.72, 0.0, 0.0], [0.0, 0.72, 0.0], [0.0, 0.0, 0.72]]).with_labels(["x", "y", "z"]).with_colors(palette::colors::SENSOR.map(palette::label)).with_radii([0.002]),
+        &rerun::Points3D::new([[0.72, 0.0, 0.0], [0.0, 0.72, 0.0], [0.0, 0.0, 0.72]])
+            .with_labels(["x", "y", "z"])
+            .with_colors(palette::colors::SENSOR.map(palette::label))
+            .with_radii([0.002]),
     )?;
     let times: Vec<f64> = v.attitude.iter().map(|a| a.0).collect();
     if !times.is_empty() {
         rec.send_columns(
             "world/imu",
             stream.time_columns(&times),
-            rerun::Transform3D::update_fields().with_many_quaternion(v.attitude.iter().map(|a| to_rerun_quaternion(&a.1))).columns_of_unit_batches()?,
+            rerun::Transform3D::update_fields()
+                .with_many_quaternion(v.attitude.iter().map(|a| to_rerun_quaternion(&a.1)))
+                .columns_of_unit_batches()?,
         )?;
     }
     let t: Vec<f64> = v.history.iter().map(|r| r.t_s).collect();
@@ -125,11 +141,19 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
         let names: Vec<String> = members.iter().map(|&k| param(k).1).collect();
         let colors = names.iter().map(|n| rgb(palette::colors::DISTINCT[line_colour(n)].1));
         rec.log_static(path.as_str(), &rerun::SeriesLines::new().with_colors(colors).with_names(names.clone()))?;
-        let values: Vec<f64> = v.history.iter().flat_map(|r| members.iter().map(|&k| (r.sigma[k] / v.prior[k]).max(1e-12).log10()).collect::<Vec<_>>()).collect();
+        let values: Vec<f64> = v
+            .history
+            .iter()
+            .flat_map(|r| members.iter().map(|&k| (r.sigma[k] / v.prior[k]).max(1e-12).log10()).collect::<Vec<_>>())
+            .collect();
         stream.send_series(&path, &names, &t, values, members.len())?;
         stream.mark_events(&path, "moves", "moves", v.move_starts_s, 0.0)?;
         // Keyed in the document (a legend would cover the lines, the title has no room).
-        observability.push(Node::view("TimeSeries", title, path).with_property("TimeAxis", &seq_axis).with_property("PlotLegend", &layout::no_legend()));
+        observability.push(
+            Node::view("TimeSeries", title, path)
+                .with_property("TimeAxis", &seq_axis)
+                .with_property("PlotLegend", &layout::no_legend()),
+        );
         for &k in &members {
             let (kind, name) = param(k);
             let (unit, per_si) = kind.unit();
@@ -137,11 +161,20 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
             let truth = v.truth.map_or(0.0, |t| t[k]);
             let what = if v.truth.is_some() { "estimate − true" } else { "estimate" };
             let series = [what.to_owned(), "+3σ".to_owned(), "−3σ".to_owned()];
-            rec.log_static(path.as_str(), &rerun::SeriesLines::new().with_colors([rgb([250, 200, 60]), rgb([150, 150, 150]), rgb([150, 150, 150])]).with_names(series.clone()))?;
-            let values: Vec<f64> = v.history.iter().flat_map(|r| {
-                let (e, s) = ((r.estimate[k] - truth) * per_si, 3.0 * r.sigma[k] * per_si);
-                [e, s, -s]
-            }).collect();
+            rec.log_static(
+                path.as_str(),
+                &rerun::SeriesLines::new()
+                    .with_colors([rgb([250, 200, 60]), rgb([150, 150, 150]), rgb([150, 150, 150])])
+                    .with_names(series.clone()),
+            )?;
+            let values: Vec<f64> = v
+                .history
+                .iter()
+                .flat_map(|r| {
+                    let (e, s) = ((r.estimate[k] - truth) * per_si, 3.0 * r.sigma[k] * per_si);
+                    [e, s, -s]
+                })
+                .collect();
             stream.send_series(&path, &series, &t, values, 3)?;
             // Framed on the last tenth of the prior: the start (the prior's width) would flatten the rest.
             let last = v.history.last().map_or(1.0, |r| 3.0 * r.sigma[k] * per_si);
@@ -159,15 +192,33 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
     let mut navigation = navigation.into_iter();
     let mut observability = observability.into_iter();
     let rows: Vec<Node> = (0..2)
-        .map(|_| Node::container(ContainerKind::Horizontal, observability.by_ref().take(2).chain(navigation.next()).collect(), &[]))
+        .map(|_| {
+            Node::container(
+                ContainerKind::Horizontal,
+                observability.by_ref().take(2).chain(navigation.next()).collect(),
+                &[],
+            )
+        })
         .collect();
     let mut grid = Node::container(ContainerKind::Vertical, rows, &[]);
     // More motions than rows (none today): a row of their own.
     let more: Vec<Node> = navigation.collect();
     if !more.is_empty() {
-        grid = Node::container(ContainerKind::Vertical, vec![grid, Node::container(ContainerKind::Horizontal, more, &[])], &[2.0, 1.0]);
+        grid = Node::container(
+            ContainerKind::Vertical,
+            vec![grid, Node::container(ContainerKind::Horizontal, more, &[])],
+            &[2.0, 1.0],
+        );
     }
-    let left = Node::container(ContainerKind::Vertical, vec![Node::view("3D", "the IMU turning through the sequence (true attitude; the grid is level)", "world").with_property("EyeControls3D", &layout::eye([1.5, -1.7, 1.0], [0.0, 0.0, 0.0])), Node::view("TextDocument", "result", "docs/selfcal")], &[1.0, 1.2]);
+    let left = Node::container(
+        ContainerKind::Vertical,
+        vec![
+            Node::view("3D", "the IMU turning through the sequence (true attitude; the grid is level)", "world")
+                .with_property("EyeControls3D", &layout::eye([1.5, -1.7, 1.0], [0.0, 0.0, 0.0])),
+            Node::view("TextDocument", "result", "docs/selfcal"),
+        ],
+        &[1.0, 1.2],
+    );
     let right = Node::container(
         ContainerKind::Vertical,
         vec![grid, Node::container(ContainerKind::Tabs, tabs, &[])],
@@ -201,18 +252,30 @@ fn log_navigation(stream: &Stream, lines: &[NavLine<'_>], motions: &[&str]) -> R
     let log10_m = |m: f64| m.max(1e-3).log10();
     // From the first hundredth of the run on (the lines' steep start from 0 m would set the range).
     let end_s = lines.iter().filter_map(|l| l.trace.samples.last()).map(|s| s.t_s).fold(0.0, f64::max);
-    let (lo, hi) = lines.iter().flat_map(|l| &l.trace.samples).filter(|s| s.t_s >= 0.01 * end_s).map(|s| log10_m(s.position_m[2])).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| (lo.min(y), hi.max(y)));
+    let (lo, hi) = lines
+        .iter()
+        .flat_map(|l| &l.trace.samples)
+        .filter(|s| s.t_s >= 0.01 * end_s)
+        .map(|s| log10_m(s.position_m[2]))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| (lo.min(y), hi.max(y)));
     let mut plots = Vec::new();
     for motion in motions {
         let runs: Vec<&NavLine<'_>> = lines.iter().filter(|l| l.motion == *motion).collect();
         let path = format!("selfcal/navigation/{}/radial_position_error_log10_m", motion.replace([' ', '-'], "_"));
         let names: Vec<String> = runs.iter().map(|l| l.compensation.to_owned()).collect();
         let colors = (0..runs.len()).map(|i| rgb(nav_colour(i).1));
-        stream.rec().log_static(path.as_str(), &rerun::SeriesLines::new().with_colors(colors).with_names(names.clone()))?;
+        stream
+            .rec()
+            .log_static(path.as_str(), &rerun::SeriesLines::new().with_colors(colors).with_names(names.clone()))?;
         let n = runs.iter().map(|l| l.trace.samples.len()).min().unwrap_or(0);
         let times: Vec<f64> = runs[0].trace.samples.iter().take(n).map(|s| s.t_s).collect();
-        let values: Vec<f64> = (0..n).flat_map(|i| runs.iter().map(move |l| log10_m(l.trace.samples[i].position_m[2]))).collect();
-        stream.rec().send_columns(path.as_str(), stream.time_columns(&times), rerun::Scalars::new(values).columns(std::iter::repeat_n(names.len(), n))?)?;
+        let values: Vec<f64> =
+            (0..n).flat_map(|i| runs.iter().map(move |l| log10_m(l.trace.samples[i].position_m[2]))).collect();
+        stream.rec().send_columns(
+            path.as_str(),
+            stream.time_columns(&times),
+            rerun::Scalars::new(values).columns(std::iter::repeat_n(names.len(), n))?,
+        )?;
         let mut plot = Node::view("TimeSeries", format!("{motion}: log10 error (m)"), path)
             .with_property("TimeAxis", &layout::whole_run_time_axis())
             // Below the lines once they have left 0 m: the legend covers none of them.

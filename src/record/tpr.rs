@@ -1,14 +1,14 @@
 //! The recording of `rinscope tpr`: azimuth and radial position errors of the conventional reset and
 //! of TPR overlaid, the fixes marked, the comparison with Zheng et al. 2016 as a document.
 
-use rerun::blueprint::components::ContainerKind;
 use rerun::RecordingStreamResult;
+use rerun::blueprint::components::ContainerKind;
 
 use super::layout::{self, Node};
 use super::palette::rgb;
-use super::{Stream, APPLICATION_ID, TIMELINE};
+use super::{APPLICATION_ID, Stream, TIMELINE};
+use crate::ins::reset::{BRANCH_NAMES, BRANCHES, PAPER_RADIAL_M, TprResult};
 use crate::scenario::Params;
-use crate::ins::reset::{TprResult, BRANCHES, BRANCH_NAMES, PAPER_RADIAL_M};
 
 const COLORS: [[u8; 3]; BRANCHES] = [[230, 76, 60], [46, 170, 90], [70, 130, 230]];
 
@@ -33,7 +33,10 @@ pub fn log(stream: &Stream, params: &Params, r: &TprResult, table: &str) -> Reco
         PAPER_RADIAL_M.1
     );
     rec.log_static("docs/tpr", &rerun::TextDocument::from_markdown(doc))?;
-    rec.log_static("docs/config", &rerun::TextDocument::from_markdown(format!("```toml\n{}\n```\n", params.resolved_toml)))?;
+    rec.log_static(
+        "docs/config",
+        &rerun::TextDocument::from_markdown(format!("```toml\n{}\n```\n", params.resolved_toml)),
+    )?;
     let colors: Vec<rerun::Color> = COLORS.iter().map(|c| rgb(*c)).collect();
     let paths = ["tpr/heading_error_arcsec", "tpr/radial_position_error_m", "tpr/east_error_m", "tpr/north_error_m"];
     for path in paths {
@@ -47,7 +50,10 @@ pub fn log(stream: &Stream, params: &Params, r: &TprResult, table: &str) -> Reco
         r.samples.iter().flat_map(|s| s.east_north_m[1]).collect(),
     ];
     let names = BRANCH_NAMES.map(String::from);
-    let fix_label = format!("position fixes ({})", r.fixes_s.iter().map(|t| format!("{:.0} h", t / 3600.0)).collect::<Vec<_>>().join(", "));
+    let fix_label = format!(
+        "position fixes ({})",
+        r.fixes_s.iter().map(|t| format!("{:.0} h", t / 3600.0)).collect::<Vec<_>>().join(", ")
+    );
     for (path, values) in paths.iter().zip(columns) {
         let top = values.iter().copied().filter(|v| v.is_finite()).fold(0.0_f64, f64::max);
         stream.send_series(path, &names, &times, values, BRANCHES)?;
@@ -67,19 +73,32 @@ pub fn log(stream: &Stream, params: &Params, r: &TprResult, table: &str) -> Reco
     }
     // Legends would sit over the data: the first title gives the colours.
     let plot = |name: &str, origin: &str| {
-        Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::whole_run_time_axis()).with_property("PlotLegend", &layout::no_legend())
+        Node::view("TimeSeries", name, origin)
+            .with_property("TimeAxis", &layout::whole_run_time_axis())
+            .with_property("PlotLegend", &layout::no_legend())
     };
     let key = format!("red {} · green {} · blue {} · ▼ fixes", BRANCH_NAMES[0], BRANCH_NAMES[1], BRANCH_NAMES[2]);
     let root = Node::container(
         ContainerKind::Horizontal,
         vec![
-            Node::container(ContainerKind::Vertical, vec![plot(&format!("azimuth (heading) error (″) — {key}"), "tpr/heading_error_arcsec"), plot("radial position error (m)", "tpr/radial_position_error_m")], &[]),
+            Node::container(
+                ContainerKind::Vertical,
+                vec![
+                    plot(&format!("azimuth (heading) error (″) — {key}"), "tpr/heading_error_arcsec"),
+                    plot("radial position error (m)", "tpr/radial_position_error_m"),
+                ],
+                &[],
+            ),
             Node::container(
                 ContainerKind::Vertical,
                 vec![
                     Node::container(
                         ContainerKind::Tabs,
-                        vec![Node::view("TextDocument", "about", "docs/tpr"), Node::view("TextDocument", "config", "docs/config"), Node::view("TextLog", "events", "events")],
+                        vec![
+                            Node::view("TextDocument", "about", "docs/tpr"),
+                            Node::view("TextDocument", "config", "docs/config"),
+                            Node::view("TextLog", "events", "events"),
+                        ],
                         &[],
                     ),
                     plot("east error (m)", "tpr/east_error_m"),

@@ -3,16 +3,19 @@
 
 use nalgebra::Vector3;
 
+use super::ConfigError;
 use super::raw::{RawCalibration, RawFir, RawImu, RawNavigation, RawSpec};
 use super::validate::{Checker, ERROR_HINT, MAX_ERROR_ANGLE_ARCSEC};
-use super::ConfigError;
 use crate::calib::{CalibConfig, InsErrorModel, MonteCarloConfig, Nuisance};
 use crate::ins::coning::Algorithm;
 use crate::ins::nav::{NavOptions, Vertical};
 use crate::ins::noise::IeeeTerms;
 use crate::ins::sensor::{AccelSpec, DitherSpec, GyroSpec, Spec};
-use crate::ins::{fir, InsParams};
-use crate::math::units::{MPS2_PER_UG, RAD_PER_ARCMIN, RAD_PER_ARCSEC, RAD_PER_DEG, RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H, RAD_PER_S_PER_DEG_PER_H, STANDARD_GRAVITY_MPS2};
+use crate::ins::{InsParams, fir};
+use crate::math::units::{
+    MPS2_PER_UG, RAD_PER_ARCMIN, RAD_PER_ARCSEC, RAD_PER_DEG, RAD_PER_S_PER_DEG_PER_H,
+    RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H, STANDARD_GRAVITY_MPS2,
+};
 use crate::model::gimbal::TableErrors;
 
 /// Starting values of the `[imu]` section; keys in the file override them.
@@ -69,7 +72,11 @@ pub fn imu_preset(name: &str) -> Option<InsParams> {
                 markov_sigma_mps2: 20.0 * UG,
                 correlation_s: 3600.0,
             };
-            cfg.errors.dither = DitherSpec { frequencies_hz: [335.4, 375.5, 425.7], amplitudes_rad: [500.0 * RAD_PER_ARCSEC; 3], coupling: 0.3 };
+            cfg.errors.dither = DitherSpec {
+                frequencies_hz: [335.4, 375.5, 425.7],
+                amplitudes_rad: [500.0 * RAD_PER_ARCSEC; 3],
+                coupling: 0.3,
+            };
             cfg.fir_taps = fir::SEED001_TAPS.to_vec();
             cfg.zero_order_hold = true;
         }
@@ -80,7 +87,9 @@ pub fn imu_preset(name: &str) -> Option<InsParams> {
 
 fn spec(c: &Checker<'_>, key: &str, v: RawSpec, unit: &'static str, max: f64, to_si: f64) -> Result<Spec, ConfigError> {
     Ok(match v {
-        RawSpec::Sigma(s) => Spec::Sigma(c.range(key, s, unit, 0.0, max, "a number is the 1σ of a per-axis draw")? * to_si),
+        RawSpec::Sigma(s) => {
+            Spec::Sigma(c.range(key, s, unit, 0.0, max, "a number is the 1σ of a per-axis draw")? * to_si)
+        }
         RawSpec::Fixed(a) => {
             let mut out = [0.0; 3];
             for (i, x) in a.iter().enumerate() {
@@ -93,15 +102,27 @@ fn spec(c: &Checker<'_>, key: &str, v: RawSpec, unit: &'static str, max: f64, to
 
 /// `[imu]` with `[navigation]` at the IMU rate `step_hz` (None without `[imu]`; `[navigation]`
 /// alone is refused).
-pub(super) fn validate_ins(c: &Checker<'_>, imu: Option<&RawImu>, nav: Option<&RawNavigation>, step_hz: f64) -> Result<Option<InsParams>, ConfigError> {
+pub(super) fn validate_ins(
+    c: &Checker<'_>,
+    imu: Option<&RawImu>,
+    nav: Option<&RawNavigation>,
+    step_hz: f64,
+) -> Result<Option<InsParams>, ConfigError> {
     match imu {
-        None if nav.is_some() => Err(c.invalid("navigation", "needs an [imu] section (navigation runs on the IMU's increments)")),
+        None if nav.is_some() => {
+            Err(c.invalid("navigation", "needs an [imu] section (navigation runs on the IMU's increments)"))
+        }
         None => Ok(None),
         Some(imu) => validate_imu(c, imu, nav, step_hz).map(Some),
     }
 }
 
-fn validate_imu(c: &Checker<'_>, raw: &RawImu, nav: Option<&RawNavigation>, step_hz: f64) -> Result<InsParams, ConfigError> {
+fn validate_imu(
+    c: &Checker<'_>,
+    raw: &RawImu,
+    nav: Option<&RawNavigation>,
+    step_hz: f64,
+) -> Result<InsParams, ConfigError> {
     const DEG_PER_H: f64 = RAD_PER_S_PER_DEG_PER_H;
     const UG: f64 = MPS2_PER_UG;
     let preset_name = raw.preset.as_deref().unwrap_or("none");
@@ -125,7 +146,11 @@ fn validate_imu(c: &Checker<'_>, raw: &RawImu, nav: Option<&RawNavigation>, step
         None => {}
         Some(RawFir::Named(n)) if n == "seed001" => cfg.fir_taps = fir::SEED001_TAPS.to_vec(),
         Some(RawFir::Named(n)) if n == "none" => cfg.fir_taps = vec![1.0],
-        Some(RawFir::Named(n)) => return Err(c.invalid("imu.fir", format!("\"{n}\" is not a filter; use \"seed001\", \"none\" or a list of taps"))),
+        Some(RawFir::Named(n)) => {
+            return Err(
+                c.invalid("imu.fir", format!("\"{n}\" is not a filter; use \"seed001\", \"none\" or a list of taps"))
+            );
+        }
         Some(RawFir::Taps(t)) => {
             if t.is_empty() || t.len() > 1001 {
                 return Err(c.invalid("imu.fir", format!("{} taps given; 1 to 1001 are supported", t.len())));
@@ -157,17 +182,22 @@ fn validate_imu(c: &Checker<'_>, raw: &RawImu, nav: Option<&RawNavigation>, step
         e.gyro.scale = spec(c, "imu.gyro.scale_ppm", v, "ppm", 1e5, 1e-6)?;
     }
     if let Some(v) = g.misalignment_arcsec {
-        e.gyro.misalignment_rad = c.range("imu.gyro.misalignment_arcsec", v, "arcsec", 0.0, MAX_ERROR_ANGLE_ARCSEC, ERROR_HINT)? * RAD_PER_ARCSEC;
+        e.gyro.misalignment_rad =
+            c.range("imu.gyro.misalignment_arcsec", v, "arcsec", 0.0, MAX_ERROR_ANGLE_ARCSEC, ERROR_HINT)?
+                * RAD_PER_ARCSEC;
     }
     super::stochastic::gyro_terms(c, g, &mut e.gyro.noise, step_hz)?;
     if let Some(v) = g.markov_sigma_deg_per_h {
-        e.gyro.markov_sigma_rad_per_s = c.range("imu.gyro.markov_sigma_deg_per_h", v, "deg/h", 0.0, 3600.0, "")? * DEG_PER_H;
+        e.gyro.markov_sigma_rad_per_s =
+            c.range("imu.gyro.markov_sigma_deg_per_h", v, "deg/h", 0.0, 3600.0, "")? * DEG_PER_H;
     }
     if let Some(v) = g.correlation_time_s {
         e.gyro.correlation_s = c.positive("imu.gyro.correlation_time_s", v, "s", 1e9)?;
     }
     if let Some(v) = g.g_sensitivity_deg_per_h_per_g {
-        e.g_sensitivity = c.range("imu.gyro.g_sensitivity_deg_per_h_per_g", v, "deg/h/g", -3600.0, 3600.0, "")? * DEG_PER_H / STANDARD_GRAVITY_MPS2;
+        e.g_sensitivity = c.range("imu.gyro.g_sensitivity_deg_per_h_per_g", v, "deg/h/g", -3600.0, 3600.0, "")?
+            * DEG_PER_H
+            / STANDARD_GRAVITY_MPS2;
     }
     let a = &raw.accel;
     if let Some(v) = a.bias_ug {
@@ -177,7 +207,9 @@ fn validate_imu(c: &Checker<'_>, raw: &RawImu, nav: Option<&RawNavigation>, step
         e.accel.scale = spec(c, "imu.accel.scale_ppm", v, "ppm", 1e5, 1e-6)?;
     }
     if let Some(v) = a.misalignment_arcsec {
-        e.accel.misalignment_rad = c.range("imu.accel.misalignment_arcsec", v, "arcsec", 0.0, MAX_ERROR_ANGLE_ARCSEC, ERROR_HINT)? * RAD_PER_ARCSEC;
+        e.accel.misalignment_rad =
+            c.range("imu.accel.misalignment_arcsec", v, "arcsec", 0.0, MAX_ERROR_ANGLE_ARCSEC, ERROR_HINT)?
+                * RAD_PER_ARCSEC;
     }
     super::stochastic::accel_terms(c, a, &mut e.accel.noise, step_hz)?;
     if let Some(v) = a.markov_sigma_ug {
@@ -189,12 +221,21 @@ fn validate_imu(c: &Checker<'_>, raw: &RawImu, nav: Option<&RawNavigation>, step
     let d = &raw.dither;
     if let Some(f) = d.frequencies_hz {
         for (i, x) in f.iter().enumerate() {
-            e.dither.frequencies_hz[i] = c.range(&format!("imu.dither.frequencies_hz[{i}]"), *x, "Hz", 0.0, 0.5 * step_hz, "below half the IMU rate (simulation.step_hz)")?;
+            e.dither.frequencies_hz[i] = c.range(
+                &format!("imu.dither.frequencies_hz[{i}]"),
+                *x,
+                "Hz",
+                0.0,
+                0.5 * step_hz,
+                "below half the IMU rate (simulation.step_hz)",
+            )?;
         }
     }
     if let Some(amp) = d.amplitudes_arcsec {
         for (i, x) in amp.iter().enumerate() {
-            e.dither.amplitudes_rad[i] = c.range(&format!("imu.dither.amplitudes_arcsec[{i}]"), *x, "arcsec", 0.0, MAX_ERROR_ANGLE_ARCSEC, "")? * RAD_PER_ARCSEC;
+            e.dither.amplitudes_rad[i] =
+                c.range(&format!("imu.dither.amplitudes_arcsec[{i}]"), *x, "arcsec", 0.0, MAX_ERROR_ANGLE_ARCSEC, "")?
+                    * RAD_PER_ARCSEC;
         }
     }
     if let Some(k) = d.coupling {
@@ -204,13 +245,22 @@ fn validate_imu(c: &Checker<'_>, raw: &RawImu, nav: Option<&RawNavigation>, step
         let vertical = match n.vertical.as_str() {
             "held" => Vertical::Held,
             "free" => Vertical::Free,
-            other => return Err(c.invalid("navigation.vertical", format!("\"{other}\" is not a mode; use \"held\" or \"free\""))),
+            other => {
+                return Err(
+                    c.invalid("navigation.vertical", format!("\"{other}\" is not a mode; use \"held\" or \"free\""))
+                );
+            }
         };
         let mut err = [0.0; 3];
         for (i, x) in n.initial_attitude_error_arcmin.iter().enumerate() {
-            err[i] = c.range(&format!("navigation.initial_attitude_error_arcmin[{i}]"), *x, "arcmin", -600.0, 600.0, "")? * RAD_PER_ARCMIN;
+            err[i] =
+                c.range(&format!("navigation.initial_attitude_error_arcmin[{i}]"), *x, "arcmin", -600.0, 600.0, "")?
+                    * RAD_PER_ARCMIN;
         }
-        cfg.navigation = Some(NavOptions { vertical, damping_per_s: if n.velocity_damping { crate::model::earth::schuler_rate() } else { 0.0 } });
+        cfg.navigation = Some(NavOptions {
+            vertical,
+            damping_per_s: if n.velocity_damping { crate::model::earth::schuler_rate() } else { 0.0 },
+        });
         cfg.initial_error_rad = Vector3::from(err);
     }
     Ok(cfg)
@@ -219,10 +269,17 @@ fn validate_imu(c: &Checker<'_>, raw: &RawImu, nav: Option<&RawNavigation>, step
 /// The INS error a calibration allows for: the stated keys, else what `ins` simulates (its angle
 /// random walk; its bias's 1σ — the RMS per axis of a fixed bias, which the calibration does not
 /// know either — with a Gauss–Markov bias, nearly constant over a test, added in quadrature).
-fn calibration_ins_error(c: &Checker<'_>, cal: &RawCalibration, ins: Option<&InsParams>) -> Result<InsErrorModel, ConfigError> {
+fn calibration_ins_error(
+    c: &Checker<'_>,
+    cal: &RawCalibration,
+    ins: Option<&InsParams>,
+) -> Result<InsErrorModel, ConfigError> {
     let gyro = ins.map(|i| i.errors.gyro);
     let walk = match cal.ins_random_walk_deg_per_sqrt_h {
-        Some(v) => c.range("calibration.ins_random_walk_deg_per_sqrt_h", v, "deg/sqrt(h)", 0.0, 100.0, "")? * RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H,
+        Some(v) => {
+            c.range("calibration.ins_random_walk_deg_per_sqrt_h", v, "deg/sqrt(h)", 0.0, 100.0, "")?
+                * RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H
+        }
         None => gyro.map_or(0.0, |g| g.noise.random_walk_si),
     };
     let bias = match cal.ins_bias_deg_per_h {
@@ -238,11 +295,18 @@ fn calibration_ins_error(c: &Checker<'_>, cal: &RawCalibration, ins: Option<&Ins
     Ok(InsErrorModel { random_walk_rad_per_sqrt_s: walk, bias_sigma_rad_per_s: bias })
 }
 
-pub(super) fn validate_calibration(c: &Checker<'_>, cal: &RawCalibration, truth: &TableErrors, ins: Option<&InsParams>) -> Result<CalibConfig, ConfigError> {
+pub(super) fn validate_calibration(
+    c: &Checker<'_>,
+    cal: &RawCalibration,
+    truth: &TableErrors,
+    ins: Option<&InsParams>,
+) -> Result<CalibConfig, ConfigError> {
     // The isotropic part: the INS and the reference, 1″ unless stated; the encoders' part comes
     // from their stated noise, per axis, in the direction each one acts.
     let measurement_sigma_rad = match cal.measurement_sigma_arcsec {
-        Some(v) => c.positive("calibration.measurement_sigma_arcsec", v, "arcsec", MAX_ERROR_ANGLE_ARCSEC)? * RAD_PER_ARCSEC,
+        Some(v) => {
+            c.positive("calibration.measurement_sigma_arcsec", v, "arcsec", MAX_ERROR_ANGLE_ARCSEC)? * RAD_PER_ARCSEC
+        }
         None => RAD_PER_ARCSEC,
     };
     let encoder_noise_rad: Vec<f64> = truth.axes.iter().map(|a| a.encoder_noise_rad).collect();
@@ -250,25 +314,54 @@ pub(super) fn validate_calibration(c: &Checker<'_>, cal: &RawCalibration, truth:
         "none" => Nuisance::None,
         "offset" => Nuisance::Offset,
         "offset+drift" => Nuisance::OffsetDrift,
-        other => return Err(c.invalid("calibration.nuisance", format!("\"{other}\" is not a choice; use \"none\", \"offset\" or \"offset+drift\""))),
+        other => {
+            return Err(c.invalid(
+                "calibration.nuisance",
+                format!("\"{other}\" is not a choice; use \"none\", \"offset\" or \"offset+drift\""),
+            ));
+        }
     };
     let mc = &cal.montecarlo;
     let pair = |key: &str, v: [f64; 2], unit: &'static str, lo: f64, hi: f64| -> Result<[f64; 2], ConfigError> {
         let a = c.range(&format!("calibration.montecarlo.{key}[0]"), v[0], unit, lo, hi, "")?;
         let b = c.range(&format!("calibration.montecarlo.{key}[1]"), v[1], unit, lo, hi, "")?;
         if b < a {
-            return Err(c.invalid(&format!("calibration.montecarlo.{key}"), format!("[{a}, {b}]: the upper bound is below the lower one")));
+            return Err(c.invalid(
+                &format!("calibration.montecarlo.{key}"),
+                format!("[{a}, {b}]: the upper bound is below the lower one"),
+            ));
         }
         Ok([a, b])
     };
     let montecarlo = MonteCarloConfig {
         runs: mc.runs,
-        swing_half_angle_rad: pair("swing_half_angle_arcsec", mc.swing_half_angle_arcsec, "arcsec", 0.0, MAX_ERROR_ANGLE_ARCSEC)?.map(|x| x * RAD_PER_ARCSEC),
+        swing_half_angle_rad: pair(
+            "swing_half_angle_arcsec",
+            mc.swing_half_angle_arcsec,
+            "arcsec",
+            0.0,
+            MAX_ERROR_ANGLE_ARCSEC,
+        )?
+        .map(|x| x * RAD_PER_ARCSEC),
         swing_phase_rad: pair("swing_phase_deg", mc.swing_phase_deg, "deg", -360.0, 360.0)?.map(|x| x * RAD_PER_DEG),
-        non_orthogonality_rad: pair("non_orthogonality_arcsec", mc.non_orthogonality_arcsec, "arcsec", -MAX_ERROR_ANGLE_ARCSEC, MAX_ERROR_ANGLE_ARCSEC)?.map(|x| x * RAD_PER_ARCSEC),
+        non_orthogonality_rad: pair(
+            "non_orthogonality_arcsec",
+            mc.non_orthogonality_arcsec,
+            "arcsec",
+            -MAX_ERROR_ANGLE_ARCSEC,
+            MAX_ERROR_ANGLE_ARCSEC,
+        )?
+        .map(|x| x * RAD_PER_ARCSEC),
         eta_measured_sigma_rad: mc
             .non_orthogonality_measured_sigma_arcsec
-            .map(|v| c.positive("calibration.montecarlo.non_orthogonality_measured_sigma_arcsec", v, "arcsec", MAX_ERROR_ANGLE_ARCSEC))
+            .map(|v| {
+                c.positive(
+                    "calibration.montecarlo.non_orthogonality_measured_sigma_arcsec",
+                    v,
+                    "arcsec",
+                    MAX_ERROR_ANGLE_ARCSEC,
+                )
+            })
             .transpose()?
             .map(|v| v * RAD_PER_ARCSEC),
     };
@@ -277,14 +370,28 @@ pub(super) fn validate_calibration(c: &Checker<'_>, cal: &RawCalibration, truth:
         encoder_noise_rad,
         measurement_sigma_stated: cal.measurement_sigma_arcsec.is_some(),
         ins_error: calibration_ins_error(c, cal, ins)?,
-        prior_swing_sigma_rad: c.positive("calibration.prior_swing_sigma_arcsec", cal.prior_swing_sigma_arcsec, "arcsec", MAX_ERROR_ANGLE_ARCSEC)? * RAD_PER_ARCSEC,
-        prior_eta_rad: c.range("calibration.prior_non_orthogonality_arcsec", cal.prior_non_orthogonality_arcsec, "arcsec", -MAX_ERROR_ANGLE_ARCSEC, MAX_ERROR_ANGLE_ARCSEC, ERROR_HINT)?
-            * RAD_PER_ARCSEC,
-        prior_eta_sigma_rad: c.positive("calibration.prior_non_orthogonality_sigma_arcsec", cal.prior_non_orthogonality_sigma_arcsec, "arcsec", MAX_ERROR_ANGLE_ARCSEC)?
-            * RAD_PER_ARCSEC,
+        prior_swing_sigma_rad: c.positive(
+            "calibration.prior_swing_sigma_arcsec",
+            cal.prior_swing_sigma_arcsec,
+            "arcsec",
+            MAX_ERROR_ANGLE_ARCSEC,
+        )? * RAD_PER_ARCSEC,
+        prior_eta_rad: c.range(
+            "calibration.prior_non_orthogonality_arcsec",
+            cal.prior_non_orthogonality_arcsec,
+            "arcsec",
+            -MAX_ERROR_ANGLE_ARCSEC,
+            MAX_ERROR_ANGLE_ARCSEC,
+            ERROR_HINT,
+        )? * RAD_PER_ARCSEC,
+        prior_eta_sigma_rad: c.positive(
+            "calibration.prior_non_orthogonality_sigma_arcsec",
+            cal.prior_non_orthogonality_sigma_arcsec,
+            "arcsec",
+            MAX_ERROR_ANGLE_ARCSEC,
+        )? * RAD_PER_ARCSEC,
         nuisance,
         record_hz: c.positive("calibration.record_hz", cal.record_hz, "Hz", 1000.0)?,
         montecarlo,
     })
 }
-

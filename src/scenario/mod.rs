@@ -16,7 +16,10 @@ pub fn check_duration(duration_s: f64) -> Result<f64, String> {
     if duration_s.is_finite() && duration_s > 0.0 && duration_s <= MAX_DURATION_S {
         Ok(duration_s)
     } else {
-        Err(format!("{} s: must be > 0 and at most {MAX_DURATION_S} s (30 days), as simulation.duration_s", crate::io::short_number(duration_s)))
+        Err(format!(
+            "{} s: must be > 0 and at most {MAX_DURATION_S} s (30 days), as simulation.duration_s",
+            crate::io::short_number(duration_s)
+        ))
     }
 }
 
@@ -31,8 +34,8 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use crate::calib::CalibConfig;
-use crate::ins::pipeline::InsRun;
 use crate::ins::InsParams;
+use crate::ins::pipeline::InsRun;
 use crate::math::timeline::Timeline;
 use crate::model::earth::Site;
 use crate::sim::{Model, TableParams};
@@ -134,7 +137,10 @@ impl RecordingParams {
     /// Whether the attitude algorithm named `name` is shown.
     #[must_use]
     pub fn shows(&self, name: &str) -> bool {
-        crate::ins::coning::Algorithm::ALL.iter().position(|a| a.name() == name).is_none_or(|i| !self.hidden_algorithms[i])
+        crate::ins::coning::Algorithm::ALL
+            .iter()
+            .position(|a| a.name() == name)
+            .is_none_or(|i| !self.hidden_algorithms[i])
     }
 }
 
@@ -257,7 +263,11 @@ pub fn read_text(path: &Path) -> Result<String, ConfigError> {
     let file = crate::io::files::open_input(path).map_err(err)?;
     let meta = file.metadata().map_err(err)?;
     if meta.len() > MAX_CONFIG_BYTES {
-        return Err(err(std::io::Error::other(format!("{} bytes: larger than any configuration ({} MB at most)", meta.len(), MAX_CONFIG_BYTES >> 20))));
+        return Err(err(std::io::Error::other(format!(
+            "{} bytes: larger than any configuration ({} MB at most)",
+            meta.len(),
+            MAX_CONFIG_BYTES >> 20
+        ))));
     }
     let mut text = String::new();
     file.take(MAX_CONFIG_BYTES + 1).read_to_string(&mut text).map_err(err)?;
@@ -271,10 +281,8 @@ pub fn load_file(path: &Path) -> Result<Params, ConfigError> {
 
 /// Parses and validates scenario text; `origin` names the file or the embedded scenario in errors.
 pub fn parse(text: &str, origin: &str) -> Result<Params, ConfigError> {
-    let raw: RawConfig = toml::from_str(text).map_err(|e| ConfigError::Parse {
-        origin: origin.to_owned(),
-        message: parse_message(&e),
-    })?;
+    let raw: RawConfig = toml::from_str(text)
+        .map_err(|e| ConfigError::Parse { origin: origin.to_owned(), message: parse_message(&e) })?;
     validate::validate(raw, origin)
 }
 
@@ -311,7 +319,9 @@ pub fn parse_message(e: &toml::de::Error) -> String {
 /// name(s) by edit distance, and every valid name of the section (None for any other line).
 #[must_use]
 pub fn did_you_mean(line: &str) -> Option<String> {
-    let (what, rest) = [("field", "key"), ("variant", "value")].iter().find_map(|(serde_word, ours)| line.strip_prefix(&format!("unknown {serde_word} `")).map(|r| (*ours, r)))?;
+    let (what, rest) = [("field", "key"), ("variant", "value")]
+        .iter()
+        .find_map(|(serde_word, ours)| line.strip_prefix(&format!("unknown {serde_word} `")).map(|r| (*ours, r)))?;
     let (given, rest) = rest.split_once('`')?;
     let rest = rest.strip_prefix(", ")?;
     let valid: Vec<&str> = if rest.starts_with("there are no") {
@@ -326,7 +336,11 @@ pub fn did_you_mean(line: &str) -> Option<String> {
     // The closest by edit distance, if close enough to be a slip (a third of the name, at least 2).
     let distance = |v: &str| strsim::damerau_levenshtein(&given.to_lowercase(), &v.to_lowercase());
     let best = valid.iter().map(|v| distance(v)).min().unwrap_or(usize::MAX);
-    let near: Vec<String> = valid.iter().filter(|v| distance(v) == best && best <= (given.chars().count() / 3).max(2)).map(|v| format!("`{v}`")).collect();
+    let near: Vec<String> = valid
+        .iter()
+        .filter(|v| distance(v) == best && best <= (given.chars().count() / 3).max(2))
+        .map(|v| format!("`{v}`"))
+        .collect();
     let hint = if near.is_empty() { String::new() } else { format!("; did you mean {}?", near.join(" or ")) };
     Some(format!("unknown {what} `{given}`{hint}\nvalid {what}s here ({}): {}", valid.len(), valid.join(", ")))
 }
@@ -360,11 +374,13 @@ pub fn flatten(raw: &RawConfig) -> BTreeMap<String, String> {
     out
 }
 
-
 /// The `[compensation]` keys that state `errors` on `chain` (every key given): what a calibration
 /// writes for `replay --compensation` and a scenario's `[compensation]`.
 #[must_use]
-pub fn compensation_keys(chain: &crate::model::gimbal::Chain, errors: &crate::model::gimbal::TableErrors) -> raw::RawCompensation {
+pub fn compensation_keys(
+    chain: &crate::model::gimbal::Chain,
+    errors: &crate::model::gimbal::TableErrors,
+) -> raw::RawCompensation {
     use crate::math::units::{ARCSEC_PER_RAD, DEG_PER_RAD};
     let arcsec = |x: f64| Some(x * ARCSEC_PER_RAD);
     let mut axis = BTreeMap::new();
@@ -407,7 +423,11 @@ mod tests {
         assert!(said.contains("did you mean `duration_s`?") && said.contains("duration_s, step_hz"), "{said}");
         let said = super::did_you_mean("unknown field `zzzzzzzz`, expected `duration_s`").expect("one");
         assert!(!said.contains("did you mean") && said.contains("duration_s"), "{said}");
-        assert!(super::did_you_mean("unknown variant `sin`, expected one of `sine`, `square`").expect("variant").contains("did you mean `sine`?"));
+        assert!(
+            super::did_you_mean("unknown variant `sin`, expected one of `sine`, `square`")
+                .expect("variant")
+                .contains("did you mean `sine`?")
+        );
         assert!(super::did_you_mean("invalid type: string, expected f64").is_none());
         // Through the parser, as a user meets it: the whole list, never cut.
         let e = super::parse("[simulation]\nduraton_s = 3\n", "t.toml").expect_err("typo").to_string();

@@ -419,7 +419,14 @@ pub struct RawRecording {
 
 impl Default for RawRecording {
     fn default() -> Self {
-        Self { series_hz: None, scene_hz: None, error_unit: None, exaggeration: 60.0, open_at: None, show: std::collections::BTreeMap::new() }
+        Self {
+            series_hz: None,
+            scene_hz: None,
+            error_unit: None,
+            exaggeration: 60.0,
+            open_at: None,
+            show: std::collections::BTreeMap::new(),
+        }
     }
 }
 
@@ -679,4 +686,3 @@ pub struct RawAxisCompensation {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub encoder_delay_ms: Option<f64>,
 }
-

@@ -1,13 +1,14 @@
 //! The stochastic keys of `[imu.gyro]` and `[imu.accel]` by the names and units of IEEE Std 952 and
 //! 1293 (Q, N, B, K, R, saturation), checked and converted to the SI [`IeeeTerms`] once.
 
+use super::ConfigError;
 use super::raw::{RawAccel, RawGyro};
 use super::validate::Checker;
-use super::ConfigError;
 use crate::ins::noise::IeeeTerms;
 use crate::math::units::{
-    MPS2_PER_SQRT_S_PER_UG_PER_SQRT_H, MPS2_PER_UG, MPS3_PER_UG_PER_H, MPS_PER_SQRT_S_PER_UG_PER_SQRT_HZ, RAD_PER_ARCSEC, RAD_PER_DEG, RAD_PER_S2_PER_DEG_PER_H2, RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H,
-    RAD_PER_S_PER_DEG_PER_H, RAD_PER_S_PER_SQRT_S_PER_DEG_PER_H_PER_SQRT_H, STANDARD_GRAVITY_MPS2,
+    MPS_PER_SQRT_S_PER_UG_PER_SQRT_HZ, MPS2_PER_SQRT_S_PER_UG_PER_SQRT_H, MPS2_PER_UG, MPS3_PER_UG_PER_H,
+    RAD_PER_ARCSEC, RAD_PER_DEG, RAD_PER_S_PER_DEG_PER_H, RAD_PER_S_PER_SQRT_S_PER_DEG_PER_H_PER_SQRT_H,
+    RAD_PER_S2_PER_DEG_PER_H2, RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H, STANDARD_GRAVITY_MPS2,
 };
 
 /// One key: its name in the section, unit, SI per unit, and the largest value accepted.
@@ -49,10 +50,17 @@ const MAX_FLICKER_DECADES: f64 = 8.0;
 
 fn terms(c: &Checker<'_>, s: &Section, g: &Given, out: &mut IeeeTerms, step_hz: f64) -> Result<(), ConfigError> {
     let key = |k: &Key| format!("{}.{}", s.path, k.name);
-    let value = |k: &Key, v: f64| -> Result<f64, ConfigError> { Ok(c.range(&key(k), v, k.unit, 0.0, k.max, "")? * k.to_si) };
+    let value =
+        |k: &Key, v: f64| -> Result<f64, ConfigError> { Ok(c.range(&key(k), v, k.unit, 0.0, k.max, "")? * k.to_si) };
     match (g.quantization, g.pulse_weight) {
         (Some(_), Some(_)) => {
-            return Err(c.invalid(&key(&s.pulse_weight), format!("give one of `{}` (Q) and `{}` (the pulse weight, √12·Q), not both", s.quantization.name, s.pulse_weight.name)));
+            return Err(c.invalid(
+                &key(&s.pulse_weight),
+                format!(
+                    "give one of `{}` (Q) and `{}` (the pulse weight, √12·Q), not both",
+                    s.quantization.name, s.pulse_weight.name
+                ),
+            ));
         }
         (Some(q), None) => out.quantization_si = value(&s.quantization, q)?,
         (None, Some(w)) => out.quantization_si = value(&s.pulse_weight, w)? / 12f64.sqrt(),
@@ -81,7 +89,13 @@ fn terms(c: &Checker<'_>, s: &Section, g: &Given, out: &mut IeeeTerms, step_hz: 
             return Err(c.invalid(&k, format!("[{lo}, {hi}] s: the upper end must be above the lower one, by at most {MAX_FLICKER_DECADES} decades (one Gauss-Markov process per decade)")));
         }
         if lo < 0.5 / step_hz {
-            return Err(c.invalid(&k, format!("[{lo}, {hi}] s: the floor cannot start below half the IMU's sample interval ({} s)", 0.5 / step_hz)));
+            return Err(c.invalid(
+                &k,
+                format!(
+                    "[{lo}, {hi}] s: the floor cannot start below half the IMU's sample interval ({} s)",
+                    0.5 / step_hz
+                ),
+            ));
         }
         out.flicker_range_s = [lo, hi];
     }
@@ -105,9 +119,24 @@ pub(super) fn gyro_terms(c: &Checker<'_>, g: &RawGyro, out: &mut IeeeTerms, step
         path: "imu.gyro",
         quantization: Key { name: "quantization_arcsec", unit: "arcsec", to_si: RAD_PER_ARCSEC, max: 1000.0 },
         pulse_weight: Key { name: "pulse_weight_arcsec", unit: "arcsec", to_si: RAD_PER_ARCSEC, max: 3600.0 },
-        random_walk: Key { name: "arw_deg_per_sqrt_h", unit: "deg/√h", to_si: RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H, max: 100.0 },
-        bias_instability: Key { name: "bias_instability_deg_per_h", unit: "deg/h", to_si: RAD_PER_S_PER_DEG_PER_H, max: 3600.0 },
-        rate_random_walk: Key { name: "rate_random_walk_deg_per_h_per_sqrt_h", unit: "deg/h/√h", to_si: RAD_PER_S_PER_SQRT_S_PER_DEG_PER_H_PER_SQRT_H, max: 1e5 },
+        random_walk: Key {
+            name: "arw_deg_per_sqrt_h",
+            unit: "deg/√h",
+            to_si: RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H,
+            max: 100.0,
+        },
+        bias_instability: Key {
+            name: "bias_instability_deg_per_h",
+            unit: "deg/h",
+            to_si: RAD_PER_S_PER_DEG_PER_H,
+            max: 3600.0,
+        },
+        rate_random_walk: Key {
+            name: "rate_random_walk_deg_per_h_per_sqrt_h",
+            unit: "deg/h/√h",
+            to_si: RAD_PER_S_PER_SQRT_S_PER_DEG_PER_H_PER_SQRT_H,
+            max: 1e5,
+        },
         rate_ramp: Key { name: "rate_ramp_deg_per_h2", unit: "deg/h²", to_si: RAD_PER_S2_PER_DEG_PER_H2, max: 1e6 },
         saturation: Key { name: "saturation_deg_per_s", unit: "deg/s", to_si: RAD_PER_DEG, max: 1e5 },
         markov: "markov_sigma_deg_per_h",
@@ -132,9 +161,19 @@ pub(super) fn accel_terms(c: &Checker<'_>, a: &RawAccel, out: &mut IeeeTerms, st
         path: "imu.accel",
         quantization: Key { name: "quantization_mps", unit: "m/s", to_si: 1.0, max: 1.0 },
         pulse_weight: Key { name: "pulse_weight_mps", unit: "m/s", to_si: 1.0, max: 3.0 },
-        random_walk: Key { name: "vrw_ug_per_sqrt_hz", unit: "µg/√Hz", to_si: MPS_PER_SQRT_S_PER_UG_PER_SQRT_HZ, max: 1e5 },
+        random_walk: Key {
+            name: "vrw_ug_per_sqrt_hz",
+            unit: "µg/√Hz",
+            to_si: MPS_PER_SQRT_S_PER_UG_PER_SQRT_HZ,
+            max: 1e5,
+        },
         bias_instability: Key { name: "bias_instability_ug", unit: "µg", to_si: MPS2_PER_UG, max: 1e5 },
-        rate_random_walk: Key { name: "acceleration_random_walk_ug_per_sqrt_h", unit: "µg/√h", to_si: MPS2_PER_SQRT_S_PER_UG_PER_SQRT_H, max: 1e7 },
+        rate_random_walk: Key {
+            name: "acceleration_random_walk_ug_per_sqrt_h",
+            unit: "µg/√h",
+            to_si: MPS2_PER_SQRT_S_PER_UG_PER_SQRT_H,
+            max: 1e7,
+        },
         rate_ramp: Key { name: "acceleration_ramp_ug_per_h", unit: "µg/h", to_si: MPS3_PER_UG_PER_H, max: 1e7 },
         saturation: Key { name: "saturation_g", unit: "g", to_si: STANDARD_GRAVITY_MPS2, max: 1e4 },
         markov: "markov_sigma_ug",

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use nalgebra::Vector3;
 
 use super::raw::{RawAxisCompensation, RawCompensation, RawConfig, RawRecording, RawScheme, RawSite, RawTurntable};
-use super::{instruments, ConfigError, Params, RecordingParams, ScenarioMeta};
+use super::{ConfigError, Params, RecordingParams, ScenarioMeta, instruments};
 use crate::math::attitude::Attitude;
 use crate::math::units::{RAD_PER_ARCSEC, RAD_PER_DEG};
 use crate::model::earth::Site;
@@ -30,16 +30,31 @@ impl Checker<'_> {
     }
 
     /// Checks `lo <= value <= hi` (and finiteness).
-    pub(super) fn range(&self, key: &str, value: f64, unit: &'static str, lo: f64, hi: f64, hint: &str) -> Result<f64, ConfigError> {
+    pub(super) fn range(
+        &self,
+        key: &str,
+        value: f64,
+        unit: &'static str,
+        lo: f64,
+        hi: f64,
+        hint: &str,
+    ) -> Result<f64, ConfigError> {
         self.finite(key, value, unit)?;
         if value < lo || value > hi {
-            let mut range = format!("allowed {} ..= {} {unit}", crate::io::short_number(lo), crate::io::short_number(hi));
+            let mut range =
+                format!("allowed {} ..= {} {unit}", crate::io::short_number(lo), crate::io::short_number(hi));
             if !hint.is_empty() {
                 range.push_str(" (");
                 range.push_str(hint);
                 range.push(')');
             }
-            return Err(ConfigError::OutOfRange { origin: self.origin.to_owned(), key: key.to_owned(), value, unit, range });
+            return Err(ConfigError::OutOfRange {
+                origin: self.origin.to_owned(),
+                key: key.to_owned(),
+                value,
+                unit,
+                range,
+            });
         }
         Ok(value)
     }
@@ -74,7 +89,9 @@ fn angle_kind(c: &Checker<'_>, key: &str, s: &str) -> Result<AngleKind, ConfigEr
         "pitch" => Ok(AngleKind::Pitch),
         "roll" => Ok(AngleKind::Roll),
         "heading" => Ok(AngleKind::Heading),
-        other => Err(c.invalid(key, format!("\"{other}\" is not an Euler angle; use \"pitch\", \"roll\" or \"heading\""))),
+        other => {
+            Err(c.invalid(key, format!("\"{other}\" is not an Euler angle; use \"pitch\", \"roll\" or \"heading\"")))
+        }
     }
 }
 
@@ -87,7 +104,10 @@ pub(super) fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigErr
     {
         return Err(c.invalid(
             "scenario.name",
-            format!("\"{}\" must be non-empty and use only letters, digits, '-' and '_' (it names the recording file)", raw.scenario.name),
+            format!(
+                "\"{}\" must be non-empty and use only letters, digits, '-' and '_' (it names the recording file)",
+                raw.scenario.name
+            ),
         ));
     }
 
@@ -132,23 +152,46 @@ pub(super) fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigErr
         wobbles.push(Wobble {
             angle: angle_kind(&c, &k("angle"), &w.angle)?,
             amplitude_rad: c.range(&k("amplitude_deg"), w.amplitude_deg, "deg", 0.0, 45.0, "")? * RAD_PER_DEG,
-            omega_rad_per_s: c.range(&k("frequency_hz"), w.frequency_hz, "Hz", 0.0, 0.25 * step_hz, "at most a quarter of simulation.step_hz")?
-                * std::f64::consts::TAU,
+            omega_rad_per_s: c.range(
+                &k("frequency_hz"),
+                w.frequency_hz,
+                "Hz",
+                0.0,
+                0.25 * step_hz,
+                "at most a quarter of simulation.step_hz",
+            )? * std::f64::consts::TAU,
             phase_rad: c.finite(&k("phase_deg"), w.phase_deg, "deg")? * RAD_PER_DEG,
         });
     }
     let coning = crate::model::motion::Coning {
-        half_angle_rad: c.range("vehicle.coning_half_angle_deg", raw.vehicle.coning_half_angle_deg, "deg", 0.0, 45.0, "")? * RAD_PER_DEG,
-        omega_rad_per_s: c.range("vehicle.coning_frequency_hz", raw.vehicle.coning_frequency_hz, "Hz", 0.0, 0.25 * step_hz, "at most a quarter of simulation.step_hz")?
-            * std::f64::consts::TAU,
+        half_angle_rad: c.range(
+            "vehicle.coning_half_angle_deg",
+            raw.vehicle.coning_half_angle_deg,
+            "deg",
+            0.0,
+            45.0,
+            "",
+        )? * RAD_PER_DEG,
+        omega_rad_per_s: c.range(
+            "vehicle.coning_frequency_hz",
+            raw.vehicle.coning_frequency_hz,
+            "Hz",
+            0.0,
+            0.25 * step_hz,
+            "at most a quarter of simulation.step_hz",
+        )? * std::f64::consts::TAU,
     };
-    let vehicle = VehicleMotion::new(base, ramps, wobbles).map_err(|m| c.invalid("vehicle.ramp", m))?.with_coning(coning);
+    let vehicle =
+        VehicleMotion::new(base, ramps, wobbles).map_err(|m| c.invalid("vehicle.ramp", m))?.with_coning(coning);
     // Pitch must stay clear of the Euler singularity over the whole profile (ramps + wobble).
     let max_pitch = vehicle.max_abs_pitch_rad(duration_s);
     if max_pitch > 85.0 * RAD_PER_DEG {
         return Err(c.invalid(
             "vehicle",
-            format!("the pitch profile reaches {:.2} deg; keep |pitch| <= 85 deg ({pitch_hint})", max_pitch / RAD_PER_DEG),
+            format!(
+                "the pitch profile reaches {:.2} deg; keep |pitch| <= 85 deg ({pitch_hint})",
+                max_pitch / RAD_PER_DEG
+            ),
         ));
     }
 
@@ -157,7 +200,11 @@ pub(super) fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigErr
     // [scheme]
     let scheme = validate_scheme(&c, &raw.scheme, &chain)?;
 
-    let motion_hz = raw.vehicle.wobble.iter().map(|w| w.frequency_hz).fold(raw.vehicle.coning_frequency_hz * f64::from(u8::from(raw.vehicle.coning_half_angle_deg > 0.0)), f64::max);
+    let motion_hz =
+        raw.vehicle.wobble.iter().map(|w| w.frequency_hz).fold(
+            raw.vehicle.coning_frequency_hz * f64::from(u8::from(raw.vehicle.coning_half_angle_deg > 0.0)),
+            f64::max,
+        );
     let bandwidth = Bandwidth { shaft_deg_per_s: scheme.max_rate().to_degrees(), motion_hz, duration_s };
     // [compensation]
     let (compensation, resolved_comp) = validate_compensation(&c, &raw.compensation, &raw.turntable, &chain, &truth)?;
@@ -165,7 +212,13 @@ pub(super) fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigErr
     // The plots' unit follows the size of the table's errors: a preview of the uncompensated error
     // on at most 2000 instants (a millisecond; the model is pure).
     let preview = {
-        let table = TableParams { chain: chain.clone(), vehicle: vehicle.clone(), scheme: scheme.clone(), truth: truth.clone(), compensation: compensation.clone() };
+        let table = TableParams {
+            chain: chain.clone(),
+            vehicle: vehicle.clone(),
+            scheme: scheme.clone(),
+            truth: truth.clone(),
+            compensation: compensation.clone(),
+        };
         let model = crate::sim::Model::new(&table, raw.scenario.seed);
         let hz = (2000.0 / duration_s).min(step_hz);
         crate::sim::run_stats(&model, &crate::math::timeline::Timeline::new(duration_s, hz)).peak_over_axes(0)
@@ -180,17 +233,22 @@ pub(super) fn validate(raw: RawConfig, origin: &str) -> Result<Params, ConfigErr
     };
     let live_speed = c.range("live.speed", raw.live.speed, "x real time", 0.01, 10_000.0, "")?;
     let ins = instruments::validate_ins(&c, raw.imu.as_ref(), raw.navigation.as_ref(), step_hz)?;
-    let calibration = instruments::validate_calibration(&c, &raw.calibration.clone().unwrap_or_default(), &truth, ins.as_ref())?;
+    let calibration =
+        instruments::validate_calibration(&c, &raw.calibration.clone().unwrap_or_default(), &truth, ins.as_ref())?;
     let mut position_fix_s = Vec::new();
     if let Some(fix) = &raw.position_fix {
         if raw.navigation.is_none() {
-            return Err(c.invalid("position_fix", "needs a [navigation] section (a position fix resets the navigation)"));
+            return Err(
+                c.invalid("position_fix", "needs a [navigation] section (a position fix resets the navigation)")
+            );
         }
         for (i, h) in fix.at_h.iter().enumerate() {
             let key = format!("position_fix.at_h[{i}]");
             let t = c.positive(&key, *h, "h", duration_s / 3600.0)? * 3600.0;
             if position_fix_s.last().is_some_and(|prev| t <= *prev) {
-                return Err(c.invalid(&key, format!("{h} h is not after the previous fix; list the fixes in increasing time")));
+                return Err(
+                    c.invalid(&key, format!("{h} h is not after the previous fix; list the fixes in increasing time"))
+                );
             }
             position_fix_s.push(t);
         }
@@ -231,7 +289,9 @@ fn axis_index(c: &Checker<'_>, key: &str, chain: &Chain, name: &str) -> Result<u
 
 fn validate_scheme(c: &Checker<'_>, s: &RawScheme, chain: &Chain) -> Result<Scheme, ConfigError> {
     let n = chain.axes().len();
-    let only_for = |key: &str, kind: &str| c.invalid(key, format!("is only read when scheme.kind = \"{kind}\"; remove it or change the kind"));
+    let only_for = |key: &str, kind: &str| {
+        c.invalid(key, format!("is only read when scheme.kind = \"{kind}\"; remove it or change the kind"))
+    };
     match s.kind.as_str() {
         "static" | "continuous" => {
             if s.initial_dwell_s.is_some() {
@@ -250,7 +310,10 @@ fn validate_scheme(c: &Checker<'_>, s: &RawScheme, chain: &Chain) -> Result<Sche
             }
         }
         other => {
-            return Err(c.invalid("scheme.kind", format!("\"{other}\" is not a scheme; use \"static\", \"continuous\" or \"indexed\"")));
+            return Err(c.invalid(
+                "scheme.kind",
+                format!("\"{other}\" is not a scheme; use \"static\", \"continuous\" or \"indexed\""),
+            ));
         }
     }
     let initial: Vec<f64> = chain.axes().iter().map(|a| a.initial_angle_rad).collect();
@@ -268,7 +331,14 @@ fn validate_scheme(c: &Checker<'_>, s: &RawScheme, chain: &Chain) -> Result<Sche
             let mut rates = vec![0.0; n];
             for (i, r) in s.rate.iter().enumerate() {
                 let idx = axis_index(c, &format!("scheme.rate[{i}].axis"), chain, &r.axis)?;
-                rates[idx] = c.range(&format!("scheme.rate[{i}].rate_deg_per_s"), r.rate_deg_per_s, "deg/s", -1000.0, 1000.0, "")? * RAD_PER_DEG;
+                rates[idx] = c.range(
+                    &format!("scheme.rate[{i}].rate_deg_per_s"),
+                    r.rate_deg_per_s,
+                    "deg/s",
+                    -1000.0,
+                    1000.0,
+                    "",
+                )? * RAD_PER_DEG;
             }
             Ok(Scheme::continuous(initial, rates))
         }
@@ -285,8 +355,14 @@ fn validate_scheme(c: &Checker<'_>, s: &RawScheme, chain: &Chain) -> Result<Sche
                     angle_rad: c.range(&k("angle_deg"), st.angle_deg, "deg", -3600.0, 3600.0, "")? * RAD_PER_DEG,
                     rate_rad_per_s: c.positive(&k("rate_deg_per_s"), st.rate_deg_per_s, "deg/s", 1000.0)? * RAD_PER_DEG,
                     dwell_s: c.range(&k("dwell_s"), st.dwell_s, "s", 0.0, 1e7, "")?,
-                    accel_rad_per_s2: c.range(&k("accel_deg_per_s2"), st.accel_deg_per_s2, "deg/s^2", 0.0, 1e5, "0 means the rate steps instantly")?
-                        * RAD_PER_DEG,
+                    accel_rad_per_s2: c.range(
+                        &k("accel_deg_per_s2"),
+                        st.accel_deg_per_s2,
+                        "deg/s^2",
+                        0.0,
+                        1e5,
+                        "0 means the rate steps instantly",
+                    )? * RAD_PER_DEG,
                 });
             }
             let scheme = Scheme::indexed(initial, dwell0, steps, s.repeat.unwrap_or(true));
@@ -333,7 +409,10 @@ pub(super) fn validate_compensation(
             encoder_delay_ms: Some(pick(given.encoder_delay_ms, a.encoder_delay_ms)),
         };
         if i == 0 && r.non_orthogonality_arcsec != Some(0.0) {
-            return Err(c.invalid(&k("non_orthogonality_arcsec"), "the first axis has no non-orthogonality; compensate installation_*_arcsec instead"));
+            return Err(c.invalid(
+                &k("non_orthogonality_arcsec"),
+                "the first axis has no non-orthogonality; compensate installation_*_arcsec instead",
+            ));
         }
         let values = AxisErrorKeys {
             swing_half_angle_arcsec: r.swing_half_angle_arcsec.unwrap_or_default(),
@@ -354,12 +433,14 @@ pub(super) fn validate_compensation(
         installation_rad: rotation_arcsec(
             c,
             "compensation.installation",
-            [resolved.installation_x_arcsec, resolved.installation_y_arcsec, resolved.installation_z_arcsec].map(Option::unwrap_or_default),
+            [resolved.installation_x_arcsec, resolved.installation_y_arcsec, resolved.installation_z_arcsec]
+                .map(Option::unwrap_or_default),
         )?,
         imu_mount_rad: rotation_arcsec(
             c,
             "compensation.imu_mount",
-            [resolved.imu_mount_x_arcsec, resolved.imu_mount_y_arcsec, resolved.imu_mount_z_arcsec].map(Option::unwrap_or_default),
+            [resolved.imu_mount_x_arcsec, resolved.imu_mount_y_arcsec, resolved.imu_mount_z_arcsec]
+                .map(Option::unwrap_or_default),
         )?,
         axes,
     };
@@ -394,11 +475,25 @@ struct AxisErrorKeys {
 /// One axis's errors (no encoder noise), each key checked; `key` makes the dotted key of a field.
 fn axis_errors_of(c: &Checker<'_>, key: &dyn Fn(&str) -> String, v: &AxisErrorKeys) -> Result<AxisErrors, ConfigError> {
     Ok(AxisErrors {
-        swing_half_angle_rad: c.range(&key("swing_half_angle_arcsec"), v.swing_half_angle_arcsec, "arcsec", 0.0, MAX_ERROR_ANGLE_ARCSEC, ERROR_HINT)? * RAD_PER_ARCSEC,
+        swing_half_angle_rad: c.range(
+            &key("swing_half_angle_arcsec"),
+            v.swing_half_angle_arcsec,
+            "arcsec",
+            0.0,
+            MAX_ERROR_ANGLE_ARCSEC,
+            ERROR_HINT,
+        )? * RAD_PER_ARCSEC,
         swing_phase_rad: c.range(&key("swing_phase_deg"), v.swing_phase_deg, "deg", -360.0, 360.0, "")? * RAD_PER_DEG,
         non_orthogonality_rad: error_angle(c, &key("non_orthogonality_arcsec"), v.non_orthogonality_arcsec)?,
         encoder_offset_rad: error_angle(c, &key("encoder_offset_arcsec"), v.encoder_offset_arcsec)?,
-        encoder_scale: c.range(&key("encoder_scale_ppm"), v.encoder_scale_ppm, "ppm", -10_000.0, 10_000.0, "1% at most")? * 1e-6,
+        encoder_scale: c.range(
+            &key("encoder_scale_ppm"),
+            v.encoder_scale_ppm,
+            "ppm",
+            -10_000.0,
+            10_000.0,
+            "1% at most",
+        )? * 1e-6,
         encoder_delay_s: c.range(&key("encoder_delay_ms"), v.encoder_delay_ms, "ms", -1000.0, 1000.0, "")? * 1e-3,
         encoder_noise_rad: 0.0,
     })
@@ -448,11 +543,19 @@ impl Bandwidth {
 
 /// `[recording]`: output rates (at most the simulation rate `step_hz`; absent, from `bandwidth`)
 /// and the drawing factor.
-pub(super) fn recording(c: &Checker<'_>, raw: &RawRecording, step_hz: f64, bandwidth: Bandwidth, error_peak_rad: f64) -> Result<RecordingParams, ConfigError> {
+pub(super) fn recording(
+    c: &Checker<'_>,
+    raw: &RawRecording,
+    step_hz: f64,
+    bandwidth: Bandwidth,
+    error_peak_rad: f64,
+) -> Result<RecordingParams, ConfigError> {
     let hint = "at most the step rate; at least one point every 1000 s";
     let error_unit = match &raw.error_unit {
         None => crate::math::units::AngleUnit::for_peak(error_peak_rad),
-        Some(s) => crate::math::units::AngleUnit::parse(s).ok_or_else(|| c.invalid("recording.error_unit", format!("\"{s}\" is not a unit; use \"arcsec\", \"arcmin\" or \"deg\"")))?,
+        Some(s) => crate::math::units::AngleUnit::parse(s).ok_or_else(|| {
+            c.invalid("recording.error_unit", format!("\"{s}\" is not a unit; use \"arcsec\", \"arcmin\" or \"deg\""))
+        })?,
     };
     Ok(RecordingParams {
         series_hz: match raw.series_hz {
@@ -468,7 +571,12 @@ pub(super) fn recording(c: &Checker<'_>, raw: &RawRecording, step_hz: f64, bandw
         open_at_end: match raw.open_at.as_deref() {
             None | Some("start") => false,
             Some("end") => true,
-            Some(s) => return Err(c.invalid("recording.open_at", format!("\"{s}\" is not a place in the run; use \"start\" or \"end\""))),
+            Some(s) => {
+                return Err(c.invalid(
+                    "recording.open_at",
+                    format!("\"{s}\" is not a place in the run; use \"start\" or \"end\""),
+                ));
+            }
         },
         chosen: (raw.series_hz.is_none(), raw.scene_hz.is_none()),
         bandwidth,
@@ -478,7 +586,10 @@ pub(super) fn recording(c: &Checker<'_>, raw: &RawRecording, step_hz: f64, bandw
             for (name, shown) in &raw.show {
                 let Some(i) = Algorithm::ALL.iter().position(|a| a.name() == name) else {
                     let names: Vec<&str> = Algorithm::ALL.iter().map(|a| a.name()).collect();
-                    return Err(c.invalid(&format!("recording.show.{name}"), format!("\"{name}\" is not an attitude algorithm; the names are {}", names.join(", "))));
+                    return Err(c.invalid(
+                        &format!("recording.show.{name}"),
+                        format!("\"{name}\" is not an attitude algorithm; the names are {}", names.join(", ")),
+                    ));
                 };
                 hidden[i] = !shown;
             }
@@ -513,14 +624,19 @@ pub(super) fn turntable(c: &Checker<'_>, raw: &RawTurntable) -> Result<(Chain, T
             "x" => Vector3::x(),
             "y" => Vector3::y(),
             "z" => Vector3::z(),
-            other => return Err(c.invalid(&k("axis"), format!("\"{other}\" is not an axis; use \"x\", \"y\" or \"z\""))),
+            other => {
+                return Err(c.invalid(&k("axis"), format!("\"{other}\" is not an axis; use \"x\", \"y\" or \"z\"")));
+            }
         };
         if let Some(prev) = geometry.last() {
             let prev: &AxisGeometry = prev;
             if prev.axis.dot(&dir).abs() > 0.5 {
                 return Err(c.invalid(
                     &k("axis"),
-                    format!("\"{}\" is parallel to the previous axis \"{}\"; consecutive gimbal axes must be perpendicular", a.axis, prev.name),
+                    format!(
+                        "\"{}\" is parallel to the previous axis \"{}\"; consecutive gimbal axes must be perpendicular",
+                        a.axis, prev.name
+                    ),
                 ));
             }
         }
@@ -533,7 +649,11 @@ pub(super) fn turntable(c: &Checker<'_>, raw: &RawTurntable) -> Result<(Chain, T
                 ),
             ));
         }
-        geometry.push(AxisGeometry::new(a.name.clone(), dir, c.finite(&k("initial_angle_deg"), a.initial_angle_deg, "deg")? * RAD_PER_DEG));
+        geometry.push(AxisGeometry::new(
+            a.name.clone(),
+            dir,
+            c.finite(&k("initial_angle_deg"), a.initial_angle_deg, "deg")? * RAD_PER_DEG,
+        ));
         let values = AxisErrorKeys {
             swing_half_angle_arcsec: a.swing_half_angle_arcsec,
             swing_phase_deg: a.swing_phase_deg,
@@ -543,13 +663,28 @@ pub(super) fn turntable(c: &Checker<'_>, raw: &RawTurntable) -> Result<(Chain, T
             encoder_delay_ms: a.encoder_delay_ms,
         };
         let mut errors = axis_errors_of(c, &k, &values)?;
-        errors.encoder_noise_rad = c.range(&k("encoder_noise_arcsec"), a.encoder_noise_arcsec, "arcsec", 0.0, 3600.0, "1σ per reading, 1° at most")? * RAD_PER_ARCSEC;
+        errors.encoder_noise_rad = c.range(
+            &k("encoder_noise_arcsec"),
+            a.encoder_noise_arcsec,
+            "arcsec",
+            0.0,
+            3600.0,
+            "1σ per reading, 1° at most",
+        )? * RAD_PER_ARCSEC;
         axis_errors.push(errors);
     }
     let chain = Chain::new(geometry);
     let truth = TableErrors {
-        installation_rad: rotation_arcsec(c, "turntable.installation", [t.installation_x_arcsec, t.installation_y_arcsec, t.installation_z_arcsec])?,
-        imu_mount_rad: rotation_arcsec(c, "turntable.imu_mount", [t.imu_mount_x_arcsec, t.imu_mount_y_arcsec, t.imu_mount_z_arcsec])?,
+        installation_rad: rotation_arcsec(
+            c,
+            "turntable.installation",
+            [t.installation_x_arcsec, t.installation_y_arcsec, t.installation_z_arcsec],
+        )?,
+        imu_mount_rad: rotation_arcsec(
+            c,
+            "turntable.imu_mount",
+            [t.imu_mount_x_arcsec, t.imu_mount_y_arcsec, t.imu_mount_z_arcsec],
+        )?,
         axes: axis_errors,
     };
     Ok((chain, truth))

@@ -5,12 +5,12 @@
 //! The IMU attitude is exact here (an ideal INS), so every error is the turntable's.
 
 use crate::math::attitude::{Attitude, AttitudeError};
-use crate::math::frames::{Rot, B, N, S};
+use crate::math::frames::{B, N, Rot, S};
 use crate::math::stats::RunningStat;
 use crate::math::timeline::Timeline;
 use crate::model::gimbal::{Chain, ErrorRotations, TableErrors};
 use crate::model::motion::VehicleMotion;
-use crate::model::scheme::{AxisValues, Scheme, MAX_AXES};
+use crate::model::scheme::{AxisValues, MAX_AXES, Scheme};
 
 /// The three ways of computing the body attitude, in recording order.
 pub const DEMODULATIONS: [&str; 3] = ["uncompensated", "compensated", "closed_form"];
@@ -64,7 +64,18 @@ impl Model {
         let truth_rot = chain.error_rotations(&truth);
         let compensation_rot = chain.error_rotations(&compensation);
         let fixed_attitude = vehicle.is_fixed().then(|| vehicle.state(0.0));
-        Self { chain, vehicle, scheme, scheme_t0_s: 0.0, truth, compensation, noise_seed, truth_rot, compensation_rot, fixed_attitude }
+        Self {
+            chain,
+            vehicle,
+            scheme,
+            scheme_t0_s: 0.0,
+            truth,
+            compensation,
+            noise_seed,
+            truth_rot,
+            compensation_rot,
+            fixed_attitude,
+        }
     }
 
     /// Number of gimbal axes.
@@ -108,7 +119,8 @@ pub fn encoder_readings(model: &Model, t_s: f64) -> AxisValues {
     let mut encoder_rad = [0.0; MAX_AXES];
     let now = model.scheme.state(t_scheme).0;
     for (k, e) in model.truth.axes.iter().enumerate() {
-        let latched = if e.encoder_delay_s == 0.0 { now[k] } else { model.scheme.state(t_scheme - e.encoder_delay_s).0[k] };
+        let latched =
+            if e.encoder_delay_s == 0.0 { now[k] } else { model.scheme.state(t_scheme - e.encoder_delay_s).0[k] };
         encoder_rad[k] = e.encoder_reading(latched);
         if e.encoder_noise_rad > 0.0 {
             encoder_rad[k] += e.encoder_noise_rad * crate::math::noise::gaussian(model.noise_seed, k as u64, t_s);
@@ -195,7 +207,8 @@ pub fn step(model: &Model, state: &mut DemodState, t_s: f64) -> StepOutput {
 
     let encoder_rad = encoder_readings(model, t_s);
     // Shaft rotations of other angles; reuses the true ones when the angles are identical.
-    let shafts_of = |angles: &AxisValues| if *angles == gimbal_rad { true_shafts } else { model.chain.shaft_rotations(angles) };
+    let shafts_of =
+        |angles: &AxisValues| if *angles == gimbal_rad { true_shafts } else { model.chain.shaft_rotations(angles) };
 
     // 1. Uncompensated: the nominal table with the raw encoder angles.
     let uncompensated = demodulate(n_from_s, model.chain.b_from_s_nominal_with(&shafts_of(&encoder_rad)));
@@ -205,7 +218,8 @@ pub fn step(model: &Model, state: &mut DemodState, t_s: f64) -> StepOutput {
     let compensated = demodulate(n_from_s, model.chain.b_from_s_with(&model.compensation_rot, &shafts_of(&corrected)));
 
     // 3. Closed form: first-order error model (docs/closed-form.md).
-    let phi_b = model.chain.first_order_phi_b_with(&model.truth, &model.truth_rot, &gimbal_rad, &rate_rad_per_s, &true_shafts);
+    let phi_b =
+        model.chain.first_order_phi_b_with(&model.truth, &model.truth_rot, &gimbal_rad, &rate_rad_per_s, &true_shafts);
     let closed_form = AttitudeError::first_order(&n_from_b, n_from_b.apply(phi_b));
 
     StepOutput {
@@ -265,11 +279,17 @@ mod tests {
     use nalgebra::Vector3;
 
     use super::*;
+    use crate::math::units::{ARCSEC_PER_RAD, RAD_PER_ARCMIN, RAD_PER_ARCSEC, RAD_PER_DEG};
     use crate::model::gimbal::AxisGeometry;
     use crate::model::scheme::IndexedStep;
-    use crate::math::units::{ARCSEC_PER_RAD, RAD_PER_ARCMIN, RAD_PER_ARCSEC, RAD_PER_DEG};
 
-    fn table_model(chain: Chain, vehicle: VehicleMotion, scheme: Scheme, truth: TableErrors, compensation: TableErrors) -> Model {
+    fn table_model(
+        chain: Chain,
+        vehicle: VehicleMotion,
+        scheme: Scheme,
+        truth: TableErrors,
+        compensation: TableErrors,
+    ) -> Model {
         Model::new(&TableParams { chain, vehicle, scheme, truth, compensation }, 0)
     }
 
@@ -282,9 +302,33 @@ mod tests {
 
     /// A 16-step dual-axis sequence (docs/schemes.md) at 10 deg/s with 20 s dwells.
     fn sixteen_position() -> Scheme {
-        let s = |axis, deg: f64| IndexedStep { axis, angle_rad: deg * RAD_PER_DEG, rate_rad_per_s: 10.0 * RAD_PER_DEG, dwell_s: 20.0, accel_rad_per_s2: 0.0 };
-        let first = [s(1, 180.0), s(0, 180.0), s(1, 180.0), s(0, 180.0), s(0, -180.0), s(1, -180.0), s(0, -180.0), s(1, -180.0)];
-        let second = [s(1, -180.0), s(0, -180.0), s(1, -180.0), s(0, -180.0), s(0, 180.0), s(1, 180.0), s(0, 180.0), s(1, 180.0)];
+        let s = |axis, deg: f64| IndexedStep {
+            axis,
+            angle_rad: deg * RAD_PER_DEG,
+            rate_rad_per_s: 10.0 * RAD_PER_DEG,
+            dwell_s: 20.0,
+            accel_rad_per_s2: 0.0,
+        };
+        let first = [
+            s(1, 180.0),
+            s(0, 180.0),
+            s(1, 180.0),
+            s(0, 180.0),
+            s(0, -180.0),
+            s(1, -180.0),
+            s(0, -180.0),
+            s(1, -180.0),
+        ];
+        let second = [
+            s(1, -180.0),
+            s(0, -180.0),
+            s(1, -180.0),
+            s(0, -180.0),
+            s(0, 180.0),
+            s(1, 180.0),
+            s(0, 180.0),
+            s(1, 180.0),
+        ];
         Scheme::indexed(vec![0.0, 0.0], 20.0, first.into_iter().chain(second).collect(), true)
     }
 
@@ -294,8 +338,18 @@ mod tests {
             Attitude { pitch_rad: 10.0 * RAD_PER_DEG, roll_rad: -20.0 * RAD_PER_DEG, heading_rad: 40.0 * RAD_PER_DEG },
             vec![],
             vec![
-                Wobble { angle: AngleKind::Pitch, amplitude_rad: 5.0 * RAD_PER_DEG, omega_rad_per_s: 0.3, phase_rad: 0.0 },
-                Wobble { angle: AngleKind::Heading, amplitude_rad: 30.0 * RAD_PER_DEG, omega_rad_per_s: 0.05, phase_rad: 1.0 },
+                Wobble {
+                    angle: AngleKind::Pitch,
+                    amplitude_rad: 5.0 * RAD_PER_DEG,
+                    omega_rad_per_s: 0.3,
+                    phase_rad: 0.0,
+                },
+                Wobble {
+                    angle: AngleKind::Heading,
+                    amplitude_rad: 30.0 * RAD_PER_DEG,
+                    omega_rad_per_s: 0.05,
+                    phase_rad: 1.0,
+                },
             ],
         )
         .expect("valid motion")
@@ -324,7 +378,8 @@ mod tests {
         // Analytic anchor: with a perfect table the nominal demodulation is exact (issue: < 1e-6 arcsec).
         let scheme = sixteen_position();
         let duration = 20.0 + scheme.period_s();
-        let model = table_model(dual_axis_chain(), moving_vehicle(), scheme, TableErrors::zero(2), TableErrors::zero(2));
+        let model =
+            table_model(dual_axis_chain(), moving_vehicle(), scheme, TableErrors::zero(2), TableErrors::zero(2));
         let stats = run_stats(&model, &Timeline::new(duration, 50.0));
         for v in 0..3 {
             assert!(peak_arcsec(&stats, v) < 1e-6, "variant {v}: {}", peak_arcsec(&stats, v));
@@ -379,7 +434,13 @@ mod tests {
         let run = |eta_arcsec: f64| {
             let mut e = TableErrors::zero(2);
             e.axes[1].non_orthogonality_rad = eta_arcsec * RAD_PER_ARCSEC;
-            let model = table_model(dual_axis_chain(), VehicleMotion::fixed(Attitude::default()), scheme.clone(), e, TableErrors::zero(2));
+            let model = table_model(
+                dual_axis_chain(),
+                VehicleMotion::fixed(Attitude::default()),
+                scheme.clone(),
+                e,
+                TableErrors::zero(2),
+            );
             let mut st = DemodState::default();
             (0..=720).map(|i| step(&model, &mut st, i as f64 * 0.1).errors[0]).collect::<Vec<_>>()
         };
@@ -409,7 +470,13 @@ mod tests {
         let run = |a: f64| {
             let mut e = TableErrors::zero(2);
             set(&mut e, a);
-            let model = table_model(dual_axis_chain(), VehicleMotion::fixed(Attitude::default()), scheme.clone(), e, TableErrors::zero(2));
+            let model = table_model(
+                dual_axis_chain(),
+                VehicleMotion::fixed(Attitude::default()),
+                scheme.clone(),
+                e,
+                TableErrors::zero(2),
+            );
             let mut st = DemodState::default();
             (0..=600).map(|i| step(&model, &mut st, i as f64 * 0.1)).collect::<Vec<_>>()
         };
@@ -420,7 +487,13 @@ mod tests {
             let exp = expected(angle, w_outer * o.t_s, w_inner * o.t_s);
             for ((got, want), got2) in o.errors[0].as_array().iter().zip(exp).zip(o2.errors[0].as_array()) {
                 // Second-order remainder: (100")^2 ~ 0.05".
-                assert!((got - want).abs() * ARCSEC_PER_RAD < 0.1, "t = {}: {} vs {}", o.t_s, got * ARCSEC_PER_RAD, want * ARCSEC_PER_RAD);
+                assert!(
+                    (got - want).abs() * ARCSEC_PER_RAD < 0.1,
+                    "t = {}: {} vs {}",
+                    o.t_s,
+                    got * ARCSEC_PER_RAD,
+                    want * ARCSEC_PER_RAD
+                );
                 assert!((got2 - 2.0 * got).abs() * ARCSEC_PER_RAD < 0.2, "linear in the error angle");
                 peak = peak.max(got.abs());
             }

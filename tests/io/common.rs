@@ -2,8 +2,8 @@
 
 use arrow_array::{ArrayRef, Float64Array, Int64Array, RecordBatch};
 use arrow_schema::{DataType, Field, Schema};
-use rinscope::io::{ImuEvent, ImuReader, ImuSample};
 use nalgebra::{Matrix3, Vector3};
+use rinscope::io::{ImuEvent, ImuReader, ImuSample};
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -11,9 +11,7 @@ use std::sync::Arc;
 
 /// A fresh, empty directory under cargo's per-target temp dir.
 pub fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("logio-tests")
-        .join(name);
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("logio-tests").join(name);
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
@@ -32,16 +30,8 @@ pub fn truth_rates(n: usize) -> Vec<ImuSample> {
             let t = i as f64 * DT;
             ImuSample {
                 t_s: t,
-                gyro: Vector3::new(
-                    1e-5 * (t * 3.0).sin(),
-                    -2e-5 + 1e-6 * i as f64,
-                    4e-5 * (t * 2.0).cos(),
-                ),
-                accel: Vector3::new(
-                    0.01 * (t * 5.0).sin(),
-                    -0.02,
-                    9.80665 + 1e-3 * (t * 7.0).cos(),
-                ),
+                gyro: Vector3::new(1e-5 * (t * 3.0).sin(), -2e-5 + 1e-6 * i as f64, 4e-5 * (t * 2.0).cos()),
+                accel: Vector3::new(0.01 * (t * 5.0).sin(), -0.02, 9.80665 + 1e-3 * (t * 7.0).cos()),
             }
         })
         .collect()
@@ -49,14 +39,7 @@ pub fn truth_rates(n: usize) -> Vec<ImuSample> {
 
 /// The same truth as increments over the previous sample (rate × dt; exact enough for a test).
 pub fn truth_increments(n: usize) -> Vec<ImuSample> {
-    truth_rates(n)
-        .into_iter()
-        .map(|s| ImuSample {
-            t_s: s.t_s,
-            gyro: s.gyro * DT,
-            accel: s.accel * DT,
-        })
-        .collect()
+    truth_rates(n).into_iter().map(|s| ImuSample { t_s: s.t_s, gyro: s.gyro * DT, accel: s.accel * DT }).collect()
 }
 
 /// `v` expressed in a frame whose matrix to RFU is `c` (`v_rfu = c · v_frame`).
@@ -78,24 +61,9 @@ pub fn samples(reader: ImuReader) -> Vec<ImuSample> {
 pub fn assert_same(got: &[ImuSample], want: &[ImuSample], tol: f64) {
     assert_eq!(got.len(), want.len(), "sample count");
     for (i, (g, w)) in got.iter().zip(want).enumerate() {
-        assert!(
-            (g.t_s - w.t_s).abs() <= tol.max(1e-12),
-            "sample {i}: t {} vs {}",
-            g.t_s,
-            w.t_s
-        );
-        assert!(
-            (g.gyro - w.gyro).abs().max() <= tol,
-            "sample {i}: gyro {:?} vs {:?}",
-            g.gyro,
-            w.gyro
-        );
-        assert!(
-            (g.accel - w.accel).abs().max() <= tol,
-            "sample {i}: accel {:?} vs {:?}",
-            g.accel,
-            w.accel
-        );
+        assert!((g.t_s - w.t_s).abs() <= tol.max(1e-12), "sample {i}: t {} vs {}", g.t_s, w.t_s);
+        assert!((g.gyro - w.gyro).abs().max() <= tol, "sample {i}: gyro {:?} vs {:?}", g.gyro, w.gyro);
+        assert!((g.accel - w.accel).abs().max() <= tol, "sample {i}: accel {:?} vs {:?}", g.accel, w.accel);
     }
 }
 
@@ -109,10 +77,7 @@ pub fn write_text(dir: &Path, name: &str, text: &str) -> PathBuf {
 /// A .npy v1.0 `<f8` C-order file, encoded here by hand from the format spec (independent of logio's writer).
 pub fn write_npy(path: &Path, rows: &[Vec<f64>], descr: &str) {
     let cols = rows.first().map_or(0, Vec::len);
-    let dict = format!(
-        "{{'descr': '{descr}', 'fortran_order': False, 'shape': ({}, {cols}), }}",
-        rows.len()
-    );
+    let dict = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': ({}, {cols}), }}", rows.len());
     let total = (10 + dict.len() + 1).div_ceil(64) * 64;
     let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
     bytes.extend(u16::try_from(total - 10).unwrap().to_le_bytes());
@@ -132,26 +97,12 @@ pub fn write_npy(path: &Path, rows: &[Vec<f64>], descr: &str) {
 
 /// A Parquet file written with the parquet crate's own ArrowWriter (independent of logio's).
 /// `int_first` makes column 0 an Int64 column.
-pub fn write_parquet(
-    path: &Path,
-    names: &[&str],
-    rows: &[Vec<f64>],
-    int_first: Option<&[i64]>,
-    rows_per_group: usize,
-) {
+pub fn write_parquet(path: &Path, names: &[&str], rows: &[Vec<f64>], int_first: Option<&[i64]>, rows_per_group: usize) {
     let fields: Vec<Field> = names
         .iter()
         .enumerate()
         .map(|(i, n)| {
-            Field::new(
-                *n,
-                if i == 0 && int_first.is_some() {
-                    DataType::Int64
-                } else {
-                    DataType::Float64
-                },
-                false,
-            )
+            Field::new(*n, if i == 0 && int_first.is_some() { DataType::Int64 } else { DataType::Float64 }, false)
         })
         .collect();
     let schema = Arc::new(Schema::new(fields));
@@ -163,13 +114,10 @@ pub fn write_parquet(
     let arrays: Vec<ArrayRef> = (0..names.len())
         .map(|c| match (c, int_first) {
             (0, Some(ints)) => Arc::new(Int64Array::from(ints.to_vec())) as ArrayRef,
-            _ => Arc::new(Float64Array::from(
-                rows.iter().map(|r| r[c]).collect::<Vec<_>>(),
-            )) as ArrayRef,
+            _ => Arc::new(Float64Array::from(rows.iter().map(|r| r[c]).collect::<Vec<_>>())) as ArrayRef,
         })
         .collect();
-    w.write(&RecordBatch::try_new(schema, arrays).unwrap())
-        .unwrap();
+    w.write(&RecordBatch::try_new(schema, arrays).unwrap()).unwrap();
     w.close().unwrap();
 }
 
@@ -216,18 +164,12 @@ pub struct McapTopic<'a> {
 /// Writes an MCAP file with the mcap crate's writer (chunked, zstd, with summary by default).
 pub fn write_mcap(path: &Path, topics: &[McapTopic<'_>], summary: bool) {
     let file = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
-    let opts = mcap::WriteOptions::new()
-        .emit_summary_records(summary)
-        .emit_summary_offsets(summary);
+    let opts = mcap::WriteOptions::new().emit_summary_records(summary).emit_summary_offsets(summary);
     let mut w = opts.create(file).unwrap();
     let mut seq = 0;
     for t in topics {
-        let schema_id = w
-            .add_schema(t.schema, "ros2msg", IMU_MSG_DEF.as_bytes())
-            .unwrap();
-        let channel = w
-            .add_channel(schema_id, t.topic, "cdr", &BTreeMap::new())
-            .unwrap();
+        let schema_id = w.add_schema(t.schema, "ros2msg", IMU_MSG_DEF.as_bytes()).unwrap();
+        let channel = w.add_channel(schema_id, t.topic, "cdr", &BTreeMap::new()).unwrap();
         for (log_time, data) in &t.messages {
             seq += 1;
             let header = mcap::records::MessageHeader {

@@ -10,14 +10,7 @@ use rinscope::io::{Frame, ImuOptions, ImuReader, Layout, SampleKind, StartTime, 
 const N: usize = 40;
 
 fn rinscope_rates_rows() -> Vec<Vec<f64>> {
-    truth_rates(N)
-        .iter()
-        .map(|s| {
-            vec![
-                s.t_s, s.gyro.x, s.gyro.y, s.gyro.z, s.accel.x, s.accel.y, s.accel.z,
-            ]
-        })
-        .collect()
+    truth_rates(N).iter().map(|s| vec![s.t_s, s.gyro.x, s.gyro.y, s.gyro.z, s.accel.x, s.accel.y, s.accel.z]).collect()
 }
 
 fn csv(header: &str, rows: &[Vec<f64>], sep: &str) -> String {
@@ -45,9 +38,7 @@ fn rinscope_csv_rates_and_increments() {
     // Increments in degrees / m/s, extra columns ignored, column order shuffled.
     let inc = truth_increments(N);
     let deg = 180.0 / std::f64::consts::PI;
-    let mut text = String::from(
-        "temp_c_1,dv_z_mps,dv_y_mps,dv_x_mps,t_s,dtheta_x_deg,dtheta_y_deg,dtheta_z_deg\n",
-    );
+    let mut text = String::from("temp_c_1,dv_z_mps,dv_y_mps,dv_x_mps,t_s,dtheta_x_deg,dtheta_y_deg,dtheta_z_deg\n");
     for s in &inc {
         text += &format!(
             "21.5,{},{},{},{},{},{},{}\n",
@@ -92,19 +83,11 @@ fn parquet_matches_csv() {
 fn npy7_matches() {
     let dir = scratch("npy7");
     let inc = truth_increments(N);
-    let rows: Vec<Vec<f64>> = inc
-        .iter()
-        .map(|s| {
-            vec![
-                s.t_s, s.gyro.x, s.gyro.y, s.gyro.z, s.accel.x, s.accel.y, s.accel.z,
-            ]
-        })
-        .collect();
+    let rows: Vec<Vec<f64>> =
+        inc.iter().map(|s| vec![s.t_s, s.gyro.x, s.gyro.y, s.gyro.z, s.accel.x, s.accel.y, s.accel.z]).collect();
     let path = dir.join("imu.npy");
     write_npy(&path, &rows, "<f8");
-    let mut opts = ImuOptions::new(Layout::Npy7 {
-        time: TimeUnit::Seconds,
-    });
+    let mut opts = ImuOptions::new(Layout::Npy7 { time: TimeUnit::Seconds });
     opts.frame = Some(Frame::Named("rfu".into()));
     assert_same(&samples(ImuReader::open(&path, &opts).unwrap()), &inc, 0.0);
     // float32 arrays widen exactly; compare to f32 precision.
@@ -134,16 +117,9 @@ fn mcap_ros2_imu_matches() {
             (ns as u64 + 5_000, cdr)
         })
         .collect();
-    let other = McapTopic {
-        topic: "/tf",
-        schema: "tf2_msgs/msg/TFMessage",
-        messages: vec![(T0_NS as u64, vec![0, 1, 0, 0])],
-    };
-    let imu = McapTopic {
-        topic: "/imu/data",
-        schema: "sensor_msgs/msg/Imu",
-        messages,
-    };
+    let other =
+        McapTopic { topic: "/tf", schema: "tf2_msgs/msg/TFMessage", messages: vec![(T0_NS as u64, vec![0, 1, 0, 0])] };
+    let imu = McapTopic { topic: "/imu/data", schema: "sensor_msgs/msg/Imu", messages };
     for summary in [true, false] {
         let path = dir.join(format!("imu_summary_{summary}.mcap"));
         write_mcap(&path, &[other.clone(), imu.clone()], summary);
@@ -157,24 +133,10 @@ fn mcap_ros2_imu_matches() {
 #[test]
 fn mcap_zero_stamp_falls_back_to_log_time() {
     let dir = scratch("mcap_logtime");
-    let messages = (0..12u64)
-        .map(|i| {
-            (
-                1_000_000_000 + i * 5_000_000,
-                cdr_imu(0, 0, "", [0.0; 3], [0.0, 0.0, 9.8]),
-            )
-        })
-        .collect();
+    let messages =
+        (0..12u64).map(|i| (1_000_000_000 + i * 5_000_000, cdr_imu(0, 0, "", [0.0; 3], [0.0, 0.0, 9.8]))).collect();
     let path = dir.join("imu.mcap");
-    write_mcap(
-        &path,
-        &[McapTopic {
-            topic: "/imu",
-            schema: "sensor_msgs/msg/Imu",
-            messages,
-        }],
-        true,
-    );
+    write_mcap(&path, &[McapTopic { topic: "/imu", schema: "sensor_msgs/msg/Imu", messages }], true);
     let reader = ImuReader::open(&path, &ImuOptions::new(Layout::Ros2)).unwrap();
     let s = samples(reader);
     assert_eq!(s.len(), 12);
@@ -189,22 +151,9 @@ fn psins_kfgins_kalibr_layouts() {
     // PSINS [wm vm t], RFU; once header-less, once with a header line.
     let psins: Vec<Vec<f64>> = inc
         .iter()
-        .map(|s| {
-            vec![
-                s.gyro.x,
-                s.gyro.y,
-                s.gyro.z,
-                s.accel.x,
-                s.accel.y,
-                s.accel.z,
-                s.t_s + 100.0,
-            ]
-        })
+        .map(|s| vec![s.gyro.x, s.gyro.y, s.gyro.z, s.accel.x, s.accel.y, s.accel.z, s.t_s + 100.0])
         .collect();
-    for (name, header) in [
-        ("psins.txt", None),
-        ("psins_h.csv", Some("wx,wy,wz,vx,vy,vz,t")),
-    ] {
+    for (name, header) in [("psins.txt", None), ("psins_h.csv", Some("wx,wy,wz,vx,vy,vz,t"))] {
         let text = match header {
             Some(h) => csv(h, &psins, ","),
             None => csv("", &psins, " ").trim_start().to_owned(),
@@ -219,16 +168,7 @@ fn psins_kfgins_kalibr_layouts() {
     let mut text = String::new();
     for s in &inc {
         let (g, a) = (in_frame(&frd, &s.gyro), in_frame(&frd, &s.accel));
-        text += &format!(
-            "{}\t{} {} {}  {} {} {} 0.0\n",
-            345_600.0 + s.t_s,
-            g.x,
-            g.y,
-            g.z,
-            a.x,
-            a.y,
-            a.z
-        );
+        text += &format!("{}\t{} {} {}  {} {} {} 0.0\n", 345_600.0 + s.t_s, g.x, g.y, g.z, a.x, a.y, a.z);
     }
     let path = write_text(&dir, "kfgins.txt", &text);
     let reader = ImuReader::open(&path, &ImuOptions::new(Layout::KfGins)).unwrap();
@@ -240,23 +180,11 @@ fn psins_kfgins_kalibr_layouts() {
     );
     for (i, s) in rates.iter().enumerate() {
         let (g, a) = (in_frame(&flu, &s.gyro), in_frame(&flu, &s.accel));
-        text += &format!(
-            "{},{},{},{},{},{},{}\n",
-            T0_NS + i as i64 * 10_000_000,
-            g.x,
-            g.y,
-            g.z,
-            a.x,
-            a.y,
-            a.z
-        );
+        text += &format!("{},{},{},{},{},{},{}\n", T0_NS + i as i64 * 10_000_000, g.x, g.y, g.z, a.x, a.y, a.z);
     }
     let path = write_text(&dir, "imu0.csv", &text);
     let mut opts = ImuOptions::new(Layout::Kalibr);
-    assert!(
-        ImuReader::open(&path, &opts).is_err(),
-        "Kalibr has no standard frame: it must be given"
-    );
+    assert!(ImuReader::open(&path, &opts).is_err(), "Kalibr has no standard frame: it must be given");
     opts.frame = Some(Frame::Named("flu".into()));
     let reader = ImuReader::open(&path, &opts).unwrap();
     assert_eq!(reader.columns()[0], "timestamp [ns]");
@@ -268,11 +196,7 @@ fn psins_kfgins_kalibr_layouts() {
         1,
     );
     let path = write_text(&dir, "imu0_wiki.csv", &text);
-    assert_same(
-        &samples(ImuReader::open(&path, &opts).unwrap()),
-        &rates,
-        0.0,
-    );
+    assert_same(&samples(ImuReader::open(&path, &opts).unwrap()), &rates, 0.0);
 }
 
 #[test]

@@ -47,14 +47,8 @@ fn read_imu(path: &Path, layout: Layout) -> rinscope::io::Result<usize> {
 
 fn valid_files(dir: &Path) -> Vec<(std::path::PathBuf, Layout)> {
     let truth = truth_rates(30);
-    let rows: Vec<Vec<f64>> = truth
-        .iter()
-        .map(|s| {
-            vec![
-                s.t_s, s.gyro.x, s.gyro.y, s.gyro.z, s.accel.x, s.accel.y, s.accel.z,
-            ]
-        })
-        .collect();
+    let rows: Vec<Vec<f64>> =
+        truth.iter().map(|s| vec![s.t_s, s.gyro.x, s.gyro.y, s.gyro.z, s.accel.x, s.accel.y, s.accel.z]).collect();
     let names = [
         "t_s",
         "gyro_x_rad_per_s",
@@ -72,33 +66,15 @@ fn valid_files(dir: &Path) -> Vec<(std::path::PathBuf, Layout)> {
             w.write_row(r).unwrap();
         }
         w.finish().unwrap();
-        let layout = if ext == "npy" {
-            Layout::Npy7 {
-                time: rinscope::io::TimeUnit::Seconds,
-            }
-        } else {
-            Layout::Rinscope
-        };
+        let layout =
+            if ext == "npy" { Layout::Npy7 { time: rinscope::io::TimeUnit::Seconds } } else { Layout::Rinscope };
         out.push((path, layout));
     }
     let path = dir.join("valid.mcap");
     let messages = (0..30u32)
-        .map(|i| {
-            (
-                u64::from(i) * 10_000_000 + 1,
-                cdr_imu(5, i * 10_000_000, "imu", [1e-5, 0.0, 0.0], [0.0, 0.0, 9.8]),
-            )
-        })
+        .map(|i| (u64::from(i) * 10_000_000 + 1, cdr_imu(5, i * 10_000_000, "imu", [1e-5, 0.0, 0.0], [0.0, 0.0, 9.8])))
         .collect();
-    write_mcap(
-        &path,
-        &[McapTopic {
-            topic: "/imu",
-            schema: "sensor_msgs/msg/Imu",
-            messages,
-        }],
-        true,
-    );
+    write_mcap(&path, &[McapTopic { topic: "/imu", schema: "sensor_msgs/msg/Imu", messages }], true);
     out.push((path, Layout::Ros2));
     out
 }
@@ -108,10 +84,7 @@ fn truncated_files_are_errors() {
     let dir = scratch("garbage_truncated");
     for (path, layout) in valid_files(&dir) {
         let bytes = std::fs::read(&path).unwrap();
-        assert!(
-            read_all(&path).is_ok() && read_imu(&path, layout.clone()).is_ok(),
-            "{path:?} should be valid"
-        );
+        assert!(read_all(&path).is_ok() && read_imu(&path, layout.clone()).is_ok(), "{path:?} should be valid");
         let ext = path.extension().unwrap().to_str().unwrap().to_owned();
         let cut_path = dir.join(format!("cut.{ext}"));
         let mut cuts: Vec<usize> = (0..bytes.len()).step_by(7).collect();
@@ -121,30 +94,17 @@ fn truncated_files_are_errors() {
                 // A text table cut exactly at a line end is a valid shorter table; cut inside the
                 // last line so that it loses at least one field separator.
                 let last_nl = bytes[..cut].iter().rposition(|&b| b == b'\n');
-                let tail_has_comma = bytes[last_nl.map_or(0, |i| i + 1)..]
-                    .iter()
-                    .take_while(|&&b| b != b'\n')
-                    .any(|&b| b == b',');
-                let cut_has_all = bytes[last_nl.map_or(0, |i| i + 1)..cut]
-                    .iter()
-                    .filter(|&&b| b == b',')
-                    .count()
-                    >= 6;
+                let tail_has_comma =
+                    bytes[last_nl.map_or(0, |i| i + 1)..].iter().take_while(|&&b| b != b'\n').any(|&b| b == b',');
+                let cut_has_all = bytes[last_nl.map_or(0, |i| i + 1)..cut].iter().filter(|&&b| b == b',').count() >= 6;
                 if last_nl.is_none() || last_nl == Some(cut - 1) || !tail_has_comma || cut_has_all {
                     continue;
                 }
             }
             std::fs::write(&cut_path, &bytes[..cut]).unwrap();
-            let r = if ext == "csv" || ext == "mcap" {
-                read_imu(&cut_path, layout.clone())
-            } else {
-                read_all(&cut_path)
-            };
-            assert!(
-                r.is_err(),
-                "{ext} cut at {cut} of {} read as {r:?}",
-                bytes.len()
-            );
+            let r =
+                if ext == "csv" || ext == "mcap" { read_imu(&cut_path, layout.clone()) } else { read_all(&cut_path) };
+            assert!(r.is_err(), "{ext} cut at {cut} of {} read as {r:?}", bytes.len());
         }
     }
 }
@@ -195,8 +155,5 @@ fn random_garbage_and_bit_flips_never_panic() {
 
 /// Mutations per format: 1000, or LOGIO_FUZZ_ITERATIONS for a longer run.
 fn flips() -> usize {
-    std::env::var("LOGIO_FUZZ_ITERATIONS")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(1000)
+    std::env::var("LOGIO_FUZZ_ITERATIONS").ok().and_then(|v| v.parse().ok()).unwrap_or(1000)
 }

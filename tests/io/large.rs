@@ -19,10 +19,7 @@ fn peak_rss_mib() -> f64 {
 #[ignore = "writes ~0.5 GB; run alone: cargo test -- --ignored large"]
 fn large_files_stream_in_flat_memory() {
     let dir = scratch("large");
-    let rows: u64 = std::env::var("LOGIO_LARGE_ROWS")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(3_000_000);
+    let rows: u64 = std::env::var("LOGIO_LARGE_ROWS").ok().and_then(|v| v.parse().ok()).unwrap_or(3_000_000);
     let names = [
         "t_s",
         "gyro_x_rad_per_s",
@@ -38,16 +35,7 @@ fn large_files_stream_in_flat_memory() {
         let mut w = TableWriter::create(&path, &names).unwrap();
         for i in 0..rows {
             let t = i as f64 * 0.005;
-            w.write_row(&[
-                t,
-                1e-5 * t.sin(),
-                2e-5,
-                3e-5,
-                0.01,
-                0.02,
-                9.80665 + 1e-3 * t.cos(),
-            ])
-            .unwrap();
+            w.write_row(&[t, 1e-5 * t.sin(), 2e-5, 3e-5, 0.01, 0.02, 9.80665 + 1e-3 * t.cos()]).unwrap();
         }
         w.finish().unwrap();
         let size_mib = std::fs::metadata(&path).unwrap().len() as f64 / (1 << 20) as f64;
@@ -60,26 +48,15 @@ fn large_files_stream_in_flat_memory() {
         }
         assert_eq!(n, rows);
         let peak = peak_rss_mib();
-        eprintln!(
-            "{ext}: {size_mib:.0} MiB file, {rows} rows; peak RSS {peak:.0} MiB (was {before:.0} MiB before)"
-        );
-        assert!(
-            peak - before < 128.0,
-            "{ext}: memory grew by {:.0} MiB",
-            peak - before
-        );
+        eprintln!("{ext}: {size_mib:.0} MiB file, {rows} rows; peak RSS {peak:.0} MiB (was {before:.0} MiB before)");
+        assert!(peak - before < 128.0, "{ext}: memory grew by {:.0} MiB", peak - before);
         std::fs::remove_file(&path).unwrap();
     }
     // MCAP: messages written one by one with the mcap crate, read back with logio.
     let path = dir.join("big.mcap");
-    let mut w = mcap::Writer::new(std::io::BufWriter::new(
-        std::fs::File::create(&path).unwrap(),
-    ))
-    .unwrap();
+    let mut w = mcap::Writer::new(std::io::BufWriter::new(std::fs::File::create(&path).unwrap())).unwrap();
     let schema = w.add_schema("sensor_msgs/msg/Imu", "ros2msg", b"").unwrap();
-    let channel = w
-        .add_channel(schema, "/imu", "cdr", &std::collections::BTreeMap::new())
-        .unwrap();
+    let channel = w.add_channel(schema, "/imu", "cdr", &std::collections::BTreeMap::new()).unwrap();
     for i in 0..rows {
         let ns = 1_700_000_000_000_000_000 + i * 5_000_000;
         let cdr = cdr_imu(
@@ -89,12 +66,8 @@ fn large_files_stream_in_flat_memory() {
             [1e-5, 0.0, 0.0],
             [0.0, 0.0, 9.8 + (i % 7) as f64 * 1e-3],
         );
-        let header = mcap::records::MessageHeader {
-            channel_id: channel,
-            sequence: i as u32,
-            log_time: ns,
-            publish_time: ns,
-        };
+        let header =
+            mcap::records::MessageHeader { channel_id: channel, sequence: i as u32, log_time: ns, publish_time: ns };
         w.write_to_known_channel(&header, &cdr).unwrap();
     }
     w.finish().unwrap();
@@ -109,12 +82,6 @@ fn large_files_stream_in_flat_memory() {
     }
     assert_eq!(n, rows);
     let peak = peak_rss_mib();
-    eprintln!(
-        "mcap: {size_mib:.0} MiB file, {rows} messages; peak RSS {peak:.0} MiB (was {before:.0} MiB before)"
-    );
-    assert!(
-        peak - before < 128.0,
-        "mcap: memory grew by {:.0} MiB",
-        peak - before
-    );
+    eprintln!("mcap: {size_mib:.0} MiB file, {rows} messages; peak RSS {peak:.0} MiB (was {before:.0} MiB before)");
+    assert!(peak - before < 128.0, "mcap: memory grew by {:.0} MiB", peak - before);
 }

@@ -1,8 +1,6 @@
 //! .npy files written by NumPy itself (tests/data, see its README: NumPy 2.4.6 `np.save`).
 
-use rinscope::io::{
-    Col, ColumnReader, Frame, ImuOptions, ImuReader, Layout, LogError, ReadOptions, TimeUnit,
-};
+use rinscope::io::{Col, ColumnReader, Frame, ImuOptions, ImuReader, Layout, LogError, ReadOptions, TimeUnit};
 use std::path::PathBuf;
 
 /// The array the golden files were saved from (tests/data/README.md).
@@ -13,9 +11,7 @@ const A: [[f64; 7]; 3] = [
 ];
 
 fn data(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
-        .join(name)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
 }
 
 fn read(name: &str) -> rinscope::io::Result<Vec<[f64; 7]>> {
@@ -39,21 +35,11 @@ fn numpy_written_files() {
             assert_eq!(r[k], f64::from(a[k] as f32), "f32 widens exactly");
         }
     }
-    assert!(matches!(
-        read("numpy_fortran.npy"),
-        Err(LogError::Shape { .. })
-    ));
-    assert!(matches!(
-        read("numpy_i8.npy"),
-        Err(LogError::NpyDtype { .. })
-    ));
+    assert!(matches!(read("numpy_fortran.npy"), Err(LogError::Shape { .. })));
+    assert!(matches!(read("numpy_i8.npy"), Err(LogError::NpyDtype { .. })));
     // As an N×7 increments log (time in s, rad, m/s): 200 Hz, 0.049 m/s ≈ 9.8 m/s² × 5 ms.
-    let mut opts = ImuOptions::new(Layout::Npy7 {
-        time: TimeUnit::Seconds,
-    });
+    let mut opts = ImuOptions::new(Layout::Npy7 { time: TimeUnit::Seconds });
     opts.frame = Some(Frame::Named("rfu".into()));
-    let n = ImuReader::open(data("numpy_f8.npy"), &opts)
-        .unwrap()
-        .count();
+    let n = ImuReader::open(data("numpy_f8.npy"), &opts).unwrap().count();
     assert_eq!(n, 3);
 }

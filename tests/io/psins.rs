@@ -10,12 +10,12 @@
 
 use crate::common::*;
 use rinscope::io::{
-    Col, ColumnReader, Format, ImuOptions, ImuReader, ImuSample, Layout, PsinsHeader, ReadOptions,
-    SampleKind, StartTime, detect_format, read_psins_header,
+    Col, ColumnReader, Format, ImuOptions, ImuReader, ImuSample, Layout, PsinsHeader, ReadOptions, SampleKind,
+    StartTime, detect_format, read_psins_header,
 };
 use std::path::Path;
 
-pub use crate::psins_writer::{imufile_text, SimuInput, GLV_G0, G_PRINTED};
+pub use crate::psins_writer::{G_PRINTED, GLV_G0, SimuInput, imufile_text};
 
 /// `n` increments at interval `ts`, sample k (from 1) at `t0 + k·ts + jitter_s(k)`: rates of one
 /// sign per axis (rad/s, m/s²) times ts.
@@ -126,7 +126,10 @@ fn six_columns_round_trip() {
     // As a table: imufile.m's [wm vm t], t absolute.
     let cols: Vec<Col> = (0..7).map(Col::Index).collect();
     let mut table = ColumnReader::open(&path, &cols, &ReadOptions::default()).unwrap();
-    assert_eq!(table.columns(), ["dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad", "dv_x_mps", "dv_y_mps", "dv_z_mps", "t_s"]);
+    assert_eq!(
+        table.columns(),
+        ["dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad", "dv_x_mps", "dv_y_mps", "dv_z_mps", "t_s"]
+    );
     assert_eq!(table.psins_header(), Some(&header));
     let mut row = [0.0; 7];
     assert!(table.next_row(&mut row).unwrap());

@@ -7,8 +7,7 @@
 use crate::common::*;
 use crate::psins::{imufile_text, input};
 use rinscope::io::{
-    Col, ColumnReader, ImuOptions, ImuReader, Layout, Location, LogError, ReadOptions, TimeUnit,
-    read_psins_header,
+    Col, ColumnReader, ImuOptions, ImuReader, Layout, Location, LogError, ReadOptions, TimeUnit, read_psins_header,
 };
 use std::path::{Path, PathBuf};
 
@@ -67,7 +66,11 @@ fn counts_that_are_not_integers() {
     error(&path, &["data row 4 (line 22)", "dt (field 7)", "\"0.5\""]);
     // An integral number is a count, as MATLAB's load reads it.
     let lines = valid_lines(false);
-    let path = write_lines(&dir, "float.imu", &with_field(&lines, 19, 0, &format!("{}.0", lines[18].split(' ').next().unwrap())));
+    let path = write_lines(
+        &dir,
+        "float.imu",
+        &with_field(&lines, 19, 0, &format!("{}.0", lines[18].split(' ').next().unwrap())),
+    );
     assert!(ImuReader::open(&path, &ImuOptions::new(Layout::PsinsImu)).unwrap().all(|e| e.is_ok()));
 }
 
@@ -123,7 +126,13 @@ fn header_values() {
         ("ts0.imu", 16, 4, "0.00000000", ["sampling-interval(ms) (header row 2, field 5)", "at least 0.01 ms"]),
         ("ts_neg.imu", 16, 4, "-10.00000000", ["sampling-interval(ms)", "at least 0.01 ms"]),
         // Issue 31: every header number passes the samples' rule, said short (no 300 digits).
-        ("pitch.imu", 15, 0, "1e300", ["pitch0(deg) (header row 1, field 1)", "1e300 deg is out of range for a pitch: it must be within ±90 deg"]),
+        (
+            "pitch.imu",
+            15,
+            0,
+            "1e300",
+            ["pitch0(deg) (header row 1, field 1)", "1e300 deg is out of range for a pitch: it must be within ±90 deg"],
+        ),
         ("ve.imu", 15, 3, "1e300", ["VE0(m/s) (header row 1, field 4)", "1e300 m/s is out of range for a velocity"]),
         ("h.imu", 16, 2, "-1e300", ["height0(m)", "-1e300 m is out of range for a height"]),
         ("t0.imu", 16, 3, "1e300", ["t0(s)", "a time on the file's clock"]),
@@ -141,7 +150,15 @@ fn header_values() {
         let quoted = if value == "NaN" { value.to_owned() } else { format!("{value:?}") };
         let e = error(&path, &[&line_text, &quoted, expected[0], expected[1]]);
         assert!(e.to_string().len() < 400, "short: {e}");
-        assert!(matches!(&e, LogError::BadValue { at: Location { row: 0, .. }, .. } | LogError::NonFinite { .. } | LogError::NonNumeric { .. }), "{e:?}");
+        assert!(
+            matches!(
+                &e,
+                LogError::BadValue { at: Location { row: 0, .. }, .. }
+                    | LogError::NonFinite { .. }
+                    | LogError::NonNumeric { .. }
+            ),
+            "{e:?}"
+        );
         let header_error = read_psins_header(&path).unwrap_err().to_string();
         assert_eq!(header_error, e.to_string());
     }
@@ -177,17 +194,30 @@ fn other_layouts_refuse_a_psins_file_and_psins_imu_refuses_others() {
         opts.frame = Some(rinscope::io::Frame::Named("rfu".into()));
         let e = ImuReader::open(&psins, &opts).unwrap_err();
         let msg = e.to_string();
-        assert!(msg.contains("PSINS .imu file") && msg.contains("layout = \"psins-imu\"") && msg.contains(layout.name()), "{msg}");
+        assert!(
+            msg.contains("PSINS .imu file") && msg.contains("layout = \"psins-imu\"") && msg.contains(layout.name()),
+            "{msg}"
+        );
     }
     // A .imu of whitespace-separated numbers (KF-GINS style) asked to be psins-imu.
-    let kf = write_text(&dir, "kf.imu", "345600.00 1e-5 2e-5 3e-5 0.01 0.02 0.098\n345600.01 1e-5 2e-5 3e-5 0.01 0.02 0.098\n");
-    error(&kf, &["not a PSINS SIMU file", "line 1 is \"345600.00 1e-5", "% PSINS-format SIMU log file. (DO NOT MODIFY!)"]);
+    let kf = write_text(
+        &dir,
+        "kf.imu",
+        "345600.00 1e-5 2e-5 3e-5 0.01 0.02 0.098\n345600.01 1e-5 2e-5 3e-5 0.01 0.02 0.098\n",
+    );
+    error(
+        &kf,
+        &["not a PSINS SIMU file", "line 1 is \"345600.00 1e-5", "% PSINS-format SIMU log file. (DO NOT MODIFY!)"],
+    );
     // It stays a text table for the other layouts.
     assert!(ImuReader::open(&kf, &ImuOptions::new(Layout::KfGins)).is_ok());
     // A first line naming PSINS and SIMU that is not a % comment (MATLAB's load would refuse it).
     let mut lines = valid_lines(false);
     lines[0] = "PSINS-format SIMU log file".into();
-    error(&write_lines(&dir, "nopercent.imu", &lines), &["not a PSINS SIMU file", "line 1 is \"PSINS-format SIMU log file\""]);
+    error(
+        &write_lines(&dir, "nopercent.imu", &lines),
+        &["not a PSINS SIMU file", "line 1 is \"PSINS-format SIMU log file\""],
+    );
     lines[0] = "% PSINS log file".into();
     let path = write_lines(&dir, "nosimu.imu", &lines);
     error(&path, &["line 1 is \"% PSINS log file\""]);
@@ -220,9 +250,11 @@ fn bit_flips_never_panic() {
         }
         std::fs::write(&bad, &g).unwrap();
         let _ = ImuReader::open(&bad, &ImuOptions::new(Layout::PsinsImu)).map(|r| r.count());
-        let _ = ColumnReader::open(&bad, &(0..7).map(Col::Index).collect::<Vec<_>>(), &ReadOptions::default()).map(|mut r| {
-            let mut row = [0.0; 7];
-            while let Ok(true) = r.next_row(&mut row) {}
-        });
+        let _ = ColumnReader::open(&bad, &(0..7).map(Col::Index).collect::<Vec<_>>(), &ReadOptions::default()).map(
+            |mut r| {
+                let mut row = [0.0; 7];
+                while let Ok(true) = r.next_row(&mut row) {}
+            },
+        );
     }
 }

@@ -88,4 +88,3 @@ pub fn imufile_text(input: &SimuInput) -> String {
     }
     text
 }
-

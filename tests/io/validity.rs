@@ -12,7 +12,15 @@ fn increments_csv(rows: usize) -> Vec<Vec<String>> {
     (0..rows)
         .map(|k| {
             let t = k as f64 * DT;
-            vec![format!("{t:.2}"), "1.5e-7".into(), "-2.5e-7".into(), "3.0e-7".into(), "0.0316".into(), "-0.0021".into(), "0.098".into()]
+            vec![
+                format!("{t:.2}"),
+                "1.5e-7".into(),
+                "-2.5e-7".into(),
+                "3.0e-7".into(),
+                "0.0316".into(),
+                "-0.0021".into(),
+                "0.098".into(),
+            ]
         })
         .collect()
 }
@@ -134,7 +142,14 @@ fn a_reader_reports_its_own_first_error() {
     let e = ImuReader::open(&path, &ImuOptions::new(Layout::Rinscope)).unwrap_err();
     message_of(&e, &path, &["data row 1 (line 2)", "4 fields", "header has 7"]);
     // An MCAP whose first (only) chunk is corrupt: the chunk's error, at open.
-    let messages: Vec<(u64, Vec<u8>)> = (0..200).map(|k| (1_000_000_000 + k * 10_000_000, cdr_imu(1, (k * 10_000_000) as u32, "imu", [0.01, 0.02, 0.03], [0.0, 0.0, 9.8]))).collect();
+    let messages: Vec<(u64, Vec<u8>)> = (0..200)
+        .map(|k| {
+            (
+                1_000_000_000 + k * 10_000_000,
+                cdr_imu(1, (k * 10_000_000) as u32, "imu", [0.01, 0.02, 0.03], [0.0, 0.0, 9.8]),
+            )
+        })
+        .collect();
     let path = dir.join("corrupt.mcap");
     write_mcap(&path, &[McapTopic { topic: "/imu", schema: "sensor_msgs/msg/Imu", messages }], true);
     let mut bytes = std::fs::read(&path).unwrap();
@@ -154,7 +169,16 @@ fn positional_layouts_refuse_files_they_cannot_read_by_position() {
     let path = write_text(&dir, "imu.csv", &csv_text(&increments_csv(20)));
     for layout in [Layout::Kalibr, Layout::Npy7 { time: TimeUnit::Seconds }, Layout::Psins] {
         let e = read(&path, layout.clone()).unwrap_err();
-        message_of(&e, &path, &["rinscope columns", "dtheta_x_rad", &format!("layout = \"{}\"", layout.name()), "use layout = \"rinscope\""]);
+        message_of(
+            &e,
+            &path,
+            &[
+                "rinscope columns",
+                "dtheta_x_rad",
+                &format!("layout = \"{}\"", layout.name()),
+                "use layout = \"rinscope\"",
+            ],
+        );
         assert!(!e.to_string().contains("holds rates"), "{e}");
     }
     let messages = vec![(1_000_000_000, cdr_imu(1, 0, "imu", [0.0; 3], [0.0, 0.0, 9.8]))];
@@ -169,7 +193,14 @@ fn bytes_after_a_files_end_are_refused() {
     // Issue 20, item 8: a second file appended after an MCAP's closing magic, or two Parquet files
     // joined with `cat` (the second's footer then reads the first's bytes), read as if whole.
     let dir = scratch("validity_after_end");
-    let messages: Vec<(u64, Vec<u8>)> = (0..50).map(|k| (1_000_000_000 + k * 10_000_000, cdr_imu(1, (k * 10_000_000) as u32, "imu", [0.01, 0.02, 0.03], [0.0, 0.0, 9.8]))).collect();
+    let messages: Vec<(u64, Vec<u8>)> = (0..50)
+        .map(|k| {
+            (
+                1_000_000_000 + k * 10_000_000,
+                cdr_imu(1, (k * 10_000_000) as u32, "imu", [0.01, 0.02, 0.03], [0.0, 0.0, 9.8]),
+            )
+        })
+        .collect();
     let mcap = dir.join("imu.mcap");
     write_mcap(&mcap, &[McapTopic { topic: "/imu", schema: "sensor_msgs/msg/Imu", messages }], true);
     assert_eq!(read(&mcap, Layout::Ros2).unwrap(), 50);
@@ -180,7 +211,10 @@ fn bytes_after_a_files_end_are_refused() {
         let e = read(&path, Layout::Ros2).unwrap_err();
         message_of(&e, &path, &["bytes follow the recording's closing magic", &format!("at byte {}", whole.len())]);
     }
-    let rows: Vec<Vec<f64>> = truth_increments(100).iter().map(|s| vec![s.t_s, s.gyro.x, s.gyro.y, s.gyro.z, s.accel.x, s.accel.y, s.accel.z]).collect();
+    let rows: Vec<Vec<f64>> = truth_increments(100)
+        .iter()
+        .map(|s| vec![s.t_s, s.gyro.x, s.gyro.y, s.gyro.z, s.accel.x, s.accel.y, s.accel.z])
+        .collect();
     let names = ["t_s", "dtheta_x_rad", "dtheta_y_rad", "dtheta_z_rad", "dv_x_mps", "dv_y_mps", "dv_z_mps"];
     let parquet = dir.join("imu.parquet");
     write_parquet(&parquet, &names, &rows, None, 40);

@@ -8,27 +8,12 @@ const COLUMNS: [&str; 4] = ["t_s", "att_roll_deg", "pos_h_m", "gyro_bias_x_deg_p
 
 /// Awkward f64s: signed zeros, subnormals, extremes, values with long shortest representations.
 fn tricky_rows(n: usize) -> Vec<[f64; 4]> {
-    let specials = [
-        0.0,
-        -0.0,
-        f64::MIN_POSITIVE,
-        5e-324,
-        f64::MAX,
-        -f64::MAX,
-        1.0 / 3.0,
-        0.1 + 0.2,
-        1e-7,
-        123_456_789.123_456_78,
-    ];
+    let specials =
+        [0.0, -0.0, f64::MIN_POSITIVE, 5e-324, f64::MAX, -f64::MAX, 1.0 / 3.0, 0.1 + 0.2, 1e-7, 123_456_789.123_456_78];
     (0..n)
         .map(|i| {
             let x = i as f64;
-            [
-                x * 0.005,
-                specials[i % specials.len()],
-                (x * 0.7).sin() * 1e3,
-                -(x + 0.5).ln(),
-            ]
+            [x * 0.005, specials[i % specials.len()], (x * 0.7).sin() * 1e3, -(x + 0.5).ln()]
         })
         .collect()
 }
@@ -61,20 +46,11 @@ fn round_trips_are_bit_identical() {
         assert_eq!(back.len(), rows.len(), "{name}");
         for (i, (a, b)) in back.iter().zip(&rows).enumerate() {
             for k in 0..4 {
-                assert_eq!(
-                    a[k].to_bits(),
-                    b[k].to_bits(),
-                    "{name} row {i} col {k}: {} vs {}",
-                    a[k],
-                    b[k]
-                );
+                assert_eq!(a[k].to_bits(), b[k].to_bits(), "{name} row {i} col {k}: {} vs {}", a[k], b[k]);
             }
         }
     }
-    let names = ColumnReader::open(dir.join("t.parquet"), &[], &ReadOptions::default())
-        .unwrap()
-        .all_columns()
-        .to_vec();
+    let names = ColumnReader::open(dir.join("t.parquet"), &[], &ReadOptions::default()).unwrap().all_columns().to_vec();
     assert_eq!(names, COLUMNS);
     let meta = parquet::file::reader::FileReader::metadata(
         &parquet::file::serialized_reader::SerializedFileReader::new(
@@ -86,11 +62,7 @@ fn round_trips_are_bit_identical() {
     assert_eq!(meta.num_row_groups(), 3);
     assert_eq!(meta.row_group(0).num_rows(), 65_536);
     let csv_head = std::fs::read_to_string(dir.join("t.csv")).unwrap();
-    assert!(
-        csv_head.starts_with("t_s,att_roll_deg,pos_h_m,gyro_bias_x_deg_per_h\n0,0,0,"),
-        "{}",
-        &csv_head[..80]
-    );
+    assert!(csv_head.starts_with("t_s,att_roll_deg,pos_h_m,gyro_bias_x_deg_per_h\n0,0,0,"), "{}", &csv_head[..80]);
 }
 
 #[test]
@@ -98,10 +70,7 @@ fn empty_table_round_trips() {
     let dir = scratch("empty_tables");
     for name in ["e.csv", "e.npy", "e.parquet"] {
         let path = dir.join(name);
-        TableWriter::create(&path, &COLUMNS)
-            .unwrap()
-            .finish()
-            .unwrap();
+        TableWriter::create(&path, &COLUMNS).unwrap().finish().unwrap();
         assert!(read_back(&path).is_empty(), "{name}");
     }
 }
@@ -129,7 +98,10 @@ fn partial_file_discipline() {
     let mut other = TableWriter::create(&path, &COLUMNS).unwrap();
     other.write_row(&[0.0, 1.0, 2.0, 3.0]).unwrap();
     let e = TableWriter::create(&path, &COLUMNS).unwrap_err();
-    assert!(e.to_string().starts_with(&path.display().to_string()) && e.to_string().contains("another run is writing"), "{e}");
+    assert!(
+        e.to_string().starts_with(&path.display().to_string()) && e.to_string().contains("another run is writing"),
+        "{e}"
+    );
     assert!(dir.join("out.csv.partial").exists());
     drop(other);
     std::fs::write(dir.join("out.csv.partial"), "a crashed run's bytes").unwrap();
@@ -154,36 +126,18 @@ fn partial_file_discipline() {
     let mut w = TableWriter::create(&path, &COLUMNS).unwrap();
     w.write_row(&[0.0, 1.0, 2.0, 3.0]).unwrap();
     w.finish().unwrap();
-    assert_eq!(
-        std::fs::read_to_string(&path).unwrap(),
-        "t_s,att_roll_deg,pos_h_m,gyro_bias_x_deg_per_h\n0,1,2,3\n"
-    );
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), "t_s,att_roll_deg,pos_h_m,gyro_bias_x_deg_per_h\n0,1,2,3\n");
 }
 
 #[test]
 fn column_names_are_checked() {
     let dir = scratch("names");
     let p = dir.join("x.csv");
-    assert!(
-        TableWriter::create(&p, &["time", "a_m"]).is_err(),
-        "t_s must be first"
-    );
-    assert!(
-        TableWriter::create(&p, &["t_s", "roll"]).is_err(),
-        "no unit"
-    );
-    assert!(
-        TableWriter::create(&p, &["t_s", "a b_m"]).is_err(),
-        "bad character"
-    );
-    assert!(
-        TableWriter::create(&p, &["t_s", "a_m", "a_m"]).is_err(),
-        "duplicate"
-    );
-    assert!(
-        TableWriter::create(dir.join("x.mcap"), &["t_s"]).is_err(),
-        "no MCAP writer"
-    );
+    assert!(TableWriter::create(&p, &["time", "a_m"]).is_err(), "t_s must be first");
+    assert!(TableWriter::create(&p, &["t_s", "roll"]).is_err(), "no unit");
+    assert!(TableWriter::create(&p, &["t_s", "a b_m"]).is_err(), "bad character");
+    assert!(TableWriter::create(&p, &["t_s", "a_m", "a_m"]).is_err(), "duplicate");
+    assert!(TableWriter::create(dir.join("x.mcap"), &["t_s"]).is_err(), "no MCAP writer");
     // A table that is not a time series (an Allan curve, fitted coefficients): any key first, any
     // names, but still plain characters, each once.
     let keyed = dir.join("k.csv");

@@ -4,15 +4,15 @@
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use super::{check_scenario, log_set, options, series, simulate, AllanRequest};
+use super::{AllanRequest, check_scenario, log_set, options, series, simulate};
 use crate::app::failure::Failure;
-use crate::app::outputs::{check_output, logged, write_json, RecordingName, RecordingRequest};
+use crate::app::outputs::{RecordingName, RecordingRequest, check_output, logged, write_json};
 use crate::ins::allan::ImuAllan;
 use crate::io::series::{Sampling, SeriesColumn};
 use crate::record::export::{ExportFormat, Exporter};
 use crate::record::sink::Saved;
-use crate::scenario::logset::LogSet;
 use crate::scenario::Params;
+use crate::scenario::logset::LogSet;
 
 /// What `allan` analyses.
 pub enum AllanSource {
@@ -59,7 +59,10 @@ pub fn execute(req: &AllanCommand, stop: &AtomicBool, progress: &dyn Fn(u64)) ->
     check_output("--json", req.json.as_deref())?;
     options(&req.analysis)?;
     let (name, description) = match &req.source {
-        AllanSource::Series(file, _, _, given) => (file.file_stem().map_or_else(|| "series".to_owned(), |s| s.to_string_lossy().into_owned()), format!("Series `{}`, columns {given}.", file.display())),
+        AllanSource::Series(file, _, _, given) => (
+            file.file_stem().map_or_else(|| "series".to_owned(), |s| s.to_string_lossy().into_owned()),
+            format!("Series `{}`, columns {given}.", file.display()),
+        ),
         AllanSource::Log(log) => (log.name.clone(), log.description.clone()),
         AllanSource::Scenario(p) => {
             check_scenario(p)?;
@@ -68,7 +71,9 @@ pub fn execute(req: &AllanCommand, stop: &AtomicBool, progress: &dyn Fn(u64)) ->
     };
     let mut exporter = match &req.export {
         None => None,
-        Some((dir, format)) => Some(Exporter::new(dir, *format).map_err(|e| Failure::input(format!("--export {}: {e}", dir.display())))?),
+        Some((dir, format)) => {
+            Some(Exporter::new(dir, *format).map_err(|e| Failure::input(format!("--export {}: {e}", dir.display())))?)
+        }
     };
     let sinks = match &req.recording {
         None => None,
@@ -88,7 +93,12 @@ pub fn execute(req: &AllanCommand, stop: &AtomicBool, progress: &dyn Fn(u64)) ->
             series(file, columns, sampling, &req.analysis, stop)
         }
         AllanSource::Scenario(p) => {
-            errln!("rinscope: simulating {:.2} h of {} at {} Hz, then the Allan analysis of 6 channels ...", p.duration_s / 3600.0, p.meta.name, p.step_hz);
+            errln!(
+                "rinscope: simulating {:.2} h of {} at {} Hz, then the Allan analysis of 6 channels ...",
+                p.duration_s / 3600.0,
+                p.meta.name,
+                p.step_hz
+            );
             simulate(p, &req.analysis, stop, progress)
         }
     }?;
@@ -96,7 +106,12 @@ pub fn execute(req: &AllanCommand, stop: &AtomicBool, progress: &dyn Fn(u64)) ->
         write_json("--json", path, &result.json())?;
     }
     let exported = match exporter.as_mut() {
-        Some(e) => crate::record::allan::export(e, &result).and_then(|()| e.finish()).map_err(|e| Failure::run(format!("--export: {e}")))?.files,
+        Some(e) => {
+            crate::record::allan::export(e, &result)
+                .and_then(|()| e.finish())
+                .map_err(|e| Failure::run(format!("--export: {e}")))?
+                .files
+        }
         None => Vec::new(),
     };
     let saved = match sinks {

@@ -3,7 +3,7 @@
 //! docs/allan.md). Memory: 8 bytes per sample and channel (10 h at 200 Hz: 346 MB).
 
 mod command;
-pub use command::{execute, AllanCommand, AllanReport, AllanSource};
+pub use command::{AllanCommand, AllanReport, AllanSource, execute};
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -11,15 +11,15 @@ use std::time::Instant;
 use nalgebra::Vector3;
 
 use super::playback::{ImuItem, ImuSamples, PlaybackError};
-use crate::ins::allan::{analyze_channel, analyze_imu, ChannelError, ImuAllan, Sensor, Truth};
-use crate::io::series::{read_series_until, Sampling, SeriesColumn};
-use crate::io::units::Quantity;
 use crate::ins::InsParams;
+use crate::ins::allan::{ChannelError, ImuAllan, Sensor, Truth, analyze_channel, analyze_imu};
+use crate::io::series::{Sampling, SeriesColumn, read_series_until};
+use crate::io::units::Quantity;
 use crate::math::allan::estimators::Estimator;
-use crate::math::allan::{averaging_factors, AllanOptions, Phase, TauSpacing, MIN_SAMPLES};
+use crate::math::allan::{AllanOptions, MIN_SAMPLES, Phase, TauSpacing, averaging_factors};
 use crate::math::units::RAD_PER_DEG;
-use crate::scenario::logset::LogSet;
 use crate::scenario::Params;
+use crate::scenario::logset::LogSet;
 
 /// The cluster times `text` asks for: octave, decade, all, or N per decade (1 ..= 1000).
 ///
@@ -47,7 +47,9 @@ pub fn parse_estimators(text: &str) -> Result<Vec<Estimator>, String> {
     }
     let mut list = Vec::new();
     for name in text.split(',').map(str::trim).filter(|n| !n.is_empty()) {
-        let e = Estimator::parse(&name.to_lowercase()).ok_or_else(|| format!("{name:?} is not an estimator (adev, oadev, mdev, tdev, hdev, ohdev, totdev, or all)"))?;
+        let e = Estimator::parse(&name.to_lowercase()).ok_or_else(|| {
+            format!("{name:?} is not an estimator (adev, oadev, mdev, tdev, hdev, ohdev, totdev, or all)")
+        })?;
         if !list.contains(&e) {
             list.push(e);
         }
@@ -73,7 +75,13 @@ pub struct AllanRequest {
 
 impl Default for AllanRequest {
     fn default() -> Self {
-        Self { spacing: TauSpacing::Octave, estimators: vec![Estimator::Oadev], decimate: 1, ci_sigma: 1.0, errors_only: false }
+        Self {
+            spacing: TauSpacing::Octave,
+            estimators: vec![Estimator::Oadev],
+            decimate: 1,
+            ci_sigma: 1.0,
+            errors_only: false,
+        }
     }
 }
 
@@ -173,13 +181,20 @@ pub fn options(req: &AllanRequest) -> Result<AllanOptions, AllanRunError> {
         return Err(AllanRunError::Config(format!("--decimate {}: must be 1 ..= 1000000 samples", req.decimate)));
     }
     if !(req.ci_sigma > 0.0 && req.ci_sigma <= 3.0) {
-        return Err(AllanRunError::Config(format!("--ci-sigma {}: must be > 0 and <= 3 (normal sigmas)", crate::io::short_number(req.ci_sigma))));
+        return Err(AllanRunError::Config(format!(
+            "--ci-sigma {}: must be > 0 and <= 3 (normal sigmas)",
+            crate::io::short_number(req.ci_sigma)
+        )));
     }
     if req.spacing == TauSpacing::PerDecade(0) {
-        return Err(AllanRunError::Config("--taus 0: give at least 1 cluster time per decade (or octave, decade, all)".into()));
+        return Err(AllanRunError::Config(
+            "--taus 0: give at least 1 cluster time per decade (or octave, decade, all)".into(),
+        ));
     }
     if req.estimators.is_empty() {
-        return Err(AllanRunError::Config("--estimator: name at least one (adev, oadev, mdev, tdev, hdev, ohdev, totdev, or all)".into()));
+        return Err(AllanRunError::Config(
+            "--estimator: name at least one (adev, oadev, mdev, tdev, hdev, ohdev, totdev, or all)".into(),
+        ));
     }
     Ok(AllanOptions { spacing: req.spacing.clone(), ci_sigma: req.ci_sigma, ..AllanOptions::default() })
 }
@@ -190,7 +205,9 @@ const MAX_WORK: f64 = 3e10;
 /// Refuses a τ set whose cost is out of reach (`--taus all` on millions of samples), naming the
 /// way out.
 fn check_work(n: usize, opts: &AllanOptions, req: &AllanRequest) -> Result<(), AllanRunError> {
-    let taus = averaging_factors(n / opts.min_clusters.max(2), &opts.spacing).map_err(|e| AllanRunError::Config(e.to_string()))?.len();
+    let taus = averaging_factors(n / opts.min_clusters.max(2), &opts.spacing)
+        .map_err(|e| AllanRunError::Config(e.to_string()))?
+        .len();
     let work = n as f64 * taus as f64 * req.estimators.len().max(1) as f64;
     if work > MAX_WORK {
         return Err(AllanRunError::Config(format!(
@@ -235,7 +252,12 @@ pub fn check_scenario(params: &Params) -> Result<&InsParams, AllanRunError> {
 ///
 /// # Errors
 /// No `[imu]`, a bad request, a stop before enough samples, a channel that cannot be analysed.
-pub fn simulate(params: &Params, req: &AllanRequest, stop: &AtomicBool, progress: &dyn Fn(u64)) -> Result<ImuAllan, AllanRunError> {
+pub fn simulate(
+    params: &Params,
+    req: &AllanRequest,
+    stop: &AtomicBool,
+    progress: &dyn Fn(u64),
+) -> Result<ImuAllan, AllanRunError> {
     let ins = check_scenario(params)?;
     let opts = options(req)?;
     let steps = params.timeline().intervals();
@@ -272,13 +294,19 @@ pub fn simulate(params: &Params, req: &AllanRequest, stop: &AtomicBool, progress
     let gather_s = started.elapsed().as_secs_f64();
     let mut notes = common_notes(&g, ins.rate_hz);
     if g.max_rate_rad_per_s > MOTION_RAD_PER_S {
-        notes.push("--errors-only analyses the simulated sensor errors alone (output − truth), without the motion.".into());
+        notes.push(
+            "--errors-only analyses the simulated sensor errors alone (output − truth), without the motion.".into(),
+        );
     }
     let (sat_g, sat_a) = run.saturation_counts();
     if sat_g.iter().chain(&sat_a).any(|n| *n > 0) {
         notes.push(format!("saturation clipped samples: gyros {sat_g:?}, accelerometers {sat_a:?} (x, y, z)"));
     }
-    let source = format!("scenario {} ({})", params.meta.name, if req.errors_only { "simulated; sensor errors alone, output − truth" } else { "simulated IMU output" });
+    let source = format!(
+        "scenario {} ({})",
+        params.meta.name,
+        if req.errors_only { "simulated; sensor errors alone, output − truth" } else { "simulated IMU output" }
+    );
     finish(g, source, Some(params.meta.seed), ins.rate_hz, truth_of(ins), &opts, req, notes, interrupted, gather_s)
 }
 
@@ -286,7 +314,12 @@ pub fn simulate(params: &Params, req: &AllanRequest, stop: &AtomicBool, progress
 ///
 /// # Errors
 /// Unreadable data, a bad request, too few samples, a channel that cannot be analysed.
-pub fn log_set(log: &LogSet, req: &AllanRequest, stop: &AtomicBool, progress: &dyn Fn(u64)) -> Result<ImuAllan, AllanRunError> {
+pub fn log_set(
+    log: &LogSet,
+    req: &AllanRequest,
+    stop: &AtomicBool,
+    progress: &dyn Fn(u64),
+) -> Result<ImuAllan, AllanRunError> {
     let opts = options(req)?;
     let started = Instant::now();
     let rate_hz = log.imu.rate_hz;
@@ -340,7 +373,18 @@ pub fn log_set(log: &LogSet, req: &AllanRequest, stop: &AtomicBool, progress: &d
 }
 
 #[allow(clippy::too_many_arguments)]
-fn finish(g: Gather, source: String, seed: Option<u64>, rate_hz: f64, truth: Option<[Truth; 2]>, opts: &AllanOptions, req: &AllanRequest, notes: Vec<String>, interrupted: bool, gather_s: f64) -> Result<ImuAllan, AllanRunError> {
+fn finish(
+    g: Gather,
+    source: String,
+    seed: Option<u64>,
+    rate_hz: f64,
+    truth: Option<[Truth; 2]>,
+    opts: &AllanOptions,
+    req: &AllanRequest,
+    notes: Vec<String>,
+    interrupted: bool,
+    gather_s: f64,
+) -> Result<ImuAllan, AllanRunError> {
     let n = g.len();
     if n < MIN_SAMPLES.max(2 * opts.min_clusters) && interrupted {
         return Err(AllanRunError::Interrupted(n * req.decimate));
@@ -349,7 +393,19 @@ fn finish(g: Gather, source: String, seed: Option<u64>, rate_hz: f64, truth: Opt
     let tau0_s = req.decimate as f64 / rate_hz;
     check_work(n, opts, req)?;
     let channels = analyze_imu(&g.phases, tau0_s, opts, &req.estimators, truth, true)?;
-    Ok(ImuAllan { source, seed, rate_hz, decimate: req.decimate, samples: n, ci_sigma: req.ci_sigma, channels, notes, interrupted, gather_s, analysis_s: started.elapsed().as_secs_f64() })
+    Ok(ImuAllan {
+        source,
+        seed,
+        rate_hz,
+        decimate: req.decimate,
+        samples: n,
+        ci_sigma: req.ci_sigma,
+        channels,
+        notes,
+        interrupted,
+        gather_s,
+        analysis_s: started.elapsed().as_secs_f64(),
+    })
 }
 
 /// `allan --series`: the columns of one table file, each its own channel (a gyro for angular
@@ -360,7 +416,13 @@ fn finish(g: Gather, source: String, seed: Option<u64>, rate_hz: f64, truth: Opt
 /// The file, a column, the sampling, a request out of range, a channel with too few samples.
 /// `stop` ends the reading at its next batch of rows: the analysis is then of the rows read, and
 /// says so (`interrupted`).
-pub fn series(path: &std::path::Path, columns: &[SeriesColumn], sampling: &Sampling, req: &AllanRequest, stop: &AtomicBool) -> Result<ImuAllan, AllanRunError> {
+pub fn series(
+    path: &std::path::Path,
+    columns: &[SeriesColumn],
+    sampling: &Sampling,
+    req: &AllanRequest,
+    stop: &AtomicBool,
+) -> Result<ImuAllan, AllanRunError> {
     options(req)?;
     let started = Instant::now();
     let data = read_series_until(path, columns, sampling, stop).map_err(|e| match e {
@@ -376,7 +438,12 @@ pub fn series(path: &std::path::Path, columns: &[SeriesColumn], sampling: &Sampl
 ///
 /// # Errors
 /// A request out of range, a channel with too few samples.
-pub fn analyze_series(data: crate::io::series::Series, source: &str, req: &AllanRequest, gather_s: f64) -> Result<ImuAllan, AllanRunError> {
+pub fn analyze_series(
+    data: crate::io::series::Series,
+    source: &str,
+    req: &AllanRequest,
+    gather_s: f64,
+) -> Result<ImuAllan, AllanRunError> {
     let mut opts = options(req)?;
     opts.min_clusters = 2;
     let started = Instant::now();
@@ -393,7 +460,8 @@ pub fn analyze_series(data: crate::io::series::Series, source: &str, req: &Allan
         };
         let phase = decimated(increments, req.decimate);
         check_work(phase.len(), &opts, req)?;
-        let channel = analyze_channel(sensor, name, &phase, data.tau0_s * req.decimate as f64, &opts, &req.estimators, None)?;
+        let channel =
+            analyze_channel(sensor, name, &phase, data.tau0_s * req.decimate as f64, &opts, &req.estimators, None)?;
         if sensor.is_inertial() && channel.report.is_none() {
             notes.push(format!("{}: {} samples, fewer than the {MIN_SAMPLES} the IEEE fit needs: the curves only, as far as each estimator is defined", channel.name(), phase.len()));
         }
@@ -403,12 +471,26 @@ pub fn analyze_series(data: crate::io::series::Series, source: &str, req: &Allan
         for k in &channel.curves {
             let limit = k.estimator.max_m(phase.len() + 1).min(phase.len() / 2);
             if phase.len() < 64 {
-                notes.push(format!("{}: {} samples: {} defined up to m = {limit} (τ = {} s)", channel.name(), phase.len(), k.estimator.name(), limit as f64 * data.tau0_s * req.decimate as f64));
+                notes.push(format!(
+                    "{}: {} samples: {} defined up to m = {limit} (τ = {} s)",
+                    channel.name(),
+                    phase.len(),
+                    k.estimator.name(),
+                    limit as f64 * data.tau0_s * req.decimate as f64
+                ));
             }
         }
         channels.push(channel);
     }
-    let source = format!("{source} ({})", data.columns.iter().zip(&data.names).map(|(c, n)| format!("{n}: {} ({})", c.kind.name(), c.unit_text())).collect::<Vec<_>>().join("; "));
+    let source = format!(
+        "{source} ({})",
+        data.columns
+            .iter()
+            .zip(&data.names)
+            .map(|(c, n)| format!("{n}: {} ({})", c.kind.name(), c.unit_text()))
+            .collect::<Vec<_>>()
+            .join("; ")
+    );
     Ok(ImuAllan {
         source,
         seed: None,

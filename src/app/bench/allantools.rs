@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-use anyhow::{anyhow, ensure, Context};
+use anyhow::{Context, anyhow, ensure};
 use serde::Serialize;
 use serde_json::Value;
 
@@ -52,7 +52,12 @@ pub struct EstimatorReport {
 ///
 /// # Errors
 /// Python or allantools missing, a process that fails, an interruption (`stop`).
-pub fn compare(python: &Path, samples: u64, rounds: usize, stop: &std::sync::atomic::AtomicBool) -> anyhow::Result<Vec<EstimatorReport>> {
+pub fn compare(
+    python: &Path,
+    samples: u64,
+    rounds: usize,
+    stop: &std::sync::atomic::AtomicBool,
+) -> anyhow::Result<Vec<EstimatorReport>> {
     ensure!(rounds >= 1, "--rounds must be at least 1");
     let dir = std::env::temp_dir().join(format!("rinscope-bench-allantools-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
@@ -61,15 +66,29 @@ pub fn compare(python: &Path, samples: u64, rounds: usize, stop: &std::sync::ato
     result
 }
 
-fn compare_in(dir: &Path, python: &Path, samples: u64, rounds: usize, stop: &std::sync::atomic::AtomicBool) -> anyhow::Result<Vec<EstimatorReport>> {
+fn compare_in(
+    dir: &Path,
+    python: &Path,
+    samples: u64,
+    rounds: usize,
+    stop: &std::sync::atomic::AtomicBool,
+) -> anyhow::Result<Vec<EstimatorReport>> {
     let script = dir.join("allantools_bench.py");
     std::fs::write(&script, SCRIPT)?;
     let series = dir.join("series.npy");
-    let made = Command::new(python).arg(&script).arg("make").arg(&series).arg(samples.to_string()).arg("952").output().with_context(|| format!("running {}", python.display()))?;
+    let made = Command::new(python)
+        .arg(&script)
+        .arg("make")
+        .arg(&series)
+        .arg(samples.to_string())
+        .arg("952")
+        .output()
+        .with_context(|| format!("running {}", python.display()))?;
     ensure!(made.status.success(), "making the series failed: {}", String::from_utf8_lossy(&made.stderr));
     let mut reports = Vec::new();
     for est in ESTIMATORS {
-        let (mut proc_r, mut region_r, mut ours, mut theirs, mut diff, mut taus) = (vec![], vec![], vec![], vec![], 0.0f64, 0);
+        let (mut proc_r, mut region_r, mut ours, mut theirs, mut diff, mut taus) =
+            (vec![], vec![], vec![], vec![], 0.0f64, 0);
         for round in 0..rounds {
             ensure!(!stop.load(std::sync::atomic::Ordering::SeqCst), "interrupted");
             let run_ours = || run_rinscope(dir, &series, est);
@@ -83,7 +102,12 @@ fn compare_in(dir: &Path, python: &Path, samples: u64, rounds: usize, stop: &std
                 let p = run_allantools(python, &script, &series, est, &taus_json)?;
                 (run_ours()?, p)
             };
-            ensure!(mine.devs.len() == peer.devs.len(), "{est}: rinscope evaluated {} τ, allantools returned {}", mine.devs.len(), peer.devs.len());
+            ensure!(
+                mine.devs.len() == peer.devs.len(),
+                "{est}: rinscope evaluated {} τ, allantools returned {}",
+                mine.devs.len(),
+                peer.devs.len()
+            );
             taus = mine.devs.len();
             for (a, b) in mine.devs.iter().zip(&peer.devs) {
                 diff = diff.max((a / b - 1.0).abs());
@@ -119,14 +143,32 @@ fn run_rinscope(dir: &Path, series: &Path, est: &str) -> anyhow::Result<Run> {
     let out = Command::new(std::env::current_exe()?)
         .args(["allan", "--series"])
         .arg(series)
-        .args(["--column", "0:frequency", "--rate-hz", &RATE_HZ.to_string(), "--estimator", est, "--taus", "octave", "--no-recording", "--json"])
+        .args([
+            "--column",
+            "0:frequency",
+            "--rate-hz",
+            &RATE_HZ.to_string(),
+            "--estimator",
+            est,
+            "--taus",
+            "octave",
+            "--no-recording",
+            "--json",
+        ])
         .arg(&json)
         .output()?;
     let process_s = started.elapsed().as_secs_f64();
     ensure!(out.status.success(), "rinscope allan failed: {}", String::from_utf8_lossy(&out.stderr));
     let v: Value = serde_json::from_str(&std::fs::read_to_string(&json)?)?;
     let curve = &v["clock"][0]["curves"][0];
-    let list = |k: &str| -> anyhow::Result<Vec<f64>> { curve[k].as_array().ok_or_else(|| anyhow!("no {k} in rinscope's JSON"))?.iter().map(|x| x.as_f64().ok_or_else(|| anyhow!("{k}: not a number"))).collect() };
+    let list = |k: &str| -> anyhow::Result<Vec<f64>> {
+        curve[k]
+            .as_array()
+            .ok_or_else(|| anyhow!("no {k} in rinscope's JSON"))?
+            .iter()
+            .map(|x| x.as_f64().ok_or_else(|| anyhow!("{k}: not a number")))
+            .collect()
+    };
     let taus = list("tau_s")?;
     let taus_json = dir.join(format!("{est}-taus.json"));
     std::fs::write(&taus_json, serde_json::to_string(&taus)?)?;
@@ -136,18 +178,37 @@ fn run_rinscope(dir: &Path, series: &Path, est: &str) -> anyhow::Result<Run> {
 
 fn run_allantools(python: &Path, script: &Path, series: &Path, est: &str, taus_json: &Path) -> anyhow::Result<Run> {
     let started = Instant::now();
-    let out = Command::new(python).arg(script).arg("run").arg(series).arg(RATE_HZ.to_string()).arg(est).arg(taus_json).output()?;
+    let out = Command::new(python)
+        .arg(script)
+        .arg("run")
+        .arg(series)
+        .arg(RATE_HZ.to_string())
+        .arg(est)
+        .arg(taus_json)
+        .output()?;
     let process_s = started.elapsed().as_secs_f64();
-    ensure!(out.status.success(), "allantools {est} failed (pip install allantools==2024.6?): {}", String::from_utf8_lossy(&out.stderr));
-    let v: Value = serde_json::from_str(String::from_utf8_lossy(&out.stdout).lines().last().unwrap_or_default()).context("allantools_bench.py's output")?;
+    ensure!(
+        out.status.success(),
+        "allantools {est} failed (pip install allantools==2024.6?): {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_str(String::from_utf8_lossy(&out.stdout).lines().last().unwrap_or_default())
+        .context("allantools_bench.py's output")?;
     let devs = v["dev"].as_array().ok_or_else(|| anyhow!("no dev"))?.iter().filter_map(Value::as_f64).collect();
-    Ok(Run { process_s, region_s: v["seconds"].as_f64().ok_or_else(|| anyhow!("no seconds"))?, devs, taus_json: taus_json.to_owned() })
+    Ok(Run {
+        process_s,
+        region_s: v["seconds"].as_f64().ok_or_else(|| anyhow!("no seconds"))?,
+        devs,
+        taus_json: taus_json.to_owned(),
+    })
 }
 
 /// The comparison as text.
 #[must_use]
 pub fn text(reports: &[EstimatorReport], samples: u64) -> String {
-    let mut s = format!("rinscope allan --series vs allantools, one channel of {samples} samples, octave τ set (the same τ values), median (range) over rounds:\n");
+    let mut s = format!(
+        "rinscope allan --series vs allantools, one channel of {samples} samples, octave τ set (the same τ values), median (range) over rounds:\n"
+    );
     s += "estimator  τ    whole process: rinscope s  allantools s  ratio            timed region ratio   largest deviation difference\n";
     for r in reports {
         s += &format!(

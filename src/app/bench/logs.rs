@@ -6,7 +6,7 @@
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
-use super::{check, in_scratch, Figures};
+use super::{Figures, check, in_scratch};
 use crate::scenario::logset;
 
 /// The parked vehicle: a navigation-grade IMU at 100 Hz, rocked in pitch and roll, 30 minutes.
@@ -72,7 +72,12 @@ pub(super) fn log_speed(figs: &mut Figures, stop: &AtomicBool) -> anyhow::Result
             heading = s.alignment.as_ref().map_or(f64::NAN, |a| a.imu_heading_deg);
         }
         walls.sort_by(f64::total_cmp);
-        figs.figures.push(super::Figure { name: "field log/30 min 100 Hz csv, aligned + replayed".into(), value: walls[2], unit: "s", best: Some(walls[0]) });
+        figs.figures.push(super::Figure {
+            name: "field log/30 min 100 Hz csv, aligned + replayed".into(),
+            value: walls[2],
+            unit: "s",
+            best: Some(walls[0]),
+        });
         outln!(
             "field log         30 min at 100 Hz, strapdown csv ({:.1} MB), aligned on its first 300 s and replayed with navigation: best {:.3} s, median {:.3} s of 5 (target < 1 s; heading {heading:.4}°)",
             bytes as f64 / 1e6,

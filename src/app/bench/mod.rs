@@ -10,9 +10,9 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::scenario::presets;
-use crate::sim::{step, DemodState};
 use crate::record::sink::{self, SinkRequest};
+use crate::scenario::presets;
+use crate::sim::{DemodState, step};
 
 /// One number of `rinscope bench`, as `bench --json` writes it: a change is compared against the
 /// last run figure by figure (names are stable; the printed lines say the same in prose).
@@ -42,7 +42,11 @@ pub struct Figures {
 
 impl Figures {
     fn new() -> Self {
-        Self { version: env!("CARGO_PKG_VERSION"), threads: std::thread::available_parallelism().map_or(1, std::num::NonZero::get), figures: Vec::new() }
+        Self {
+            version: env!("CARGO_PKG_VERSION"),
+            threads: std::thread::available_parallelism().map_or(1, std::num::NonZero::get),
+            figures: Vec::new(),
+        }
     }
 
     fn add(&mut self, name: impl Into<String>, value: f64, unit: &'static str) {
@@ -60,7 +64,9 @@ impl Figures {
 pub fn peak_rss_bytes() -> u64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
-        .and_then(|s| s.lines().find(|l| l.starts_with("VmHWM:")).and_then(|l| l.split_whitespace().nth(1)?.parse::<u64>().ok()))
+        .and_then(|s| {
+            s.lines().find(|l| l.starts_with("VmHWM:")).and_then(|l| l.split_whitespace().nth(1)?.parse::<u64>().ok())
+        })
         .map_or(0, |kb| kb * 1024)
 }
 
@@ -72,7 +78,8 @@ fn check(stop: &AtomicBool) -> anyhow::Result<()> {
 }
 
 /// The benchmark sections, in the order they run (`bench --only`).
-pub const SECTIONS: [&str; 9] = ["simulation", "strapdown", "pipeline", "navigation", "logs", "recorded", "calibration", "allan", "selfcal"];
+pub const SECTIONS: [&str; 9] =
+    ["simulation", "strapdown", "pipeline", "navigation", "logs", "recorded", "calibration", "allan", "selfcal"];
 
 /// Runs the benchmarks (the sections in `only`; all when it is empty), prints their numbers and
 /// returns them; an error as soon as `stop` is set.
@@ -114,7 +121,8 @@ fn recorded_runs(dir: &std::path::Path, figs: &mut Figures, stop: &AtomicBool) -
         let mut p = presets::load(name)?;
         p.set_duration(3600.0);
         let path = dir.join(format!("{name}.rrd"));
-        let sinks = sink::open(&SinkRequest { save: Some(path.clone()), ..Default::default() }, "rinscope-bench", name)?;
+        let sinks =
+            sink::open(&SinkRequest { save: Some(path.clone()), ..Default::default() }, "rinscope-bench", name)?;
         let started = Instant::now();
         let summary = crate::app::run::run_recorded(&p, &sinks, stop, false)?;
         let (_, bytes) = sinks.finish()?.recording.ok_or_else(|| anyhow::anyhow!("no file written"))?;
@@ -215,7 +223,11 @@ fn strapdown_speed(figs: &mut Figures, stop: &AtomicBool) -> anyhow::Result<()> 
             let (t0, t1) = (i as f64 / 2000.0, (i + 1) as f64 / 2000.0);
             let w = std::f64::consts::TAU * 5.0;
             let a = 0.01f64;
-            Vector3::new(a.sin() * ((w * t1).cos() - (w * t0).cos()), a.sin() * ((w * t1).sin() - (w * t0).sin()), -2.0 * (0.5 * a).sin().powi(2) * w / 2000.0)
+            Vector3::new(
+                a.sin() * ((w * t1).cos() - (w * t0).cos()),
+                a.sin() * ((w * t1).sin() - (w * t0).sin()),
+                -2.0 * (0.5 * a).sin().powi(2) * w / 2000.0,
+            )
         })
         .collect();
     let zeta = Vector3::new(0.0, 3e-8, 4e-8);
@@ -270,7 +282,10 @@ fn best_and_median(mut chunk: impl FnMut()) -> (f64, f64) {
 fn pipeline_speed(figs: &mut Figures, stop: &AtomicBool) -> anyhow::Result<()> {
     use crate::ins::truth::TruthImu;
     use crate::model::earth::Earth;
-    let jiang = format!("{}\n[imu]\npreset = \"jiang2017-table1\"\n[navigation]\n", crate::scenario::presets::text("jiang2017-dual-axis").unwrap_or_default());
+    let jiang = format!(
+        "{}\n[imu]\npreset = \"jiang2017-table1\"\n[navigation]\n",
+        crate::scenario::presets::text("jiang2017-dual-axis").unwrap_or_default()
+    );
     let cases = [
         ("jiang2017-dual-axis + table-1 IMU", crate::scenario::parse(&jiang, "bench")?),
         ("coning 1 deg/1 Hz + Earth rate, 2 kHz, 34 N", crate::scenario::parse(CONING_2KHZ, "bench")?),
@@ -359,7 +374,14 @@ fn live_latency(dir: &std::path::Path, figs: &mut Figures, interrupt: &AtomicBoo
     let params = crate::scenario::load_file(&path)?;
     let status = live::new_status(&params, 1.0);
     let stop = std::sync::Arc::new(AtomicBool::new(false));
-    let opts = live::LiveOptions { config_path: path.clone(), speed: Some(1.0), duration_s: None, panel: false, log_to_stderr: false, page_url: None };
+    let opts = live::LiveOptions {
+        config_path: path.clone(),
+        speed: Some(1.0),
+        duration_s: None,
+        panel: false,
+        log_to_stderr: false,
+        page_url: None,
+    };
     let rec_path = dir.join("live.rrd");
     let sinks = sink::open(&SinkRequest { save: Some(rec_path), ..Default::default() }, "rinscope-bench", "live")?;
     let session = {
@@ -377,10 +399,19 @@ fn live_latency(dir: &std::path::Path, figs: &mut Figures, interrupt: &AtomicBoo
         let value = 300.0 + f64::from(i % 2 + 1) * 10.0 * f64::from(i + 1);
         let started = Instant::now();
         if i % 2 == 0 {
-            let new = edit::set_in_text(text, &edit::KeyPath::parse("turntable.axis[1].swing_half_angle_arcsec"), edit::float(value)).map_err(anyhow::Error::msg)?;
+            let new = edit::set_in_text(
+                text,
+                &edit::KeyPath::parse("turntable.axis[1].swing_half_angle_arcsec"),
+                edit::float(value),
+            )
+            .map_err(anyhow::Error::msg)?;
             std::fs::write(&path, new)?; // truncate and write in place
         } else {
-            edit::set_in_file(&path, &edit::KeyPath::parse("turntable.axis[1].swing_half_angle_arcsec"), edit::float(value))?; // by rename
+            edit::set_in_file(
+                &path,
+                &edit::KeyPath::parse("turntable.axis[1].swing_half_angle_arcsec"),
+                edit::float(value),
+            )?; // by rename
         }
         while live::snapshot(&status).generation == generation {
             anyhow::ensure!(started.elapsed().as_secs() < 5, "save {i} was not applied within 5 s");
@@ -416,7 +447,7 @@ fn live_latency(dir: &std::path::Path, figs: &mut Figures, interrupt: &AtomicBoo
 /// alone: the simulated IMU is generated in the same loop but not counted), 100 Monte Carlo
 /// self-calibrations (simulation included) in under a minute on two cores.
 fn selfcal_speed(figs: &mut Figures, stop: &AtomicBool) -> anyhow::Result<()> {
-    use crate::app::selfcal::{monte_carlo, run_one, setup, SequenceChoice};
+    use crate::app::selfcal::{SequenceChoice, monte_carlo, run_one, setup};
     let p = presets::load("selfcal-nav-grade")?;
     let s = setup(&p, SequenceChoice::BuiltIn(crate::ins::selfcal::Sequence::DualAxis29))?;
     let hours = s.samples as f64 * s.config.h / 3600.0;
@@ -424,10 +455,19 @@ fn selfcal_speed(figs: &mut Figures, stop: &AtomicBool) -> anyhow::Result<()> {
     let one = run_one(&s, p.meta.seed, false, stop)?;
     let whole = started.elapsed().as_secs_f64();
     figs.add("selfcal/estimation per 2 h at 200 Hz", one.estimation_s * 2.0 / hours, "s");
-    outln!("selfcal           {}: {hours:.2} h at 200 Hz estimated in {:.2} s (= {:.2} s per 2 h; target < 3), {whole:.2} s with the IMU's simulation", s.sequence, one.estimation_s, one.estimation_s * 2.0 / hours);
+    outln!(
+        "selfcal           {}: {hours:.2} h at 200 Hz estimated in {:.2} s (= {:.2} s per 2 h; target < 3), {whole:.2} s with the IMU's simulation",
+        s.sequence,
+        one.estimation_s,
+        one.estimation_s * 2.0 / hours
+    );
     let mc = monte_carlo(&s, 100, p.meta.seed + 1, stop)?;
     figs.add("selfcal/100 Monte Carlo runs", mc.wall_s, "s");
-    outln!("selfcal MC        100 IMUs ({hours:.2} h each, simulated and estimated) in {:.1} s on {} threads (target < 60 s on 2)", mc.wall_s, rayon::current_num_threads());
+    outln!(
+        "selfcal MC        100 IMUs ({hours:.2} h each, simulated and estimated) in {:.1} s on {} threads (target < 60 s on 2)",
+        mc.wall_s,
+        rayon::current_num_threads()
+    );
     Ok(())
 }
 
@@ -470,7 +510,7 @@ fn calibration_speed(figs: &mut Figures, stop: &AtomicBool) -> anyhow::Result<()
 /// core; and the simulation of `static-imu-10h` that feeds it (truth, sensor errors with the flicker
 /// bank and the rate random walk, the six cumulative sums), which `rinscope allan` runs first.
 fn allan_speed(figs: &mut Figures, stop: &AtomicBool) -> anyhow::Result<()> {
-    use crate::app::allan::{simulate, AllanRequest};
+    use crate::app::allan::{AllanRequest, simulate};
     use crate::ins::allan::analyze_imu;
     use crate::math::allan::{AllanOptions, Phase, TauSpacing};
     use rand::SeedableRng;
@@ -483,7 +523,8 @@ fn allan_speed(figs: &mut Figures, stop: &AtomicBool) -> anyhow::Result<()> {
             let mut p = Phase::with_capacity(n);
             let mut walk = 0.0;
             for _ in 0..n {
-                let (a, b): (f64, f64) = (rand_distr::StandardNormal.sample(&mut rng), rand_distr::StandardNormal.sample(&mut rng));
+                let (a, b): (f64, f64) =
+                    (rand_distr::StandardNormal.sample(&mut rng), rand_distr::StandardNormal.sample(&mut rng));
                 walk += 1e-4 * b;
                 p.push(1e-6 * a + 1e-6 * walk);
             }
@@ -496,12 +537,15 @@ fn allan_speed(figs: &mut Figures, stop: &AtomicBool) -> anyhow::Result<()> {
         let mut taus = 0;
         for _ in 0..3 {
             let started = Instant::now();
-            let channels = analyze_imu(&phases, 0.005, &opts, &[crate::math::allan::estimators::Estimator::Oadev], None, false)?;
+            let channels =
+                analyze_imu(&phases, 0.005, &opts, &[crate::math::allan::estimators::Estimator::Oadev], None, false)?;
             best = best.min(started.elapsed().as_secs_f64());
             taus = channels[0].report.as_ref().map_or(0, |r| r.taus_s.len());
         }
         figs.add(format!("Allan analysis/10 h, 6 channels, {label}"), best, "s");
-        outln!("Allan analysis    10 h at 200 Hz, 6 channels x {n} samples, {label} ({taus} cluster times), one core: best of 3 {best:.2} s (target < 2 s)");
+        outln!(
+            "Allan analysis    10 h at 200 Hz, 6 channels x {n} samples, {label} ({taus} cluster times), one core: best of 3 {best:.2} s (target < 2 s)"
+        );
     }
     let p = presets::load("static-imu-10h")?;
     let started = Instant::now();

@@ -177,7 +177,11 @@ fn check_python(python: &Path) -> anyhow::Result<()> {
         .with_context(|| format!("cannot run the Python interpreter {} (give one with --python)", python.display()))?;
     let version = String::from_utf8_lossy(&out.stdout).trim().to_owned();
     if !out.status.success() {
-        bail!("{} has no pyins: install it with `{} -m pip install python-ins==1.0.1` (assets/bench/pyins/requirements-lock.txt has the versions measured)", python.display(), python.display());
+        bail!(
+            "{} has no pyins: install it with `{} -m pip install python-ins==1.0.1` (assets/bench/pyins/requirements-lock.txt has the versions measured)",
+            python.display(),
+            python.display()
+        );
     }
     if version != "1.0.1" {
         errln!("note: {} has python-ins {version}; the numbers in docs/benchmarks.md are for 1.0.1", python.display());
@@ -185,27 +189,50 @@ fn check_python(python: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn compare_stream(opts: &PeerOptions, dir: &Path, kind: &str, stop: &std::sync::atomic::AtomicBool) -> anyhow::Result<StreamReport> {
+fn compare_stream(
+    opts: &PeerOptions,
+    dir: &Path,
+    kind: &str,
+    stop: &std::sync::atomic::AtomicBool,
+) -> anyhow::Result<StreamReport> {
     let stream = dir.join(format!("{kind}.npy"));
-    let out = Command::new(&opts.python).arg(dir.join("make_stream.py")).arg(kind).arg(&stream).arg("--n").arg(opts.samples.to_string()).output()?;
+    let out = Command::new(&opts.python)
+        .arg(dir.join("make_stream.py"))
+        .arg(kind)
+        .arg(&stream)
+        .arg("--n")
+        .arg(opts.samples.to_string())
+        .output()?;
     ensure!(out.status.success(), "make_stream.py {kind} failed: {}", String::from_utf8_lossy(&out.stderr));
     let meta: Value = serde_json::from_str(&std::fs::read_to_string(dir.join(format!("{kind}.json")))?)?;
     let num = |v: &Value, what: &str| v.as_f64().ok_or_else(|| anyhow!("make_stream.py's sidecar lacks {what}"));
-    let triple = |v: &Value, what: &str| -> anyhow::Result<[f64; 3]> { Ok([num(&v[0], what)?, num(&v[1], what)?, num(&v[2], what)?]) };
+    let triple = |v: &Value, what: &str| -> anyhow::Result<[f64; 3]> {
+        Ok([num(&v[0], what)?, num(&v[1], what)?, num(&v[2], what)?])
+    };
     let (rate, lat) = (num(&meta["rate_hz"], "rate_hz")?, num(&meta["initial"]["lla"][0], "initial.lla")?);
     let rph0 = triple(&meta["initial"]["rph"], "initial.rph")?;
-    let truth = State { rph_deg: triple(&meta["truth_final"]["rph"], "truth_final.rph")?, lla: triple(&meta["truth_final"]["lla"], "truth_final.lla")?, vel_enu_mps: triple(&meta["truth_final"]["vel_enu"], "truth_final.vel_enu")? };
+    let truth = State {
+        rph_deg: triple(&meta["truth_final"]["rph"], "truth_final.rph")?,
+        lla: triple(&meta["truth_final"]["lla"], "truth_final.lla")?,
+        vel_enu_mps: triple(&meta["truth_final"]["vel_enu"], "truth_final.vel_enu")?,
+    };
 
     let logs = dir.join(format!("{kind}-log"));
     write_log_set(&logs, &stream, rate, lat, kind, &meta)?;
     let scenario = dir.join(format!("{kind}-scenario.toml"));
     std::fs::write(&scenario, simulated(kind, opts.samples as f64 / rate, rate, lat, &meta)?)?;
 
-    let pipeline_params = crate::scenario::parse(&std::fs::read_to_string(&scenario)?, "bench").map_err(|e| anyhow!("{e}"))?;
+    let pipeline_params =
+        crate::scenario::parse(&std::fs::read_to_string(&scenario)?, "bench").map_err(|e| anyhow!("{e}"))?;
     let mut rounds: Vec<[Timing; 5]> = Vec::new();
     let (mut ours, mut theirs) = (None, None);
     let args_pyins = |mode: &str| -> Vec<String> {
-        let mut a = vec![dir.join("pyins_bench.py").display().to_string(), mode.to_owned(), stream.display().to_string(), "--rph".to_owned()];
+        let mut a = vec![
+            dir.join("pyins_bench.py").display().to_string(),
+            mode.to_owned(),
+            stream.display().to_string(),
+            "--rph".to_owned(),
+        ];
         a.extend(rph0.iter().map(|x| x.to_string()));
         a.push("--lla".to_owned());
         a.extend([lat, 0.0, 0.0].iter().map(|x| x.to_string()));
@@ -254,7 +281,9 @@ fn write_log_set(dir: &Path, stream: &Path, rate: f64, lat: f64, kind: &str, met
     std::fs::create_dir_all(dir)?;
     std::fs::write(
         dir.join("table.toml"),
-        format!("[site]\nlatitude_deg = {lat}\n\n[turntable]\n[[turntable.axis]]\nname = \"table\"\naxis = \"z\"\n\n[imu]\nalgorithm = \"two-sample-p1\"\n\n[navigation]\nvertical = \"free\"\n"),
+        format!(
+            "[site]\nlatitude_deg = {lat}\n\n[turntable]\n[[turntable.axis]]\nname = \"table\"\naxis = \"z\"\n\n[imu]\nalgorithm = \"two-sample-p1\"\n\n[navigation]\nvertical = \"free\"\n"
+        ),
     )?;
     let manifest = |q: [f64; 4]| {
         format!(
@@ -321,7 +350,14 @@ fn time_pipeline(p: &crate::scenario::Params, samples: u64) -> anyhow::Result<Ti
 fn run_self(command: &str, input: &[&std::ffi::OsStr], stem: &Path) -> anyhow::Result<(f64, Value)> {
     let json = stem.with_extension("json");
     let started = Instant::now();
-    let out = Command::new(std::env::current_exe()?).arg(command).args(input).arg("--save").arg(stem.with_extension("rrd")).arg("--summary-json").arg(&json).output()?;
+    let out = Command::new(std::env::current_exe()?)
+        .arg(command)
+        .args(input)
+        .arg("--save")
+        .arg(stem.with_extension("rrd"))
+        .arg("--summary-json")
+        .arg(&json)
+        .output()?;
     let process_s = started.elapsed().as_secs_f64();
     ensure!(out.status.success(), "rinscope {command} failed: {}", String::from_utf8_lossy(&out.stderr));
     Ok((process_s, serde_json::from_str(&std::fs::read_to_string(&json)?)?))
@@ -342,11 +378,16 @@ fn run_simulated(scenario: &Path) -> anyhow::Result<Timing> {
 fn run_rinscope(logs: &Path) -> anyhow::Result<(Timing, State)> {
     let (process_s, s) = run_self("replay", &[logs.as_os_str()], &logs.join("replay"))?;
     let f = &s["final_state"];
-    let num = |v: &Value| v.as_f64().ok_or_else(|| anyhow!("replay summary lacks a final state (is the navigation on?)"));
+    let num =
+        |v: &Value| v.as_f64().ok_or_else(|| anyhow!("replay summary lacks a final state (is the navigation on?)"));
     let state = State {
         rph_deg: [num(&f["imu_roll_deg"])?, num(&f["imu_pitch_deg"])?, num(&f["imu_heading_deg"])?],
         lla: [num(&f["latitude_deg"])?, num(&f["longitude_deg"])?, num(&f["height_m"])?],
-        vel_enu_mps: [num(&f["velocity_enu_mps"][0])?, num(&f["velocity_enu_mps"][1])?, num(&f["velocity_enu_mps"][2])?],
+        vel_enu_mps: [
+            num(&f["velocity_enu_mps"][0])?,
+            num(&f["velocity_enu_mps"][1])?,
+            num(&f["velocity_enu_mps"][2])?,
+        ],
     };
     Ok((timing(process_s, &s)?, state))
 }
@@ -377,15 +418,26 @@ pub fn text(reports: &[StreamReport]) -> String {
             let p = spread(t.iter().map(|x| x.process_s).collect());
             let g = spread(t.iter().map(|x| x.region_s).collect());
             let m = spread(t.iter().map(|x| x.peak_rss_mb).collect());
-            format!("  {name:<16} whole process {:.2} s [{:.2}, {:.2}]   {region} {:.2} s [{:.2}, {:.2}]   peak RSS {:.0} MB\n", p.median, p.min, p.max, g.median, g.min, g.max, m.max)
+            format!(
+                "  {name:<16} whole process {:.2} s [{:.2}, {:.2}]   {region} {:.2} s [{:.2}, {:.2}]   peak RSS {:.0} MB\n",
+                p.median, p.min, p.max, g.median, g.min, g.max, m.max
+            )
         };
-        s.push_str(&format!("peer pyins 1.0.1  {} stream, {} samples at 2 kHz, {} alternated rounds (median [min, max])\n", r.stream, r.samples, r.rinscope.len()));
+        s.push_str(&format!(
+            "peer pyins 1.0.1  {} stream, {} samples at 2 kHz, {} alternated rounds (median [min, max])\n",
+            r.stream,
+            r.samples,
+            r.rinscope.len()
+        ));
         s.push_str(&line("rinscope replay", &r.rinscope, "replay loop "));
         s.push_str(&line("pyins kernel", &r.pyins_kernel, "kernel      "));
         s.push_str(&line("pyins pipeline", &r.pyins_pipeline, "pipeline    "));
         s.push_str(&line("rinscope run", &r.rinscope_run, "run loop    "));
         let q = spread(r.rinscope_pipeline.iter().map(|x| x.region_s).collect());
-        s.push_str(&format!("  {:<16} in this process                 pipeline     {:.2} s [{:.2}, {:.2}]\n", "rinscope INS", q.median, q.min, q.max));
+        s.push_str(&format!(
+            "  {:<16} in this process                 pipeline     {:.2} s [{:.2}, {:.2}]\n",
+            "rinscope INS", q.median, q.min, q.max
+        ));
         let ratio = |x: Spread| format!("{:.1}x [{:.1}, {:.1}]", x.median, x.min, x.max);
         s.push_str(&format!(
             "  speed: pyins kernel / rinscope replay process {} (target >= 3x); pyins pipeline / rinscope replay process {} (target >= 10x); whole processes {}\n",
@@ -401,7 +453,14 @@ pub fn text(reports: &[StreamReport]) -> String {
         let diff = |d: &Difference| {
             format!(
                 "roll {:+.2e}″ pitch {:+.2e}″ heading {:+.2e}″, horizontal {:.2e} m, height {:+.2e} m, velocity ENU [{:+.1e}, {:+.1e}, {:+.1e}] m/s",
-                d.attitude_arcsec[0], d.attitude_arcsec[1], d.attitude_arcsec[2], d.horizontal_m, d.height_m, d.velocity_mps[0], d.velocity_mps[1], d.velocity_mps[2]
+                d.attitude_arcsec[0],
+                d.attitude_arcsec[1],
+                d.attitude_arcsec[2],
+                d.horizontal_m,
+                d.height_m,
+                d.velocity_mps[0],
+                d.velocity_mps[1],
+                d.velocity_mps[2]
             )
         };
         s.push_str(&format!("  final state, rinscope − truth: {}\n", diff(&r.rinscope_error)));

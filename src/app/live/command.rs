@@ -2,13 +2,13 @@
 //! its saved file and its class page.
 
 use std::path::PathBuf;
-use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 
 use crate::app::failure::Failure;
 use crate::app::outputs::RecordingName;
-use crate::record::sink::{self, SinkRequest};
 use crate::record::APPLICATION_ID;
+use crate::record::sink::{self, SinkRequest};
 use crate::scenario::{self, presets};
 
 /// `rinscope live`.
@@ -60,7 +60,11 @@ pub fn execute(req: &LiveRequest, stop: &Arc<AtomicBool>) -> Result<LiveReport, 
             presets::load(name)?; // a clear error for an unknown name
             let (path, created) = super::ensure_preset_copy(name).map_err(|e| Failure::input(format!("{e:#}")))?;
             let sliders = if !req.panel { "" } else { ", or move the sliders" };
-            errln!("rinscope live: {} {} — edit it{sliders}", if created { "wrote" } else { "using your edited" }, path.display());
+            errln!(
+                "rinscope live: {} {} — edit it{sliders}",
+                if created { "wrote" } else { "using your edited" },
+                path.display()
+            );
             path
         }
     };
@@ -70,9 +74,12 @@ pub fn execute(req: &LiveRequest, stop: &Arc<AtomicBool>) -> Result<LiveReport, 
     {
         return Err(Failure::input(format!("--speed {s}: must be > 0 and <= 10000 (x real time)")));
     }
-    let viewer_given = req.sinks.spawn || req.sinks.connect.is_some() || req.sinks.serve.is_some() || req.sinks.serve_web.is_some();
+    let viewer_given =
+        req.sinks.spawn || req.sinks.connect.is_some() || req.sinks.serve.is_some() || req.sinks.serve_web.is_some();
     if req.sinks.figures.is_some() && req.sinks.save.is_none() {
-        return Err(Failure::input("live --figures DIR draws the session's plots from its saved file when it ends: add --save FILE"));
+        return Err(Failure::input(
+            "live --figures DIR draws the session's plots from its saved file when it ends: add --save FILE",
+        ));
     }
     if req.no_viewer && req.sinks.save.is_none() {
         return Err(Failure::input("--no-viewer needs --save FILE (otherwise nothing would be kept)"));
@@ -85,7 +92,9 @@ pub fn execute(req: &LiveRequest, stop: &Arc<AtomicBool>) -> Result<LiveReport, 
         bind: req.sinks.bind,
         // The class page takes --serve-web's port; the viewer it embeds the next one.
         serve_web: match req.sinks.serve_web {
-            Some(p) => Some(p.checked_add(1).filter(|p| p.checked_add(1).is_some()).ok_or_else(|| Failure::input(format!("--serve-web {p}: the class page needs this port and the next two")))?),
+            Some(p) => Some(p.checked_add(1).filter(|p| p.checked_add(1).is_some()).ok_or_else(|| {
+                Failure::input(format!("--serve-web {p}: the class page needs this port and the next two"))
+            })?),
             None => None,
         },
         // The class page serves the session so far to late viewers; the stream then keeps none.
@@ -104,7 +113,11 @@ pub fn execute(req: &LiveRequest, stop: &Arc<AtomicBool>) -> Result<LiveReport, 
         }
         None => (None, None),
     };
-    let viewer_sinks = if viewer_request.spawn || viewer_request.connect.is_some() || viewer_request.serve.is_some() || viewer_request.serve_web.is_some() {
+    let viewer_sinks = if viewer_request.spawn
+        || viewer_request.connect.is_some()
+        || viewer_request.serve.is_some()
+        || viewer_request.serve_web.is_some()
+    {
         let implicit = !viewer_given;
         Some(sink::open(&viewer_request, APPLICATION_ID, &recording_id).map_err(|e| {
             let mut f = Failure::from(e);
@@ -117,13 +130,23 @@ pub fn execute(req: &LiveRequest, stop: &Arc<AtomicBool>) -> Result<LiveReport, 
         None
     };
     let file_sinks = match &req.sinks.save {
-        Some(p) => Some(sink::open(&SinkRequest { save: Some(p.clone()), stop_on_failure: Some(Arc::clone(stop)), export, figures: req.sinks.figures.clone(), ..Default::default() }, APPLICATION_ID, &recording_id)?),
+        Some(p) => Some(sink::open(
+            &SinkRequest {
+                save: Some(p.clone()),
+                stop_on_failure: Some(Arc::clone(stop)),
+                export,
+                figures: req.sinks.figures.clone(),
+                ..Default::default()
+            },
+            APPLICATION_ID,
+            &recording_id,
+        )?),
         None => None,
     };
     for d in viewer_sinks.iter().chain(file_sinks.iter()).flat_map(|s| &s.description) {
         errln!("rinscope live: {d}");
     }
-    let panel = !!req.panel && std::io::stdout().is_terminal() && std::io::stdin().is_terminal();
+    let panel = req.panel && std::io::stdout().is_terminal() && std::io::stdin().is_terminal();
     if !panel {
         errln!("rinscope live: running; edit {} to change parameters, Ctrl-C to stop", path.display());
     }
@@ -133,19 +156,39 @@ pub fn execute(req: &LiveRequest, stop: &Arc<AtomicBool>) -> Result<LiveReport, 
     let class_page = match (req.sinks.serve_web, viewer_sinks.as_ref().and_then(sink::OpenSinks::web_page)) {
         (Some(port), Some(_)) => {
             let ip = req.sinks.bind.unwrap_or(std::net::IpAddr::V4(std::net::Ipv4Addr::LOCALHOST));
-            let token = if ip.is_loopback() { None } else { Some(super::web::random_token().map_err(|e| Failure::run(format!("no random token for the class page: {e}")))?) };
-            let cfg = super::web::PageConfig { addr: std::net::SocketAddr::new(ip, port), host: sink::address::local_host(ip), config_path: path.clone(), token: token.clone(), history: history_requests.clone() };
-            let page = super::web::start(cfg, status.clone(), format!("{} — {}", params.meta.name, params.meta.title)).map_err(|e| Failure::input(format!("--serve-web: {e:#}")))?;
+            let token = if ip.is_loopback() {
+                None
+            } else {
+                Some(
+                    super::web::random_token()
+                        .map_err(|e| Failure::run(format!("no random token for the class page: {e}")))?,
+                )
+            };
+            let cfg = super::web::PageConfig {
+                addr: std::net::SocketAddr::new(ip, port),
+                host: sink::address::local_host(ip),
+                config_path: path.clone(),
+                token: token.clone(),
+                history: history_requests.clone(),
+            };
+            let page = super::web::start(cfg, status.clone(), format!("{} — {}", params.meta.name, params.meta.title))
+                .map_err(|e| Failure::input(format!("--serve-web: {e:#}")))?;
             errln!("rinscope live: the class page (viewer and sliders): {}", page.url);
             // Every address: 127.0.0.1 above names each reader's own machine; others open this one's.
-            let network_url = if ip.is_unspecified() { sink::address::network_host(ip).map(|h| page.url_at(&h)) } else { None };
+            let network_url =
+                if ip.is_unspecified() { sink::address::network_host(ip).map(|h| page.url_at(&h)) } else { None };
             match &network_url {
                 Some(url) => errln!("rinscope live: from other machines: {url}"),
-                None if ip.is_unspecified() => errln!("rinscope live: from other machines: that URL with this machine's address in place of {} (it has no route out and no name to print)", sink::address::local_host(ip)),
+                None if ip.is_unspecified() => errln!(
+                    "rinscope live: from other machines: that URL with this machine's address in place of {} (it has no route out and no name to print)",
+                    sink::address::local_host(ip)
+                ),
                 None => {}
             }
             if token.is_some() {
-                errln!("rinscope live: shared beyond this machine: anyone who reaches the page can watch; changing a parameter needs the token in that URL (give it only to whom may)");
+                errln!(
+                    "rinscope live: shared beyond this machine: anyone who reaches the page can watch; changing a parameter needs the token in that URL (give it only to whom may)"
+                );
             }
             Some((page, network_url))
         }
@@ -153,8 +196,19 @@ pub fn execute(req: &LiveRequest, stop: &Arc<AtomicBool>) -> Result<LiveReport, 
     };
     // The panel's title shows the URL the class opens.
     let page_url = class_page.as_ref().map(|(p, network)| network.clone().unwrap_or_else(|| p.url.clone()));
-    let options = super::LiveOptions { config_path: path, speed: req.speed, duration_s: req.duration_s, panel, log_to_stderr: true, page_url };
-    let outputs = super::Outputs { viewer: viewer_sinks.as_ref().map(sink::OpenSinks::stream), file: file_sinks.as_ref().map(sink::OpenSinks::stream), history };
+    let options = super::LiveOptions {
+        config_path: path,
+        speed: req.speed,
+        duration_s: req.duration_s,
+        panel,
+        log_to_stderr: true,
+        page_url,
+    };
+    let outputs = super::Outputs {
+        viewer: viewer_sinks.as_ref().map(sink::OpenSinks::stream),
+        file: file_sinks.as_ref().map(sink::OpenSinks::stream),
+        history,
+    };
     let result = super::run_session_with_status(&options, params, outputs, stop, &status);
     // A signal that ended the session (not one that ends the wait of a viewer left open after it).
     let interrupted = crate::app::terminate::stop_reason().is_some();

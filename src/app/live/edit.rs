@@ -30,9 +30,10 @@ impl KeyPath {
             let (name, rest) = part.split_once('[').map_or((part, None), |(n, r)| (n, Some(r)));
             segs.push(Seg::Key(name.to_owned()));
             if let Some(r) = rest
-                && let Ok(i) = r.trim_end_matches(']').parse() {
-                    segs.push(Seg::Index(i));
-                }
+                && let Ok(i) = r.trim_end_matches(']').parse()
+            {
+                segs.push(Seg::Index(i));
+            }
         }
         Self(segs)
     }
@@ -97,14 +98,18 @@ pub fn set_in_text(text: &str, key: &KeyPath, value: Value) -> Result<String, St
         };
         let current = table;
         if let Some(Seg::Index(n)) = parents.get(i + 1) {
-            let array = current.get_mut(k).and_then(Item::as_array_of_tables_mut).ok_or_else(|| format!("`{k}` is not an array of tables"))?;
+            let array = current
+                .get_mut(k)
+                .and_then(Item::as_array_of_tables_mut)
+                .ok_or_else(|| format!("`{k}` is not an array of tables"))?;
             table = array.get_mut(*n).ok_or_else(|| format!("`{k}` has no entry [{n}]"))?;
             i += 2;
         } else {
             if current.get(k).is_none() {
                 current.insert(k, Item::Table(Table::new()));
             }
-            table = current.get_mut(k).and_then(Item::as_table_like_mut).ok_or_else(|| format!("`{k}` is not a table"))?;
+            table =
+                current.get_mut(k).and_then(Item::as_table_like_mut).ok_or_else(|| format!("`{k}` is not a table"))?;
             i += 1;
         }
     }

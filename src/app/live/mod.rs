@@ -4,9 +4,9 @@
 //! Threads: config watcher → (channel) → simulation → (channel) → recorder; the main thread runs the
 //! panel. Sliders and a text editor drive the same path: both write the file, the watcher reloads it.
 
+mod command;
 pub mod edit;
 pub mod panel;
-mod command;
 mod session;
 pub mod watch;
 pub mod web;
@@ -18,13 +18,13 @@ use std::time::{Duration, Instant};
 
 use crossbeam_channel::{Receiver, Sender};
 
+use crate::ins::pipeline::InsView;
 use crate::math::timeline::decimation;
 use crate::record::{LiveOutput, Recorder, Stream};
 use crate::scenario::{Params, RawConfig};
-use crate::ins::pipeline::InsView;
 use crate::sim::StepOutput;
-pub use command::{execute, LiveReport, LiveRequest};
-pub use session::{describe_changes, LiveSim};
+pub use command::{LiveReport, LiveRequest, execute};
+pub use session::{LiveSim, describe_changes};
 use watch::WatchEvent;
 
 /// Scene frames per wall-clock second streamed in live mode.
@@ -97,12 +97,21 @@ fn lock(status: &SharedStatus) -> std::sync::MutexGuard<'_, Status> {
 
 /// Paces `sim` to the wall clock, applies reloads between steps, streams decimated outputs to `out`.
 /// Returns when `stop` is set, `duration_s` is reached, or the recorder went away.
-pub fn sim_loop(mut sim: LiveSim, reloads: &Receiver<WatchEvent>, out: &Sender<RecorderMsg>, status: &SharedStatus, stop: &AtomicBool, duration_s: Option<f64>, log_to_stderr: bool) -> LiveSim {
+pub fn sim_loop(
+    mut sim: LiveSim,
+    reloads: &Receiver<WatchEvent>,
+    out: &Sender<RecorderMsg>,
+    status: &SharedStatus,
+    stop: &AtomicBool,
+    duration_s: Option<f64>,
+    log_to_stderr: bool,
+) -> LiveSim {
     let mut speed = lock(status).speed;
     let mut anchor = (Instant::now(), 0.0f64);
     let decimation = |speed: f64, p: &Params| {
         let scene = decimation(p.step_hz, (SCENE_WALL_HZ / speed).min(p.step_hz));
-        let series = decimation(p.step_hz, p.recording.series_hz).max(decimation(p.step_hz, (SERIES_WALL_HZ / speed).min(p.step_hz)));
+        let series = decimation(p.step_hz, p.recording.series_hz)
+            .max(decimation(p.step_hz, (SERIES_WALL_HZ / speed).min(p.step_hz)));
         (scene, series)
     };
     let (mut scene_every, mut series_every) = decimation(speed, &sim.params);
@@ -141,10 +150,20 @@ pub fn sim_loop(mut sim: LiveSim, reloads: &Receiver<WatchEvent>, out: &Sender<R
                                 s.speed = speed;
                                 s.latencies_ms.push(latency_ms);
                             }
-                            if out.send(RecorderMsg::Reconfigure { t_s: t, params: Box::new(sim.params.clone()) }).is_err() {
+                            if out
+                                .send(RecorderMsg::Reconfigure { t_s: t, params: Box::new(sim.params.clone()) })
+                                .is_err()
+                            {
                                 return sim;
                             }
-                            say(format!("reloaded at t = {t:.2} s ({latency_ms:.0} ms after the save): {}", changes.join("; ")), "INFO", t);
+                            say(
+                                format!(
+                                    "reloaded at t = {t:.2} s ({latency_ms:.0} ms after the save): {}",
+                                    changes.join("; ")
+                                ),
+                                "INFO",
+                                t,
+                            );
                         }
                         Err(why) => {
                             say(format!("not applied: {why}"), "WARN", t);
@@ -155,7 +174,12 @@ pub fn sim_loop(mut sim: LiveSim, reloads: &Receiver<WatchEvent>, out: &Sender<R
                     say(format!("config error, keeping the last good parameters: {message}"), "ERROR", t);
                 }
                 WatchEvent::Deleted => {
-                    say("the config file was deleted; keeping the last parameters and waiting for it to come back".into(), "WARN", t);
+                    say(
+                        "the config file was deleted; keeping the last parameters and waiting for it to come back"
+                            .into(),
+                        "WARN",
+                        t,
+                    );
                 }
                 WatchEvent::Restored => {
                     say("the config file is back".into(), "INFO", t);
@@ -257,7 +281,12 @@ pub struct Outputs {
 
 /// Turns [`RecorderMsg`]s into Rerun calls until the channel closes. `viewer` flushes on a timer,
 /// `file` only when its chunks are full, `history` when a late viewer asks for it.
-pub fn recorder_loop(mut viewer: Option<Recorder>, mut file: Option<Recorder>, mut history: Option<(Recorder, History)>, msgs: &Receiver<RecorderMsg>) -> anyhow::Result<()> {
+pub fn recorder_loop(
+    mut viewer: Option<Recorder>,
+    mut file: Option<Recorder>,
+    mut history: Option<(Recorder, History)>,
+    msgs: &Receiver<RecorderMsg>,
+) -> anyhow::Result<()> {
     let (mut last_scene, mut last_series) = (Instant::now(), Instant::now());
     // After a reload, the first moments of the new parameters go out at once (a teacher waits for
     // them), not at the next tick.
@@ -272,8 +301,12 @@ pub fn recorder_loop(mut viewer: Option<Recorder>, mut file: Option<Recorder>, m
         if let Some(msg) = &msg {
             for recorder in viewer.iter_mut().chain(file.iter_mut()).chain(history.iter_mut().map(|(r, _)| r)) {
                 match msg {
-                    RecorderMsg::Series(rows) => rows.iter().try_for_each(|(r, ins)| recorder.push_row(r, ins.as_ref()))?,
-                    RecorderMsg::Scene(rows) => rows.iter().try_for_each(|(r, ins)| recorder.push_scene_row(r, ins.as_ref()))?,
+                    RecorderMsg::Series(rows) => {
+                        rows.iter().try_for_each(|(r, ins)| recorder.push_row(r, ins.as_ref()))?
+                    }
+                    RecorderMsg::Scene(rows) => {
+                        rows.iter().try_for_each(|(r, ins)| recorder.push_scene_row(r, ins.as_ref()))?
+                    }
                     RecorderMsg::Signal(samples) => samples.iter().try_for_each(|s| recorder.push_signal(s))?,
                     RecorderMsg::Reconfigure { t_s, params } => recorder.reconfigure(*t_s, params)?,
                     RecorderMsg::Event { t_s, text, level } => recorder.event(*t_s, text, level)?,
@@ -407,16 +440,28 @@ impl Drop for TerminalGuard {
 
 /// Runs a live session streaming into `rec` until the user quits, `stop` is set or the duration
 /// is reached. The caller owns the sinks (and finishes the saved file afterwards).
-pub fn run_session(opts: &LiveOptions, params: Params, outputs: Outputs, stop: &Arc<AtomicBool>) -> anyhow::Result<LiveSummary> {
+pub fn run_session(
+    opts: &LiveOptions,
+    params: Params,
+    outputs: Outputs,
+    stop: &Arc<AtomicBool>,
+) -> anyhow::Result<LiveSummary> {
     let status = new_status(&params, opts.speed.unwrap_or(params.live_speed));
     run_session_with_status(opts, params, outputs, stop, &status)
 }
 
 /// [`run_session`] reporting into a status the caller can watch (benchmarks, tests).
-pub fn run_session_with_status(opts: &LiveOptions, params: Params, outputs: Outputs, stop: &Arc<AtomicBool>, status: &SharedStatus) -> anyhow::Result<LiveSummary> {
+pub fn run_session_with_status(
+    opts: &LiveOptions,
+    params: Params,
+    outputs: Outputs,
+    stop: &Arc<AtomicBool>,
+    status: &SharedStatus,
+) -> anyhow::Result<LiveSummary> {
     let text = read_text(&opts.config_path)?;
     let (reload_tx, reload_rx) = crossbeam_channel::unbounded();
-    let _watcher = watch::watch(&opts.config_path, text, reload_tx).map_err(|e| anyhow::anyhow!("cannot watch {}: {e}", opts.config_path.display()))?;
+    let _watcher = watch::watch(&opts.config_path, text, reload_tx)
+        .map_err(|e| anyhow::anyhow!("cannot watch {}: {e}", opts.config_path.display()))?;
     let viewer = outputs.viewer.map(|rec| Recorder::new_live(rec, &params, LiveOutput::Viewer)).transpose()?;
     let file = outputs.file.map(|rec| Recorder::new_live(rec, &params, LiveOutput::File)).transpose()?;
     let history = match outputs.history {
@@ -431,11 +476,15 @@ pub fn run_session_with_status(opts: &LiveOptions, params: Params, outputs: Outp
     };
     let resolved = params.resolved.clone();
 
-    let recorder_thread = std::thread::Builder::new().name("recorder".into()).spawn(move || recorder_loop(viewer, file, history, &out_rx))?;
+    let recorder_thread = std::thread::Builder::new()
+        .name("recorder".into())
+        .spawn(move || recorder_loop(viewer, file, history, &out_rx))?;
     let sim_thread = {
         let (status, stop) = (status.clone(), stop.clone());
         let (duration, log) = (opts.duration_s, opts.log_to_stderr && !opts.panel);
-        std::thread::Builder::new().name("simulation".into()).spawn(move || sim_loop(LiveSim::new(params), &reload_rx, &out_tx, &status, &stop, duration, log))?
+        std::thread::Builder::new()
+            .name("simulation".into())
+            .spawn(move || sim_loop(LiveSim::new(params), &reload_rx, &out_tx, &status, &stop, duration, log))?
     };
 
     let panel_result = if opts.panel { panel_loop(&opts.config_path, &resolved, title, status, stop) } else { Ok(()) };
@@ -451,7 +500,13 @@ pub fn run_session_with_status(opts: &LiveOptions, params: Params, outputs: Outp
 }
 
 /// The panel on this thread: draw, read keys, write the config file for every slider move.
-fn panel_loop(path: &Path, resolved: &RawConfig, title: String, status: &SharedStatus, stop: &AtomicBool) -> anyhow::Result<()> {
+fn panel_loop(
+    path: &Path,
+    resolved: &RawConfig,
+    title: String,
+    status: &SharedStatus,
+    stop: &AtomicBool,
+) -> anyhow::Result<()> {
     use ratatui::crossterm::event::{self, Event, KeyEventKind};
     let mut terminal = ratatui::try_init()?;
     let _guard = TerminalGuard;
@@ -475,25 +530,26 @@ fn panel_loop(path: &Path, resolved: &RawConfig, title: String, status: &SharedS
             break;
         }
         if event::poll(Duration::from_millis(50))?
-            && let Event::Key(key) = event::read()? {
-                if key.kind != KeyEventKind::Press {
-                    continue;
-                }
-                match panel.handle(key) {
-                    panel::Action::Quit => {
-                        stop.store(true, Ordering::SeqCst);
-                        break;
-                    }
-                    panel::Action::Set(writes) => {
-                        last_write = Instant::now();
-                        let writes: Vec<_> = writes.into_iter().map(|(k, v)| (k, v.to_value())).collect();
-                        if let Err(e) = edit::set_many_in_file(path, &writes) {
-                            lock(status).message = format!("slider not written: {e}");
-                        }
-                    }
-                    panel::Action::None => {}
-                }
+            && let Event::Key(key) = event::read()?
+        {
+            if key.kind != KeyEventKind::Press {
+                continue;
             }
+            match panel.handle(key) {
+                panel::Action::Quit => {
+                    stop.store(true, Ordering::SeqCst);
+                    break;
+                }
+                panel::Action::Set(writes) => {
+                    last_write = Instant::now();
+                    let writes: Vec<_> = writes.into_iter().map(|(k, v)| (k, v.to_value())).collect();
+                    if let Err(e) = edit::set_many_in_file(path, &writes) {
+                        lock(status).message = format!("slider not written: {e}");
+                    }
+                }
+                panel::Action::None => {}
+            }
+        }
     }
     Ok(())
 }

@@ -2,15 +2,15 @@
 //! Moving a slider writes the scenario file (the watcher then reloads it), so the panel and a text
 //! editor drive the same path. State and key handling are plain data, testable without a terminal.
 
+use ratatui::Frame;
 use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use ratatui::layout::{Constraint, Layout};
 use ratatui::style::{Color, Modifier, Style};
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Borders, Paragraph, Wrap};
-use ratatui::Frame;
 
-use super::edit::{KeyPath, Scalar};
 use super::Status;
+use super::edit::{KeyPath, Scalar};
 use crate::scenario::{self, RawConfig};
 
 /// One control.
@@ -90,10 +90,27 @@ pub struct Panel {
 pub const HELP: &str = "↑↓ select  ←→ adjust  Shift+←→/PgUp/PgDn ×10  Home/End min/max  0 zero  r reset  Space toggle  c calibrate now  ? help (Esc closes)  q quit";
 
 /// The per-axis table errors `[compensation.axis.NAME]` can hold.
-const COMPENSATED_AXIS_FIELDS: [&str; 6] = ["swing_half_angle_arcsec", "swing_phase_deg", "non_orthogonality_arcsec", "encoder_offset_arcsec", "encoder_scale_ppm", "encoder_delay_ms"];
+const COMPENSATED_AXIS_FIELDS: [&str; 6] = [
+    "swing_half_angle_arcsec",
+    "swing_phase_deg",
+    "non_orthogonality_arcsec",
+    "encoder_offset_arcsec",
+    "encoder_scale_ppm",
+    "encoder_delay_ms",
+];
 
 fn slider(label: String, key: &str, unit: &'static str, (min, max): (f64, f64), step: f64) -> Control {
-    Control::Slider { label, keys: vec![KeyPath::parse(key)], unit, min, max, step, log: false, value: 0.0, initial: 0.0 }
+    Control::Slider {
+        label,
+        keys: vec![KeyPath::parse(key)],
+        unit,
+        min,
+        max,
+        step,
+        log: false,
+        value: 0.0,
+        initial: 0.0,
+    }
 }
 
 impl Panel {
@@ -106,10 +123,26 @@ impl Panel {
         let mut controls = Vec::new();
         let turns = raw.scheme.kind != "static";
         let t = &raw.turntable;
-        let has_errors = [t.installation_x_arcsec, t.installation_y_arcsec, t.installation_z_arcsec, t.imu_mount_x_arcsec, t.imu_mount_y_arcsec, t.imu_mount_z_arcsec]
-            .into_iter()
-            .chain(t.axis.iter().flat_map(|a| [a.swing_half_angle_arcsec, a.non_orthogonality_arcsec, a.encoder_offset_arcsec, a.encoder_scale_ppm, a.encoder_delay_ms, a.encoder_noise_arcsec]))
-            .any(|x| x != 0.0);
+        let has_errors = [
+            t.installation_x_arcsec,
+            t.installation_y_arcsec,
+            t.installation_z_arcsec,
+            t.imu_mount_x_arcsec,
+            t.imu_mount_y_arcsec,
+            t.imu_mount_z_arcsec,
+        ]
+        .into_iter()
+        .chain(t.axis.iter().flat_map(|a| {
+            [
+                a.swing_half_angle_arcsec,
+                a.non_orthogonality_arcsec,
+                a.encoder_offset_arcsec,
+                a.encoder_scale_ppm,
+                a.encoder_delay_ms,
+                a.encoder_noise_arcsec,
+            ]
+        }))
+        .any(|x| x != 0.0);
         if turns || has_errors {
             Self::table_controls(raw, turns, &mut controls);
         }
@@ -117,12 +150,20 @@ impl Panel {
         match raw.scheme.kind.as_str() {
             "continuous" => {
                 for (j, r) in raw.scheme.rate.iter().enumerate() {
-                    controls.push(slider(format!("{} rotation rate", r.axis), &format!("scheme.rate[{j}].rate_deg_per_s"), "°/s", (-60.0, 60.0), 1.0));
+                    controls.push(slider(
+                        format!("{} rotation rate", r.axis),
+                        &format!("scheme.rate[{j}].rate_deg_per_s"),
+                        "°/s",
+                        (-60.0, 60.0),
+                        1.0,
+                    ));
                 }
             }
             "indexed" => controls.push(Control::Slider {
                 label: "move rate (all steps)".into(),
-                keys: (0..raw.scheme.step.len()).map(|j| KeyPath::parse(&format!("scheme.step[{j}].rate_deg_per_s"))).collect(),
+                keys: (0..raw.scheme.step.len())
+                    .map(|j| KeyPath::parse(&format!("scheme.step[{j}].rate_deg_per_s")))
+                    .collect(),
                 unit: "°/s",
                 min: 1.0,
                 max: 60.0,
@@ -149,7 +190,12 @@ impl Panel {
         // lesson's INS trace and dial take a factor of their own, from the analytic drift).
         if turns || has_errors {
             controls.push(log("3D exaggeration", "recording.exaggeration", (1.0, 10_000.0)));
-            controls.push(Control::Toggle { label: "compensation".into(), key: KeyPath::parse("compensation.enabled"), value: true, initial: true });
+            controls.push(Control::Toggle {
+                label: "compensation".into(),
+                key: KeyPath::parse("compensation.enabled"),
+                value: true,
+                initial: true,
+            });
         }
         let axis_names = raw.turntable.axis.iter().map(|a| a.name.clone()).collect();
         let mut panel = Self { controls, selected: 0, show_help: false, title, axis_names };
@@ -169,23 +215,59 @@ impl Panel {
         for (i, a) in raw.turntable.axis.iter().enumerate() {
             let n = &a.name;
             let k = |f: &str| format!("turntable.axis[{i}].{f}");
-            controls.push(slider(format!("{n} swing half-angle"), &k("swing_half_angle_arcsec"), "″", (0.0, 3600.0), 10.0));
+            controls.push(slider(
+                format!("{n} swing half-angle"),
+                &k("swing_half_angle_arcsec"),
+                "″",
+                (0.0, 3600.0),
+                10.0,
+            ));
             controls.push(slider(format!("{n} swing phase"), &k("swing_phase_deg"), "°", (-180.0, 180.0), 5.0));
             if i > 0 {
-                controls.push(slider(format!("{n} non-orthogonality"), &k("non_orthogonality_arcsec"), "″", (-600.0, 600.0), 5.0));
+                controls.push(slider(
+                    format!("{n} non-orthogonality"),
+                    &k("non_orthogonality_arcsec"),
+                    "″",
+                    (-600.0, 600.0),
+                    5.0,
+                ));
             }
-            controls.push(slider(format!("{n} encoder offset"), &k("encoder_offset_arcsec"), "″", (-600.0, 600.0), 5.0));
+            controls.push(slider(
+                format!("{n} encoder offset"),
+                &k("encoder_offset_arcsec"),
+                "″",
+                (-600.0, 600.0),
+                5.0,
+            ));
             if turns {
-                controls.push(slider(format!("{n} encoder scale"), &k("encoder_scale_ppm"), " ppm", (-1000.0, 1000.0), 10.0));
+                controls.push(slider(
+                    format!("{n} encoder scale"),
+                    &k("encoder_scale_ppm"),
+                    " ppm",
+                    (-1000.0, 1000.0),
+                    10.0,
+                ));
                 controls.push(slider(format!("{n} encoder delay"), &k("encoder_delay_ms"), " ms", (0.0, 50.0), 0.5));
             }
             controls.push(slider(format!("{n} encoder noise"), &k("encoder_noise_arcsec"), "″ 1σ", (0.0, 60.0), 1.0));
         }
         for about in ["x", "y", "z"] {
-            controls.push(slider(format!("installation about {about}"), &format!("turntable.installation_{about}_arcsec"), "″", (-1800.0, 1800.0), 10.0));
+            controls.push(slider(
+                format!("installation about {about}"),
+                &format!("turntable.installation_{about}_arcsec"),
+                "″",
+                (-1800.0, 1800.0),
+                10.0,
+            ));
         }
         for about in ["x", "y", "z"] {
-            controls.push(slider(format!("IMU mounting about {about}"), &format!("turntable.imu_mount_{about}_arcsec"), "″", (-1800.0, 1800.0), 10.0));
+            controls.push(slider(
+                format!("IMU mounting about {about}"),
+                &format!("turntable.imu_mount_{about}_arcsec"),
+                "″",
+                (-1800.0, 1800.0),
+                10.0,
+            ));
         }
     }
 
@@ -200,8 +282,20 @@ impl Panel {
             controls.push(slider("cone frequency".into(), "vehicle.coning_frequency_hz", " Hz", (0.1, 50.0), 0.1));
         }
         if !v.wobble.is_empty() {
-            let all = |field: &str| (0..v.wobble.len()).map(|j| KeyPath::parse(&format!("vehicle.wobble[{j}].{field}"))).collect::<Vec<_>>();
-            let many = |label: &str, keys, unit, (min, max), step| Control::Slider { label: label.into(), keys, unit, min, max, step, log: false, value: 0.0, initial: 0.0 };
+            let all = |field: &str| {
+                (0..v.wobble.len()).map(|j| KeyPath::parse(&format!("vehicle.wobble[{j}].{field}"))).collect::<Vec<_>>()
+            };
+            let many = |label: &str, keys, unit, (min, max), step| Control::Slider {
+                label: label.into(),
+                keys,
+                unit,
+                min,
+                max,
+                step,
+                log: false,
+                value: 0.0,
+                initial: 0.0,
+            };
             controls.push(many("wobble amplitude (every axis)", all("amplitude_deg"), "°", (0.0, 20.0), 0.5));
             controls.push(many("wobble frequency (every axis)", all("frequency_hz"), " Hz", (0.1, 20.0), 0.1));
         }
@@ -236,7 +330,9 @@ impl Panel {
         for c in &mut self.controls {
             match c {
                 Control::Slider { keys, value, min, max, .. } => {
-                    if let Some(v) = keys.first().and_then(|k| flat.get(&k.to_string())).and_then(|s| s.parse::<f64>().ok()) {
+                    if let Some(v) =
+                        keys.first().and_then(|k| flat.get(&k.to_string())).and_then(|s| s.parse::<f64>().ok())
+                    {
                         *value = v;
                         *min = min.min(v);
                         *max = max.max(v);
@@ -317,7 +413,9 @@ impl Panel {
             return Err(format!("{}: {value} is not a finite number", control.label()));
         }
         match control {
-            Control::Slider { label, unit, min, max, .. } if !(*min..=*max).contains(&value) => Err(format!("{label}: {value}{unit} is outside {}{unit} ..= {}{unit}", trim(*min), trim(*max))),
+            Control::Slider { label, unit, min, max, .. } if !(*min..=*max).contains(&value) => {
+                Err(format!("{label}: {value}{unit} is outside {}{unit} ..= {}{unit}", trim(*min), trim(*max)))
+            }
             Control::Slider { .. } => {
                 self.selected = index;
                 Ok(self.set_selected(|_, _, _| value))
@@ -346,7 +444,10 @@ impl Panel {
                 let k = key.to_string();
                 let target = if let Some(rest) = k.strip_prefix("turntable.axis[") {
                     let (index, field) = rest.split_once("].").unwrap_or_default();
-                    match (index.parse::<usize>().ok().and_then(|i| self.axis_names.get(i)), COMPENSATED_AXIS_FIELDS.contains(&field)) {
+                    match (
+                        index.parse::<usize>().ok().and_then(|i| self.axis_names.get(i)),
+                        COMPENSATED_AXIS_FIELDS.contains(&field),
+                    ) {
                         (Some(name), true) => Some(format!("compensation.axis.{name}.{field}")),
                         _ => None,
                     }
@@ -376,11 +477,18 @@ impl Panel {
         let (step, log) = (*step, *log);
         let times = if coarse { 10.0 } else { 1.0 };
         // Logarithmic sliders walk 1, 2, 5, 10, 20, ... (coarse: a decade), so the file gets round values.
-        self.set_selected(|v, _, _| if log { if coarse { ladder(v * 10f64.powf(direction * 0.999), 0.0) } else { ladder(v, direction) } } else { v + direction * step * times })
+        self.set_selected(|v, _, _| {
+            if log {
+                if coarse { ladder(v * 10f64.powf(direction * 0.999), 0.0) } else { ladder(v, direction) }
+            } else {
+                v + direction * step * times
+            }
+        })
     }
 
     fn set_selected(&mut self, f: impl Fn(f64, f64, f64) -> f64) -> Action {
-        let Some(Control::Slider { keys, value, min, max, step, log, .. }) = self.controls.get_mut(self.selected) else {
+        let Some(Control::Slider { keys, value, min, max, step, log, .. }) = self.controls.get_mut(self.selected)
+        else {
             return Action::None;
         };
         // Land on the control's grid (the step, or 1-2-5 for a logarithmic slider), whoever set it
@@ -416,11 +524,19 @@ impl Panel {
 
     /// Draws the panel.
     pub fn render(&self, frame: &mut Frame<'_>, status: &Status, config_path: &str) {
-        let [top, list, bottom] =
-            Layout::vertical([Constraint::Length(2), Constraint::Min(3), Constraint::Length(if self.show_help { 15 } else { 9 })]).areas(frame.area());
+        let [top, list, bottom] = Layout::vertical([
+            Constraint::Length(2),
+            Constraint::Min(3),
+            Constraint::Length(if self.show_help { 15 } else { 9 }),
+        ])
+        .areas(frame.area());
         let head = vec![
             Line::from(Span::styled(self.title.clone(), Style::default().add_modifier(Modifier::BOLD))),
-            Line::from(format!("sim t = {:.1} s   speed ×{}   config {config_path}", status.sim_t_s, trim(status.speed))),
+            Line::from(format!(
+                "sim t = {:.1} s   speed ×{}   config {config_path}",
+                status.sim_t_s,
+                trim(status.speed)
+            )),
         ];
         frame.render_widget(Paragraph::new(head), top);
 
@@ -432,26 +548,51 @@ impl Panel {
             .enumerate()
             .map(|(i, c)| {
                 let selected = i == self.selected;
-                let style = if selected { Style::default().fg(Color::Yellow).add_modifier(Modifier::BOLD) } else { Style::default() };
+                let style = if selected {
+                    Style::default().fg(Color::Yellow).add_modifier(Modifier::BOLD)
+                } else {
+                    Style::default()
+                };
                 let marker = if selected { "▶ " } else { "  " };
                 let (label, bar, value) = match c {
                     Control::Slider { label, unit, min, max, value, log, .. } => {
-                        let frac = if *log { (value.ln() - min.ln()) / (max.ln() - min.ln()) } else { (value - min) / (max - min) };
+                        let frac = if *log {
+                            (value.ln() - min.ln()) / (max.ln() - min.ln())
+                        } else {
+                            (value - min) / (max - min)
+                        };
                         let filled = ((frac.clamp(0.0, 1.0)) * bar_width as f64).round() as usize;
-                        (label.as_str(), format!("[{}{}]", "█".repeat(filled), "·".repeat(bar_width - filled)), format!("{}{unit}", trim(*value)))
+                        (
+                            label.as_str(),
+                            format!("[{}{}]", "█".repeat(filled), "·".repeat(bar_width - filled)),
+                            format!("{}{unit}", trim(*value)),
+                        )
                     }
-                    Control::Toggle { label, value, .. } => (label.as_str(), format!("[{}]", if *value { " on " } else { " off" }), String::new()),
+                    Control::Toggle { label, value, .. } => {
+                        (label.as_str(), format!("[{}]", if *value { " on " } else { " off" }), String::new())
+                    }
                 };
-                Line::from(vec![Span::styled(format!("{marker}{label:<28}"), style), Span::raw(bar), Span::styled(format!(" {value:>12}"), style)])
+                Line::from(vec![
+                    Span::styled(format!("{marker}{label:<28}"), style),
+                    Span::raw(bar),
+                    Span::styled(format!(" {value:>12}"), style),
+                ])
             })
             .collect();
-        frame.render_widget(Paragraph::new(lines).block(Block::default().borders(Borders::ALL).title(" parameters (write the config file) ")), list);
+        frame.render_widget(
+            Paragraph::new(lines)
+                .block(Block::default().borders(Borders::ALL).title(" parameters (write the config file) ")),
+            list,
+        );
 
         let p95 = super::p95(&status.latencies_ms);
         let mut foot = Vec::new();
         if let Some(Control::Slider { min, max, step, log, unit, .. }) = self.controls.get(self.selected) {
             let steps = if *log { "steps 1-2-5".to_owned() } else { format!("step {}{unit}", trim(*step)) };
-            foot.push(Line::from(Span::styled(format!("selected: range {} … {}{unit}, {steps}", trim(*min), trim(*max)), Style::default().fg(Color::Yellow))));
+            foot.push(Line::from(Span::styled(
+                format!("selected: range {} … {}{unit}, {steps}", trim(*min), trim(*max)),
+                Style::default().fg(Color::Yellow),
+            )));
         }
         foot.push(error_line(status));
         foot.extend([
@@ -463,9 +604,15 @@ impl Panel {
             foot.push(Line::from("Every slider writes its key into the config file (comments and layout kept);"));
             foot.push(Line::from("the file watcher reloads it exactly as when you save from an editor. Editing the"));
             foot.push(Line::from("file by hand moves the sliders. Bad values are reported and the old ones kept."));
-            foot.push(Line::from("c (calibrate now) freezes [compensation] at the table's current errors: move a slider after it"));
-            foot.push(Line::from("to see what a table that changed since its calibration does to the compensated curve."));
-            foot.push(Line::from("q or Ctrl-C ends the session (a --save recording is completed); Esc closes this help."));
+            foot.push(Line::from(
+                "c (calibrate now) freezes [compensation] at the table's current errors: move a slider after it",
+            ));
+            foot.push(Line::from(
+                "to see what a table that changed since its calibration does to the compensated curve.",
+            ));
+            foot.push(Line::from(
+                "q or Ctrl-C ends the session (a --save recording is completed); Esc closes this help.",
+            ));
         }
         frame.render_widget(Paragraph::new(foot).wrap(Wrap { trim: true }), bottom);
     }
@@ -486,7 +633,11 @@ fn error_line(status: &Status) -> Line<'static> {
             .collect::<Vec<_>>()
             .join("  ")
     };
-    Line::from(format!("error since the last change, RMS/peak ″ — uncompensated: {}   compensated: {}", variant(0), variant(1)))
+    Line::from(format!(
+        "error since the last change, RMS/peak ″ — uncompensated: {}   compensated: {}",
+        variant(0),
+        variant(1)
+    ))
 }
 
 /// The next value of the 1-2-5 ladder after `v` in `direction` (+1 up, −1 down; 0: the nearest).
@@ -551,18 +702,39 @@ mod tests {
         assert_eq!(value_of(&p, "outer rotation rate"), 10.0);
         assert_eq!(value_of(&p, "speed (× real time)"), 1.0);
         assert_eq!(value_of(&p, "3D exaggeration"), 100.0);
-        assert!(p.controls.iter().any(|c| matches!(c, Control::Toggle { label, value: true, .. } if label == "compensation")));
+        assert!(
+            p.controls
+                .iter()
+                .any(|c| matches!(c, Control::Toggle { label, value: true, .. } if label == "compensation"))
+        );
     }
 
     #[test]
     fn arrows_select_and_adjust_and_write_the_right_key() {
         let mut p = panel();
         assert_eq!(p.selected, 0); // outer swing half-angle, 600″, step 10″
-        assert_eq!(p.handle(key(KeyCode::Right)), Action::Set(vec![(KeyPath::parse("turntable.axis[0].swing_half_angle_arcsec"), Scalar::Float(610.0))]));
-        let shift_left = KeyEvent { code: KeyCode::Left, modifiers: KeyModifiers::SHIFT, kind: KeyEventKind::Press, state: ratatui::crossterm::event::KeyEventState::NONE };
-        assert_eq!(p.handle(shift_left), Action::Set(vec![(KeyPath::parse("turntable.axis[0].swing_half_angle_arcsec"), Scalar::Float(510.0))]));
-        assert_eq!(p.handle(key(KeyCode::Char('r'))), Action::Set(vec![(KeyPath::parse("turntable.axis[0].swing_half_angle_arcsec"), Scalar::Float(600.0))]));
-        assert_eq!(p.handle(key(KeyCode::Home)), Action::Set(vec![(KeyPath::parse("turntable.axis[0].swing_half_angle_arcsec"), Scalar::Float(0.0))]));
+        assert_eq!(
+            p.handle(key(KeyCode::Right)),
+            Action::Set(vec![(KeyPath::parse("turntable.axis[0].swing_half_angle_arcsec"), Scalar::Float(610.0))])
+        );
+        let shift_left = KeyEvent {
+            code: KeyCode::Left,
+            modifiers: KeyModifiers::SHIFT,
+            kind: KeyEventKind::Press,
+            state: ratatui::crossterm::event::KeyEventState::NONE,
+        };
+        assert_eq!(
+            p.handle(shift_left),
+            Action::Set(vec![(KeyPath::parse("turntable.axis[0].swing_half_angle_arcsec"), Scalar::Float(510.0))])
+        );
+        assert_eq!(
+            p.handle(key(KeyCode::Char('r'))),
+            Action::Set(vec![(KeyPath::parse("turntable.axis[0].swing_half_angle_arcsec"), Scalar::Float(600.0))])
+        );
+        assert_eq!(
+            p.handle(key(KeyCode::Home)),
+            Action::Set(vec![(KeyPath::parse("turntable.axis[0].swing_half_angle_arcsec"), Scalar::Float(0.0))])
+        );
         // At the minimum, further presses write nothing.
         assert_eq!(p.handle(key(KeyCode::Left)), Action::None);
         // Down moves to the next control; Up from the top wraps to the last (the compensation toggle).
@@ -571,7 +743,10 @@ mod tests {
         p.handle(key(KeyCode::Up));
         p.handle(key(KeyCode::Up));
         assert_eq!(p.selected, p.controls.len() - 1);
-        assert_eq!(p.handle(key(KeyCode::Char(' '))), Action::Set(vec![(KeyPath::parse("compensation.enabled"), Scalar::Bool(false))]));
+        assert_eq!(
+            p.handle(key(KeyCode::Char(' '))),
+            Action::Set(vec![(KeyPath::parse("compensation.enabled"), Scalar::Bool(false))])
+        );
         assert_eq!(p.handle(key(KeyCode::Char('q'))), Action::Quit);
         assert_eq!(p.handle(KeyEvent::new(KeyCode::Char('c'), KeyModifiers::CONTROL)), Action::Quit);
     }
@@ -580,7 +755,11 @@ mod tests {
     fn logarithmic_sliders_walk_the_1_2_5_ladder() {
         // The speed slider used to write 1.25^5 = 3.051758 into the file: now round values only.
         let mut p = panel();
-        p.selected = p.controls.iter().position(|c| matches!(c, Control::Slider { label, .. } if label.starts_with("speed"))).expect("speed");
+        p.selected = p
+            .controls
+            .iter()
+            .position(|c| matches!(c, Control::Slider { label, .. } if label.starts_with("speed")))
+            .expect("speed");
         let speed = |v: f64| Action::Set(vec![(KeyPath::parse("live.speed"), Scalar::Float(v))]);
         for expected in [2.0, 5.0, 10.0, 20.0] {
             assert_eq!(p.handle(key(KeyCode::Right)), speed(expected));
@@ -616,7 +795,8 @@ mod tests {
     #[test]
     fn renders_without_a_terminal() {
         let p = panel();
-        let status = super::super::new_status(&crate::scenario::presets::load("jiang2017-dual-axis").expect("preset"), 1.0);
+        let status =
+            super::super::new_status(&crate::scenario::presets::load("jiang2017-dual-axis").expect("preset"), 1.0);
         let status = status.lock().expect("lock").clone();
         let mut term = ratatui::Terminal::new(ratatui::backend::TestBackend::new(110, 40)).expect("terminal");
         term.draw(|f| p.render(f, &status, "x.toml")).expect("draw");

@@ -4,7 +4,7 @@
 use crate::ins::pipeline::{InsRun, InsView};
 use crate::model::scheme::AxisValues;
 use crate::scenario::{self, Params, RawConfig};
-use crate::sim::{step, DemodState, ErrorStats, Model, StepOutput};
+use crate::sim::{DemodState, ErrorStats, Model, StepOutput, step};
 
 /// The simulation of a live session: a [`Model`] that can be replaced between two steps.
 pub struct LiveSim {
@@ -145,7 +145,10 @@ impl LiveSim {
                 None
             };
             if let Some(why) = why {
-                return Err(format!("simulation.step_hz cannot change in this running session ({} Hz -> {} Hz): {why}; restart `rinscope live`", old.step_hz, new.step_hz));
+                return Err(format!(
+                    "simulation.step_hz cannot change in this running session ({} Hz -> {} Hz): {why}; restart `rinscope live`",
+                    old.step_hz, new.step_hz
+                ));
             }
         }
         let changes = describe_changes(&old.written, &new.written);
@@ -156,12 +159,20 @@ impl LiveSim {
         let instrument = |k: &String| k.starts_with("imu.") || k.starts_with("navigation.");
         // (What the INS computes from the step rate — its sample period — follows the rate below.)
         if let Some(key) = a.keys().chain(b.keys()).filter(|k| instrument(k)).find(|k| a.get(*k) != b.get(*k)) {
-            return Err(format!("{key} cannot change in a running session (the INS has been integrating with the old one); restart `rinscope live`"));
+            return Err(format!(
+                "{key} cannot change in a running session (the INS has been integrating with the old one); restart `rinscope live`"
+            ));
         }
         let mut model = new.table_model();
         // The body goes on from where it is (a changed cone or wobble ramps, its phase kept).
         model.vehicle = model.vehicle.continuing_from(&self.model.vehicle, self.t_s());
-        let initial_changed = old.resolved.turntable.axis.iter().zip(&new.resolved.turntable.axis).any(|(a, b)| a.initial_angle_deg != b.initial_angle_deg);
+        let initial_changed = old
+            .resolved
+            .turntable
+            .axis
+            .iter()
+            .zip(&new.resolved.turntable.axis)
+            .any(|(a, b)| a.initial_angle_deg != b.initial_angle_deg);
         if old.resolved.scheme == new.resolved.scheme && !initial_changed {
             // Same motion: keep its clock, so nothing jumps.
             model.scheme = self.model.scheme.clone();
@@ -203,7 +214,8 @@ pub fn describe_changes(old: &RawConfig, new: &RawConfig) -> Vec<String> {
             continue;
         }
         let unit = unit_of(key);
-        let show = |v: Option<&String>| v.map_or_else(|| "(unset)".to_owned(), |v| format!("{}{unit}", pretty_value(v)));
+        let show =
+            |v: Option<&String>| v.map_or_else(|| "(unset)".to_owned(), |v| format!("{}{unit}", pretty_value(v)));
         out.push(format!("{} {} → {}", label_of(key, new), show(x), show(y)));
     }
     out
@@ -248,7 +260,10 @@ fn label_of(key: &str, raw: &RawConfig) -> String {
             break;
         }
     }
-    let name = name.replace('_', " ").replace("swing half angle", "swing half-angle").replace("non orthogonality", "non-orthogonality");
+    let name = name
+        .replace('_', " ")
+        .replace("swing half angle", "swing half-angle")
+        .replace("non orthogonality", "non-orthogonality");
     let index = |p: &str| p.split_once('[').and_then(|(_, r)| r.trim_end_matches(']').parse::<usize>().ok());
     match parts.as_slice() {
         ["turntable", ax, _] if ax.starts_with("axis[") => {
@@ -275,4 +290,3 @@ fn label_of(key: &str, raw: &RawConfig) -> String {
         _ => key.to_owned(),
     }
 }
-

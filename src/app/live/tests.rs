@@ -6,8 +6,8 @@ use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 use super::*;
-use crate::scenario;
 use crate::math::units::RAD_PER_ARCSEC;
+use crate::scenario;
 
 const PRESET: &str = include_str!("../../../assets/scenarios/jiang2017-dual-axis.toml");
 
@@ -26,13 +26,18 @@ fn apply_describes_the_change_in_words_and_swaps_the_model() {
     for _ in 0..100 {
         sim.step();
     }
-    let changes = sim.apply(edited("swing_half_angle_arcsec = 300.0", "swing_half_angle_arcsec = 600.0")).expect("applied");
+    let changes =
+        sim.apply(edited("swing_half_angle_arcsec = 300.0", "swing_half_angle_arcsec = 600.0")).expect("applied");
     assert_eq!(changes, vec!["inner swing half-angle 300″ → 600″".to_owned()]);
     assert!((sim.model.truth.axes[1].swing_half_angle_rad - 600.0 * RAD_PER_ARCSEC).abs() < 1e-15);
     // Same scheme: its clock is kept (no re-anchoring).
     assert_eq!(sim.model.scheme_t0_s, 0.0);
     // Applying the same parameters again changes nothing.
-    assert!(sim.apply(edited("swing_half_angle_arcsec = 300.0", "swing_half_angle_arcsec = 600.0")).expect("no-op").is_empty());
+    assert!(
+        sim.apply(edited("swing_half_angle_arcsec = 300.0", "swing_half_angle_arcsec = 600.0"))
+            .expect("no-op")
+            .is_empty()
+    );
 }
 
 #[test]
@@ -54,7 +59,8 @@ fn a_new_rotation_rate_starts_from_where_the_gimbals_are() {
 #[test]
 fn structural_changes_are_refused_and_the_old_parameters_stay() {
     let mut sim = LiveSim::new(params());
-    let err = sim.apply(edited("name = \"inner\"\naxis = \"z\"", "name = \"inner\"\naxis = \"x\"")).expect_err("refused");
+    let err =
+        sim.apply(edited("name = \"inner\"\naxis = \"z\"", "name = \"inner\"\naxis = \"x\"")).expect_err("refused");
     assert!(err.contains("axes"), "{err}");
     // A FIR holds samples of the old rate: its session cannot change rate.
     let wobble = scenario::presets::text("li2014-wobble-1").expect("preset");
@@ -71,7 +77,12 @@ fn structural_changes_are_refused_and_the_old_parameters_stay() {
 fn signature(sim: &mut LiveSim) -> Vec<u64> {
     let o = sim.step();
     let ins = sim.ins_view(false);
-    let table = o.errors.iter().flat_map(|e| e.as_array()).chain(o.gimbal_rad.iter().copied()).chain(o.encoder_rad.iter().copied());
+    let table = o
+        .errors
+        .iter()
+        .flat_map(|e| e.as_array())
+        .chain(o.gimbal_rad.iter().copied())
+        .chain(o.encoder_rad.iter().copied());
     let ins = ins.iter().flat_map(|v| v.errors.iter().flat_map(|e| e.as_array()));
     table.chain(ins).map(f64::to_bits).collect()
 }
@@ -95,20 +106,44 @@ fn every_control_offered_acts_on_its_preset() {
             // A swing phase turns a swing, the compensation compensates errors: the axis (the first
             // one) gets a swing first.
             let mut base_text = (*text).to_owned();
-            let needs_swing = label.strip_suffix(" swing phase").or((label == "compensation").then_some(p.resolved.turntable.axis[0].name.as_str()));
+            let needs_swing = label
+                .strip_suffix(" swing phase")
+                .or((label == "compensation").then_some(p.resolved.turntable.axis[0].name.as_str()));
             if let Some(axis) = needs_swing {
                 let k = p.resolved.turntable.axis.iter().position(|a| a.name == axis).expect("axis");
-                base_text = edit::set_in_text(&base_text, &edit::KeyPath::parse(&format!("turntable.axis[{k}].swing_half_angle_arcsec")), edit::float(300.0)).expect("edit");
+                base_text = edit::set_in_text(
+                    &base_text,
+                    &edit::KeyPath::parse(&format!("turntable.axis[{k}].swing_half_angle_arcsec")),
+                    edit::float(300.0),
+                )
+                .expect("edit");
             }
             let mut moved = panel.clone();
             let target = match control {
-                Control::Slider { min, max, value, log: true, .. } => if value * 2.5 <= *max { value * 2.5 } else { (value / 2.5).max(*min) },
-                Control::Slider { min, max, value, .. } => if value + (max - min) / 4.0 <= *max { value + (max - min) / 4.0 } else { value - (max - min) / 4.0 },
+                Control::Slider { min, max, value, log: true, .. } => {
+                    if value * 2.5 <= *max {
+                        value * 2.5
+                    } else {
+                        (value / 2.5).max(*min)
+                    }
+                }
+                Control::Slider { min, max, value, .. } => {
+                    if value + (max - min) / 4.0 <= *max {
+                        value + (max - min) / 4.0
+                    } else {
+                        value - (max - min) / 4.0
+                    }
+                }
                 Control::Toggle { value, .. } => f64::from(u8::from(!*value)),
             };
-            let Ok(Action::Set(writes)) = moved.set_control(i, target) else { panic!("{name}: {label} did not move to {target}") };
-            let edited = writes.iter().fold(base_text.clone(), |t, (k, v)| edit::set_in_text(&t, k, v.to_value()).expect("edit"));
-            let (base, new) = (scenario::parse(&base_text, name).expect("base"), scenario::parse(&edited, name).expect("edited"));
+            let Ok(Action::Set(writes)) = moved.set_control(i, target) else {
+                panic!("{name}: {label} did not move to {target}")
+            };
+            let edited = writes
+                .iter()
+                .fold(base_text.clone(), |t, (k, v)| edit::set_in_text(&t, k, v.to_value()).expect("edit"));
+            let (base, new) =
+                (scenario::parse(&base_text, name).expect("base"), scenario::parse(&edited, name).expect("edited"));
             // An indexed scheme's move rate acts while the table moves: the change comes before the
             // first move and the comparison runs through it.
             // An indexed scheme's axis turns when its move comes: the comparison runs through a
@@ -123,7 +158,10 @@ fn every_control_offered_acts_on_its_preset() {
             }
             changed.apply(new.clone()).unwrap_or_else(|e| panic!("{name}: {label}: {e}"));
             let acts = (0..steps).any(|_| signature(&mut same) != signature(&mut changed));
-            assert!(acts, "{name}: moving \"{label}\" to {target} changes nothing the session computes in {steps} steps");
+            assert!(
+                acts,
+                "{name}: moving \"{label}\" to {target} changes nothing the session computes in {steps} steps"
+            );
         }
     }
 }
@@ -157,7 +195,8 @@ fn drift(rows: &[(f64, Vec<f64>)], k: usize, from: f64, to: f64) -> f64 {
     let pts: Vec<(f64, f64)> = rows.iter().filter(|(t, _)| *t >= from && *t < to).map(|(t, e)| (*t, e[k])).collect();
     let n = pts.len() as f64;
     let (mt, me) = (pts.iter().map(|p| p.0).sum::<f64>() / n, pts.iter().map(|p| p.1).sum::<f64>() / n);
-    (pts.iter().map(|p| (p.0 - mt) * (p.1 - me)).sum::<f64>() / pts.iter().map(|p| (p.0 - mt).powi(2)).sum::<f64>()).abs()
+    (pts.iter().map(|p| (p.0 - mt) * (p.1 - me)).sum::<f64>() / pts.iter().map(|p| (p.0 - mt).powi(2)).sum::<f64>())
+        .abs()
 }
 
 #[test]
@@ -168,14 +207,27 @@ fn a_cone_changed_live_goes_on_without_a_jump_and_drifts_as_if_it_had_always_bee
     // algorithm drifts as an INS that ran on 2° at 10 Hz from the start does (an independent run),
     // then, after the sample rate goes 100 → 200 Hz, as one that ran at 200 Hz from the start. The
     // two simplest algorithms also match the analytic rate (Li et al. 2014; sin²α ε(λ)/h).
-    use crate::ins::coning::{coning_drift_rate, Algorithm};
+    use crate::ins::coning::{Algorithm, coning_drift_rate};
     let text = scenario::presets::text("pure-coning").expect("preset");
     let (t1, t2, end) = (3.0, 12.0, 30.0);
-    let rows = coning_session(text, &[(t1, "coning_half_angle_deg = 1.0", "coning_half_angle_deg = 2.0"), (t1, "coning_frequency_hz = 5.0", "coning_frequency_hz = 10.0"), (t2, "step_hz = 100.0", "step_hz = 200.0")], end);
-    let new_cone = text.replacen("coning_half_angle_deg = 1.0", "coning_half_angle_deg = 2.0", 1).replacen("coning_frequency_hz = 5.0", "coning_frequency_hz = 10.0", 1);
+    let rows = coning_session(
+        text,
+        &[
+            (t1, "coning_half_angle_deg = 1.0", "coning_half_angle_deg = 2.0"),
+            (t1, "coning_frequency_hz = 5.0", "coning_frequency_hz = 10.0"),
+            (t2, "step_hz = 100.0", "step_hz = 200.0"),
+        ],
+        end,
+    );
+    let new_cone = text.replacen("coning_half_angle_deg = 1.0", "coning_half_angle_deg = 2.0", 1).replacen(
+        "coning_frequency_hz = 5.0",
+        "coning_frequency_hz = 10.0",
+        1,
+    );
     let fresh_100 = coning_session(&new_cone, &[], 12.0);
     let fresh_200 = coning_session(&new_cone.replacen("step_hz = 100.0", "step_hz = 200.0", 1), &[], 20.0);
-    let algorithms: Vec<Algorithm> = scenario::presets::load("pure-coning").expect("preset").ins.expect("imu").algorithms();
+    let algorithms: Vec<Algorithm> =
+        scenario::presets::load("pure-coning").expect("preset").ins.expect("imu").algorithms();
     let rate = |a: Algorithm, sample_hz: f64| coning_drift_rate(a, 2f64.to_radians(), 10.0, 1.0 / sample_hz).abs();
     // No jump: no update moves an error by more than 3 updates of the crudest algorithm's coning
     // drift there is (single-sample, 2° at 10 Hz sampled at 100 Hz: 5.2″ an update); the reload of
@@ -183,18 +235,38 @@ fn a_cone_changed_live_goes_on_without_a_jump_and_drifts_as_if_it_had_always_bee
     // transition itself is its response to that motion: 0.04″ an update for two-sample-p2.)
     let bound = 3.0 * rate(Algorithm::SingleSample, 100.0) / 100.0;
     for (k, a) in algorithms.iter().enumerate() {
-        let (worst, at) = rows.windows(2).map(|w| ((w[1].1[k] - w[0].1[k]).abs(), w[1].0)).fold((0.0, 0.0), |m, x| if x.0 > m.0 { x } else { m });
-        assert!(worst < bound, "{}: the heading error moves by {:.3e}″ in one update at t = {at} s (bound {:.3e}″)", a.name(), worst * 206_264.8, bound * 206_264.8);
+        let (worst, at) = rows
+            .windows(2)
+            .map(|w| ((w[1].1[k] - w[0].1[k]).abs(), w[1].0))
+            .fold((0.0, 0.0), |m, x| if x.0 > m.0 { x } else { m });
+        assert!(
+            worst < bound,
+            "{}: the heading error moves by {:.3e}″ in one update at t = {at} s (bound {:.3e}″)",
+            a.name(),
+            worst * 206_264.8,
+            bound * 206_264.8
+        );
         // The same drift as the independent runs: the slopes of the same motion over other whole
         // periods agree to 4-5 digits (measured); the band is 0.5 % and, for drifts at the level
         // of the Earth-rate terms (two-sample-p2 at 200 Hz: 2e-9 rad/s), 2e-10 rad/s.
-        for (live, fresh, what) in [(drift(&rows, k, t1 + 2.0, t2), drift(&fresh_100, k, 2.0, 12.0), "100 Hz"), (drift(&rows, k, t2 + 2.0, end), drift(&fresh_200, k, 2.0, 20.0), "200 Hz")] {
-            assert!((live - fresh).abs() <= 0.005 * fresh + 2e-10, "{} (2° at 10 Hz, {what}): drifts at {live:.5e} rad/s after the change, {fresh:.5e} rad/s run so from the start", a.name());
+        for (live, fresh, what) in [
+            (drift(&rows, k, t1 + 2.0, t2), drift(&fresh_100, k, 2.0, 12.0), "100 Hz"),
+            (drift(&rows, k, t2 + 2.0, end), drift(&fresh_200, k, 2.0, 20.0), "200 Hz"),
+        ] {
+            assert!(
+                (live - fresh).abs() <= 0.005 * fresh + 2e-10,
+                "{} (2° at 10 Hz, {what}): drifts at {live:.5e} rad/s after the change, {fresh:.5e} rad/s run so from the start",
+                a.name()
+            );
         }
         if matches!(a, Algorithm::SingleSample | Algorithm::TwoSample) {
             for (hz, from, to) in [(100.0, t1 + 2.0, t2), (200.0, t2 + 2.0, end)] {
                 let (measured, expected) = (drift(&rows, k, from, to), rate(*a, hz));
-                assert!((measured - expected).abs() <= 0.002 * expected, "{} at {hz} Hz: drift {measured:.5e} rad/s, analytic {expected:.5e}", a.name());
+                assert!(
+                    (measured - expected).abs() <= 0.002 * expected,
+                    "{} at {hz} Hz: drift {measured:.5e} rad/s, analytic {expected:.5e}",
+                    a.name()
+                );
             }
         }
     }
@@ -253,13 +325,15 @@ impl Session {
 fn saves_in_place_by_rename_and_with_errors_reach_the_simulation_thread() {
     let s = Session::start("reload");
     // 1. Truncate-and-write, as many editors do.
-    std::fs::write(&s.path, PRESET.replacen("swing_half_angle_arcsec = 300.0", "swing_half_angle_arcsec = 450.0", 1)).expect("write");
+    std::fs::write(&s.path, PRESET.replacen("swing_half_angle_arcsec = 300.0", "swing_half_angle_arcsec = 450.0", 1))
+        .expect("write");
     let st = s.wait_for("the first reload", |st| st.generation == 1);
     assert!(st.message.contains("inner swing half-angle 300″ → 450″"), "{}", st.message);
     assert_eq!(st.resolved.turntable.axis[1].swing_half_angle_arcsec, 450.0);
 
     // 2. A broken value: reported once, old parameters stay in force.
-    std::fs::write(&s.path, PRESET.replacen("swing_half_angle_arcsec = 300.0", "swing_half_angle_arcsec = -5", 1)).expect("write");
+    std::fs::write(&s.path, PRESET.replacen("swing_half_angle_arcsec = 300.0", "swing_half_angle_arcsec = -5", 1))
+        .expect("write");
     let st = s.wait_for("the error report", |st| st.message.contains("config error"));
     assert!(st.message.contains("swing_half_angle_arcsec") && st.message.contains("-5 arcsec"), "{}", st.message);
     assert_eq!(st.generation, 1, "not applied");
@@ -267,7 +341,8 @@ fn saves_in_place_by_rename_and_with_errors_reach_the_simulation_thread() {
 
     // 3. Save by rename (vim, VS Code): a new inode replaces the file.
     let tmp = s.dir.join("scenario.toml.swp");
-    std::fs::write(&tmp, PRESET.replacen("non_orthogonality_arcsec = 20.0", "non_orthogonality_arcsec = 60.0", 1)).expect("write");
+    std::fs::write(&tmp, PRESET.replacen("non_orthogonality_arcsec = 20.0", "non_orthogonality_arcsec = 60.0", 1))
+        .expect("write");
     std::fs::rename(&tmp, &s.path).expect("rename");
     let st = s.wait_for("the rename reload", |st| st.generation == 2);
     assert!(st.message.contains("inner non-orthogonality 20″ → 60″"), "{}", st.message);
@@ -277,7 +352,8 @@ fn saves_in_place_by_rename_and_with_errors_reach_the_simulation_thread() {
     // 4. Deleted, then back.
     std::fs::remove_file(&s.path).expect("remove");
     s.wait_for("the deletion report", |st| st.message.contains("deleted"));
-    std::fs::write(&s.path, PRESET.replacen("swing_half_angle_arcsec = 600.0", "swing_half_angle_arcsec = 900.0", 1)).expect("write");
+    std::fs::write(&s.path, PRESET.replacen("swing_half_angle_arcsec = 600.0", "swing_half_angle_arcsec = 900.0", 1))
+        .expect("write");
     let st = s.wait_for("the reload after the return", |st| st.generation == 3);
     assert!(st.message.contains("outer swing half-angle 600″ → 900″"), "{}", st.message);
 
@@ -299,7 +375,9 @@ fn the_slider_path_writes_the_file_and_the_watcher_applies_it() {
         .position(|c| matches!(c, panel::Control::Slider { label, .. } if label == "inner swing half-angle"))
         .expect("slider");
     for _ in 0..3 {
-        if let panel::Action::Set(writes) = panel.handle(ratatui::crossterm::event::KeyEvent::from(ratatui::crossterm::event::KeyCode::Right)) {
+        if let panel::Action::Set(writes) =
+            panel.handle(ratatui::crossterm::event::KeyEvent::from(ratatui::crossterm::event::KeyCode::Right))
+        {
             for (k, v) in writes {
                 edit::set_in_file(&s.path, &k, v.to_value()).expect("write");
             }
@@ -336,7 +414,10 @@ fn calibrate_now_freezes_the_compensation_and_a_later_change_shows_in_the_compen
     // "Calibrate now": the panel's writes, applied to the file's text as the panel applies them.
     let mut panel = Panel::new(&params().resolved, "t".into());
     let Action::Set(writes) = panel.calibrate_now() else { panic!("calibrate now writes") };
-    assert!(writes.iter().any(|(k, _)| k.to_string() == "compensation.axis.inner.swing_half_angle_arcsec"), "{writes:?}");
+    assert!(
+        writes.iter().any(|(k, _)| k.to_string() == "compensation.axis.inner.swing_half_angle_arcsec"),
+        "{writes:?}"
+    );
     let mut calibrated = PRESET.to_owned();
     for (k, v) in &writes {
         calibrated = edit::set_in_text(&calibrated, k, v.to_value()).expect("written");

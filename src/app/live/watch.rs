@@ -60,9 +60,10 @@ pub fn watch(path: &Path, initial_text: String, tx: Sender<WatchEvent>) -> notif
     let (poke_tx, poke_rx) = crossbeam_channel::unbounded::<Instant>();
     let mut w = notify::recommended_watcher(move |res: notify::Result<notify::Event>| {
         if let Ok(ev) = res
-            && ev.paths.iter().any(|p| p.file_name() == Some(name.as_os_str())) {
-                let _ = poke_tx.send(Instant::now());
-            }
+            && ev.paths.iter().any(|p| p.file_name() == Some(name.as_os_str()))
+        {
+            let _ = poke_tx.send(Instant::now());
+        }
     })?;
     w.watch(&dir, RecursiveMode::NonRecursive)?;
     let debounce = std::thread::Builder::new()

@@ -182,7 +182,15 @@ pub fn start(cfg: PageConfig, status: SharedStatus, title: String) -> anyhow::Re
     let panel = Panel::new(&lock(&status).resolved, title.clone());
     let state = State { panel, seen_generation: u64::MAX, window: Instant::now(), served: 0, changes: 0 };
     let token = cfg.token.clone();
-    let server = Arc::new(Server { hostname: address::this_hostname(), cfg, port, title, status, state: Mutex::new(state), history: tokio::sync::Mutex::new(None) });
+    let server = Arc::new(Server {
+        hostname: address::this_hostname(),
+        cfg,
+        port,
+        title,
+        status,
+        state: Mutex::new(state),
+        history: tokio::sync::Mutex::new(None),
+    });
     let (stop, stopped) = oneshot::channel();
     let (finished_tx, finished) = mpsc::channel::<()>();
     let thread = std::thread::Builder::new().name("class page".into()).spawn(move || {
@@ -249,7 +257,11 @@ async fn connection(stream: TcpStream, server: Arc<Server>, _slot: OwnedSemaphor
         let server = server.clone();
         async move { Ok::<_, Infallible>(server.answer(req).await) }
     });
-    let conn = http1::Builder::new().timer(TokioTimer::new()).header_read_timeout(HEADER_TIMEOUT).max_buf_size(MAX_HEAD).serve_connection(io, service);
+    let conn = http1::Builder::new()
+        .timer(TokioTimer::new())
+        .header_read_timeout(HEADER_TIMEOUT)
+        .max_buf_size(MAX_HEAD)
+        .serve_connection(io, service);
     tokio::select! {
         _ = conn => {}
         () = idle(opened, &last_byte_ms) => {}
@@ -276,7 +288,8 @@ struct Watched {
 
 impl Watched {
     fn moved(&self) {
-        self.last_byte_ms.store(u64::try_from(self.opened.elapsed().as_millis()).unwrap_or(u64::MAX), Ordering::Relaxed);
+        self.last_byte_ms
+            .store(u64::try_from(self.opened.elapsed().as_millis()).unwrap_or(u64::MAX), Ordering::Relaxed);
     }
 }
 
@@ -343,7 +356,8 @@ impl Server {
                 // The page in an agent cluster of its own origin: the browser may then run it apart
                 // from the viewer's frame (another origin on the same host), whose drawing without a
                 // GPU would otherwise hold up a slider's release by a frame (~0.4 s).
-                page.headers_mut().insert(header::HeaderName::from_static("origin-agent-cluster"), HeaderValue::from_static("?1"));
+                page.headers_mut()
+                    .insert(header::HeaderName::from_static("origin-agent-cluster"), HeaderValue::from_static("?1"));
                 page
             }
             (&Method::GET, "/controls") => {
@@ -355,7 +369,9 @@ impl Server {
             (&Method::POST, "/calibrate") => self.change(req, &host, Change::Calibrate).await,
             (method, _) => error(
                 StatusCode::NOT_FOUND,
-                &format!("no {method} {path} here: the page is /, its controls /controls, a change POST /set, \"calibrate now\" POST /calibrate"),
+                &format!(
+                    "no {method} {path} here: the page is /, its controls /controls, a change POST /set, \"calibrate now\" POST /calibrate"
+                ),
             ),
         }
     }
@@ -386,8 +402,12 @@ impl Server {
         if change {
             state.changes = state.changes.saturating_add(1);
         }
-        (state.served > MAX_REQUESTS_PER_S || state.changes > MAX_CHANGES_PER_S)
-            .then(|| error(StatusCode::TOO_MANY_REQUESTS, &format!("more than {MAX_REQUESTS_PER_S} requests or {MAX_CHANGES_PER_S} changes a second")))
+        (state.served > MAX_REQUESTS_PER_S || state.changes > MAX_CHANGES_PER_S).then(|| {
+            error(
+                StatusCode::TOO_MANY_REQUESTS,
+                &format!("more than {MAX_REQUESTS_PER_S} requests or {MAX_CHANGES_PER_S} changes a second"),
+            )
+        })
     }
 
     fn state(&self) -> MutexGuard<'_, State> {
@@ -429,7 +449,12 @@ impl Server {
                         *cached = Some((Instant::now(), bytes.clone()));
                         bytes
                     }
-                    Ok(Ok(Err(e))) => return error(StatusCode::INTERNAL_SERVER_ERROR, &format!("the session so far could not be encoded: {e}")),
+                    Ok(Ok(Err(e))) => {
+                        return error(
+                            StatusCode::INTERNAL_SERVER_ERROR,
+                            &format!("the session so far could not be encoded: {e}"),
+                        );
+                    }
                     Ok(Err(_)) => return error(StatusCode::SERVICE_UNAVAILABLE, "the session has ended"),
                     Err(_) => return error(StatusCode::SERVICE_UNAVAILABLE, "the session did not answer in time"),
                 }
@@ -441,7 +466,9 @@ impl Server {
         h.insert(header::CONTENT_TYPE, HeaderValue::from_static("application/octet-stream"));
         h.insert(header::CACHE_CONTROL, HeaderValue::from_static("no-store"));
         h.insert(header::X_CONTENT_TYPE_OPTIONS, HeaderValue::from_static("nosniff"));
-        if let Ok(origin) = HeaderValue::from_str(&format!("http://{}:{}", self.viewer_host(host), self.port.saturating_add(1))) {
+        if let Ok(origin) =
+            HeaderValue::from_str(&format!("http://{}:{}", self.viewer_host(host), self.port.saturating_add(1)))
+        {
             h.insert(header::ACCESS_CONTROL_ALLOW_ORIGIN, origin);
         }
         r
@@ -459,7 +486,12 @@ impl Server {
     /// page's script works around Rerun's first start).
     fn page(&self, host: &Host) -> String {
         let history = self.cfg.history.as_ref().map(|_| self.port);
-        let viewer = address::web_viewer_page(&self.viewer_host(host), self.port.saturating_add(1), self.port.saturating_add(2), history);
+        let viewer = address::web_viewer_page(
+            &self.viewer_host(host),
+            self.port.saturating_add(1),
+            self.port.saturating_add(2),
+            history,
+        );
         PAGE.replace("{{VIEWER_URL}}", &html_escape(&viewer)).replace("{{TITLE}}", &html_escape(&self.title))
     }
 
@@ -475,7 +507,9 @@ impl Server {
         let path = &self.cfg.config_path;
         let done = match what {
             Change::Set => self.with_panel(|panel, _| set(panel, &body, path)),
-            Change::Calibrate if is_empty_object(&body) => self.with_panel(|panel, _| write(panel.calibrate_now(), path)),
+            Change::Calibrate if is_empty_object(&body) => {
+                self.with_panel(|panel, _| write(panel.calibrate_now(), path))
+            }
             Change::Calibrate => Err("\"calibrate now\" takes no body (or {})".into()),
         };
         match done {
@@ -488,20 +522,32 @@ impl Server {
     fn change_refusal(&self, headers: &HeaderMap, host: &Host) -> Option<Answer> {
         let text = |name: &str| headers.get(name).map(|v| v.to_str().unwrap_or("(not text)"));
         if text("sec-fetch-site").is_some_and(|s| s.eq_ignore_ascii_case("cross-site")) {
-            return Some(error(StatusCode::FORBIDDEN, "a page of another site cannot change this session (Sec-Fetch-Site: cross-site)"));
+            return Some(error(
+                StatusCode::FORBIDDEN,
+                "a page of another site cannot change this session (Sec-Fetch-Site: cross-site)",
+            ));
         }
         if let Some(origin) = text("origin")
             && origin != format!("http://{}", host.header)
         {
-            return Some(error(StatusCode::FORBIDDEN, &format!("a change comes from this page: Origin {origin} is not http://{}", host.header)));
+            return Some(error(
+                StatusCode::FORBIDDEN,
+                &format!("a change comes from this page: Origin {origin} is not http://{}", host.header),
+            ));
         }
         if let Some(token) = &self.cfg.token
             && text("x-rinscope-token") != Some(token.as_str())
         {
-            return Some(error(StatusCode::FORBIDDEN, "this session is shared beyond this machine: changing a parameter needs the token of the URL the terminal printed"));
+            return Some(error(
+                StatusCode::FORBIDDEN,
+                "this session is shared beyond this machine: changing a parameter needs the token of the URL the terminal printed",
+            ));
         }
-        let json = text("content-type").is_some_and(|t| t.split(';').next().unwrap_or_default().trim().eq_ignore_ascii_case(JSON));
-        (!json).then(|| error(StatusCode::UNSUPPORTED_MEDIA_TYPE, "a change is sent as JSON (Content-Type: application/json)"))
+        let json = text("content-type")
+            .is_some_and(|t| t.split(';').next().unwrap_or_default().trim().eq_ignore_ascii_case(JSON));
+        (!json).then(|| {
+            error(StatusCode::UNSUPPORTED_MEDIA_TYPE, "a change is sent as JSON (Content-Type: application/json)")
+        })
     }
 }
 
@@ -533,30 +579,42 @@ fn checked_host<'a>(host: &'a str, port: u16, loopback_only: bool, hostname: Opt
     };
     match (ok, loopback_only) {
         (true, _) => Ok(name),
-        (false, true) => Err(format!("Host {host}: this page answers to a loopback address or localhost only (a site's name pointing here is refused)")),
-        (false, false) => Err(format!("Host {host}: this page answers to an IP address, localhost or this machine's name only (a site's name pointing here is refused)")),
+        (false, true) => Err(format!(
+            "Host {host}: this page answers to a loopback address or localhost only (a site's name pointing here is refused)"
+        )),
+        (false, false) => Err(format!(
+            "Host {host}: this page answers to an IP address, localhost or this machine's name only (a site's name pointing here is refused)"
+        )),
     }
 }
 
 /// A change's body: at most [`MAX_BODY`] bytes, arrived within [`BODY_TIMEOUT`]; the refusal
 /// otherwise (which closes the connection).
 async fn read_body(req: Request<Incoming>) -> Result<Bytes, Answer> {
-    let too_big = || closing(error(StatusCode::PAYLOAD_TOO_LARGE, &format!("a request body is at most {MAX_BODY} bytes")));
-    let declared = req.headers().get(header::CONTENT_LENGTH).and_then(|v| v.to_str().ok()).and_then(|v| v.parse::<u64>().ok());
+    let too_big =
+        || closing(error(StatusCode::PAYLOAD_TOO_LARGE, &format!("a request body is at most {MAX_BODY} bytes")));
+    let declared =
+        req.headers().get(header::CONTENT_LENGTH).and_then(|v| v.to_str().ok()).and_then(|v| v.parse::<u64>().ok());
     if declared.is_some_and(|n| n > MAX_BODY as u64) {
         return Err(too_big());
     }
     match tokio::time::timeout(BODY_TIMEOUT, Limited::new(req.into_body(), MAX_BODY).collect()).await {
         Ok(Ok(body)) => Ok(body.to_bytes()),
         Ok(Err(e)) if e.downcast_ref::<LengthLimitError>().is_some() => Err(too_big()),
-        Ok(Err(e)) => Err(closing(error(StatusCode::BAD_REQUEST, &format!("the request's body could not be read: {e}")))),
-        Err(_) => Err(closing(error(StatusCode::REQUEST_TIMEOUT, &format!("the request's body did not arrive within {} s of its headers", BODY_TIMEOUT.as_secs())))),
+        Ok(Err(e)) => {
+            Err(closing(error(StatusCode::BAD_REQUEST, &format!("the request's body could not be read: {e}"))))
+        }
+        Err(_) => Err(closing(error(
+            StatusCode::REQUEST_TIMEOUT,
+            &format!("the request's body did not arrive within {} s of its headers", BODY_TIMEOUT.as_secs()),
+        ))),
     }
 }
 
 /// An empty body (blank) or `{}`.
 fn is_empty_object(body: &[u8]) -> bool {
-    body.iter().all(u8::is_ascii_whitespace) || serde_json::from_slice::<Value>(body).is_ok_and(|v| v.as_object().is_some_and(serde_json::Map::is_empty))
+    body.iter().all(u8::is_ascii_whitespace)
+        || serde_json::from_slice::<Value>(body).is_ok_and(|v| v.as_object().is_some_and(serde_json::Map::is_empty))
 }
 
 fn reply(code: StatusCode, body: String, kind: &'static str) -> Answer {
@@ -581,12 +639,16 @@ fn closing(mut answer: Answer) -> Answer {
 
 /// Applies `{"control": N, "value": X}` through the panel and writes the file.
 fn set(panel: &mut Panel, body: &[u8], config_path: &Path) -> Result<(), String> {
-    let v: Value = serde_json::from_slice(body).map_err(|e| format!("the body must be JSON {{\"control\": N, \"value\": X}}: {e}"))?;
+    let v: Value = serde_json::from_slice(body)
+        .map_err(|e| format!("the body must be JSON {{\"control\": N, \"value\": X}}: {e}"))?;
     let obj = v.as_object().ok_or("the body must be a JSON object {\"control\": N, \"value\": X}")?;
     if let Some(extra) = obj.keys().find(|k| *k != "control" && *k != "value") {
-        return Err(format!("unknown field {extra:?}: a change names a control by its number and a value, nothing else"));
+        return Err(format!(
+            "unknown field {extra:?}: a change names a control by its number and a value, nothing else"
+        ));
     }
-    let index = obj.get("control").and_then(Value::as_u64).ok_or("\"control\" must be a control's number (see /controls)")?;
+    let index =
+        obj.get("control").and_then(Value::as_u64).ok_or("\"control\" must be a control's number (see /controls)")?;
     let value = match obj.get("value") {
         Some(Value::Bool(b)) => f64::from(u8::from(*b)),
         Some(x) => x.as_f64().ok_or("\"value\" must be a number (or true/false for a switch)")?,

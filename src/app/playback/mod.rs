@@ -15,7 +15,7 @@ use std::collections::VecDeque;
 use nalgebra::Vector3;
 
 pub use start::AlignmentReport;
-use track::{open_track, Track};
+use track::{Track, open_track};
 
 use crate::ins::core::{InsCore, SampleOut};
 use crate::io::{BlockEnd, ImuEvent, ImuOptions, ImuReader, ImuSample, LogError, SampleKind, StartTime};
@@ -24,7 +24,7 @@ use crate::math::frames::{Rot, S};
 use crate::model::gimbal::TableErrors;
 use crate::model::scheme::{AxisValues, MAX_AXES};
 use crate::scenario::logset::{Initial, LogSet, Reference};
-use crate::sim::{demodulate, DemodState};
+use crate::sim::{DemodState, demodulate};
 
 /// A problem with a log set's data, naming the file and where.
 #[derive(Debug, thiserror::Error)]
@@ -39,6 +39,9 @@ pub enum PlaybackError {
     #[error("rerun: {0}")]
     Record(String),
 }
+
+/// One sample's (Δθ, Δv) increments.
+type IncrementPair = (Vector3<f64>, Vector3<f64>);
 
 fn data_err(message: impl Into<String>) -> PlaybackError {
     PlaybackError::Data(message.into())
@@ -198,7 +201,8 @@ impl Playback {
         let encoders = match &log.encoders {
             None => None,
             Some(e) => {
-                let mut t = open_track(&e.path, "encoder", &axis_names, vec![true; axis_names.len()], start, nominal_s)?;
+                let mut t =
+                    open_track(&e.path, "encoder", &axis_names, vec![true; axis_names.len()], start, nominal_s)?;
                 t.shift_s = -e.latch_delay_s;
                 t.interpolate_gaps = e.interpolate_gaps;
                 Some(t)
@@ -216,7 +220,8 @@ impl Playback {
             }
         };
         let file_start_s = clock_s(start);
-        let (from_rel, until_s) = (log.span_s.0.map(|t| t - file_start_s), log.span_s.1.map_or(f64::INFINITY, |t| t - file_start_s));
+        let (from_rel, until_s) =
+            (log.span_s.0.map(|t| t - file_start_s), log.span_s.1.map_or(f64::INFINITY, |t| t - file_start_s));
         let mut me = Self {
             core: InsCore::new(cfg, log.table.site, Rot::identity(), &[]),
             imu,
@@ -239,7 +244,11 @@ impl Playback {
             let mut skipped = 0u64;
             loop {
                 let Some(s) = me.read()? else {
-                    return Err(data_err(format!("{}: log.from_s = {} s is after the file's last sample", f.path.display(), crate::io::fixed_number(from + file_start_s, 6))));
+                    return Err(data_err(format!(
+                        "{}: log.from_s = {} s is after the file's last sample",
+                        f.path.display(),
+                        crate::io::fixed_number(from + file_start_s, 6)
+                    )));
                 };
                 if s.t_s >= from - 0.5 * nominal_s {
                     me.pending.push_back(s);
@@ -247,10 +256,16 @@ impl Playback {
                 }
                 skipped += 1;
             }
-            me.notes.push(format!("replayed from {} s on the file's clock ({skipped} samples before it skipped)", crate::io::fixed_number(from + file_start_s, 6)));
+            me.notes.push(format!(
+                "replayed from {} s on the file's clock ({skipped} samples before it skipped)",
+                crate::io::fixed_number(from + file_start_s, 6)
+            ));
         }
         if until_s.is_finite() {
-            me.notes.push(format!("replayed up to {} s on the file's clock", crate::io::fixed_number(until_s + file_start_s, 6)));
+            me.notes.push(format!(
+                "replayed up to {} s on the file's clock",
+                crate::io::fixed_number(until_s + file_start_s, 6)
+            ));
         }
         if matches!(log.reference, Reference::Static(_)) {
             check_units_at_rest(log, 5.0)?;
@@ -290,11 +305,20 @@ impl Playback {
     }
 
     /// A start whose attitude is given: the pre-roll read, C_s^n at its end.
-    fn given_start(&mut self, log: &LogSet, compensation: &TableErrors, given: &Initial, pre: usize) -> Result<(Rot<crate::math::frames::N, S>, Vec<(Vector3<f64>, Vector3<f64>)>), PlaybackError> {
+    fn given_start(
+        &mut self,
+        log: &LogSet,
+        compensation: &TableErrors,
+        given: &Initial,
+        pre: usize,
+    ) -> Result<(Rot<crate::math::frames::N, S>, Vec<IncrementPair>), PlaybackError> {
         let mut window = Vec::with_capacity(pre);
         while window.len() < pre {
             let Some(s) = self.read()? else {
-                return Err(data_err(format!("{}: the log ends before the pre-roll ({pre} samples)", log.imu.path.display())));
+                return Err(data_err(format!(
+                    "{}: the log ends before the pre-roll ({pre} samples)",
+                    log.imu.path.display()
+                )));
             };
             window.push(s);
         }
@@ -305,7 +329,9 @@ impl Playback {
                 // FRAME: the manifest states C_s^n at the end of the pre-roll.
                 Rot::from_quaternion(nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(w, x, y, z)))
             }
-            Initial::BodyAttitude(att) => att.n_from_b() * self.table_b_from_s(log, compensation, -self.core.fir_delay_s)?,
+            Initial::BodyAttitude(att) => {
+                att.n_from_b() * self.table_b_from_s(log, compensation, -self.core.fir_delay_s)?
+            }
             Initial::Alignment { .. } => return Err(data_err("internal: an alignment is not a given start")),
         };
         Ok((attitude, pre_roll))
@@ -313,7 +339,12 @@ impl Playback {
 
     /// C_b^s... as `b_from_s`: the compensated table's rotation at instant `t_s` (seconds after the
     /// origin), from the encoder reading then.
-    fn table_b_from_s(&mut self, log: &LogSet, compensation: &TableErrors, t_s: f64) -> Result<Rot<crate::math::frames::B, S>, PlaybackError> {
+    fn table_b_from_s(
+        &mut self,
+        log: &LogSet,
+        compensation: &TableErrors,
+        t_s: f64,
+    ) -> Result<Rot<crate::math::frames::B, S>, PlaybackError> {
         let enc = self.encoders_at(t_s)?;
         let corrected = DemodState::default().correct(compensation, t_s, &enc);
         Ok(log.table.chain.b_from_s(&log.table.chain.error_rotations(compensation), &corrected))
@@ -395,13 +426,23 @@ impl Playback {
     /// The body attitude the computer's integrator `k` gives through the table rotation of `corrected`
     /// encoder angles with errors `rot` of `errors`, at its latest output.
     #[must_use]
-    pub fn body_attitude(&self, k: usize, chain: &crate::model::gimbal::Chain, rot: &crate::model::gimbal::ErrorRotations, angles: &AxisValues) -> Attitude {
+    pub fn body_attitude(
+        &self,
+        k: usize,
+        chain: &crate::model::gimbal::Chain,
+        rot: &crate::model::gimbal::ErrorRotations,
+        angles: &AxisValues,
+    ) -> Attitude {
         self.body_attitude_through(k, chain.b_from_s(rot, angles))
     }
 
     /// The body attitude integrator `k` gives through the table rotation C_b^s... as `b_from_s`.
     #[must_use]
-    pub fn body_attitude_through(&self, k: usize, b_from_s: crate::math::frames::Rot<crate::math::frames::B, crate::math::frames::S>) -> Attitude {
+    pub fn body_attitude_through(
+        &self,
+        k: usize,
+        b_from_s: crate::math::frames::Rot<crate::math::frames::B, crate::math::frames::S>,
+    ) -> Attitude {
         let (_, n_from_s) = self.core.output_attitude(k);
         demodulate(n_from_s, b_from_s)
     }
@@ -419,7 +460,9 @@ impl Playback {
                 }
                 // The end of the span replayed (--to): the rest of the file is not read.
                 Some(ImuItem::Sample { t_s, .. }) if t_s > self.until_s + 1e-9 => return Ok(None),
-                Some(ImuItem::Gap { from_s, to_s }) => self.gaps.push(Gap { from_s: from_s - self.origin_s, to_s: to_s - self.origin_s }),
+                Some(ImuItem::Gap { from_s, to_s }) => {
+                    self.gaps.push(Gap { from_s: from_s - self.origin_s, to_s: to_s - self.origin_s })
+                }
                 Some(ImuItem::Sample { t_s, dtheta, dv }) => return Ok(Some(Sample { t_s, dtheta, dv })),
             }
         }

@@ -8,14 +8,17 @@ use std::collections::VecDeque;
 use nalgebra::Vector3;
 use serde::Serialize;
 
-use super::{data_err, Playback, PlaybackError, Sample};
+use super::{Playback, PlaybackError, Sample, data_err};
 use crate::ins::align::{self, AlignConfig, Increment, RestScanner};
 use crate::ins::sensor::Spec;
 use crate::math::attitude::Attitude;
-use crate::math::frames::{Rot, N, S};
-use crate::math::units::{heading_deg_0_360, MPS2_PER_UG, MPS_PER_SQRT_S_PER_UG_PER_SQRT_HZ, RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H, RAD_PER_S_PER_DEG_PER_H};
+use crate::math::frames::{N, Rot, S};
+use crate::math::units::{
+    MPS_PER_SQRT_S_PER_UG_PER_SQRT_HZ, MPS2_PER_UG, RAD_PER_S_PER_DEG_PER_H, RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H,
+    heading_deg_0_360,
+};
 use crate::model::gimbal::TableErrors;
-use crate::scenario::logset::{LogSet, DEFAULT_ALIGNMENT_S};
+use crate::scenario::logset::{DEFAULT_ALIGNMENT_S, LogSet};
 
 /// The alignment as reported (terminal, summary JSON, recording).
 #[derive(Debug, Clone, Serialize)]
@@ -113,7 +116,10 @@ impl AlignmentReport {
             s.push_str(&format!("  {from} says pitch {p:.4}°, roll {r:.4}°, heading {h:.4}°: the alignment's body heading differs by {dh:+.4}°\n"));
         }
         if let Some((lat, sigma)) = self.latitude_implied_deg {
-            s.push_str(&format!("  latitude: site {:.4}°, the data imply {lat:.3}° ± {sigma:.3}°\n", self.latitude_site_deg));
+            s.push_str(&format!(
+                "  latitude: site {:.4}°, the data imply {lat:.3}° ± {sigma:.3}°\n",
+                self.latitude_site_deg
+            ));
         }
         for w in &self.warnings {
             s.push_str(&format!("  WARNING: {w}\n"));
@@ -130,7 +136,13 @@ impl AlignmentReport {
 }
 
 fn sigma_text(deg: f64) -> String {
-    if deg < 1.0 / 60.0 { format!("{:.1}″", deg * 3600.0) } else if deg < 1.0 { format!("{:.2}′", deg * 60.0) } else { format!("{deg:.1}°") }
+    if deg < 1.0 / 60.0 {
+        format!("{:.1}″", deg * 3600.0)
+    } else if deg < 1.0 {
+        format!("{:.2}′", deg * 60.0)
+    } else {
+        format!("{deg:.1}°")
+    }
 }
 
 fn triple(v: &[f64; 3], decimals: usize) -> String {
@@ -160,7 +172,16 @@ const ALIGN_MAX_HZ: f64 = 400.0;
 /// Reads the window at rest, aligns, reports: (C_s^n at the window's end, the pre-roll, the report).
 /// None: the vehicle moves at the start and the log's header gives a start (the samples read are put
 /// back for the INS).
-pub(super) fn aligned(pb: &mut Playback, log: &LogSet, compensation: &TableErrors, declared_s: Option<f64>, pre: usize) -> Result<Option<(Rot<N, S>, Vec<Increment>, AlignmentReport)>, PlaybackError> {
+/// What [`aligned`] finds: C_s^n at the window's end, the pre-roll, the report.
+pub(super) type Aligned = (Rot<N, S>, Vec<Increment>, AlignmentReport);
+
+pub(super) fn aligned(
+    pb: &mut Playback,
+    log: &LogSet,
+    compensation: &TableErrors,
+    declared_s: Option<f64>,
+    pre: usize,
+) -> Result<Option<Aligned>, PlaybackError> {
     let f = &log.imu;
     let h = 1.0 / f.rate_hz;
     let per_block = align::block_samples(h);
@@ -260,7 +281,9 @@ pub(super) fn aligned(pb: &mut Playback, log: &LogSet, compensation: &TableError
         gyro_random_walk: (imu_spec.gyro.noise.random_walk_si > 0.0).then_some(imu_spec.gyro.noise.random_walk_si),
         accel_random_walk: (imu_spec.accel.noise.random_walk_si > 0.0).then_some(imu_spec.accel.noise.random_walk_si),
     };
-    let a = align::fine(&window, &cfg).map_err(|e| data_err(format!("{}: alignment over {:.3} → {:.3} s: {e}", f.path.display(), clock(t0), clock(last_t))))?;
+    let a = align::fine(&window, &cfg).map_err(|e| {
+        data_err(format!("{}: alignment over {:.3} → {:.3} s: {e}", f.path.display(), clock(t0), clock(last_t)))
+    })?;
     pb.origin_s = last_t;
     let pre_roll: Vec<Increment> = ring.iter().map(|s| (s.dtheta, s.dv)).collect();
     let (att, sigma) = a.attitude_with_sigma();
@@ -303,7 +326,20 @@ pub(super) fn aligned(pb: &mut Playback, log: &LogSet, compensation: &TableError
         // The start of the window's first sample's interval (the exact zero of a clock shows as 0).
         window_from_s: if (clock(t0) - h).abs() < 1e-9 { 0.0 } else { clock(t0) - h },
         window_to_s: clock(last_t),
-        window_source: if declared_s.is_some() { "declared: initial.alignment_s".into() } else { format!("detected rest{}", if ended_by_motion { ", ended by motion" } else if span >= max_s - h { ", 300 s at most" } else { ", the whole log" }) },
+        window_source: if declared_s.is_some() {
+            "declared: initial.alignment_s".into()
+        } else {
+            format!(
+                "detected rest{}",
+                if ended_by_motion {
+                    ", ended by motion"
+                } else if span >= max_s - h {
+                    ", 300 s at most"
+                } else {
+                    ", the whole log"
+                }
+            )
+        },
         rest_threshold_mps2: log.align.rest_threshold_mps2,
         disturbance_change_mps2: scanner.largest_change_mps2,
         velocity_residual_rms_mps: a.velocity_residual_rms_mps,
@@ -319,11 +355,22 @@ pub(super) fn aligned(pb: &mut Playback, log: &LogSet, compensation: &TableError
         accel_bias_sigma_ug: ug(a.accel_bias_mps2.1),
         gyro_bias_prior_deg_per_h: (a.bias_prior.0.value / RAD_PER_S_PER_DEG_PER_H, a.bias_prior.0.given),
         accel_bias_prior_ug: (a.bias_prior.1.value / MPS2_PER_UG, a.bias_prior.1.given),
-        gyro_random_walk_deg_per_sqrt_h: (a.random_walk.0.value / RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H, a.random_walk.0.given),
-        accel_white_noise_ug_per_sqrt_hz: (a.random_walk.1.value / MPS_PER_SQRT_S_PER_UG_PER_SQRT_HZ, a.random_walk.1.given),
+        gyro_random_walk_deg_per_sqrt_h: (
+            a.random_walk.0.value / RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H,
+            a.random_walk.0.given,
+        ),
+        accel_white_noise_ug_per_sqrt_hz: (
+            a.random_walk.1.value / MPS_PER_SQRT_S_PER_UG_PER_SQRT_HZ,
+            a.random_walk.1.given,
+        ),
         latitude_site_deg: deg(cfg.latitude_rad),
         latitude_implied_deg: lat.map(|l| (deg(l.latitude_rad), deg(l.sigma_rad))),
-        header_attitude_deg: log.header_start.as_ref().map(|h| ([deg(h.attitude.pitch_rad), deg(h.attitude.roll_rad), heading_deg_0_360(h.attitude.heading_rad)], h.source.clone())),
+        header_attitude_deg: log.header_start.as_ref().map(|h| {
+            (
+                [deg(h.attitude.pitch_rad), deg(h.attitude.roll_rad), heading_deg_0_360(h.attitude.heading_rad)],
+                h.source.clone(),
+            )
+        }),
         warnings,
     };
     Ok(Some((a.n_from_s, pre_roll, report)))

@@ -4,9 +4,9 @@
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 
-use super::{data_err, PlaybackError};
+use super::{PlaybackError, data_err};
 use crate::io::validity::{check_angle, check_span};
-use crate::io::{fixed_number, Col, ColumnReader, Format, Location, ReadOptions, StartTime};
+use crate::io::{Col, ColumnReader, Format, Location, ReadOptions, StartTime, fixed_number};
 use crate::math::units::wrap_pi;
 use crate::model::scheme::MAX_AXES;
 
@@ -92,7 +92,13 @@ impl Track {
             if self.clip {
                 return Ok(None);
             }
-            return Err(data_err(format!("{}: the {} readings end at {} s ({at}), the IMU data go on to {} s", self.path.display(), self.what, fixed_number(t_last, 6), fixed_number(t, 6))));
+            return Err(data_err(format!(
+                "{}: the {} readings end at {} s ({at}), the IMU data go on to {} s",
+                self.path.display(),
+                self.what,
+                fixed_number(t_last, 6),
+                fixed_number(t, 6)
+            )));
         };
         let (ta, va, _) = self.buf[j - 1];
         let (tb, vb, at) = self.buf[j];
@@ -182,7 +188,14 @@ impl Track {
 
 /// Opens a track of `names` (value columns, each `<name>_<angle unit>`; in an .npy, columns 1..)
 /// with a time column `t_s`, `t_ns` or `gps_sow_s` (an .npy: column 0, seconds).
-pub(super) fn open_track(path: &Path, what: &'static str, names: &[String], wraps: Vec<bool>, start: StartTime, nominal_s: f64) -> Result<Track, PlaybackError> {
+pub(super) fn open_track(
+    path: &Path,
+    what: &'static str,
+    names: &[String],
+    wraps: Vec<bool>,
+    start: StartTime,
+    nominal_s: f64,
+) -> Result<Track, PlaybackError> {
     let probe = ColumnReader::open(path, &[], &ReadOptions::default())?;
     let all: Vec<String> = probe.all_columns().to_vec();
     let format = probe.format();
@@ -200,12 +213,20 @@ pub(super) fn open_track(path: &Path, what: &'static str, names: &[String], wrap
         ((0..=names.len()).map(Col::from).collect::<Vec<_>>(), vec![1.0; names.len()], false, false)
     } else {
         let time = ["t_s", "t_ns", "gps_sow_s"].into_iter().find(|c| all.iter().any(|a| a == c)).ok_or_else(|| {
-            data_err(format!("{}: no time column; the {what} file needs t_s, t_ns or gps_sow_s (columns: {})", path.display(), all.join(", ")))
+            data_err(format!(
+                "{}: no time column; the {what} file needs t_s, t_ns or gps_sow_s (columns: {})",
+                path.display(),
+                all.join(", ")
+            ))
         })?;
         let mut cols = vec![Col::from(time)];
         let mut to_si = Vec::new();
         for name in names {
-            let found = all.iter().find_map(|a| crate::io::units::split_unit(a).filter(|(base, u)| base == name && u.quantity == crate::io::units::Quantity::Angle).map(|(_, u)| (a.clone(), u.to_si)));
+            let found = all.iter().find_map(|a| {
+                crate::io::units::split_unit(a)
+                    .filter(|(base, u)| base == name && u.quantity == crate::io::units::Quantity::Angle)
+                    .map(|(_, u)| (a.clone(), u.to_si))
+            });
             let Some((col, f)) = found else {
                 return Err(data_err(format!(
                     "{}: no column for `{name}` in the {what} file; expected {name}_rad, {name}_deg or {name}_arcsec (columns: {})",
@@ -245,4 +266,3 @@ pub(super) fn open_track(path: &Path, what: &'static str, names: &[String], wrap
         last_t: None,
     })
 }
-

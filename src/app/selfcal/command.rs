@@ -4,13 +4,16 @@
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use super::{calibrate, check_navigate_hours, estimates_document, estimates_table, plan, run_log, setup, SequenceChoice, JSON_UNITS};
+use super::{
+    JSON_UNITS, SequenceChoice, calibrate, check_navigate_hours, estimates_document, estimates_table, plan, run_log,
+    setup,
+};
 use crate::app::failure::Failure;
-use crate::app::outputs::{check_output, logged, write_json, RecordingName, RecordingRequest};
+use crate::app::outputs::{RecordingName, RecordingRequest, check_output, logged, write_json};
 use crate::record::selfcal::SelfcalView;
 use crate::record::sink::Saved;
-use crate::scenario::logset::LogSet;
 use crate::scenario::Params;
+use crate::scenario::logset::LogSet;
 
 /// What `selfcal` calibrates.
 pub enum SelfcalInput {
@@ -57,7 +60,13 @@ pub struct SelfcalReport {
 /// Bad input, an output that cannot be written, a stop before anything was estimated.
 pub fn execute(req: &SelfcalRequest, stop: &AtomicBool) -> Result<SelfcalReport, Failure> {
     check_output("--json", req.json.as_deref())?;
-    let interrupted = |command: &str, e: anyhow::Error| if stop.load(Ordering::SeqCst) { Failure::interrupted("nothing was estimated") } else { Failure::run(format!("{command}: {e:#}")) };
+    let interrupted = |command: &str, e: anyhow::Error| {
+        if stop.load(Ordering::SeqCst) {
+            Failure::interrupted("nothing was estimated")
+        } else {
+            Failure::run(format!("{command}: {e:#}"))
+        }
+    };
     let (text, document, view_of) = match &req.input {
         SelfcalInput::Scenario { params, sequence, monte_carlo, navigate_hours, plan_only } => {
             check_navigate_hours(*navigate_hours).map_err(|e| Failure::input(format!("--navigate-hours {e}")))?;
@@ -65,7 +74,12 @@ pub fn execute(req: &SelfcalRequest, stop: &AtomicBool) -> Result<SelfcalReport,
             let plan = plan(&setup, params.meta.seed, stop).map_err(|e| interrupted("selfcal", e))?;
             if *plan_only || !plan.unobservable.is_empty() || !plan.weak.is_empty() {
                 let list = |v: &Vec<String>| if v.is_empty() { "none".to_owned() } else { v.join(", ") };
-                errln!("rinscope selfcal: plan for {}: not observable: {}; weakly observable: {}", setup.sequence, list(&plan.unobservable), list(&plan.weak));
+                errln!(
+                    "rinscope selfcal: plan for {}: not observable: {}; weakly observable: {}",
+                    setup.sequence,
+                    list(&plan.unobservable),
+                    list(&plan.weak)
+                );
                 for a in &plan.aliased {
                     errln!("rinscope selfcal: aliased: {a}");
                 }
@@ -77,10 +91,21 @@ pub fn execute(req: &SelfcalRequest, stop: &AtomicBool) -> Result<SelfcalReport,
                 }
                 return Ok(SelfcalReport { text: String::new(), document, saved: None });
             }
-            let sinks = req.recording.as_ref().map(|r| r.open(RecordingName { name: &params.meta.name, kind: Some("selfcal"), seed: Some(params.meta.seed) })).transpose()?;
+            let sinks = req
+                .recording
+                .as_ref()
+                .map(|r| {
+                    r.open(RecordingName {
+                        name: &params.meta.name,
+                        kind: Some("selfcal"),
+                        seed: Some(params.meta.seed),
+                    })
+                })
+                .transpose()?;
             // The IMU's calibration, the Monte Carlo and the free-inertial comparison; on a
             // failure the sinks are dropped unfinished (abandoned).
-            let report = calibrate(params, setup, plan, *monte_carlo, *navigate_hours, stop).map_err(|e| interrupted("selfcal", e))?;
+            let report = calibrate(params, setup, plan, *monte_carlo, *navigate_hours, stop)
+                .map_err(|e| interrupted("selfcal", e))?;
             let saved = match sinks {
                 Some(s) => {
                     logged(crate::record::selfcal::log(&s.stream(), &report.view(&params.meta.name)))?;
@@ -91,11 +116,25 @@ pub fn execute(req: &SelfcalRequest, stop: &AtomicBool) -> Result<SelfcalReport,
             (report.table.clone(), report.json(), saved)
         }
         SelfcalInput::Log(log) => {
-            let sinks = req.recording.as_ref().map(|r| r.open(RecordingName { name: &log.name, kind: Some("selfcal"), seed: None })).transpose()?;
-            let (estimate, estimation_s) = run_log(log, stop).map_err(|e| if stop.load(Ordering::SeqCst) { Failure::interrupted("nothing was estimated") } else { Failure::input(format!("selfcal --log: {e:#}")) })?;
+            let sinks = req
+                .recording
+                .as_ref()
+                .map(|r| r.open(RecordingName { name: &log.name, kind: Some("selfcal"), seed: None }))
+                .transpose()?;
+            let (estimate, estimation_s) = run_log(log, stop).map_err(|e| {
+                if stop.load(Ordering::SeqCst) {
+                    Failure::interrupted("nothing was estimated")
+                } else {
+                    Failure::input(format!("selfcal --log: {e:#}"))
+                }
+            })?;
             let seen = crate::ins::selfcal::observability(&estimate);
             let hours = estimate.history.last().map_or(0.0, |r| r.t_s) / 3600.0;
-            let head = format!("self-calibration of the log set {}: {hours:.2} h at {:.0} Hz; estimated in {estimation_s:.2} s (no truth: a log)", log.dir.display(), log.imu.rate_hz);
+            let head = format!(
+                "self-calibration of the log set {}: {hours:.2} h at {:.0} Hz; estimated in {estimation_s:.2} s (no truth: a log)",
+                log.dir.display(),
+                log.imu.rate_hz
+            );
             let text = estimates_table(format!("{head}\n\n"), &estimate, None, &seen, &[], None);
             let names = crate::ins::selfcal::param_names();
             let document = serde_json::json!({ "log": log.dir.display().to_string(), "parameters": names, "units": JSON_UNITS, "estimate": estimate.params, "sigma": estimate.sigma, "estimation_s": estimation_s, "observability": seen });

@@ -5,14 +5,14 @@
 //! over random IMUs checks the reported 1σ against the spread.
 
 mod command;
-pub use command::{execute, SelfcalInput, SelfcalReport, SelfcalRequest};
+pub use command::{SelfcalInput, SelfcalReport, SelfcalRequest, execute};
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{Result, anyhow, bail};
 use rayon::prelude::*;
 
-use crate::ins::selfcal::{self, Config, Estimate, ImuErrors, Kind, Sequence, SelfCal, N_PARAMS};
+use crate::ins::selfcal::{self, Config, Estimate, ImuErrors, Kind, N_PARAMS, SelfCal, Sequence};
 use crate::ins::sensor::ImuErrorSpec;
 use crate::ins::truth::TruthImu;
 use crate::model::earth::Earth;
@@ -54,7 +54,11 @@ pub const MONTE_CARLO_RUNS: std::ops::RangeInclusive<u64> = 2..=10_000;
 /// # Errors
 /// Not finite, negative, or over 720 h.
 pub fn check_navigate_hours(hours: f64) -> std::result::Result<f64, String> {
-    if hours.is_finite() && (0.0..=720.0).contains(&hours) { Ok(hours) } else { Err(format!("{hours}: must be 0 (skip) to 720 h")) }
+    if hours.is_finite() && (0.0..=720.0).contains(&hours) {
+        Ok(hours)
+    } else {
+        Err(format!("{hours}: must be 0 (skip) to 720 h"))
+    }
 }
 
 /// What the documents say of their numbers' units.
@@ -93,12 +97,27 @@ pub fn plan(setup: &Setup, seed: u64, stop: &AtomicBool) -> Result<selfcal::Obse
 ///
 /// # Errors
 /// Stopped, or a run failed.
-pub fn calibrate(p: &Params, setup: Setup, plan: selfcal::Observability, monte_carlo: Option<usize>, navigate_hours: f64, stop: &AtomicBool) -> Result<Report> {
+pub fn calibrate(
+    p: &Params,
+    setup: Setup,
+    plan: selfcal::Observability,
+    monte_carlo: Option<usize>,
+    navigate_hours: f64,
+    stop: &AtomicBool,
+) -> Result<Report> {
     let outcome = run_one(&setup, p.meta.seed, false, stop)?;
     let monte_carlo = monte_carlo.map(|n| self::monte_carlo(&setup, n, p.meta.seed + 1, stop)).transpose()?;
-    let navigation = if navigate_hours > 0.0 { navigation_comparison(p, &outcome, navigate_hours, stop)? } else { Vec::new() };
+    let navigation =
+        if navigate_hours > 0.0 { navigation_comparison(p, &outcome, navigate_hours, stop)? } else { Vec::new() };
     let mut table = self::table(&setup, &outcome, &plan, monte_carlo.as_ref());
-    let mut document = estimates_document(&head(&setup, &outcome), &outcome.estimate, Some(outcome.truth().to_params()), &plan, &setup.move_starts_s, monte_carlo.as_ref());
+    let mut document = estimates_document(
+        &head(&setup, &outcome),
+        &outcome.estimate,
+        Some(outcome.truth().to_params()),
+        &plan,
+        &setup.move_starts_s,
+        monte_carlo.as_ref(),
+    );
     if !navigation.is_empty() {
         table.push_str(&navigation_table(&navigation, navigate_hours));
         document.push_str(&format!("\n{}", navigation_document(&navigation, navigate_hours)));
@@ -118,7 +137,15 @@ impl Report {
             truth: Some(self.outcome.truth().to_params()),
             move_starts_s: &self.setup.move_starts_s,
             attitude: &self.outcome.attitude,
-            navigation: self.navigation.iter().map(|r| crate::record::selfcal::NavLine { motion: r.motion, compensation: r.compensation, trace: &r.trace }).collect(),
+            navigation: self
+                .navigation
+                .iter()
+                .map(|r| crate::record::selfcal::NavLine {
+                    motion: r.motion,
+                    compensation: r.compensation,
+                    trace: &r.trace,
+                })
+                .collect(),
         }
     }
 
@@ -186,18 +213,28 @@ impl Outcome {
 /// No `[imu]`, a table that is not dual-axis, a scenario scheme that is not indexed or does not
 /// start at rest.
 pub fn setup(p: &Params, choice: SequenceChoice) -> Result<Setup> {
-    let ins = p.ins.as_ref().ok_or_else(|| anyhow!("{}: selfcal needs an [imu] section (the IMU to calibrate)", p.meta.name))?;
+    let ins = p
+        .ins
+        .as_ref()
+        .ok_or_else(|| anyhow!("{}: selfcal needs an [imu] section (the IMU to calibrate)", p.meta.name))?;
     let mut table = p.table.clone();
     let (scheme, duration_s, name) = match choice {
         SequenceChoice::BuiltIn(s) => {
             if table.chain.axes().len() != 2 {
-                bail!("{}: the built-in sequences are for a dual-axis table (outer, then inner carrying the IMU about its z); this table has {} axes — use --sequence scenario with an indexed [scheme]", p.meta.name, table.chain.axes().len());
+                bail!(
+                    "{}: the built-in sequences are for a dual-axis table (outer, then inner carrying the IMU about its z); this table has {} axes — use --sequence scenario with an indexed [scheme]",
+                    p.meta.name,
+                    table.chain.axes().len()
+                );
             }
             (s.scheme(), s.duration_s(), s.name().to_owned())
         }
         SequenceChoice::Scenario => {
             if table.scheme.steps().is_empty() {
-                bail!("{}: --sequence scenario needs an indexed [scheme] (kind = \"indexed\" with [[scheme.step]])", p.meta.name);
+                bail!(
+                    "{}: --sequence scenario needs an indexed [scheme] (kind = \"indexed\" with [[scheme.step]])",
+                    p.meta.name
+                );
             }
             (table.scheme.clone(), p.duration_s, format!("{}'s [scheme]", p.meta.name))
         }
@@ -205,12 +242,27 @@ pub fn setup(p: &Params, choice: SequenceChoice) -> Result<Setup> {
     let move_starts_s = scheme.move_starts_s(duration_s, 10_000);
     let first_move = move_starts_s.first().copied().unwrap_or(duration_s);
     if first_move < 60.0 {
-        bail!("{name}: the first move starts at {first_move:.1} s; the IMU must rest at least 60 s first (its coarse alignment)");
+        bail!(
+            "{name}: the first move starts at {first_move:.1} s; the IMU must rest at least 60 s first (its coarse alignment)"
+        );
     }
     table.scheme = scheme;
     let h = 1.0 / p.step_hz;
-    let config = Config::for_datasheet(&ins.errors, h, Earth::at(p.site), (first_move.min(selfcal::INITIAL_DWELL_S) / h).round() as usize);
-    Ok(Setup { table, config, samples: (duration_s / h).round() as usize, sequence: name, move_starts_s, ins: ins.clone(), site: p.site })
+    let config = Config::for_datasheet(
+        &ins.errors,
+        h,
+        Earth::at(p.site),
+        (first_move.min(selfcal::INITIAL_DWELL_S) / h).round() as usize,
+    );
+    Ok(Setup {
+        table,
+        config,
+        samples: (duration_s / h).round() as usize,
+        sequence: name,
+        move_starts_s,
+        ins: ins.clone(),
+        site: p.site,
+    })
 }
 
 /// Calibrates one IMU drawn with `seed` (`ideal`: no errors and no noise, the plan's run).
@@ -245,8 +297,18 @@ pub fn run_one(s: &Setup, seed: u64, ideal: bool, stop: &AtomicBool) -> Result<O
 ///
 /// # Errors
 /// Interrupted, an alignment that failed, or a sample `rest` could not give.
-pub fn estimate(config: Config, align: &[crate::ins::align::Increment], rest: impl Iterator<Item = Result<crate::ins::align::Increment>>, stop: &AtomicBool) -> Result<(Estimate, f64)> {
-    let mut filter = SelfCal::new(config, align).ok_or_else(|| anyhow!("the coarse alignment on the first {:.0} s failed (no Earth-rate signature)", align.len() as f64 * config.h))?;
+pub fn estimate(
+    config: Config,
+    align: &[crate::ins::align::Increment],
+    rest: impl Iterator<Item = Result<crate::ins::align::Increment>>,
+    stop: &AtomicBool,
+) -> Result<(Estimate, f64)> {
+    let mut filter = SelfCal::new(config, align).ok_or_else(|| {
+        anyhow!(
+            "the coarse alignment on the first {:.0} s failed (no Earth-rate signature)",
+            align.len() as f64 * config.h
+        )
+    })?;
     let mut estimation = std::time::Duration::ZERO;
     let started = std::time::Instant::now();
     for m in align {
@@ -286,7 +348,10 @@ pub fn run_log(log: &crate::scenario::logset::LogSet, stop: &AtomicBool) -> Resu
         match imu.next_item() {
             Ok(None) => None,
             Ok(Some(ImuItem::Sample { dtheta, dv, .. })) => Some(Ok((dtheta, dv))),
-            Ok(Some(ImuItem::Gap { from_s, to_s })) => Some(Err(anyhow!("{}: a gap in the IMU samples from {from_s:.3} s to {to_s:.3} s: selfcal needs an unbroken sequence", log.imu.path.display()))),
+            Ok(Some(ImuItem::Gap { from_s, to_s })) => Some(Err(anyhow!(
+                "{}: a gap in the IMU samples from {from_s:.3} s to {to_s:.3} s: selfcal needs an unbroken sequence",
+                log.imu.path.display()
+            ))),
             Err(e) => Some(Err(anyhow!("{e}"))),
         }
     };
@@ -315,7 +380,11 @@ pub fn run_log(log: &crate::scenario::logset::LogSet, stop: &AtomicBool) -> Resu
         align.extend(piece);
     }
     if (align.len() as f64) * h < LOG_ALIGN_S {
-        bail!("{}: {:.1} s at rest before the first move; selfcal needs at least {LOG_ALIGN_S} s at rest first, then the sequence", log.imu.path.display(), align.len() as f64 * h);
+        bail!(
+            "{}: {:.1} s at rest before the first move; selfcal needs at least {LOG_ALIGN_S} s at rest first, then the sequence",
+            log.imu.path.display(),
+            align.len() as f64 * h
+        );
     }
     let config = Config::for_datasheet(&log.table.ins.errors, h, Earth::at(log.table.site), align.len());
     estimate(config, &align, moving.into_iter().map(Ok).chain(std::iter::from_fn(next)), stop)
@@ -345,7 +414,8 @@ pub struct MonteCarlo {
 /// Interrupted, or a run that failed.
 pub fn monte_carlo(s: &Setup, runs: usize, first_seed: u64, stop: &AtomicBool) -> Result<MonteCarlo> {
     let started = std::time::Instant::now();
-    let outcomes: Vec<Outcome> = (0..runs).into_par_iter().map(|i| run_one(s, first_seed + i as u64, false, stop)).collect::<Result<_>>()?;
+    let outcomes: Vec<Outcome> =
+        (0..runs).into_par_iter().map(|i| run_one(s, first_seed + i as u64, false, stop)).collect::<Result<_>>()?;
     let n = outcomes.len() as f64;
     let errors: Vec<[f64; N_PARAMS]> = outcomes
         .iter()
@@ -355,7 +425,9 @@ pub fn monte_carlo(s: &Setup, runs: usize, first_seed: u64, stop: &AtomicBool) -
         })
         .collect();
     let mean_error: Vec<f64> = (0..N_PARAMS).map(|k| errors.iter().map(|e| e[k]).sum::<f64>() / n).collect();
-    let spread = (0..N_PARAMS).map(|k| (errors.iter().map(|e| (e[k] - mean_error[k]).powi(2)).sum::<f64>() / (n - 1.0).max(1.0)).sqrt()).collect();
+    let spread = (0..N_PARAMS)
+        .map(|k| (errors.iter().map(|e| (e[k] - mean_error[k]).powi(2)).sum::<f64>() / (n - 1.0).max(1.0)).sqrt())
+        .collect();
     let reported_sigma = (0..N_PARAMS).map(|k| outcomes.iter().map(|o| o.estimate.sigma[k]).sum::<f64>() / n).collect();
     Ok(MonteCarlo { runs, mean_error, spread, reported_sigma, wall_s: started.elapsed().as_secs_f64() })
 }
@@ -422,7 +494,13 @@ struct Cells {
 }
 
 /// The lines of a result table, one per parameter.
-fn cells(e: &Estimate, truth: Option<[f64; N_PARAMS]>, plan: &selfcal::Observability, move_starts_s: &[f64], mc: Option<&MonteCarlo>) -> Vec<Cells> {
+fn cells(
+    e: &Estimate,
+    truth: Option<[f64; N_PARAMS]>,
+    plan: &selfcal::Observability,
+    move_starts_s: &[f64],
+    mc: Option<&MonteCarlo>,
+) -> Vec<Cells> {
     (0..N_PARAMS)
         .map(|k| {
             let (kind, name) = selfcal::param(k);
@@ -447,7 +525,11 @@ fn cells(e: &Estimate, truth: Option<[f64; N_PARAMS]>, plan: &selfcal::Observabi
                 sigma: e.sigma[k] * per_si,
                 z,
                 ratio: plan.ratio[k],
-                target: format!("{}{}", if e.sigma[k] * per_si <= target(kind) { "ok " } else { "MISS " }, target(kind)),
+                target: format!(
+                    "{}{}",
+                    if e.sigma[k] * per_si <= target(kind) { "ok " } else { "MISS " },
+                    target(kind)
+                ),
                 seen,
                 monte_carlo: mc.map(|m| (m.spread[k] * per_si, m.reported_sigma[k] / m.spread[k])),
             }
@@ -459,7 +541,10 @@ fn cells(e: &Estimate, truth: Option<[f64; N_PARAMS]>, plan: &selfcal::Observabi
 fn warnings(plan: &selfcal::Observability) -> Vec<String> {
     let mut out = Vec::new();
     if !plan.unobservable.is_empty() {
-        out.push(format!("NOT OBSERVABLE from this sequence (1σ fell by less than half): {}", plan.unobservable.join(", ")));
+        out.push(format!(
+            "NOT OBSERVABLE from this sequence (1σ fell by less than half): {}",
+            plan.unobservable.join(", ")
+        ));
     }
     if !plan.weak.is_empty() {
         out.push(format!("WEAKLY OBSERVABLE (1σ still above a tenth of its prior): {}", plan.weak.join(", ")));
@@ -475,12 +560,22 @@ const FRAME_NOTE: &str = "The IMU frame is the accelerometer triad's (K_a upper 
 
 /// The Monte Carlo's line under a result.
 fn monte_carlo_note(m: &MonteCarlo) -> String {
-    format!("Monte Carlo: {} IMUs in {:.1} s; 1σ/spread is the reported 1σ over the spread of the errors (1 = honest).\n", m.runs, m.wall_s)
+    format!(
+        "Monte Carlo: {} IMUs in {:.1} s; 1σ/spread is the reported 1σ over the spread of the errors (1 = honest).\n",
+        m.runs, m.wall_s
+    )
 }
 
 /// The table of `e` (with the truth when it is known), under `head`.
 #[must_use]
-pub fn estimates_table(head: String, e: &Estimate, truth: Option<[f64; N_PARAMS]>, plan: &selfcal::Observability, move_starts_s: &[f64], mc: Option<&MonteCarlo>) -> String {
+pub fn estimates_table(
+    head: String,
+    e: &Estimate,
+    truth: Option<[f64; N_PARAMS]>,
+    plan: &selfcal::Observability,
+    move_starts_s: &[f64],
+    mc: Option<&MonteCarlo>,
+) -> String {
     let mut out = head;
     out.push_str(&format!(
         "  {:<8} {:>5} {:>11} {:>11} {:>9} {:>7} {:>8} {:>10}  {:<14}{}\n",
@@ -502,7 +597,10 @@ pub fn estimates_table(head: String, e: &Estimate, truth: Option<[f64; N_PARAMS]
             Seen::From(t) => format!("from {t:.0} s"),
             Seen::Never => "NO".to_owned(),
         };
-        out.push_str(&format!("  {:<8} {:>5} {:>11} {:>11.4} {:>9.4} {:>7} {:>8.1e} {:>10}  {:<14}", c.name, c.unit, c.truth, c.estimate, c.sigma, c.z, c.ratio, c.target, seen));
+        out.push_str(&format!(
+            "  {:<8} {:>5} {:>11} {:>11.4} {:>9.4} {:>7} {:>8.1e} {:>10}  {:<14}",
+            c.name, c.unit, c.truth, c.estimate, c.sigma, c.z, c.ratio, c.target, seen
+        ));
         if let Some((spread, ratio)) = c.monte_carlo {
             out.push_str(&format!(" {spread:>12.4} {ratio:>10.2}"));
         }
@@ -529,9 +627,19 @@ pub fn estimates_table(head: String, e: &Estimate, truth: Option<[f64; N_PARAMS]
 /// σ/σ0, which the plots show; the Monte Carlo's columns in a table of their own), the remarks as
 /// prose.
 #[must_use]
-pub fn estimates_document(head: &str, e: &Estimate, truth: Option<[f64; N_PARAMS]>, plan: &selfcal::Observability, move_starts_s: &[f64], mc: Option<&MonteCarlo>) -> String {
+pub fn estimates_document(
+    head: &str,
+    e: &Estimate,
+    truth: Option<[f64; N_PARAMS]>,
+    plan: &selfcal::Observability,
+    move_starts_s: &[f64],
+    mc: Option<&MonteCarlo>,
+) -> String {
     let cells = cells(e, truth, plan, move_starts_s, mc);
-    let mut out = format!("{head}\n\n```\n{:<6} {:>4} {:>9} {:>9} {:>9} {:>6}  {:<10}  {}\n", "param", "unit", "true", "estimate", "1σ", "err/σ", "target", "seen from");
+    let mut out = format!(
+        "{head}\n\n```\n{:<6} {:>4} {:>9} {:>9} {:>9} {:>6}  {:<10}  {}\n",
+        "param", "unit", "true", "estimate", "1σ", "err/σ", "target", "seen from"
+    );
     for c in &cells {
         let seen = match c.seen {
             Seen::AtRest => "the start".to_owned(),
@@ -539,7 +647,10 @@ pub fn estimates_document(head: &str, e: &Estimate, truth: Option<[f64; N_PARAMS
             Seen::From(t) => format!("{t:.0} s"),
             Seen::Never => "NEVER".to_owned(),
         };
-        out.push_str(&format!("{:<6} {:>4} {:>9} {:>9.4} {:>9.4} {:>6}  {:<10}  {seen}\n", c.name, c.unit, c.truth, c.estimate, c.sigma, c.z, c.target));
+        out.push_str(&format!(
+            "{:<6} {:>4} {:>9} {:>9.4} {:>9.4} {:>6}  {:<10}  {seen}\n",
+            c.name, c.unit, c.truth, c.estimate, c.sigma, c.z, c.target
+        ));
     }
     out.push_str("```\n");
     for w in warnings(plan) {
@@ -547,7 +658,14 @@ pub fn estimates_document(head: &str, e: &Estimate, truth: Option<[f64; N_PARAMS
     }
     out.push_str(&format!("\n{FRAME_NOTE}"));
     if let Some(m) = mc {
-        out.push_str(&format!("\n{}\n```\n{:<6} {:>4} {:>10} {:>10}\n", monte_carlo_note(m), "param", "unit", "MC spread", "1σ/spread"));
+        out.push_str(&format!(
+            "\n{}\n```\n{:<6} {:>4} {:>10} {:>10}\n",
+            monte_carlo_note(m),
+            "param",
+            "unit",
+            "MC spread",
+            "1σ/spread"
+        ));
         for c in &cells {
             if let Some((spread, ratio)) = c.monte_carlo {
                 out.push_str(&format!("{:<6} {:>4} {spread:>10.4} {ratio:>10.2}\n", c.name, c.unit));
@@ -591,7 +709,9 @@ pub fn navigation_comparison(p: &Params, o: &Outcome, hours: f64, stop: &AtomicB
     // ρ: the accelerometer frame seen from the IMU's (what the estimates are expressed in).
     let rho = o.truth_drawn.accelerometer_frame_rotation();
     let mut cases = Vec::new();
-    for (motion, scheme) in [("at rest", Scheme::continuous(vec![0.0; 2], vec![0.0; 2])), ("16-position", modulation.table.scheme.clone())] {
+    for (motion, scheme) in
+        [("at rest", Scheme::continuous(vec![0.0; 2], vec![0.0; 2])), ("16-position", modulation.table.scheme.clone())]
+    {
         let mut q = p.clone();
         q.table.scheme = scheme;
         q.set_duration(hours * 3600.0);
@@ -616,7 +736,14 @@ pub fn navigation_comparison(p: &Params, o: &Outcome, hours: f64, stop: &AtomicB
         .map(|(motion, name, q, comp)| {
             let trace = crate::app::modulation::simulate(q, &format!("{motion}, {name}"), sample_s, stop, *comp);
             let last = trace.samples.last().copied().unwrap_or_default();
-            NavRow { motion, compensation: name, peak_radial_m: trace.peak_radial_m(), final_radial_m: last.position_m[2], peak_heading_arcsec: trace.peak_heading_arcsec(), trace }
+            NavRow {
+                motion,
+                compensation: name,
+                peak_radial_m: trace.peak_radial_m(),
+                final_radial_m: last.position_m[2],
+                peak_heading_arcsec: trace.peak_heading_arcsec(),
+                trace,
+            }
         })
         .collect();
     if stop.load(Ordering::SeqCst) {
@@ -628,9 +755,15 @@ pub fn navigation_comparison(p: &Params, o: &Outcome, hours: f64, stop: &AtomicB
 /// The comparison as the terminal prints it.
 #[must_use]
 pub fn navigation_table(rows: &[NavRow], hours: f64) -> String {
-    let mut s = format!("\nwhat it buys: {hours:.0} h free-inertial, the same IMU\n  {:<13} {:<13} {:>16} {:>16} {:>18}\n", "motion", "compensation", "peak radial (m)", "final radial (m)", "peak heading (″)");
+    let mut s = format!(
+        "\nwhat it buys: {hours:.0} h free-inertial, the same IMU\n  {:<13} {:<13} {:>16} {:>16} {:>18}\n",
+        "motion", "compensation", "peak radial (m)", "final radial (m)", "peak heading (″)"
+    );
     for r in rows {
-        s.push_str(&format!("  {:<13} {:<13} {:>16.1} {:>16.1} {:>18.2}\n", r.motion, r.compensation, r.peak_radial_m, r.final_radial_m, r.peak_heading_arcsec));
+        s.push_str(&format!(
+            "  {:<13} {:<13} {:>16.1} {:>16.1} {:>18.2}\n",
+            r.motion, r.compensation, r.peak_radial_m, r.final_radial_m, r.peak_heading_arcsec
+        ));
     }
     s
 }
@@ -644,7 +777,10 @@ pub fn navigation_document(rows: &[NavRow], hours: f64) -> String {
         "motion", "compensation", "peak (m)", "final (m)", "heading (″)"
     );
     for r in rows {
-        s.push_str(&format!("{:<11} {:<12} {:>9.1} {:>9.1} {:>11.2}\n", r.motion, r.compensation, r.peak_radial_m, r.final_radial_m, r.peak_heading_arcsec));
+        s.push_str(&format!(
+            "{:<11} {:<12} {:>9.1} {:>9.1} {:>11.2}\n",
+            r.motion, r.compensation, r.peak_radial_m, r.final_radial_m, r.peak_heading_arcsec
+        ));
     }
     s.push_str("```\n");
     s

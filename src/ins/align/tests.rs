@@ -23,7 +23,13 @@ fn cfg() -> AlignConfig {
 /// (an azimuth table), with constant sensor biases: exact increments (the rotation of s is
 /// composed exactly per sample, the specific force integrated by the midpoint rule at 100 Hz,
 /// whose error is ~1e-9 of g over a sample at 10°/s).
-fn imu(n_from_s0: UnitQuaternion<f64>, spin: f64, seconds: f64, gyro_bias: Vector3<f64>, accel_bias: Vector3<f64>) -> (Vec<Increment>, UnitQuaternion<f64>) {
+fn imu(
+    n_from_s0: UnitQuaternion<f64>,
+    spin: f64,
+    seconds: f64,
+    gyro_bias: Vector3<f64>,
+    accel_bias: Vector3<f64>,
+) -> (Vec<Increment>, UnitQuaternion<f64>) {
     let w_ie = omega_ie_n(LAT);
     let f_n = Vector3::new(0.0, 0.0, normal_gravity(LAT, 0.0));
     let n = (seconds / H).round() as usize;
@@ -47,7 +53,9 @@ fn heading_tilt_error(est: &Rot<N, S>, truth: &UnitQuaternion<f64>) -> Vector3<f
 }
 
 fn level_at(heading_deg: f64) -> UnitQuaternion<f64> {
-    *Attitude { pitch_rad: 2.0 * RAD_PER_DEG, roll_rad: -1.0 * RAD_PER_DEG, heading_rad: heading_deg * RAD_PER_DEG }.n_from_b().quaternion()
+    *Attitude { pitch_rad: 2.0 * RAD_PER_DEG, roll_rad: -RAD_PER_DEG, heading_rad: heading_deg * RAD_PER_DEG }
+        .n_from_b()
+        .quaternion()
 }
 
 #[test]
@@ -82,14 +90,22 @@ fn a_fixed_imu_cannot_tell_an_east_gyro_bias_from_heading_but_a_turning_one_can(
     let err_fixed = heading_tilt_error(&a.n_from_s, &t_fixed).z;
     let east_bias = (truth0 * bias).x;
     let classic = east_bias / (EARTH_RATE * LAT.cos());
-    assert!((err_fixed.abs() - classic.abs()).abs() < 0.25 * classic.abs(), "fixed: heading error {err_fixed} rad, classic limit {classic} rad");
+    assert!(
+        (err_fixed.abs() - classic.abs()).abs() < 0.25 * classic.abs(),
+        "fixed: heading error {err_fixed} rad, classic limit {classic} rad"
+    );
     let (turning, t_turning) = imu(truth0, 6.0 * RAD_PER_DEG, 300.0, bias, Vector3::zeros());
     let b = fine(&turning, &cfg()).expect("fine");
     let err_turning = heading_tilt_error(&b.n_from_s, &t_turning).z;
     assert!(err_turning.abs() < 0.1 * classic.abs(), "turning: heading error {err_turning} rad vs fixed {err_fixed}");
     let (_, sigma_fixed) = a.attitude_with_sigma();
     let (_, sigma_turning) = b.attitude_with_sigma();
-    assert!(sigma_turning[2] < 0.3 * sigma_fixed[2], "heading 1σ turning {} vs fixed {}", sigma_turning[2], sigma_fixed[2]);
+    assert!(
+        sigma_turning[2] < 0.3 * sigma_fixed[2],
+        "heading 1σ turning {} vs fixed {}",
+        sigma_turning[2],
+        sigma_fixed[2]
+    );
 }
 
 #[test]
@@ -140,7 +156,10 @@ fn the_noise_is_measured_under_rocking_that_swamps_first_differences() {
             let t = k as f64 * H;
             let rock = a * ((w * (t + H)).sin() - (w * t).sin());
             let mut n = || -> f64 { StandardNormal.sample(&mut rng) };
-            (Vector3::new(rock + arw * H.sqrt() * n(), arw * H.sqrt() * n(), arw * H.sqrt() * n()), Vector3::new(0.0, 0.0, 9.8 * H))
+            (
+                Vector3::new(rock + arw * H.sqrt() * n(), arw * H.sqrt() * n(), arw * H.sqrt() * n()),
+                Vector3::new(0.0, 0.0, 9.8 * H),
+            )
         })
         .collect();
     let measured = random_walk(&samples, H, true);

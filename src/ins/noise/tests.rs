@@ -1,8 +1,11 @@
 //! Tests of the IEEE generator, most of them through the Allan analysis (`math::allan`).
 
 use super::*;
-use crate::math::allan::{allan_curve, analyze, AllanOptions, AllanReport, Phase, FLICKER_FLOOR};
-use crate::math::units::{RAD_PER_ARCSEC, RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H, RAD_PER_S_PER_DEG_PER_H, RAD_PER_S_PER_SQRT_S_PER_DEG_PER_H_PER_SQRT_H};
+use crate::math::allan::{AllanOptions, AllanReport, FLICKER_FLOOR, Phase, allan_curve, analyze};
+use crate::math::units::{
+    RAD_PER_ARCSEC, RAD_PER_S_PER_DEG_PER_H, RAD_PER_S_PER_SQRT_S_PER_DEG_PER_H_PER_SQRT_H,
+    RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H,
+};
 
 const TAU0_S: f64 = 0.005;
 
@@ -27,7 +30,12 @@ fn assert_follows(r: &AllanReport, z: f64, model: impl Fn(f64) -> f64, what: &st
     for j in 0..r.taus_s.len() {
         let want = model(r.taus_s[j]);
         let band = z / (2.0 * r.edf[j]).sqrt();
-        assert!(rel(r.adev_si[j], want) < band, "{what}: tau {} s: ADEV/model = {:.4}, band ±{band:.4}", r.taus_s[j], r.adev_si[j] / want);
+        assert!(
+            rel(r.adev_si[j], want) < band,
+            "{what}: tau {} s: ADEV/model = {:.4}, band ±{band:.4}",
+            r.taus_s[j],
+            r.adev_si[j] / want
+        );
     }
 }
 
@@ -185,7 +193,9 @@ fn a_static_10h_log_gives_back_n_b_and_k() {
     assert!(rel(f.n_si.value, terms.random_walk_si) < 0.10, "N {}", f.n_si.value / terms.random_walk_si);
     assert!(rel(f.b_si.value, terms.bias_instability_si) < 0.25, "B {}", f.b_si.value / terms.bias_instability_si);
     assert!(rel(f.k_si.value, terms.rate_random_walk_si) < 0.10, "K {}", f.k_si.value / terms.rate_random_walk_si);
-    assert!(f.n_si.significant && f.b_si.significant && f.k_si.significant && !f.q_si.significant && !f.r_si.significant);
+    assert!(
+        f.n_si.significant && f.b_si.significant && f.k_si.significant && !f.q_si.significant && !f.r_si.significant
+    );
     assert_follows(&r, 4.0, |tau| terms.model_avar(tau).sqrt(), "static 10 h");
 }
 
@@ -197,11 +207,20 @@ fn a_quantization_dominated_log_gives_back_q() {
     // (E e^{2πiδ/q} = e^{−2π²·9} ≈ 0); a static truth without dither leaves a correlated
     // remainder instead, not √3Q/τ (docs/allan.md). Q and N to 10 %, the curve within 4σ of
     // √(3Q²/τ² + N²/τ) everywhere.
-    let terms = IeeeTerms { quantization_si: RAD_PER_ARCSEC / 12f64.sqrt(), random_walk_si: 0.001 * RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H, ..IeeeTerms::default() };
+    let terms = IeeeTerms {
+        quantization_si: RAD_PER_ARCSEC / 12f64.sqrt(),
+        random_walk_si: 0.001 * RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H,
+        ..IeeeTerms::default()
+    };
     let q = terms.pulse_weight_si();
     let mut rng = ChaCha8Rng::seed_from_u64(77);
     let rate = 10f64.to_radians() * TAU0_S;
-    let r = analyze(&error_log(&terms, 1, 720_000, |_| rate + 3.0 * q * rng.sample::<f64, _>(StandardNormal)), TAU0_S, &AllanOptions::default()).expect("ok");
+    let r = analyze(
+        &error_log(&terms, 1, 720_000, |_| rate + 3.0 * q * rng.sample::<f64, _>(StandardNormal)),
+        TAU0_S,
+        &AllanOptions::default(),
+    )
+    .expect("ok");
     eprintln!(
         "quantization: fitted Q/true {:.4} (±{:.4}), slope reading Q/true {:.4}, N/true {:.4}; √3Q/τ at τ0: ADEV/model {:.4}",
         r.fit.q_si.value / terms.quantization_si,
@@ -210,7 +229,11 @@ fn a_quantization_dominated_log_gives_back_q() {
         r.fit.n_si.value / terms.random_walk_si,
         r.adev_si[0] / terms.model_avar(r.taus_s[0]).sqrt()
     );
-    assert!(rel(r.fit.q_si.value, terms.quantization_si) < 0.10 && r.fit.q_si.significant, "Q {}", r.fit.q_si.value / terms.quantization_si);
+    assert!(
+        rel(r.fit.q_si.value, terms.quantization_si) < 0.10 && r.fit.q_si.significant,
+        "Q {}",
+        r.fit.q_si.value / terms.quantization_si
+    );
     assert!(rel(r.slope.q_si.expect("reading").value_si, terms.quantization_si) < 0.10);
     assert!(rel(r.fit.n_si.value, terms.random_walk_si) < 0.10, "N {}", r.fit.n_si.value / terms.random_walk_si);
     assert_follows(&r, 4.0, |tau| terms.model_avar(tau).sqrt(), "quantization");
@@ -225,9 +248,13 @@ fn seed_study_of_the_preset_fit() {
     let mut errs: Vec<[f64; 3]> = Vec::new();
     for seed in 100..140 {
         let r = analyze(&error_log(&terms, seed, 7_200_000, |_| 0.0), TAU0_S, &AllanOptions::default()).expect("ok");
-        let e = [r.fit.n_si.value / truth[0] - 1.0, r.fit.b_si.value / truth[1] - 1.0, r.fit.k_si.value / truth[2] - 1.0];
+        let e =
+            [r.fit.n_si.value / truth[0] - 1.0, r.fit.b_si.value / truth[1] - 1.0, r.fit.k_si.value / truth[2] - 1.0];
         let s = [r.fit.n_si.sigma / truth[0], r.fit.b_si.sigma / truth[1], r.fit.k_si.sigma / truth[2]];
-        eprintln!("seed {seed}: N {:+.4} (±{:.4}) B {:+.4} (±{:.4}) K {:+.4} (±{:.4})", e[0], s[0], e[1], s[1], e[2], s[2]);
+        eprintln!(
+            "seed {seed}: N {:+.4} (±{:.4}) B {:+.4} (±{:.4}) K {:+.4} (±{:.4})",
+            e[0], s[0], e[1], s[1], e[2], s[2]
+        );
         errs.push(e);
     }
     for (i, name) in ["N", "B", "K"].iter().enumerate() {

@@ -68,7 +68,8 @@ fn sz(t: f64, f: Option<f64>, alpha: Alpha, d: u32) -> f64 {
         2 => &[6.0, -4.0, 1.0],
         _ => &[20.0, -15.0, 6.0, -1.0],
     };
-    c[0] * sx(t, f, alpha) + (1..c.len()).map(|k| c[k] * (sx(t - k as f64, f, alpha) + sx(t + k as f64, f, alpha))).sum::<f64>()
+    c[0] * sx(t, f, alpha)
+        + (1..c.len()).map(|k| c[k] * (sx(t - k as f64, f, alpha) + sx(t + k as f64, f, alpha))).sum::<f64>()
 }
 
 /// Eq. 10: sz(0)² + (1 − J/M) sz(J/S)² + 2 Σ_{j<J} (1 − j/M) sz(j/S)².
@@ -349,12 +350,17 @@ mod tests {
         ];
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(952);
         for (est, alpha, m, band) in cases {
-            let vars: Vec<f64> = (0..R).map(|_| est.variance(&phase(alpha, N, &mut rng), 1.0, m).expect("defined").0).collect();
+            let vars: Vec<f64> =
+                (0..R).map(|_| est.variance(&phase(alpha, N, &mut rng), 1.0, m).expect("defined").0).collect();
             let mean = vars.iter().sum::<f64>() / R as f64;
             let var = vars.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (R - 1) as f64;
             let mc = 2.0 * mean * mean / var;
             let edf = est.edf(alpha, m, N + 1).expect("defined");
-            assert!((edf / mc - 1.0).abs() < band, "{} α = {alpha} m = {m}: EDF {edf:.1} vs Monte Carlo {mc:.1}", est.name());
+            assert!(
+                (edf / mc - 1.0).abs() < band,
+                "{} α = {alpha} m = {m}: EDF {edf:.1} vs Monte Carlo {mc:.1}",
+                est.name()
+            );
         }
     }
 

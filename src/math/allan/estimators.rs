@@ -8,7 +8,7 @@
 //! the estimator is not defined at that m for that length (too few terms): a short series is
 //! analysed as far as it goes, not refused.
 
-use super::edf::{identify_noise, Alpha};
+use super::edf::{Alpha, identify_noise};
 
 /// Which estimator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -80,7 +80,12 @@ impl Estimator {
             }
             Self::Ohdev => {
                 let count = n.checked_sub(3 * m).filter(|c| *c > 0)?;
-                let sum = super::sum_sq_third_diff(&x[..count], &x[m..m + count], &x[2 * m..2 * m + count], &x[3 * m..3 * m + count]);
+                let sum = super::sum_sq_third_diff(
+                    &x[..count],
+                    &x[m..m + count],
+                    &x[2 * m..2 * m + count],
+                    &x[3 * m..3 * m + count],
+                );
                 Some((sum / count as f64 / (6.0 * tau * tau), count))
             }
             Self::Hdev => {
@@ -126,7 +131,9 @@ impl Estimator {
                 let term = |i: isize| (at(i - mi) - 2.0 * at(i) + at(i + mi)).powi(2);
                 let sum: f64 = if lo <= hi {
                     let (a, b) = ((lo - mi) as usize, (hi - mi) as usize + 1);
-                    super::sum_sq_second_diff(&x[a..b], &x[a + m..b + m], &x[a + 2 * m..b + 2 * m]) + (1..lo).map(term).sum::<f64>() + (hi + 1..last).map(term).sum::<f64>()
+                    super::sum_sq_second_diff(&x[a..b], &x[a + m..b + m], &x[a + 2 * m..b + 2 * m])
+                        + (1..lo).map(term).sum::<f64>()
+                        + (hi + 1..last).map(term).sum::<f64>()
                 } else {
                     (1..last).map(term).sum()
                 };
@@ -203,11 +210,26 @@ impl Estimator {
 pub fn deviation_curve(estimator: Estimator, x: &[f64], tau0_s: f64, ms: &[usize], ci_sigma: f64) -> DeviationCurve {
     let ms: Vec<usize> = ms.iter().copied().filter(|&m| m >= 1 && m <= estimator.max_m(x.len())).collect();
     let variances: Vec<Option<(f64, usize)>> = if estimator == Estimator::Oadev {
-        super::second_difference_sums(x, &ms).into_iter().zip(&ms).map(|((s, terms), &m)| Some((s / (2.0 * (m as f64 * tau0_s).powi(2) * terms as f64), terms))).collect()
+        super::second_difference_sums(x, &ms)
+            .into_iter()
+            .zip(&ms)
+            .map(|((s, terms), &m)| Some((s / (2.0 * (m as f64 * tau0_s).powi(2) * terms as f64), terms)))
+            .collect()
     } else {
         ms.iter().map(|&m| estimator.variance(x, tau0_s, m)).collect()
     };
-    let mut c = DeviationCurve { estimator, m: vec![], taus_s: vec![], dev: vec![], lower: vec![], upper: vec![], edf: vec![], alpha: vec![], alpha_identified: vec![], n_terms: vec![] };
+    let mut c = DeviationCurve {
+        estimator,
+        m: vec![],
+        taus_s: vec![],
+        dev: vec![],
+        lower: vec![],
+        upper: vec![],
+        edf: vec![],
+        alpha: vec![],
+        alpha_identified: vec![],
+        n_terms: vec![],
+    };
     let mut last_alpha = None;
     for (&m, v) in ms.iter().zip(variances) {
         let Some((var, terms)) = v else { continue };
@@ -334,7 +356,8 @@ mod tests {
             s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             ((s >> 11) as f64 + 0.5) / (1u64 << 53) as f64
         };
-        let x: Vec<f64> = (0..20_000).map(|_| (-2.0 * uniform().ln()).sqrt() * (std::f64::consts::TAU * uniform()).cos()).collect();
+        let x: Vec<f64> =
+            (0..20_000).map(|_| (-2.0 * uniform().ln()).sqrt() * (std::f64::consts::TAU * uniform()).cos()).collect();
         let a = Estimator::Oadev.variance(&x, 1.0, 16).expect("defined").0.sqrt();
         let md = Estimator::Mdev.variance(&x, 1.0, 16).expect("defined").0.sqrt();
         assert!(md / a < 0.35, "mdev/adev {}", md / a);

@@ -5,7 +5,7 @@
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
-use super::{edf_overlapping, AllanCurve, Estimate, NoiseCoefficients, NoiseTerm, TERMS};
+use super::{AllanCurve, Estimate, NoiseCoefficients, NoiseTerm, TERMS, edf_overlapping};
 
 /// Local-slope tolerance (in decades per decade) for [`SlopeReading::matched`].
 pub const SLOPE_MATCH_TOLERANCE: f64 = 0.1;
@@ -102,7 +102,8 @@ fn runs(taus: &[f64], term: Option<NoiseTerm>, factor: impl Fn(usize) -> f64) ->
 pub fn check_claims(curve: &AllanCurve, fit: &NoiseFit) -> (Vec<Contradiction>, Vec<Contradiction>) {
     let np = curve.taus_s.len().min(fit.edf.len());
     let taus = &curve.taus_s[..np];
-    let bounds: Vec<(f64, f64)> = (0..np).map(|j| super::adev_confidence(curve.avar_si[j].sqrt(), fit.edf[j], CLAIM_Z)).collect();
+    let bounds: Vec<(f64, f64)> =
+        (0..np).map(|j| super::adev_confidence(curve.avar_si[j].sqrt(), fit.edf[j], CLAIM_Z)).collect();
     let mut terms = Vec::new();
     for t in TERMS {
         let e = fit.coefficients.get(t);
@@ -129,7 +130,10 @@ pub fn check_claims(curve: &AllanCurve, fit: &NoiseFit) -> (Vec<Contradiction>, 
     // The model's band is two-sided at 3σ on ~40 correlated points per curve: a lone point just
     // outside is what chance gives about once per report; a contradiction is a run of points, or
     // one point well outside.
-    let model = model.into_iter().filter(|c| c.worst_factor >= 1.1 && (c.tau_to_s > c.tau_from_s || c.worst_factor >= 1.5)).collect();
+    let model = model
+        .into_iter()
+        .filter(|c| c.worst_factor >= 1.1 && (c.tau_to_s > c.tau_from_s || c.worst_factor >= 1.5))
+        .collect();
     (terms, model)
 }
 
@@ -138,13 +142,7 @@ pub fn check_claims(curve: &AllanCurve, fit: &NoiseFit) -> (Vec<Contradiction>, 
 fn nnls(a: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {
     let (rows, n) = a.shape();
     let norms: Vec<f64> = (0..n).map(|k| a.column(k).norm()).collect();
-    let an = DMatrix::from_fn(rows, n, |i, k| {
-        if norms[k] > 0.0 {
-            a[(i, k)] / norms[k]
-        } else {
-            0.0
-        }
-    });
+    let an = DMatrix::from_fn(rows, n, |i, k| if norms[k] > 0.0 { a[(i, k)] / norms[k] } else { 0.0 });
     let solve = |passive: &[bool]| -> DVector<f64> {
         let idx: Vec<usize> = (0..n).filter(|&k| passive[k]).collect();
         let sub = DMatrix::from_fn(rows, idx.len(), |i, c| an[(i, idx[c])]);
@@ -179,10 +177,8 @@ fn nnls(a: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {
                 excluded[t] = true;
                 break;
             }
-            let alpha = (0..n)
-                .filter(|&k| passive[k] && z[k] <= 0.0)
-                .map(|k| x[k] / (x[k] - z[k]))
-                .fold(1.0f64, f64::min);
+            let alpha =
+                (0..n).filter(|&k| passive[k] && z[k] <= 0.0).map(|k| x[k] / (x[k] - z[k])).fold(1.0f64, f64::min);
             x += (z - &x) * alpha;
             for k in 0..n {
                 if passive[k] && x[k] <= 1e-15 * x.amax() {
@@ -192,13 +188,7 @@ fn nnls(a: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {
             }
         }
     }
-    DVector::from_fn(n, |k, _| {
-        if norms[k] > 0.0 {
-            x[k].max(0.0) / norms[k]
-        } else {
-            0.0
-        }
-    })
+    DVector::from_fn(n, |k, _| if norms[k] > 0.0 { x[k].max(0.0) / norms[k] } else { 0.0 })
 }
 
 /// Weighted least-squares fit of σ²(τ) = Σ a_i c_i² τ^{p_i}, p = −2..=2, with
@@ -264,24 +254,17 @@ fn set_significant(c: &mut NoiseCoefficients, t: NoiseTerm, found: bool) {
 
 /// One weighted NNLS fit restricted to the `allowed` terms (see [`fit_noise_model`]).
 fn fit_pass(curve: &AllanCurve, allowed: [bool; 5]) -> NoiseFit {
-    let np = curve
-        .taus_s
-        .len()
-        .min(curve.avar_si.len())
-        .min(curve.m.len());
+    let np = curve.taus_s.len().min(curve.avar_si.len()).min(curve.m.len());
     let y = &curve.avar_si;
     let ymax = y.iter().copied().fold(0.0f64, f64::max);
     let x = |j: usize, k: usize| TERMS[k].avar(1.0, curve.taus_s[j]);
-    let edf_of =
-        |j: usize, t: NoiseTerm| edf_overlapping(curve.n_samples, curve.m[j], t.noise_type());
+    let edf_of = |j: usize, t: NoiseTerm| edf_overlapping(curve.n_samples, curve.m[j], t.noise_type());
     let floor = (ymax * 1e-12).max(f64::MIN_POSITIVE);
     let mut theta = DVector::<f64>::zeros(5);
     let mut model: Vec<f64> = y.clone();
     let mut dominant = vec![NoiseTerm::RandomWalk; np];
     let mut edf: Vec<f64> = (0..np).map(|j| edf_of(j, NoiseTerm::RandomWalk)).collect();
-    let mut sd: Vec<f64> = (0..np)
-        .map(|j| y[j].max(floor) * (2.0 / edf[j]).sqrt())
-        .collect();
+    let mut sd: Vec<f64> = (0..np).map(|j| y[j].max(floor) * (2.0 / edf[j]).sqrt()).collect();
     let mut a = DMatrix::<f64>::zeros(np, 5);
     let mut b = DVector::<f64>::zeros(np);
     for _ in 0..30 {
@@ -292,11 +275,7 @@ fn fit_pass(curve: &AllanCurve, allowed: [bool; 5]) -> NoiseFit {
             }
         }
         let masked = DMatrix::from_fn(np, 5, |j, k| if allowed[k] { a[(j, k)] } else { 0.0 });
-        theta = if ymax > 0.0 {
-            nnls(&masked, &b)
-        } else {
-            DVector::zeros(5)
-        };
+        theta = if ymax > 0.0 { nnls(&masked, &b) } else { DVector::zeros(5) };
         let mut change = 0.0f64;
         for j in 0..np {
             let parts: Vec<f64> = (0..5).map(|k| x(j, k) * theta[k]).collect();
@@ -304,13 +283,9 @@ fn fit_pass(curve: &AllanCurve, allowed: [bool; 5]) -> NoiseFit {
             change = change.max((new - model[j]).abs() / model[j].max(new).max(f64::MIN_POSITIVE));
             model[j] = new;
             if new > 0.0 {
-                let best = (0..5)
-                    .max_by(|&p, &q| parts[p].total_cmp(&parts[q]))
-                    .unwrap_or(1);
+                let best = (0..5).max_by(|&p, &q| parts[p].total_cmp(&parts[q])).unwrap_or(1);
                 dominant[j] = TERMS[best];
-                let s: f64 = (0..5)
-                    .map(|k| parts[k] * (2.0 / edf_of(j, TERMS[k])).sqrt())
-                    .sum();
+                let s: f64 = (0..5).map(|k| parts[k] * (2.0 / edf_of(j, TERMS[k])).sqrt()).sum();
                 edf[j] = (2.0 * new * new / (s * s)).max(1.0);
                 sd[j] = s.max(floor);
             }
@@ -335,42 +310,19 @@ fn fit_pass(curve: &AllanCurve, allowed: [bool; 5]) -> NoiseFit {
         let sub = DMatrix::from_fn(np, cols.len(), |i, c| a[(i, cols[c])] / norm(cols[c]));
         let pos = cols.iter().position(|&c| c == k).unwrap_or(0);
         let n = cols.len();
-        let cov = (sub.transpose() * &sub)
-            .pseudo_inverse(1e-14)
-            .unwrap_or_else(|_| DMatrix::zeros(n, n));
+        let cov = (sub.transpose() * &sub).pseudo_inverse(1e-14).unwrap_or_else(|_| DMatrix::zeros(n, n));
         cov[(pos, pos)].max(0.0) * inflate / (norm(k) * norm(k))
     };
     let est = |k: usize| -> Estimate {
         let sd_t = variance_of(k).sqrt();
         let value = theta[k].sqrt();
-        let sigma = if value > 0.0 {
-            sd_t / (2.0 * value)
-        } else {
-            sd_t.sqrt()
-        };
+        let sigma = if value > 0.0 { sd_t / (2.0 * value) } else { sd_t.sqrt() };
         let dominated = dominant.iter().filter(|&&d| d == TERMS[k]).count();
-        let significant =
-            theta[k] > 0.0 && theta[k] >= SIGNIFICANCE_Z * sd_t && dominated >= 2.min(np);
-        Estimate {
-            value,
-            sigma,
-            significant,
-        }
+        let significant = theta[k] > 0.0 && theta[k] >= SIGNIFICANCE_Z * sd_t && dominated >= 2.min(np);
+        Estimate { value, sigma, significant }
     };
-    let coefficients = NoiseCoefficients {
-        q_si: est(0),
-        n_si: est(1),
-        b_si: est(2),
-        k_si: est(3),
-        r_si: est(4),
-    };
-    NoiseFit {
-        coefficients,
-        edf,
-        dominant,
-        chi2_per_dof,
-        contradictions: Vec::new(),
-    }
+    let coefficients = NoiseCoefficients { q_si: est(0), n_si: est(1), b_si: est(2), k_si: est(3), r_si: est(4) };
+    NoiseFit { coefficients, edf, dominant, chi2_per_dof, contradictions: Vec::new() }
 }
 
 /// Classic slope-line reading of one coefficient.
@@ -422,20 +374,9 @@ impl SlopeReadings {
 /// B = σ/0.664, R = σ√2/τ. `adev_si`, `lower_si`, `upper_si` in rate units
 /// (rad/s | m/s²), `taus_s` in s; slices of unequal length are cut to the shortest.
 #[must_use]
-pub fn slope_readings(
-    taus_s: &[f64],
-    adev_si: &[f64],
-    lower_si: &[f64],
-    upper_si: &[f64],
-) -> SlopeReadings {
-    let n = taus_s
-        .len()
-        .min(adev_si.len())
-        .min(lower_si.len())
-        .min(upper_si.len());
-    let pts: Vec<usize> = (0..n)
-        .filter(|&j| adev_si[j] > 0.0 && taus_s[j] > 0.0)
-        .collect();
+pub fn slope_readings(taus_s: &[f64], adev_si: &[f64], lower_si: &[f64], upper_si: &[f64]) -> SlopeReadings {
+    let n = taus_s.len().min(adev_si.len()).min(lower_si.len()).min(upper_si.len());
+    let pts: Vec<usize> = (0..n).filter(|&j| adev_si[j] > 0.0 && taus_s[j] > 0.0).collect();
     let read = |term: NoiseTerm| -> Option<SlopeReading> {
         if pts.len() < 2 {
             return None;
@@ -447,15 +388,11 @@ pub fn slope_readings(
         };
         let miss = |i: usize| (slope(i) - nominal).abs();
         let rel_ci = |i: usize| (upper_si[pts[i]] - lower_si[pts[i]]) / adev_si[pts[i]];
-        let within: Vec<usize> = (0..pts.len())
-            .filter(|&i| miss(i) <= SLOPE_MATCH_TOLERANCE)
-            .collect();
+        let within: Vec<usize> = (0..pts.len()).filter(|&i| miss(i) <= SLOPE_MATCH_TOLERANCE).collect();
         let i = if within.is_empty() {
             (0..pts.len()).min_by(|&a, &b| miss(a).total_cmp(&miss(b)))?
         } else {
-            within
-                .into_iter()
-                .min_by(|&a, &b| rel_ci(a).total_cmp(&rel_ci(b)))?
+            within.into_iter().min_by(|&a, &b| rel_ci(a).total_cmp(&rel_ci(b)))?
         };
         let j = pts[i];
         let value_si = adev_si[j] / term.avar(1.0, taus_s[j]).sqrt();

@@ -42,7 +42,11 @@ fn fast_adev_matches_direct_cluster_averages_to_1e9_at_every_tau() {
     let tau0_s = 0.01;
     let inc = mixed_increments(3000, tau0_s, 7);
     let phase = Phase::from_increments(&inc);
-    for spacing in [TauSpacing::Octave, TauSpacing::PerDecade(20), TauSpacing::Explicit((1..=40).chain([333, 500, 749, 750]).collect())] {
+    for spacing in [
+        TauSpacing::Octave,
+        TauSpacing::PerDecade(20),
+        TauSpacing::Explicit((1..=40).chain([333, 500, 749, 750]).collect()),
+    ] {
         let opts = AllanOptions { spacing, ..AllanOptions::default() };
         let curve = allan_curve(&phase, tau0_s, &opts).expect("valid input");
         assert!(curve.m.len() > 5 && *curve.m.last().expect("points") <= 750);
@@ -105,7 +109,13 @@ fn edf_matches_sp1065_table5_formulas() {
 #[test]
 fn chi2_wilson_hilferty_matches_tables() {
     // Golden: χ² critical values, NIST/SEMATECH e-Handbook of Statistical Methods table 1.3.6.7.4.
-    let cases = [(10.0, 1.644_854, 18.307), (10.0, -1.644_854, 3.940), (100.0, 1.959_964, 129.561), (100.0, -1.959_964, 74.222), (30.0, 2.326_348, 50.892)];
+    let cases = [
+        (10.0, 1.644_854, 18.307),
+        (10.0, -1.644_854, 3.940),
+        (100.0, 1.959_964, 129.561),
+        (100.0, -1.959_964, 74.222),
+        (30.0, 2.326_348, 50.892),
+    ];
     for (nu, z, want) in cases {
         let got = chi2_quantile(nu, z);
         assert!((got / want - 1.0).abs() < 5e-3, "nu={nu} z={z}: {got} vs {want}");
@@ -127,12 +137,17 @@ fn white_noise_follows_n_over_root_tau_within_its_confidence() {
     assert!(r.taus_s.len() >= 15);
     let mut worst = 0.0f64;
     for (j, (&tau, &adev)) in r.taus_s.iter().zip(&r.adev_si).enumerate() {
-        let sigma = 1.0 / (2.0 * edf_overlapping(r.n_samples, (tau / tau0_s).round() as usize, NoiseType::WhiteRate)).sqrt();
+        let sigma =
+            1.0 / (2.0 * edf_overlapping(r.n_samples, (tau / tau0_s).round() as usize, NoiseType::WhiteRate)).sqrt();
         let rel = adev / (n_si / tau.sqrt()) - 1.0;
         worst = worst.max(rel.abs() / sigma);
         assert!(rel.abs() < 4.0 * sigma, "tau {tau} s (point {j}): {rel:+.4} outside ±{:.4}", 4.0 * sigma);
     }
-    eprintln!("white noise: worst point {worst:.2}σ from N/√τ over {} cluster times; fitted N/true {:.5}", r.taus_s.len(), r.fit.n_si.value / n_si);
+    eprintln!(
+        "white noise: worst point {worst:.2}σ from N/√τ over {} cluster times; fitted N/true {:.5}",
+        r.taus_s.len(),
+        r.fit.n_si.value / n_si
+    );
     assert!((r.fit.n_si.value / n_si - 1.0).abs() < 0.01, "N {}", r.fit.n_si.value);
     assert_eq!(r.fit.significant_terms(), vec![NoiseTerm::RandomWalk]);
 }

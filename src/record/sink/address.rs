@@ -57,9 +57,15 @@ pub fn outward_ip(v6: bool) -> Option<IpAddr> {
 pub fn this_hostname() -> Option<String> {
     use std::io::Read as _;
     let mut text = String::new();
-    crate::io::files::open_input(std::path::Path::new("/proc/sys/kernel/hostname")).ok()?.take(256).read_to_string(&mut text).ok()?;
+    crate::io::files::open_input(std::path::Path::new("/proc/sys/kernel/hostname"))
+        .ok()?
+        .take(256)
+        .read_to_string(&mut text)
+        .ok()?;
     let name = text.trim().to_ascii_lowercase();
-    let plain = !name.is_empty() && name != "localhost" && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '.');
+    let plain = !name.is_empty()
+        && name != "localhost"
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '.');
     plain.then_some(name)
 }
 
@@ -68,8 +74,11 @@ pub fn this_hostname() -> Option<String> {
 /// its dark theme (each URL percent-encoded in a `url=` of the page's query).
 #[must_use]
 pub fn web_viewer_page(host: &str, web_port: u16, grpc_port: u16, history_port: Option<u16>) -> String {
-    let encode = |url: String| url.replace(':', "%3A").replace('/', "%2F").replace('+', "%2B").replace('[', "%5B").replace(']', "%5D");
-    let history = history_port.map_or_else(String::new, |p| format!("url={}&", encode(format!("http://{host}:{p}{HISTORY_PATH}"))));
+    let encode = |url: String| {
+        url.replace(':', "%3A").replace('/', "%2F").replace('+', "%2B").replace('[', "%5B").replace(']', "%5D")
+    };
+    let history = history_port
+        .map_or_else(String::new, |p| format!("url={}&", encode(format!("http://{host}:{p}{HISTORY_PATH}"))));
     let stream = encode(format!("rerun+http://{host}:{grpc_port}/proxy"));
     format!("http://{host}:{web_port}/?{history}url={stream}&theme=dark")
 }

@@ -18,7 +18,7 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use crossbeam_channel::{Receiver, Sender};
-use rerun::external::re_log_encoding::{CrateVersion, EncodingOptions, Encoder};
+use rerun::external::re_log_encoding::{CrateVersion, Encoder, EncodingOptions};
 use rerun::external::re_log_types::LogMsg;
 use rerun::log::ChunkBatcherConfig;
 use rerun::sink::{LogSink, SinkFlushError};
@@ -130,8 +130,15 @@ pub(super) struct RrdFile {
     thread: Option<std::thread::JoinHandle<()>>,
 }
 
-fn writer_loop<W: Write>(mut encoder: Option<Encoder<BufWriter<Counting<W>>>>, rx: &Receiver<Command>, shared: &Shared, shown: &str) {
-    let describe = |e: &dyn std::fmt::Display| format!("writing {shown} failed after {:.2} MB: {e}", shared.written.load(Ordering::Relaxed) as f64 / 1e6);
+fn writer_loop<W: Write>(
+    mut encoder: Option<Encoder<BufWriter<Counting<W>>>>,
+    rx: &Receiver<Command>,
+    shared: &Shared,
+    shown: &str,
+) {
+    let describe = |e: &dyn std::fmt::Display| {
+        format!("writing {shown} failed after {:.2} MB: {e}", shared.written.load(Ordering::Relaxed) as f64 / 1e6)
+    };
     while let Ok(cmd) = rx.recv() {
         match cmd {
             Command::Message(msg) => {
@@ -183,12 +190,25 @@ impl RrdFile {
 
     /// Starts the writer on `writer` (the partial's file; a test's failing writer), counting what
     /// reaches it below a 1 MB buffer.
-    fn start<W: Write + Send + 'static>(out: PartialFile, writer: W, stop: Option<Arc<AtomicBool>>) -> Result<(Self, RrdFileSink), String> {
-        let shared = Arc::new(Shared { error: Mutex::new(None), stop, written: AtomicU64::new(0), finished: AtomicBool::new(false) });
+    fn start<W: Write + Send + 'static>(
+        out: PartialFile,
+        writer: W,
+        stop: Option<Arc<AtomicBool>>,
+    ) -> Result<(Self, RrdFileSink), String> {
+        let shared = Arc::new(Shared {
+            error: Mutex::new(None),
+            stop,
+            written: AtomicU64::new(0),
+            finished: AtomicBool::new(false),
+        });
         let (tx, rx) = crossbeam_channel::bounded::<Command>(256);
         let shown = out.path().display().to_string();
-        let encoder = Encoder::new_eager(CrateVersion::LOCAL, EncodingOptions::PROTOBUF_COMPRESSED, BufWriter::with_capacity(1 << 20, Counting { inner: writer, shared: Arc::clone(&shared) }))
-            .map_err(|e| format!("writing {shown} failed at its header: {e}"))?;
+        let encoder = Encoder::new_eager(
+            CrateVersion::LOCAL,
+            EncodingOptions::PROTOBUF_COMPRESSED,
+            BufWriter::with_capacity(1 << 20, Counting { inner: writer, shared: Arc::clone(&shared) }),
+        )
+        .map_err(|e| format!("writing {shown} failed at its header: {e}"))?;
         let thread = {
             let shared = Arc::clone(&shared);
             std::thread::Builder::new()
@@ -215,7 +235,13 @@ impl RrdFile {
     pub(super) fn finish(mut self) -> Result<(PathBuf, u64), String> {
         let (tx, rx) = crossbeam_channel::bounded(1);
         let sent = self.tx.send_timeout(Command::Finish(tx), FINISH_TIMEOUT).is_ok();
-        let result = if sent { rx.recv_timeout(FINISH_TIMEOUT).unwrap_or_else(|_| Err(format!("the file writer did not finish within {} s", FINISH_TIMEOUT.as_secs()))) } else { Err("the file writer is stuck".into()) };
+        let result = if sent {
+            rx.recv_timeout(FINISH_TIMEOUT).unwrap_or_else(|_| {
+                Err(format!("the file writer did not finish within {} s", FINISH_TIMEOUT.as_secs()))
+            })
+        } else {
+            Err("the file writer is stuck".into())
+        };
         if let Some(t) = self.thread.take()
             && result.is_ok()
         {
@@ -225,7 +251,8 @@ impl RrdFile {
             return Err(e);
         }
         result?;
-        verify(self.out.partial(), self.shared.written.load(Ordering::SeqCst)).map_err(|e| format!("{}: the finished file does not read back ({e})", self.out.path().display()))?;
+        verify(self.out.partial(), self.shared.written.load(Ordering::SeqCst))
+            .map_err(|e| format!("{}: the finished file does not read back ({e})", self.out.path().display()))?;
         let path = self.out.path().to_path_buf();
         let bytes = self.out.commit().map_err(|e| e.to_string())?;
         Ok((path, bytes))

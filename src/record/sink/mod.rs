@@ -18,8 +18,8 @@ use rerun::{RecordingStream, RecordingStreamBuilder};
 
 pub use crate::io::files::partial_path;
 
-use super::export::{ExportFormat, Exporter, SharedExporter};
 use super::Stream;
+use super::export::{ExportFormat, Exporter, SharedExporter};
 use std::sync::{Arc, Mutex};
 
 pub mod address;
@@ -36,10 +36,14 @@ pub const DEFAULT_CONNECT_URL: &str = "rerun+http://127.0.0.1:9876/proxy";
 #[derive(Debug, thiserror::Error)]
 pub enum SinkError {
     /// `--spawn` but no viewer executable.
-    #[error("--spawn: no `rerun` viewer found on PATH. Install the matching viewer with `{VIEWER_INSTALL_HINT}`, or drop --spawn to save a recording under recordings/ and open it later")]
+    #[error(
+        "--spawn: no `rerun` viewer found on PATH. Install the matching viewer with `{VIEWER_INSTALL_HINT}`, or drop --spawn to save a recording under recordings/ and open it later"
+    )]
     NoViewer,
     /// `--connect` to an address where nothing listens.
-    #[error("--connect: no viewer is listening at {url}. Start one with `rerun` (install: `{VIEWER_INSTALL_HINT}`), use --spawn, or save a file with --save")]
+    #[error(
+        "--connect: no viewer is listening at {url}. Start one with `rerun` (install: `{VIEWER_INSTALL_HINT}`), use --spawn, or save a file with --save"
+    )]
     NotListening {
         /// The URL asked for.
         url: String,
@@ -179,14 +183,20 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
         if req.save.is_none() {
             return Err(SinkError::Figures("the figures are drawn from the saved recording: add --save FILE".into()));
         }
-        std::fs::create_dir_all(dir).map_err(|e| SinkError::Figures(format!("{}: cannot create the folder: {e}", dir.display())))?;
+        std::fs::create_dir_all(dir)
+            .map_err(|e| SinkError::Figures(format!("{}: cannot create the folder: {e}", dir.display())))?;
         description.push(format!("figures (SVG and PNG) of every plot to {} when the run ends", dir.display()));
     }
-    let guarded = |inner: Box<dyn LogSink>, name: String| -> Box<dyn LogSink> { Box::new(viewer::Detachable::new(inner, name, Arc::clone(&problems), file_kept)) };
+    let guarded = |inner: Box<dyn LogSink>, name: String| -> Box<dyn LogSink> {
+        Box::new(viewer::Detachable::new(inner, name, Arc::clone(&problems), file_kept))
+    };
 
     if let Some(url) = &req.connect {
-        let uri: rerun::external::re_uri::ProxyUri = url.parse().map_err(|e: rerun::external::re_uri::Error| SinkError::BadUrl { url: url.clone(), reason: e.to_string() })?;
-        let listening = socket_of(url).is_some_and(|addr| TcpStream::connect_timeout(&addr, Duration::from_millis(500)).is_ok());
+        let uri: rerun::external::re_uri::ProxyUri = url.parse().map_err(|e: rerun::external::re_uri::Error| {
+            SinkError::BadUrl { url: url.clone(), reason: e.to_string() }
+        })?;
+        let listening =
+            socket_of(url).is_some_and(|addr| TcpStream::connect_timeout(&addr, Duration::from_millis(500)).is_ok());
         if !listening {
             return Err(SinkError::NotListening { url: url.clone() });
         }
@@ -208,14 +218,18 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
         let addr = SocketAddr::new(ip, port);
         // Check the port first: the server binds in a background task and would fail silently.
         std::net::TcpListener::bind(addr).map_err(|e| SinkError::Serve { addr, reason: e.to_string() })?;
-        let options = rerun::ServerOptions { memory_limit: rerun::MemoryLimit::from_bytes(1 << 30), ..Default::default() };
-        let sink = rerun::grpc_server::GrpcServerSink::new(&ip.to_string(), port, options).map_err(|e| SinkError::Serve { addr, reason: e.to_string() })?;
+        let options =
+            rerun::ServerOptions { memory_limit: rerun::MemoryLimit::from_bytes(1 << 30), ..Default::default() };
+        let sink = rerun::grpc_server::GrpcServerSink::new(&ip.to_string(), port, options)
+            .map_err(|e| SinkError::Serve { addr, reason: e.to_string() })?;
         sinks.push(Box::new(sink));
         // For an unspecified address, a host other machines reach (127.0.0.1 would name theirs).
         let host = address::network_host(ip).unwrap_or_else(|| address::local_host(ip));
         let url = format!("rerun+http://{host}:{port}/proxy");
         if !ip.is_loopback() {
-            errln!("rinscope: WARNING: --bind {ip}: anyone who can reach port {port} of this machine can watch this session (there is no authentication)");
+            errln!(
+                "rinscope: WARNING: --bind {ip}: anyone who can reach port {port} of this machine can watch this session (there is no authentication)"
+            );
         }
         description.push(format!(
             "serving on {addr}: `rerun --connect {url}`, or in a browser https://app.rerun.io/version/0.36.3/index.html?url={}",
@@ -227,10 +241,13 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
     if let Some(web_port) = req.serve_web {
         let ip = req.bind.unwrap_or(IpAddr::V4(Ipv4Addr::LOCALHOST));
         let web_addr = SocketAddr::new(ip, web_port);
-        std::net::TcpListener::bind(web_addr).map_err(|e| SinkError::Serve { addr: web_addr, reason: e.to_string() })?;
+        std::net::TcpListener::bind(web_addr)
+            .map_err(|e| SinkError::Serve { addr: web_addr, reason: e.to_string() })?;
         // The stream on the next port (known in advance: a firewall can be opened for both); the
         // page connects to it.
-        let grpc_port = web_port.checked_add(1).ok_or(SinkError::Serve { addr: web_addr, reason: "the stream needs the next port too".into() })?;
+        let grpc_port = web_port
+            .checked_add(1)
+            .ok_or(SinkError::Serve { addr: web_addr, reason: "the stream needs the next port too".into() })?;
         // A late viewer is sent everything the server kept. A live stream is many small chunks (low
         // latency), which a web viewer ingests at a few dozen a second: 10 minutes of it took it
         // longer to replay than the session lasted. With the class page's compact history beside it,
@@ -243,17 +260,27 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
             cors_allowed_origins: vec![format!("http://*:{web_port}")],
             ..Default::default()
         };
-        let sink = rerun::grpc_server::GrpcServerSink::new(&ip.to_string(), grpc_port, options).map_err(|e| SinkError::Serve { addr: SocketAddr::new(ip, grpc_port), reason: e.to_string() })?;
+        let sink = rerun::grpc_server::GrpcServerSink::new(&ip.to_string(), grpc_port, options)
+            .map_err(|e| SinkError::Serve { addr: SocketAddr::new(ip, grpc_port), reason: e.to_string() })?;
         sinks.push(Box::new(sink));
         let host = address::local_host(ip);
         let grpc_url = format!("rerun+http://{host}:{grpc_port}/proxy");
-        let config = rerun::web_viewer::WebViewerConfig { bind_ip: ip.to_string(), web_port: web_port.into(), connect_to: vec![grpc_url], open_browser: false, ..Default::default() };
-        let server = config.host_web_viewer().map_err(|e| SinkError::Serve { addr: web_addr, reason: e.to_string() })?;
+        let config = rerun::web_viewer::WebViewerConfig {
+            bind_ip: ip.to_string(),
+            web_port: web_port.into(),
+            connect_to: vec![grpc_url],
+            open_browser: false,
+            ..Default::default()
+        };
+        let server =
+            config.host_web_viewer().map_err(|e| SinkError::Serve { addr: web_addr, reason: e.to_string() })?;
         // The viewer's dark theme whatever the browser's: the recording's 3D labels and colours are made
         // for it (on the light one white and yellow labels all but vanish).
         let page = address::web_viewer_page(&host, web_port, grpc_port, req.serve_web_history);
         if !ip.is_loopback() {
-            errln!("rinscope: WARNING: --bind {ip}: anyone who can reach ports {web_port} and {grpc_port} of this machine can watch this session (there is no authentication)");
+            errln!(
+                "rinscope: WARNING: --bind {ip}: anyone who can reach ports {web_port} and {grpc_port} of this machine can watch this session (there is no authentication)"
+            );
         }
         description.push(format!("viewer in the browser: open {page} (in its dark theme; Rerun 0.36 ignores that on a browser's very first start: reload once if it opens light)"));
         // For an unspecified address, the page other machines open names this one (the stream's URL too).
@@ -269,8 +296,11 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
     let mut file = None;
     if let Some(path) = &req.save {
         // recordings/ (the default) and any folder named in --save are created.
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty() && !path.as_os_str().to_string_lossy().ends_with('/')) {
-            std::fs::create_dir_all(dir).map_err(|e| SinkError::File(format!("{}: cannot create its folder: {e}", path.display())))?;
+        if let Some(dir) =
+            path.parent().filter(|d| !d.as_os_str().is_empty() && !path.as_os_str().to_string_lossy().ends_with('/'))
+        {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| SinkError::File(format!("{}: cannot create its folder: {e}", path.display())))?;
         }
         let (rrd, sink) = file::RrdFile::create(path, req.stop_on_failure.clone()).map_err(SinkError::File)?;
         sinks.push(Box::new(sink));
@@ -291,7 +321,16 @@ pub fn open(req: &SinkRequest, application_id: &'static str, recording_id: &str)
         .recording_id(recording_id.to_owned())
         .set_sinks(sinks)
         .map_err(|e| SinkError::Rerun(e.to_string()))?;
-    Ok(OpenSinks { rec, export, file, viewer_problems: problems, description, web, stop: req.stop_on_failure.clone(), figures: req.figures.clone() })
+    Ok(OpenSinks {
+        rec,
+        export,
+        file,
+        viewer_problems: problems,
+        description,
+        web,
+        stop: req.stop_on_failure.clone(),
+        figures: req.figures.clone(),
+    })
 }
 
 /// A live session kept in memory as one compact recording (full-size chunks, like a saved file),
@@ -316,7 +355,10 @@ impl HistoryStore {
 /// # Errors
 /// Rerun could not create the stream.
 pub fn open_history(application_id: &'static str, recording_id: &str) -> Result<(Stream, HistoryStore), SinkError> {
-    let (rec, storage) = RecordingStreamBuilder::new(application_id).recording_id(recording_id.to_owned()).memory().map_err(|e| SinkError::Rerun(e.to_string()))?;
+    let (rec, storage) = RecordingStreamBuilder::new(application_id)
+        .recording_id(recording_id.to_owned())
+        .memory()
+        .map_err(|e| SinkError::Rerun(e.to_string()))?;
     Ok((Stream::new(rec, None), HistoryStore { storage }))
 }
 
@@ -388,11 +430,18 @@ impl OpenSinks {
         };
         let crate::record::export::Finished { files: exported, tables } = match export {
             None => Default::default(),
-            Some(e) => e.lock().unwrap_or_else(std::sync::PoisonError::into_inner).finish().map_err(|e| SinkError::ExportWrite(e.to_string()))?,
+            Some(e) => e
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+                .finish()
+                .map_err(|e| SinkError::ExportWrite(e.to_string()))?,
         };
         let viewer_problems = viewer_problems.lock().unwrap_or_else(std::sync::PoisonError::into_inner).clone();
         let figures = match (&figures, &recording) {
-            (Some(dir), Some((path, _))) => Some(crate::record::figures::write(path, dir, stop_flag).map_err(|e| SinkError::FiguresWrite(format!("{e:#}")))?),
+            (Some(dir), Some((path, _))) => Some(
+                crate::record::figures::write(path, dir, stop_flag)
+                    .map_err(|e| SinkError::FiguresWrite(format!("{e:#}")))?,
+            ),
             _ => None,
         };
         if let (Some(w), Some((path, _))) = (&figures, &recording)

@@ -13,12 +13,12 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use crossbeam_channel::{Sender, SendTimeoutError};
+use crossbeam_channel::{SendTimeoutError, Sender};
 use rerun::external::re_log_types::{BlueprintActivationCommand, LogMsg};
 use rerun::log::ChunkBatcherConfig;
 use rerun::sink::{LogSink, SinkFlushError};
 
-use super::{find_on_path, SinkError};
+use super::{SinkError, find_on_path};
 
 /// A viewer that takes no data for this long is detached.
 pub const STALL: Duration = Duration::from_secs(5);
@@ -74,7 +74,11 @@ impl Detachable {
         if self.detached.swap(true, Ordering::SeqCst) {
             return;
         }
-        let rest = if self.file_kept { "the saved file goes on" } else { "nothing else keeps this run's data: use --save FILE" };
+        let rest = if self.file_kept {
+            "the saved file goes on"
+        } else {
+            "nothing else keeps this run's data: use --save FILE"
+        };
         let message = format!("{}: {why}; streaming to it stopped ({rest})", self.name);
         errln!("rinscope: {message}");
         self.problems.lock().unwrap_or_else(std::sync::PoisonError::into_inner).push(message);
@@ -86,7 +90,9 @@ impl Detachable {
         }
         match self.tx.send_timeout(cmd, STALL) {
             Ok(()) => {}
-            Err(SendTimeoutError::Timeout(_)) => self.detach(&format!("took no data for {} s (frozen, or its machine is overloaded)", STALL.as_secs())),
+            Err(SendTimeoutError::Timeout(_)) => {
+                self.detach(&format!("took no data for {} s (frozen, or its machine is overloaded)", STALL.as_secs()))
+            }
             Err(SendTimeoutError::Disconnected(_)) => self.detach("its sink ended"),
         }
     }
@@ -142,9 +148,14 @@ pub fn spawn() -> Result<u16, SinkError> {
         return Err(SinkError::NoViewer);
     };
     if !has_display() {
-        return Err(SinkError::Spawn(format!("no display to open a viewer window on (DISPLAY and WAYLAND_DISPLAY are unset: SSH, a container, WSL without WSLg?); {WITHOUT_A_VIEWER}")));
+        return Err(SinkError::Spawn(format!(
+            "no display to open a viewer window on (DISPLAY and WAYLAND_DISPLAY are unset: SSH, a container, WSL without WSLg?); {WITHOUT_A_VIEWER}"
+        )));
     }
-    let port = std::net::TcpListener::bind((Ipv4Addr::LOCALHOST, 0)).and_then(|l| l.local_addr()).map_err(|e| SinkError::Spawn(format!("no free port: {e}")))?.port();
+    let port = std::net::TcpListener::bind((Ipv4Addr::LOCALHOST, 0))
+        .and_then(|l| l.local_addr())
+        .map_err(|e| SinkError::Spawn(format!("no free port: {e}")))?
+        .port();
     let mut child = {
         use std::os::unix::process::CommandExt as _;
         Command::new(&exe)
@@ -194,11 +205,20 @@ pub fn spawn() -> Result<u16, SinkError> {
         if let Ok(Some(status)) = child.try_wait()
             && !status.success()
         {
-            return Err(SinkError::Spawn(format!("the viewer ({}) exited at start with {status}{}; {WITHOUT_A_VIEWER}", exe.display(), words())));
+            return Err(SinkError::Spawn(format!(
+                "the viewer ({}) exited at start with {status}{}; {WITHOUT_A_VIEWER}",
+                exe.display(),
+                words()
+            )));
         }
         if started.elapsed() > START_TIMEOUT {
             child.kill().ok();
-            return Err(SinkError::Spawn(format!("the viewer ({}) did not start listening on port {port} within {} s{}; {WITHOUT_A_VIEWER}", exe.display(), START_TIMEOUT.as_secs(), words())));
+            return Err(SinkError::Spawn(format!(
+                "the viewer ({}) did not start listening on port {port} within {} s{}; {WITHOUT_A_VIEWER}",
+                exe.display(),
+                START_TIMEOUT.as_secs(),
+                words()
+            )));
         }
         std::thread::sleep(Duration::from_millis(100));
     }

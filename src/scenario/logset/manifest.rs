@@ -155,7 +155,12 @@ pub(super) fn time_unit(c: &Checker<'_>, key: &str, name: &str) -> Result<TimeUn
         "us" => TimeUnit::Microseconds,
         "ns" => TimeUnit::Nanoseconds,
         "gps_sow" => TimeUnit::GpsSecondsOfWeek,
-        other => return Err(c.invalid(key, format!("\"{other}\" is not a time unit; use \"s\", \"ms\", \"us\", \"ns\" or \"gps_sow\""))),
+        other => {
+            return Err(c.invalid(
+                key,
+                format!("\"{other}\" is not a time unit; use \"s\", \"ms\", \"us\", \"ns\" or \"gps_sow\""),
+            ));
+        }
     })
 }
 
@@ -187,13 +192,24 @@ impl<'de> Deserialize<'de> for RawFrame {
         let mut m = [[0.0; 3]; 3];
         for (r, row) in rows.iter().enumerate() {
             let Some(cells) = row.as_array().filter(|c| c.len() == 3) else {
-                return Err(D::Error::custom(format!("frame: row {} is {}, not 3 numbers: {EXPECTED}", r + 1, row.as_array().map_or_else(|| format!("a {}", row.type_str()), |c| format!("{} values", c.len())))));
+                return Err(D::Error::custom(format!(
+                    "frame: row {} is {}, not 3 numbers: {EXPECTED}",
+                    r + 1,
+                    row.as_array().map_or_else(|| format!("a {}", row.type_str()), |c| format!("{} values", c.len()))
+                )));
             };
             for (k, cell) in cells.iter().enumerate() {
                 m[r][k] = match cell {
                     toml::Value::Float(x) => *x,
                     toml::Value::Integer(i) => *i as f64,
-                    other => return Err(D::Error::custom(format!("frame: row {} column {} is a {}, not a number", r + 1, k + 1, other.type_str()))),
+                    other => {
+                        return Err(D::Error::custom(format!(
+                            "frame: row {} column {} is a {}, not a number",
+                            r + 1,
+                            k + 1,
+                            other.type_str()
+                        )));
+                    }
                 };
             }
         }
@@ -299,4 +315,3 @@ pub struct RawTable {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub calibration: Option<RawCalibration>,
 }
-

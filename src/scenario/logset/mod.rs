@@ -10,7 +10,7 @@ use serde::Deserialize;
 
 use super::raw::{RawCompensation, RawNavigation, RawRecording, RawSite, RawTurntable};
 use super::validate::{self, Checker};
-use super::{instruments, ConfigError, RecordingParams};
+use super::{ConfigError, RecordingParams, instruments};
 use crate::calib::CalibConfig;
 use crate::ins::InsParams;
 use crate::io::{Frame, GapPolicy, Layout, SampleKind};
@@ -189,12 +189,20 @@ fn load_for(dir: &Path, edit: impl FnOnce(&mut RawManifest), navigates: bool) ->
     let manifest_path = dir.join(MANIFEST);
     let text = super::read_text(&manifest_path)?;
     let origin = manifest_path.display().to_string();
-    let mut raw: RawManifest = toml::from_str(&text).map_err(|e| ConfigError::Parse { origin: origin.clone(), message: super::parse_message(&e) })?;
+    let mut raw: RawManifest = toml::from_str(&text)
+        .map_err(|e| ConfigError::Parse { origin: origin.clone(), message: super::parse_message(&e) })?;
     edit(&mut raw);
     let table_path = dir.join(&raw.log.table);
     // A strapdown log needs no table description: the default name may be absent.
     if raw.log.table == default_table() && !table_path.exists() {
-        return validate_manifest_for(dir, &raw, &origin, &RawTable::strapdown(), "(no table.toml: a strapdown IMU)", navigates);
+        return validate_manifest_for(
+            dir,
+            &raw,
+            &origin,
+            &RawTable::strapdown(),
+            "(no table.toml: a strapdown IMU)",
+            navigates,
+        );
     }
     let (raw_table, table_origin) = read_table(&table_path)?;
     validate_manifest_for(dir, &raw, &origin, &raw_table, &table_origin, navigates)
@@ -204,7 +212,8 @@ fn load_for(dir: &Path, edit: impl FnOnce(&mut RawManifest), navigates: bool) ->
 pub fn read_table(path: &Path) -> Result<(RawTable, String), ConfigError> {
     let text = super::read_text(path)?;
     let origin = path.display().to_string();
-    let raw: RawTable = toml::from_str(&text).map_err(|e| ConfigError::Parse { origin: origin.clone(), message: super::parse_message(&e) })?;
+    let raw: RawTable = toml::from_str(&text)
+        .map_err(|e| ConfigError::Parse { origin: origin.clone(), message: super::parse_message(&e) })?;
     Ok((raw, origin))
 }
 
@@ -219,38 +228,67 @@ impl RawTable {
             turntable: None,
             compensation: RawCompensation::default(),
             imu: None,
-            navigation: Some(RawNavigation { vertical: "held".into(), velocity_damping: false, initial_attitude_error_arcmin: [0.0; 3] }),
+            navigation: Some(RawNavigation {
+                vertical: "held".into(),
+                velocity_damping: false,
+                initial_attitude_error_arcmin: [0.0; 3],
+            }),
             calibration: None,
         }
     }
 }
 
 /// Validates a manifest and its table description (`origin`s name the files in errors).
-pub fn validate_manifest(dir: &Path, raw: &RawManifest, origin: &str, raw_table: &RawTable, table_origin: &str) -> Result<LogSet, ConfigError> {
+pub fn validate_manifest(
+    dir: &Path,
+    raw: &RawManifest,
+    origin: &str,
+    raw_table: &RawTable,
+    table_origin: &str,
+) -> Result<LogSet, ConfigError> {
     validate_manifest_for(dir, raw, origin, raw_table, table_origin, true)
 }
 
 /// [`validate_manifest`]; `navigates`: the log will be navigated (a strapdown log needs its start position).
-fn validate_manifest_for(dir: &Path, raw: &RawManifest, origin: &str, raw_table: &RawTable, table_origin: &str, navigates: bool) -> Result<LogSet, ConfigError> {
+fn validate_manifest_for(
+    dir: &Path,
+    raw: &RawManifest,
+    origin: &str,
+    raw_table: &RawTable,
+    table_origin: &str,
+    navigates: bool,
+) -> Result<LogSet, ConfigError> {
     let c = Checker { origin };
     let name = &raw.log.name;
     if name.trim().is_empty() || !name.chars().all(|ch| ch.is_ascii_alphanumeric() || ch == '-' || ch == '_') {
-        return Err(c.invalid("log.name", format!("\"{name}\" must be non-empty and use only letters, digits, '-' and '_' (it names the recording)")));
+        return Err(c.invalid(
+            "log.name",
+            format!("\"{name}\" must be non-empty and use only letters, digits, '-' and '_' (it names the recording)"),
+        ));
     }
     let imu = imu_file(&c, dir, &raw.imu)?;
     let mut table = table_description(&Checker { origin: table_origin }, raw_table, imu.rate_hz)?;
     let i = &raw.initial;
     // A PSINS .imu states its start: the position is the site unless [initial] gives one, the
     // attitude and velocity serve a start in motion ("maybe inaccurate", its writer says).
-    let psins = if imu.layout == Layout::PsinsImu { Some(crate::io::read_psins_header(&imu.path).map_err(|e| c.invalid("imu.file", e.to_string()))?) } else { None };
+    let psins = if imu.layout == Layout::PsinsImu {
+        Some(crate::io::read_psins_header(&imu.path).map_err(|e| c.invalid("imu.file", e.to_string()))?)
+    } else {
+        None
+    };
     let header_start = psins.as_ref().map(|h| HeaderStart {
         source: format!("the PSINS header of {}", imu.path.display()),
-        attitude: Attitude { pitch_rad: h.pitch_deg * RAD_PER_DEG, roll_rad: h.roll_deg * RAD_PER_DEG, heading_rad: h.heading_deg() * RAD_PER_DEG },
+        attitude: Attitude {
+            pitch_rad: h.pitch_deg * RAD_PER_DEG,
+            roll_rad: h.roll_deg * RAD_PER_DEG,
+            heading_rad: h.heading_deg() * RAD_PER_DEG,
+        },
         velocity_enu_mps: h.velocity_enu_mps,
     });
     if let (Some(h), None) = (&psins, i.position) {
         table.site = crate::model::earth::Site {
-            latitude_rad: c.range("the PSINS header's latitude", h.latitude_deg, "deg", -89.0, 89.0, "latitude")? * RAD_PER_DEG,
+            latitude_rad: c.range("the PSINS header's latitude", h.latitude_deg, "deg", -89.0, 89.0, "latitude")?
+                * RAD_PER_DEG,
             longitude_rad: h.longitude_deg * RAD_PER_DEG,
             height_m: h.height_m,
         };
@@ -273,9 +311,19 @@ fn validate_manifest_for(dir: &Path, raw: &RawManifest, origin: &str, raw_table:
         }
     };
     let align = AlignPriors {
-        gyro_bias_rad_per_s: i.gyro_bias_deg_per_h.map(|b| c.positive("initial.gyro_bias_deg_per_h", b, "°/h", 1e5)).transpose()?.map(|b| b * crate::math::units::RAD_PER_S_PER_DEG_PER_H),
-        accel_bias_mps2: i.accel_bias_ug.map(|b| c.positive("initial.accel_bias_ug", b, "µg", 1e6)).transpose()?.map(|b| b * crate::math::units::MPS2_PER_UG),
-        rest_threshold_mps2: i.rest_threshold_mps2.map_or(Ok(crate::ins::align::REST_THRESHOLD_MPS2), |t| c.positive("initial.rest_threshold_mps2", t, "m/s²", 10.0))?,
+        gyro_bias_rad_per_s: i
+            .gyro_bias_deg_per_h
+            .map(|b| c.positive("initial.gyro_bias_deg_per_h", b, "°/h", 1e5))
+            .transpose()?
+            .map(|b| b * crate::math::units::RAD_PER_S_PER_DEG_PER_H),
+        accel_bias_mps2: i
+            .accel_bias_ug
+            .map(|b| c.positive("initial.accel_bias_ug", b, "µg", 1e6))
+            .transpose()?
+            .map(|b| b * crate::math::units::MPS2_PER_UG),
+        rest_threshold_mps2: i.rest_threshold_mps2.map_or(Ok(crate::ins::align::REST_THRESHOLD_MPS2), |t| {
+            c.positive("initial.rest_threshold_mps2", t, "m/s²", 10.0)
+        })?,
     };
     // Times on the file's clock: finite and within ±1e10 s (the one number rule's CLOCK_S).
     let clock = crate::io::validity::CLOCK_S;
@@ -286,7 +334,10 @@ fn validate_manifest_for(dir: &Path, raw: &RawManifest, origin: &str, raw_table:
     if let (Some(a), Some(b)) = span_s
         && b <= a
     {
-        return Err(c.invalid("log.to_s", format!("{} s is not after log.from_s = {} s", crate::io::short_number(b), crate::io::short_number(a))));
+        return Err(c.invalid(
+            "log.to_s",
+            format!("{} s is not after log.from_s = {} s", crate::io::short_number(b), crate::io::short_number(a)),
+        ));
     }
     let encoders = match &raw.encoders {
         None => None,
@@ -296,7 +347,12 @@ fn validate_manifest_for(dir: &Path, raw: &RawManifest, origin: &str, raw_table:
             interpolate_gaps: match e.gap_policy.as_str() {
                 "interpolate" => true,
                 "refuse" => false,
-                other => return Err(c.invalid("encoders.gap_policy", format!("\"{other}\" is not a policy; use \"interpolate\" or \"refuse\""))),
+                other => {
+                    return Err(c.invalid(
+                        "encoders.gap_policy",
+                        format!("\"{other}\" is not a policy; use \"interpolate\" or \"refuse\""),
+                    ));
+                }
             },
         }),
     };
@@ -315,12 +371,17 @@ fn validate_manifest_for(dir: &Path, raw: &RawManifest, origin: &str, raw_table:
             }
             let norm = q.iter().map(|x| x * x).sum::<f64>().sqrt();
             if (norm - 1.0).abs() > 1e-6 {
-                return Err(c.invalid("initial.imu_quaternion_wxyz", format!("norm {}: a rotation quaternion has norm 1", crate::io::short_number(norm))));
+                return Err(c.invalid(
+                    "initial.imu_quaternion_wxyz",
+                    format!("norm {}: a rotation quaternion has norm 1", crate::io::short_number(norm)),
+                ));
             }
             Initial::ImuQuaternion(q)
         }
         (None, Some(a), None) => Initial::BodyAttitude(attitude(&c, "initial.body_attitude_deg", a)?),
-        (None, None, Some(s)) => Initial::Alignment { duration_s: Some(c.positive("initial.alignment_s", s, "s", 86_400.0)?) },
+        (None, None, Some(s)) => {
+            Initial::Alignment { duration_s: Some(c.positive("initial.alignment_s", s, "s", 86_400.0)?) }
+        }
         (None, None, None) => match &reference {
             // A static reference is the initial body attitude too.
             Reference::Static(a) => Initial::BodyAttitude(*a),
@@ -328,7 +389,9 @@ fn validate_manifest_for(dir: &Path, raw: &RawManifest, origin: &str, raw_table:
         },
         _ => return Err(c.invalid("initial", "give one of imu_quaternion_wxyz, body_attitude_deg or alignment_s")),
     };
-    if matches!(initial, Initial::Alignment { .. }) && initial_velocity_enu_mps.is_some_and(|v| v.iter().any(|x| *x != 0.0)) {
+    if matches!(initial, Initial::Alignment { .. })
+        && initial_velocity_enu_mps.is_some_and(|v| v.iter().any(|x| *x != 0.0))
+    {
         return Err(c.invalid("initial.velocity_enu_mps", "a moving start cannot be aligned at rest: give its attitude too (initial.body_attitude_deg or imu_quaternion_wxyz)"));
     }
     if table.strapdown && encoders.is_some() {
@@ -377,8 +440,18 @@ fn imu_file(c: &Checker<'_>, dir: &Path, raw: &RawImuFile) -> Result<ImuFile, Co
     // refused here, with the candidates).
     let guessed = match raw.layout.as_str() {
         "" | "columns" if raw.columns.is_some() => "columns",
-        "columns" => return Err(c.invalid("imu.layout", "\"columns\" needs the [imu.columns] table that describes them")),
-        _ if raw.columns.is_some() => return Err(c.invalid("imu.columns", format!("describes a file of no named layout; drop layout = \"{}\" (or the [imu.columns] table)", raw.layout))),
+        "columns" => {
+            return Err(c.invalid("imu.layout", "\"columns\" needs the [imu.columns] table that describes them"));
+        }
+        _ if raw.columns.is_some() => {
+            return Err(c.invalid(
+                "imu.columns",
+                format!(
+                    "describes a file of no named layout; drop layout = \"{}\" (or the [imu.columns] table)",
+                    raw.layout
+                ),
+            ));
+        }
         "" => match crate::io::guess_layout(&path) {
             Ok(name) => name,
             Err(e @ crate::io::LogError::Layout { .. }) => return Err(c.invalid("imu.layout", e.to_string())),
@@ -400,21 +473,25 @@ fn imu_file(c: &Checker<'_>, dir: &Path, raw: &RawImuFile) -> Result<ImuFile, Co
                 return Err(c.invalid("imu.frame", "a file described by [imu.columns] has no standard axes: give frame = \"rfu\" (x right, y forward, z up), \"frd\", \"flu\", ... or a 3×3 matrix"));
             }
             let sensor = |r: &RawColumn| (r.column.col(), r.unit.clone());
-            Layout::Columns(crate::io::ColumnMap {
+            Layout::Columns(Box::new(crate::io::ColumnMap {
                 time: (m.time.column.col(), time_unit(c, "imu.columns.time.unit", &m.time.unit)?),
                 sensors: [sensor(&m.gyro_x), sensor(&m.gyro_y), sensor(&m.gyro_z), sensor(&m.accel_x), sensor(&m.accel_y), sensor(&m.accel_z)],
-            })
+            }))
         }
         other => return Err(c.invalid("imu.layout", format!("\"{other}\" is not a layout; use \"rinscope\", \"psins\", \"psins-imu\", \"kf-gins\", \"kalibr\", \"npy7\" or \"ros2\""))),
     };
     if raw.time.is_some() && !matches!(layout, Layout::Npy7 { .. }) {
-        return Err(c.invalid("imu.time", "is read by the npy7 layout only (the others say their time unit themselves)"));
+        return Err(
+            c.invalid("imu.time", "is read by the npy7 layout only (the others say their time unit themselves)")
+        );
     }
     let kind = match raw.kind.as_deref() {
         None => None,
         Some("increments") => Some(SampleKind::Increments),
         Some("rates") => Some(SampleKind::Rates),
-        Some(other) => return Err(c.invalid("imu.kind", format!("\"{other}\" is not a kind; use \"increments\" or \"rates\""))),
+        Some(other) => {
+            return Err(c.invalid("imu.kind", format!("\"{other}\" is not a kind; use \"increments\" or \"rates\"")));
+        }
     };
     let frame = match &raw.frame {
         None => None,
@@ -427,10 +504,20 @@ fn imu_file(c: &Checker<'_>, dir: &Path, raw: &RawImuFile) -> Result<ImuFile, Co
     let gap_policy = match raw.gap_policy.as_str() {
         "refuse" => GapPolicy::Refuse,
         "split" => GapPolicy::Split,
-        other => return Err(c.invalid("imu.gap_policy", format!("\"{other}\" is not a policy; use \"refuse\" or \"split\""))),
+        other => {
+            return Err(
+                c.invalid("imu.gap_policy", format!("\"{other}\" is not a policy; use \"refuse\" or \"split\""))
+            );
+        }
     };
     if raw.topic.is_some() && layout != Layout::Ros2 {
-        return Err(c.invalid("imu.topic", format!("is read by the ros2 layout (MCAP) only, and this file's layout is {}: drop the key", layout.name())));
+        return Err(c.invalid(
+            "imu.topic",
+            format!(
+                "is read by the ros2 layout (MCAP) only, and this file's layout is {}: drop the key",
+                layout.name()
+            ),
+        ));
     }
     let path = dir.join(&raw.file);
     let mut options = crate::io::ImuOptions::new(layout.clone());
@@ -451,7 +538,11 @@ fn imu_file(c: &Checker<'_>, dir: &Path, raw: &RawImuFile) -> Result<ImuFile, Co
         }
         None => {
             // What the stamps say (the median of the first intervals).
-            let dt = crate::io::ImuReader::open(&path, &options).map_err(|e| c.invalid("imu.rate_hz", format!("absent, and the rate cannot be read from the stamps: {e}")))?.measured_dt_s();
+            let dt = crate::io::ImuReader::open(&path, &options)
+                .map_err(|e| {
+                    c.invalid("imu.rate_hz", format!("absent, and the rate cannot be read from the stamps: {e}"))
+                })?
+                .measured_dt_s();
             let Some(dt) = dt else {
                 return Err(c.invalid("imu.rate_hz", "absent, and the file has too few samples to measure it"));
             };
@@ -475,17 +566,41 @@ fn table_description(c: &Checker<'_>, raw: &RawTable, rate_hz: f64) -> Result<Ta
     let site = validate::site(c, &raw.site)?;
     let turntable = raw.turntable.clone().unwrap_or_else(RawTurntable::strapdown);
     let (chain, stated) = validate::turntable(c, &turntable)?;
-    let (compensation, resolved_comp) = validate::validate_compensation(c, &raw.compensation, &turntable, &chain, &stated)?;
-    let ins = instruments::validate_ins(c, Some(&raw.imu.clone().unwrap_or_default()), raw.navigation.as_ref(), rate_hz)?.unwrap_or_else(|| InsParams::ideal(rate_hz, crate::ins::coning::Algorithm::TwoSampleP1));
+    let (compensation, resolved_comp) =
+        validate::validate_compensation(c, &raw.compensation, &turntable, &chain, &stated)?;
+    let ins =
+        instruments::validate_ins(c, Some(&raw.imu.clone().unwrap_or_default()), raw.navigation.as_ref(), rate_hz)?
+            .unwrap_or_else(|| InsParams::ideal(rate_hz, crate::ins::coning::Algorithm::TwoSampleP1));
     // The calibration allows for the INS error the [imu] section states (a datasheet's), if any.
-    let calibration = instruments::validate_calibration(c, &raw.calibration.clone().unwrap_or_default(), &stated, raw.imu.is_some().then_some(&ins))?;
+    let calibration = instruments::validate_calibration(
+        c,
+        &raw.calibration.clone().unwrap_or_default(),
+        &stated,
+        raw.imu.is_some().then_some(&ins),
+    )?;
     // A log's motion is not known before it is read: the defaults of a table turning at 10°/s
     // (10 Hz series and scene) unless [recording] says otherwise.
-    let recording = validate::recording(c, &raw.recording, rate_hz, validate::Bandwidth { shaft_deg_per_s: 10.0, motion_hz: 0.0, duration_s: 3600.0 }, 0.0)?;
+    let recording = validate::recording(
+        c,
+        &raw.recording,
+        rate_hz,
+        validate::Bandwidth { shaft_deg_per_s: 10.0, motion_hz: 0.0, duration_s: 3600.0 },
+        0.0,
+    )?;
     let mut resolved = raw.clone();
     resolved.compensation = resolved_comp;
     let resolved_toml = toml::to_string_pretty(&resolved).unwrap_or_else(|e| format!("# could not serialise: {e}"));
-    Ok(TableDescription { site, chain, stated, compensation, ins, calibration, recording, resolved_toml, strapdown: raw.turntable.is_none() })
+    Ok(TableDescription {
+        site,
+        chain,
+        stated,
+        compensation,
+        ins,
+        calibration,
+        recording,
+        resolved_toml,
+        strapdown: raw.turntable.is_none(),
+    })
 }
 
 impl LogSet {
@@ -495,13 +610,28 @@ impl LogSet {
         use super::raw::{RawLive, RawScenario, RawScheme, RawSimulation, RawVehicle};
         let t = &self.raw_table;
         let raw = super::RawConfig {
-            scenario: RawScenario { name: self.name.clone(), title: if self.dir == Path::new(".") { format!("replay of {}", self.imu.path.display()) } else { format!("replay of the log set {}", self.dir.display()) }, description: self.description.clone(), seed: self.seed.unwrap_or(0) },
+            scenario: RawScenario {
+                name: self.name.clone(),
+                title: if self.dir == Path::new(".") {
+                    format!("replay of {}", self.imu.path.display())
+                } else {
+                    format!("replay of the log set {}", self.dir.display())
+                },
+                description: self.description.clone(),
+                seed: self.seed.unwrap_or(0),
+            },
             simulation: RawSimulation { duration_s: duration_s.max(1.0 / self.imu.rate_hz), step_hz: self.imu.rate_hz },
             recording: t.recording.clone(),
             site: t.site.clone(),
             vehicle: RawVehicle::default(),
             turntable: t.turntable.clone().unwrap_or_else(RawTurntable::strapdown),
-            scheme: RawScheme { kind: "static".into(), rate: Vec::new(), initial_dwell_s: None, repeat: None, step: Vec::new() },
+            scheme: RawScheme {
+                kind: "static".into(),
+                rate: Vec::new(),
+                initial_dwell_s: None,
+                repeat: None,
+                step: Vec::new(),
+            },
             compensation: t.compensation.clone(),
             live: RawLive::default(),
             imu: Some(t.imu.clone().unwrap_or_default()),
@@ -517,12 +647,19 @@ impl LogSet {
 
 /// The `estimated_compensation` of a calibration JSON (`rinscope calibrate --json`) as the table errors of
 /// `table`: its keys are `[compensation]`'s, and the table's own values fill what it leaves out.
-pub fn compensation_from_calibration(table: &RawTable, json_text: &str, origin: &str) -> Result<TableErrors, ConfigError> {
+pub fn compensation_from_calibration(
+    table: &RawTable,
+    json_text: &str,
+    origin: &str,
+) -> Result<TableErrors, ConfigError> {
     #[derive(Deserialize)]
     struct WithCompensation {
         estimated_compensation: RawCompensation,
     }
-    let parsed: WithCompensation = serde_json::from_str(json_text).map_err(|e| ConfigError::Parse { origin: origin.to_owned(), message: format!("not a calibration of `rinscope calibrate --json` ({e})") })?;
+    let parsed: WithCompensation = serde_json::from_str(json_text).map_err(|e| ConfigError::Parse {
+        origin: origin.to_owned(),
+        message: format!("not a calibration of `rinscope calibrate --json` ({e})"),
+    })?;
     let c = Checker { origin };
     let turntable = table.turntable.clone().unwrap_or_else(RawTurntable::strapdown);
     let (chain, stated) = validate::turntable(&c, &turntable)?;
@@ -535,7 +672,14 @@ pub fn compensation_from_calibration(table: &RawTable, json_text: &str, origin: 
     macro_rules! take {
         ($($f:ident),*) => { $( if given.$f.is_some() { merged.$f = given.$f; } )* };
     }
-    take!(installation_x_arcsec, installation_y_arcsec, installation_z_arcsec, imu_mount_x_arcsec, imu_mount_y_arcsec, imu_mount_z_arcsec);
+    take!(
+        installation_x_arcsec,
+        installation_y_arcsec,
+        installation_z_arcsec,
+        imu_mount_x_arcsec,
+        imu_mount_y_arcsec,
+        imu_mount_z_arcsec
+    );
     Ok(validate::validate_compensation(&c, &merged, &turntable, &chain, &stated)?.0)
 }
 
@@ -544,7 +688,18 @@ mod tests {
     use super::*;
 
     fn raw_imu(file: &str, layout: &str) -> RawImuFile {
-        RawImuFile { file: file.into(), layout: layout.into(), kind: None, rate_hz: Some(100.0), frame: None, time: None, topic: None, columns: None, gap_policy: "refuse".into(), gap_factor: 3.0 }
+        RawImuFile {
+            file: file.into(),
+            layout: layout.into(),
+            kind: None,
+            rate_hz: Some(100.0),
+            frame: None,
+            time: None,
+            topic: None,
+            columns: None,
+            gap_policy: "refuse".into(),
+            gap_factor: 3.0,
+        }
     }
 
     #[test]

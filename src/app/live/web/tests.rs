@@ -21,7 +21,13 @@ fn page_on(addr: &str, token: Option<&str>, name: &str) -> (ClassPage, PathBuf) 
     std::fs::write(&path, PRESET).expect("config");
     let params = scenario::parse(PRESET, "test").expect("preset");
     let status = super::super::new_status(&params, 1.0);
-    let cfg = PageConfig { addr: addr.parse().expect("addr"), host: "127.0.0.1".into(), config_path: path.clone(), token: token.map(str::to_owned), history: None };
+    let cfg = PageConfig {
+        addr: addr.parse().expect("addr"),
+        host: "127.0.0.1".into(),
+        config_path: path.clone(),
+        token: token.map(str::to_owned),
+        history: None,
+    };
     (start(cfg, status, "test page".into()).expect("listens"), path)
 }
 
@@ -73,7 +79,13 @@ fn control(url: &str, label: &str) -> u64 {
     let (code, body) = request(url, "GET", "/controls", &[], b"");
     assert_eq!(code, 200, "{body}");
     let v: Value = serde_json::from_str(&body).expect("json");
-    v["controls"].as_array().expect("controls").iter().find(|c| c["label"] == label).and_then(|c| c["id"].as_u64()).unwrap_or_else(|| panic!("no control {label}: {body}"))
+    v["controls"]
+        .as_array()
+        .expect("controls")
+        .iter()
+        .find(|c| c["label"] == label)
+        .and_then(|c| c["id"].as_u64())
+        .unwrap_or_else(|| panic!("no control {label}: {body}"))
 }
 
 /// A connection that sent `opening` and then nothing more.
@@ -106,7 +118,11 @@ fn others_served_promptly(url: &str, over: Duration, what: &str) {
     while started.elapsed() < over {
         let t = Instant::now();
         let (code, body) = request(url, "GET", "/controls", &[], b"");
-        assert!(code == 200 && t.elapsed() < PROMPT, "{what}: another client's GET /controls answered {code} after {:?}: {body}", t.elapsed());
+        assert!(
+            code == 200 && t.elapsed() < PROMPT,
+            "{what}: another client's GET /controls answered {code} after {:?}: {body}",
+            t.elapsed()
+        );
         n += 1;
         std::thread::sleep(Duration::from_millis(200));
     }
@@ -135,10 +151,15 @@ fn a_slider_moved_on_the_page_writes_the_file_as_the_terminal_panel_does() {
     let (p, path) = page(None, "set");
     let (code, html) = request(&p.url, "GET", "/", &[], b"");
     let port = port(&p.url);
-    let viewer = format!("http://127.0.0.1:{}/?url=rerun%2Bhttp%3A%2F%2F127.0.0.1%3A{}%2Fproxy&amp;theme=dark", port + 1, port + 2);
+    let viewer = format!(
+        "http://127.0.0.1:{}/?url=rerun%2Bhttp%3A%2F%2F127.0.0.1%3A{}%2Fproxy&amp;theme=dark",
+        port + 1,
+        port + 2
+    );
     assert!(code == 200 && html.contains(&viewer) && html.contains("test page"), "{code} {html}");
     let inner = control(&p.url, "inner swing half-angle");
-    let (code, body) = request(&p.url, "POST", "/set", &[], format!("{{\"control\": {inner}, \"value\": 450}}").as_bytes());
+    let (code, body) =
+        request(&p.url, "POST", "/set", &[], format!("{{\"control\": {inner}, \"value\": 450}}").as_bytes());
     assert_eq!(code, 200, "{body}");
     let text = std::fs::read_to_string(&path).expect("config");
     let params = scenario::parse(&text, "edited").expect("still a valid scenario");
@@ -168,12 +189,54 @@ fn the_page_can_change_nothing_but_the_panels_parameters() {
         ("no token", "/set", vec![], json(&format!("{{\"control\": {inner}, \"value\": 450}}")), 403, "token"),
         ("calibrate now without the token", "/calibrate", vec![], vec![], 403, "token"),
         ("calibrate now with a body", "/calibrate", ok_token.to_vec(), json("{\"axis\": \"inner\"}"), 400, "no body"),
-        ("a wrong token", "/set", vec![("X-Rinscope-Token", "guess")], json(&format!("{{\"control\": {inner}, \"value\": 450}}")), 403, "token"),
-        ("a config key", "/set", ok_token.to_vec(), json("{\"key\": \"turntable.axis[1].swing_half_angle_arcsec\", \"value\": 450}"), 400, "unknown field"),
-        ("a key beside the control", "/set", ok_token.to_vec(), json(&format!("{{\"control\": {inner}, \"value\": 450, \"path\": \"/etc/passwd\"}}")), 400, "unknown field"),
-        ("a control that does not exist", "/set", ok_token.to_vec(), json("{\"control\": 9999, \"value\": 1}"), 400, "no control"),
-        ("a value out of range", "/set", ok_token.to_vec(), json(&format!("{{\"control\": {inner}, \"value\": 1e9}}")), 400, "outside"),
-        ("a value that is not a number", "/set", ok_token.to_vec(), json(&format!("{{\"control\": {inner}, \"value\": \"NaN\"}}")), 400, "number"),
+        (
+            "a wrong token",
+            "/set",
+            vec![("X-Rinscope-Token", "guess")],
+            json(&format!("{{\"control\": {inner}, \"value\": 450}}")),
+            403,
+            "token",
+        ),
+        (
+            "a config key",
+            "/set",
+            ok_token.to_vec(),
+            json("{\"key\": \"turntable.axis[1].swing_half_angle_arcsec\", \"value\": 450}"),
+            400,
+            "unknown field",
+        ),
+        (
+            "a key beside the control",
+            "/set",
+            ok_token.to_vec(),
+            json(&format!("{{\"control\": {inner}, \"value\": 450, \"path\": \"/etc/passwd\"}}")),
+            400,
+            "unknown field",
+        ),
+        (
+            "a control that does not exist",
+            "/set",
+            ok_token.to_vec(),
+            json("{\"control\": 9999, \"value\": 1}"),
+            400,
+            "no control",
+        ),
+        (
+            "a value out of range",
+            "/set",
+            ok_token.to_vec(),
+            json(&format!("{{\"control\": {inner}, \"value\": 1e9}}")),
+            400,
+            "outside",
+        ),
+        (
+            "a value that is not a number",
+            "/set",
+            ok_token.to_vec(),
+            json(&format!("{{\"control\": {inner}, \"value\": \"NaN\"}}")),
+            400,
+            "number",
+        ),
         ("an oversized body", "/set", ok_token.to_vec(), vec![b' '; 64 * 1024], 413, "at most"),
         ("a path", "/../../etc/passwd", ok_token.to_vec(), vec![], 404, "no POST"),
         ("another route", "/config", ok_token.to_vec(), json("{}"), 404, "no POST"),
@@ -186,7 +249,8 @@ fn the_page_can_change_nothing_but_the_panels_parameters() {
     }
     // The token in the printed URL; with it the same change goes through.
     assert!(p.url.ends_with("?token=s3cret"), "{}", p.url);
-    let (code, _) = request(&p.url, "POST", "/set", &ok_token, format!("{{\"control\": {inner}, \"value\": 450}}").as_bytes());
+    let (code, _) =
+        request(&p.url, "POST", "/set", &ok_token, format!("{{\"control\": {inner}, \"value\": 450}}").as_bytes());
     assert_eq!(code, 200);
     assert_ne!(std::fs::read(&path).expect("config"), before);
 }
@@ -235,7 +299,13 @@ fn a_page_of_another_site_can_change_nothing() {
     assert_eq!(request(&p.url, "GET", "/controls", &[("Host", &format!("localhost:{port}"))], b"").0, 200);
     // The page itself (same origin, as a browser sends it) goes through.
     let origin = format!("http://127.0.0.1:{port}");
-    let (code, answer) = request(&p.url, "POST", "/set", &[("Origin", &origin), ("Sec-Fetch-Site", "same-origin"), ("Content-Type", "application/json; charset=utf-8")], change.as_bytes());
+    let (code, answer) = request(
+        &p.url,
+        "POST",
+        "/set",
+        &[("Origin", &origin), ("Sec-Fetch-Site", "same-origin"), ("Content-Type", "application/json; charset=utf-8")],
+        change.as_bytes(),
+    );
     assert_eq!(code, 200, "{answer}");
 }
 
@@ -276,8 +346,12 @@ fn oversized_bodies_are_refused_however_they_come() {
     let mut s = TcpStream::connect(authority(&p.url)).expect("connects");
     s.set_read_timeout(Some(Duration::from_secs(5))).ok();
     let chunk = " ".repeat(MAX_BODY);
-    let head = format!("POST /set HTTP/1.1\r\nHost: {}\r\nContent-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\n", authority(&p.url));
-    s.write_all(format!("{head}{:x}\r\n{chunk}\r\n{:x}\r\n{chunk}\r\n0\r\n\r\n", chunk.len(), chunk.len()).as_bytes()).expect("writes");
+    let head = format!(
+        "POST /set HTTP/1.1\r\nHost: {}\r\nContent-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\n",
+        authority(&p.url)
+    );
+    s.write_all(format!("{head}{:x}\r\n{chunk}\r\n{:x}\r\n{chunk}\r\n0\r\n\r\n", chunk.len(), chunk.len()).as_bytes())
+        .expect("writes");
     let mut out = String::new();
     s.read_to_string(&mut out).ok();
     assert!(out.starts_with("HTTP/1.1 413"), "{out}");
@@ -300,9 +374,19 @@ fn slowloris_delays_no_one_and_is_cut() {
     let (p, path) = page(None, "slowloris");
     let before = std::fs::read(&path).expect("config");
     let opened = Instant::now();
-    let mut head = trickled(&p.url, &format!("GET /controls HTTP/1.1\r\nHost: {}\r\nX-Padding: {}\r\n\r\n", authority(&p.url), "x".repeat(40)));
+    let mut head = trickled(
+        &p.url,
+        &format!("GET /controls HTTP/1.1\r\nHost: {}\r\nX-Padding: {}\r\n\r\n", authority(&p.url), "x".repeat(40)),
+    );
     let body = "{\"control\": 0, \"value\": 1}";
-    let mut slow_body = stalled(&p.url, &format!("POST /set HTTP/1.1\r\nHost: {}\r\nContent-Type: application/json\r\nContent-Length: {}\r\n\r\n", authority(&p.url), body.len()));
+    let mut slow_body = stalled(
+        &p.url,
+        &format!(
+            "POST /set HTTP/1.1\r\nHost: {}\r\nContent-Type: application/json\r\nContent-Length: {}\r\n\r\n",
+            authority(&p.url),
+            body.len()
+        ),
+    );
     let mut writer = slow_body.try_clone().expect("clone");
     let bytes = body.as_bytes().to_vec();
     std::thread::spawn(move || {
@@ -326,7 +410,13 @@ fn a_chunked_body_cut_short_delays_no_one() {
     let (p, path) = page(None, "chunked");
     let before = std::fs::read(&path).expect("config");
     let opened = Instant::now();
-    let mut s = stalled(&p.url, &format!("POST /set HTTP/1.1\r\nHost: {}\r\nContent-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\n20\r\n{{\"control\": 0,", authority(&p.url)));
+    let mut s = stalled(
+        &p.url,
+        &format!(
+            "POST /set HTTP/1.1\r\nHost: {}\r\nContent-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\n20\r\n{{\"control\": 0,",
+            authority(&p.url)
+        ),
+    );
     others_served_promptly(&p.url, Duration::from_millis(1500), "a partial chunk");
     let (answer, closed) = until_closed(&mut s, opened, BODY_TIMEOUT + Duration::from_secs(2));
     assert!(closed.is_some() && answer.starts_with("HTTP/1.1 408"), "{closed:?}: {answer}");
@@ -338,10 +428,19 @@ fn expect_100_continue_without_a_body_delays_no_one() {
     let (p, path) = page(None, "expect");
     let before = std::fs::read(&path).expect("config");
     let opened = Instant::now();
-    let mut s = stalled(&p.url, &format!("POST /set HTTP/1.1\r\nHost: {}\r\nContent-Type: application/json\r\nExpect: 100-continue\r\nContent-Length: 100\r\n\r\n", authority(&p.url)));
+    let mut s = stalled(
+        &p.url,
+        &format!(
+            "POST /set HTTP/1.1\r\nHost: {}\r\nContent-Type: application/json\r\nExpect: 100-continue\r\nContent-Length: 100\r\n\r\n",
+            authority(&p.url)
+        ),
+    );
     others_served_promptly(&p.url, Duration::from_millis(1500), "Expect: 100-continue, no body");
     let (answer, closed) = until_closed(&mut s, opened, BODY_TIMEOUT + Duration::from_secs(2));
-    assert!(closed.is_some() && answer.starts_with("HTTP/1.1 100 Continue") && answer.contains("HTTP/1.1 408"), "{closed:?}: {answer}");
+    assert!(
+        closed.is_some() && answer.starts_with("HTTP/1.1 100 Continue") && answer.contains("HTTP/1.1 408"),
+        "{closed:?}: {answer}"
+    );
     assert_eq!(std::fs::read(&path).expect("config"), before);
 }
 
@@ -366,7 +465,8 @@ fn fifty_clients_at_once_are_all_answered() {
 fn beyond_the_connection_limit_a_new_connection_is_closed_at_once() {
     let (p, _) = page(None, "limit");
     let opened = Instant::now();
-    let silent: Vec<TcpStream> = (0..MAX_CONNECTIONS).map(|_| TcpStream::connect(authority(&p.url)).expect("connects")).collect();
+    let silent: Vec<TcpStream> =
+        (0..MAX_CONNECTIONS).map(|_| TcpStream::connect(authority(&p.url)).expect("connects")).collect();
     let mut one_more = TcpStream::connect(authority(&p.url)).expect("connects");
     let (_, closed) = until_closed(&mut one_more, Instant::now(), PROMPT);
     assert!(opened.elapsed() < HEADER_TIMEOUT, "too slow to tell ({:?})", opened.elapsed());
@@ -397,8 +497,18 @@ fn dropping_the_page_during_stalls_returns_at_once() {
     let to = authority(&url);
     let _stalls = [
         stalled(&url, "GET / HTTP/1.1\r\nHost: x"),
-        stalled(&url, &format!("POST /set HTTP/1.1\r\nHost: {to}\r\nContent-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\n20\r\n{{")),
-        stalled(&url, &format!("POST /set HTTP/1.1\r\nHost: {to}\r\nContent-Type: application/json\r\nExpect: 100-continue\r\nContent-Length: 100\r\n\r\n")),
+        stalled(
+            &url,
+            &format!(
+                "POST /set HTTP/1.1\r\nHost: {to}\r\nContent-Type: application/json\r\nTransfer-Encoding: chunked\r\n\r\n20\r\n{{"
+            ),
+        ),
+        stalled(
+            &url,
+            &format!(
+                "POST /set HTTP/1.1\r\nHost: {to}\r\nContent-Type: application/json\r\nExpect: 100-continue\r\nContent-Length: 100\r\n\r\n"
+            ),
+        ),
     ];
     // Let the server take them up (the body waits have begun).
     std::thread::sleep(Duration::from_millis(300));
@@ -417,7 +527,11 @@ fn every_address_serves_the_viewer_on_the_host_the_browser_asked_for() {
     let port = port(&p.url);
     let there = format!("127.0.0.2:{port}");
     let (code, html) = request_to(&there, "GET", "/", &[], b"");
-    let viewer = format!("http://127.0.0.2:{}/?url=rerun%2Bhttp%3A%2F%2F127.0.0.2%3A{}%2Fproxy&amp;theme=dark", port + 1, port + 2);
+    let viewer = format!(
+        "http://127.0.0.2:{}/?url=rerun%2Bhttp%3A%2F%2F127.0.0.2%3A{}%2Fproxy&amp;theme=dark",
+        port + 1,
+        port + 2
+    );
     assert!(code == 200 && html.contains(&viewer), "{code}: no {viewer} in {html}");
     assert_eq!(p.url_at("127.0.0.2"), format!("http://127.0.0.2:{port}/?token=s3cret"));
     let inner = control(&format!("http://{there}/"), "inner swing half-angle");
@@ -432,7 +546,8 @@ fn every_address_serves_the_viewer_on_the_host_the_browser_asked_for() {
         let (code, html) = request_to(&there, "GET", "/", &[("Host", &format!("{h}:{port}"))], b"");
         assert!(code == 200 && html.contains(&format!("http://{h}:{}/", port + 1)), "{code}: {html}");
     }
-    let (code, answer) = request_to(&there, "POST", "/set", &[("Origin", &origin), ("X-Rinscope-Token", "s3cret")], change.as_bytes());
+    let (code, answer) =
+        request_to(&there, "POST", "/set", &[("Origin", &origin), ("X-Rinscope-Token", "s3cret")], change.as_bytes());
     assert_eq!(code, 200, "with the token: {answer}");
     assert_ne!(std::fs::read(&path).expect("config"), before);
 }
@@ -441,7 +556,24 @@ fn every_address_serves_the_viewer_on_the_host_the_browser_asked_for() {
 fn a_flood_of_changes_is_refused_beyond_the_rate() {
     let (p, path) = page(None, "flood");
     let inner = control(&p.url, "inner swing half-angle");
-    let codes: Vec<u16> = (0..3 * MAX_CHANGES_PER_S).map(|i| request(&p.url, "POST", "/set", &[], format!("{{\"control\": {inner}, \"value\": {}}}", 10 * (i % 50)).as_bytes()).0).collect();
-    assert!(codes.contains(&429) && codes.iter().filter(|c| **c == 200).count() as u32 >= MAX_CHANGES_PER_S / 2, "{codes:?}");
-    assert!(scenario::parse(&std::fs::read_to_string(&path).expect("config"), "flooded").is_ok(), "the file stays a valid scenario");
+    let codes: Vec<u16> = (0..3 * MAX_CHANGES_PER_S)
+        .map(|i| {
+            request(
+                &p.url,
+                "POST",
+                "/set",
+                &[],
+                format!("{{\"control\": {inner}, \"value\": {}}}", 10 * (i % 50)).as_bytes(),
+            )
+            .0
+        })
+        .collect();
+    assert!(
+        codes.contains(&429) && codes.iter().filter(|c| **c == 200).count() as u32 >= MAX_CHANGES_PER_S / 2,
+        "{codes:?}"
+    );
+    assert!(
+        scenario::parse(&std::fs::read_to_string(&path).expect("config"), "flooded").is_ok(),
+        "the file stays a valid scenario"
+    );
 }
