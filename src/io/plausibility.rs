@@ -14,8 +14,7 @@ use crate::io::units::STANDARD_GRAVITY_MPS2 as G0;
 use nalgebra::Vector3;
 use std::path::Path;
 
-/// The Earth's rotation rate, WGS 84 (rad/s).
-pub const EARTH_RATE_RAD_PER_S: f64 = 7.292_115e-5;
+pub use crate::math::units::EARTH_RATE_RAD_PER_S;
 
 /// What the static segment showed.
 #[derive(Debug, Clone, PartialEq)]

@@ -50,7 +50,7 @@ const DATA_FIELDS: [&str; 7] = ["g_x", "g_y", "g_z", "a_x", "a_y", "a_z", "dt"];
 
 /// One arcsecond in radians, computed as PSINS's `glvs.m` does: `glv.deg = pi/180`,
 /// `glv.min = glv.deg/60`, `glv.sec = glv.min/60`.
-const ARCSEC_RAD: f64 = std::f64::consts::PI / 180.0 / 60.0 / 60.0;
+const ARCSEC_RAD: f64 = crate::math::units::RAD_PER_ARCSEC;
 
 /// The g accepted in header row 2, m/s²: surface gravity is 9.78 (equator) to 9.83 (poles);
 /// `imufile.m` writes PSINS's `glv.g0`, 9.7803267714, as `9.780327`.

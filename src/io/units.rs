@@ -15,8 +15,8 @@
 
 use std::f64::consts::PI;
 
-/// Standard gravity g₀ (m/s²), the conversion factor of the `_g` unit (CGPM 1901).
-pub const STANDARD_GRAVITY_MPS2: f64 = 9.806_65;
+/// Standard gravity g₀ (m/s²), the conversion factor of the `_g` unit.
+pub use crate::math::units::STANDARD_GRAVITY_MPS2;
 
 /// The physical quantity of a unit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -64,7 +64,7 @@ pub struct Unit {
     pub to_si: f64,
 }
 
-const ARCSEC: f64 = PI / 648_000.0;
+const ARCSEC: f64 = crate::math::units::RAD_PER_ARCSEC;
 
 const UNITS: &[Unit] = &[
     Unit { suffix: "rad", quantity: Quantity::Angle, to_si: 1.0 },

@@ -18,10 +18,13 @@ pub const RAD_PER_SQRT_S_PER_DEG_PER_SQRT_H: f64 = RAD_PER_DEG / 60.0;
 pub const RAD_PER_S_PER_SQRT_S_PER_DEG_PER_H_PER_SQRT_H: f64 = RAD_PER_S_PER_DEG_PER_H / 60.0;
 /// rad/s² per deg/h² (a gyro's rate ramp R).
 pub const RAD_PER_S2_PER_DEG_PER_H2: f64 = RAD_PER_DEG / (3600.0 * 3600.0);
-/// Standard gravity g₀, m/s² (the unit of "µg" and "per g").
+/// Standard gravity g₀, m/s² (the unit of "µg" and "per g"; CGPM 1901).
 pub const STANDARD_GRAVITY_MPS2: f64 = 9.806_65;
-/// m/s² per µg.
+/// m/s² per µg: g₀ × 10⁻⁶, written out (the product `STANDARD_GRAVITY_MPS2 * 1e-6` rounds to
+/// the next double; every number this program has printed used this one).
 pub const MPS2_PER_UG: f64 = 9.806_65e-6;
+/// The Earth's rotation rate, WGS 84, rad/s.
+pub const EARTH_RATE_RAD_PER_S: f64 = 7.292_115e-5;
 /// m/s/√s per µg/√Hz (an accelerometer's velocity random walk N: m/s²/√Hz is m/s/√s).
 pub const MPS_PER_SQRT_S_PER_UG_PER_SQRT_HZ: f64 = MPS2_PER_UG;
 /// m/s²/√s per µg/√h (an accelerometer's acceleration random walk K).

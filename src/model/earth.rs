@@ -14,8 +14,8 @@ pub struct Site {
     pub height_m: f64,
 }
 
-/// Earth's rotation rate, rad/s (WGS84).
-pub const EARTH_RATE: f64 = 7.292_115e-5;
+/// Earth's rotation rate, rad/s (WGS84; defined in `math::units`).
+pub const EARTH_RATE: f64 = crate::math::units::EARTH_RATE_RAD_PER_S;
 /// WGS84 semi-major axis, m.
 pub const EARTH_A: f64 = 6_378_137.0;
 /// WGS84 first eccentricity squared.

@@ -23,6 +23,7 @@ mod blueprint;
 mod body_view;
 pub mod calibration;
 mod cone;
+mod drawing;
 pub mod export;
 pub mod figures;
 mod ins_view;
@@ -39,6 +40,9 @@ mod scene;
 pub mod selfcal;
 pub mod sink;
 pub mod tpr;
+
+pub use drawing::drawing_factors;
+use drawing::{floored_peak, own_factors};
 
 use crate::ins::pipeline::InsView;
 use crate::math::rotvec;
@@ -146,46 +150,6 @@ impl Stream {
             rerun::Scalars::new(vec![y; times.len()]).columns_of_unit_batches()?,
         )?;
         Ok(())
-    }
-}
-
-/// The classes drawn with a factor of their own (not the scenario's `x`), as "η ×500".
-fn own_factors(f: &ClassFactors, x: f64) -> Vec<String> {
-    [("swing", f.swing), ("η", f.non_orthogonality), ("installation", f.installation), ("IMU mounting", f.imu_mount)]
-        .iter()
-        .filter(|(_, v)| *v != x)
-        .map(|(n, v)| format!("{n} ×{v}"))
-        .collect()
-}
-
-/// The peak an error plot of axis `a` is framed on: its own, but not below a hundredth of the
-/// largest axis of its group (1e-5″ of rounding beside a 500″ error would fill its plot and look
-/// like a drift).
-fn floored_peak(peaks: [f64; 3], a: usize) -> f64 {
-    peaks[a].max(peaks.iter().fold(0.0_f64, |m, x| m.max(*x)) / 100.0)
-}
-
-/// The smallest angle an error class is drawn at, rad (2°): under it a cone or wedge cannot be seen
-/// at the default camera (Jiang et al. 2017's 20″ non-orthogonality is 0.56° at ×100).
-const MIN_DRAWN_RAD: f64 = 2.0 * crate::math::units::RAD_PER_DEG;
-
-/// The drawing factor of each error class: the scenario's exaggeration `x`, or, for a class whose
-/// largest angle `x` would draw under [`MIN_DRAWN_RAD`], the smallest of 1, 2, 5 × 10^k that draws
-/// it there (at most 10^5). The labels say each class's factor.
-#[must_use]
-pub fn drawing_factors(truth: &TableErrors, x: f64) -> ClassFactors {
-    let raise = |a: f64| {
-        if a <= 0.0 || a * x >= MIN_DRAWN_RAD {
-            return x;
-        }
-        crate::math::units::nice_at_least(MIN_DRAWN_RAD / a * (1.0 - 1e-12)).min(1e5).max(x)
-    };
-    let s = truth.class_sizes();
-    ClassFactors {
-        swing: raise(s.swing),
-        non_orthogonality: raise(s.non_orthogonality),
-        installation: raise(s.installation),
-        imu_mount: raise(s.imu_mount),
     }
 }
 
@@ -731,39 +695,4 @@ impl Recorder {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn quaternion_reordering_puts_w_last() {
-        // nalgebra stores (w, i, j, k); Rerun wants (x, y, z, w).
-        let q = UnitQuaternion::from_scaled_axis(Vector3::new(0.1, 0.2, 0.3));
-        let r = to_rerun_quaternion(&q);
-        assert_eq!(r.0, [q.i as f32, q.j as f32, q.k as f32, q.w as f32]);
-    }
-
-    #[test]
-    fn chain_paths_nest_outer_to_inner() {
-        let p = ChainPaths::new(&["outer".into(), "inner".into()]);
-        assert_eq!(p.gimbals[1], "world/vehicle/base/outer_mount/outer/inner_mount/inner");
-        assert_eq!(p.imu, "world/vehicle/base/outer_mount/outer/inner_mount/inner/imu");
-    }
-
-    #[test]
-    fn each_error_class_is_drawn_large_enough_to_see() {
-        // Jiang et al. 2017 at ×100: swings of 5′ and 10′ are drawn at 8.3° and 16.7° (×100 kept); the 20″
-        // non-orthogonality would be 0.56°, so it gets the smallest 1-2-5 factor that draws it at 2°
-        // (2°/20″ = 360 → ×500); a class that is absent keeps ×100.
-        let p = crate::scenario::presets::load("jiang2017-dual-axis").expect("preset");
-        let f = drawing_factors(&p.table.truth, 100.0);
-        assert_eq!(f.swing, 100.0);
-        assert_eq!(f.non_orthogonality, 500.0);
-        assert_eq!(f.installation, 100.0);
-        assert_eq!(f.imu_mount, 100.0);
-        // A factor is never lowered below the scenario's, and is capped.
-        let mut tiny = p.table.truth.clone();
-        tiny.axes[1].non_orthogonality_rad = 1e-9;
-        assert_eq!(drawing_factors(&tiny, 100.0).non_orthogonality, 1e5);
-        assert_eq!(drawing_factors(&p.table.truth, 1e4).non_orthogonality, 1e4);
-    }
-}
+mod tests;
