@@ -122,7 +122,7 @@ def test_keys_read_and_write_as_items_and_attributes(tmp_path):
 @pytest.mark.parametrize(
     "section, key, value, says",
     [
-        (("simulation",), "step_hzz", 5, ["step_hzz", "unknown field"]),
+        (("simulation",), "step_hzz", 5, ["step_hzz", "did you mean `step_hz`"]),
         (("turntable", "axis", "inner"), "swing_half_angle_arcsec", -3, ["swing_half_angle_arcsec", "-3", "arcsec", "out of range"]),
         (("turntable", "axis", "inner"), "swing_half_angle_arcsec", float("nan"), ["swing_half_angle_arcsec", "nan", "not a finite number"]),
         (("simulation",), "duration_s", "ten", ["duration_s", "ten"]),
