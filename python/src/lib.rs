@@ -396,8 +396,8 @@ fn montecarlo(
     runs: Option<usize>,
     eta_measured_sigma_arcsec: Option<f64>,
 ) -> PyResult<String> {
-    use rinscope::app::calibrate::{monte_carlo_runs, monte_carlo_setup};
-    use rinscope::calib::montecarlo::{Shard, summarize};
+    use rinscope::app::montecarlo::{MonteCarloRequest, execute};
+    use rinscope::calib::montecarlo::Shard;
     let mut params = parse(toml, "the scenario")?;
     if let Some(s) = eta_measured_sigma_arcsec {
         params
@@ -408,16 +408,17 @@ fn montecarlo(
     }
     let runs = MonteCarloConfig::check_runs(runs.unwrap_or(params.calibration.montecarlo.runs as usize))
         .map_err(|e| PyValueError::new_err(format!("runs {e}")))?;
-    let json = interruptible(py, |stop| -> Result<String, Failure> {
-        let started = std::time::Instant::now();
-        let done = monte_carlo_runs(&params, runs, Shard::WHOLE, &|| (), stop)
-            .map_err(|e| Failure::Input(format!("montecarlo: {e}")))?;
-        if done.len() < runs {
-            return Err(Failure::Interrupted(format!("montecarlo: stopped after {} of {runs} runs", done.len())));
+    let request = MonteCarloRequest { params, runs: Some(runs), shard: Shard::WHOLE, json: None };
+    let json = interruptible(py, move |stop| -> Result<String, Failure> {
+        let report = execute(&request, stop, &|| ())?;
+        if report.interrupted() {
+            return Err(Failure::Interrupted(format!(
+                "montecarlo: stopped after {} of {runs} runs",
+                report.done.len()
+            )));
         }
-        let summary = summarize(&monte_carlo_setup(&params), runs, &done, started.elapsed().as_secs_f64());
-        let mut value = serde_json::to_value(&summary).map_err(|e| Failure::Run(e.to_string()))?;
-        value["runs"] = serde_json::to_value(&done).map_err(|e| Failure::Run(e.to_string()))?;
+        let mut value = serde_json::to_value(&report.summary).map_err(|e| Failure::Run(e.to_string()))?;
+        value["runs"] = serde_json::to_value(&report.done).map_err(|e| Failure::Run(e.to_string()))?;
         Ok(value.to_string())
     })??;
     Ok(json)

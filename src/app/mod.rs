@@ -10,6 +10,7 @@ pub mod export_log;
 pub mod failure;
 pub mod live;
 pub mod modulation;
+pub mod montecarlo;
 pub mod outputs;
 pub mod playback;
 pub mod replay;

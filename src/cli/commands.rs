@@ -7,12 +7,10 @@ use super::{
     CalibrateArgs, Failure, LiveArgs, ModulationArgs, MonteCarloAction, MonteCarloArgs, RunArgs, ScenarioSource,
     TprArgs,
 };
-use crate::app::calibrate::{monte_carlo_runs, monte_carlo_setup};
-use crate::app::outputs::{check_output, kept, read_small_file, write_json};
+use crate::app::outputs::{check_output, kept, write_json};
 use crate::app::terminate::stop_flag;
 use crate::app::{live, modulation, reproduce};
-use crate::calib::MonteCarloConfig;
-use crate::calib::montecarlo::{self, Shard, ShardFile};
+use crate::calib::montecarlo::Shard;
 use crate::record::sink;
 use crate::scenario::{self, Params, presets};
 
@@ -171,20 +169,23 @@ fn monte_carlo_params(source: &ScenarioSource, eta_measured_sigma_arcsec: Option
 
 /// `rinscope montecarlo`.
 pub(super) fn montecarlo(args: &MonteCarloArgs) -> Result<(), Failure> {
+    use crate::app::montecarlo::{MonteCarloRequest, execute, merge};
     if let Some(MonteCarloAction::Merge { files, source, eta_measured_sigma_arcsec, json }) = &args.action {
-        return montecarlo_merge(files, source, *eta_measured_sigma_arcsec, json.as_deref());
+        let params = monte_carlo_params(source, *eta_measured_sigma_arcsec)?;
+        out!("{}", merge(&params, files, json.as_deref())?.text());
+        return Ok(());
     }
-    let params = monte_carlo_params(&args.source, args.eta_measured_sigma_arcsec)?;
-    check_output("--json", args.json.as_deref())?;
-    let runs = MonteCarloConfig::check_runs(args.runs.unwrap_or(params.calibration.montecarlo.runs as usize))
-        .map_err(|e| Failure::input(format!("--runs {e}")))?;
     let shard = match &args.shard {
         Some(text) => Shard::parse(text).map_err(|e| Failure::input(format!("--shard {e}")))?,
         None => Shard::WHOLE,
     };
-    let mine = shard.indices(runs as u64).len();
-    let stop = stop_flag();
-    let bar = indicatif::ProgressBar::new(mine as u64);
+    let request = MonteCarloRequest {
+        params: monte_carlo_params(&args.source, args.eta_measured_sigma_arcsec)?,
+        runs: args.runs,
+        shard,
+        json: args.json.clone(),
+    };
+    let bar = indicatif::ProgressBar::new(0);
     bar.set_style(
         indicatif::ProgressStyle::with_template(
             "{spinner} {pos}/{len} calibrations [{bar:40}] {elapsed_precise} (eta {eta})",
@@ -192,72 +193,30 @@ pub(super) fn montecarlo(args: &MonteCarloArgs) -> Result<(), Failure> {
         .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
         .progress_chars("=> "),
     );
+    let runs = request.runs.unwrap_or(request.params.calibration.montecarlo.runs as usize);
+    bar.set_length(shard.indices(runs as u64).len() as u64);
     let tick = || bar.inc(1);
-    let started = std::time::Instant::now();
-    let result = monte_carlo_runs(&params, runs, shard, &tick, &stop);
+    let report = execute(&request, &stop_flag(), &tick);
     bar.finish_and_clear();
-    let done = result.map_err(|e| Failure::calibration("montecarlo", e, "montecarlo did not finish"))?;
-    let summary = montecarlo::summarize(&monte_carlo_setup(&params), runs, &done, started.elapsed().as_secs_f64());
+    let report = report?;
     if shard != Shard::WHOLE {
         outln!(
-            "shard {}/{}: {} of the {runs} runs (i mod {} == {})",
+            "shard {}/{}: {} of the {} runs (i mod {} == {})",
             shard.index,
             shard.count,
-            mine,
+            report.mine,
+            report.runs,
             shard.count,
             shard.index
         );
     }
-    out!("{}", summary.text());
-    if let Some(path) = &args.json {
-        if shard == Shard::WHOLE {
-            write_json("--json", path, &summary)?;
-        } else {
-            write_json("--json", path, &ShardFile { shard, summary: summary.clone(), runs: done.clone() })?;
-        }
-    }
-    if done.len() < mine {
+    out!("{}", report.summary.text());
+    if report.interrupted() {
         return Err(Failure::interrupted(format!(
-            "after {} of {mine} runs (the statistics above are over those only)",
-            done.len()
+            "after {} of {} runs (the statistics above are over those only)",
+            report.done.len(),
+            report.mine
         )));
-    }
-    Ok(())
-}
-
-/// `rinscope montecarlo merge`.
-fn montecarlo_merge(
-    files: &[PathBuf],
-    source: &ScenarioSource,
-    eta_measured_sigma_arcsec: Option<f64>,
-    json: Option<&Path>,
-) -> Result<(), Failure> {
-    let params = monte_carlo_params(source, eta_measured_sigma_arcsec)?;
-    check_output("--json", json)?;
-    let mut shards = Vec::new();
-    for f in files {
-        let text = read_small_file(f, "shard file")?;
-        let shard: ShardFile = serde_json::from_str(&text).map_err(|e| {
-            Failure::input(format!(
-                "{}: not a shard file of `rinscope montecarlo --shard K/M --json` ({e})",
-                f.display()
-            ))
-        })?;
-        shards.push(shard);
-    }
-    let setup = monte_carlo_setup(&params);
-    let summary = montecarlo::merge(&setup, &shards).map_err(|e| Failure::input(format!("montecarlo merge: {e}")))?;
-    if let Some(first) = shards.first()
-        && first.summary.setup != summary.setup
-    {
-        return Err(Failure::input(format!(
-            "montecarlo merge: the shards ran with \"{}\", this merge with \"{}\" (give the same --scenario/--config and --eta-measured-sigma-arcsec)",
-            first.summary.setup, summary.setup
-        )));
-    }
-    out!("{}", summary.text());
-    if let Some(path) = json {
-        write_json("--json", path, &summary)?;
     }
     Ok(())
 }

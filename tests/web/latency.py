@@ -14,8 +14,10 @@ the viewer, which answers between its frames).
                [--screenshot OUT.png [--dark]]
 
 Prints a line per second and a summary; exits 1 when the steady-state lag (after the viewer first
-shows data plus WARMUP) exceeds MAX_LAG in more than 5 % of the samples or MAX_LAG_PEAK in any, or
-a change took longer than MAX_MOVE to show.
+shows data plus WARMUP) has a median over MAX_LAG or exceeds MAX_LAG_PEAK in any sample, or a change
+took longer than MAX_MOVE to show. A viewer that falls behind (the defect this guards against: 52 s after
+two minutes) fails both; one that keeps up but paints at 1.6-2.5 fps in software rendering lags by
+its frame period on top of the stream's flush (0.25-0.5 s), which the peak bound allows.
 """
 import argparse
 import json
@@ -43,7 +45,7 @@ ap.add_argument("--move-values", default="450,300")
 ap.add_argument("--warmup", type=float, default=10.0)
 ap.add_argument("--max-lag", type=float)
 ap.add_argument("--max-move", type=float)
-ap.add_argument("--max-lag-peak", type=float, help="the largest lag allowed in any sample (--max-lag bounds the 95th percentile)")
+ap.add_argument("--max-lag-peak", type=float, help="the largest lag allowed in any sample (--max-lag bounds the median)")
 ap.add_argument("--json")
 ap.add_argument("--screenshot")
 ap.add_argument("--dark", action="store_true")
@@ -177,8 +179,8 @@ if a.json:
     with open(a.json, "w") as f:
         json.dump({"samples": samples, "moves": moves, "summary": summary}, f, indent=1)
 failed = []
-if a.max_lag is not None and (not steady or summary["lag_p95_s"] > a.max_lag):
-    failed.append(f"the viewer's lag was over {a.max_lag} s in more than 5 % of the samples (p95 {summary.get('lag_p95_s')} s)")
+if a.max_lag is not None and (not steady or summary["lag_median_s"] > a.max_lag):
+    failed.append(f"the viewer's median lag was {summary.get('lag_median_s')} s (at most {a.max_lag} s)")
 if a.max_lag_peak is not None and (not steady or max(steady) > a.max_lag_peak):
     failed.append(f"the viewer's lag reached {max(steady) if steady else 'no data'} s (at most {a.max_lag_peak} s)")
 if a.max_move is not None and moves and (len(seen) < len(moves) or max(seen) > a.max_move):

@@ -76,6 +76,8 @@ watch() {  # watch NAME SCENARIO SECONDS MOVE_LABEL MOVE_VALUES
   (cd "$work/$name" && exec "$bin" live --scenario "$scenario" --no-panel --serve-web "$port" --save "$work/$name/session.rrd" --duration-s 3600) >"$work/$name/live.log" 2>&1 &
   pid=$!
   for _ in $(seq 100); do grep -q "class page" "$work/$name/live.log" && break; sleep 0.1; done
+  # The viewer within a second of the session: its median lag at most 1 s, no sample over 1.5 s
+  # (the stream's flush plus one software-rendered frame at 1.6-2.5 fps; see latency.py).
   local args=(--page "http://127.0.0.1:$port/" --viewer-origin "http://127.0.0.1:$((port + 1))" --cdp "$cport" --seconds "$seconds"
               --controls "http://127.0.0.1:$port/controls" --max-lag 1.0 --max-lag-peak 1.5 --json "$work/$name/latency.json" --screenshot "$work/$name/page.png")
   # A slider's change is shown once the viewer's lag (at most 1 s, above) has passed it and the viewer
