@@ -17,7 +17,7 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 
 use crate::app::failure::Failure;
-use crate::app::outputs::{RecordingName, RecordingRequest, check_output, logged, write_json};
+use crate::app::outputs::{RecordingName, RecordingRequest, check_output, finish, logged, write_json};
 use crate::record::sink::Saved;
 
 use crate::app::run::record_run;
@@ -513,7 +513,7 @@ pub fn execute(req: &CalibrateRequest, stop: &AtomicBool) -> Result<CalibrateRep
             let saved = match sinks {
                 Some(s) => {
                     logged(record_outcome(s.stream(), params, &outcome, stop))?;
-                    Some(s.finish()?)
+                    Some(finish(s)?)
                 }
                 None => None,
             };
@@ -544,7 +544,7 @@ pub fn execute(req: &CalibrateRequest, stop: &AtomicBool) -> Result<CalibrateRep
                         crate::record::calibration::log(s.stream(), &params, &cal, &report, &traces)
                             .and_then(|mut r| r.finish()),
                     )?;
-                    Some(s.finish()?)
+                    Some(finish(s)?)
                 }
                 None => None,
             };

@@ -5,7 +5,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::app::failure::Failure;
-use crate::app::outputs::{RecordingName, RecordingRequest, logged};
+use crate::app::outputs::{RecordingName, RecordingRequest, finish, logged};
 use crate::ins::trace::{NavSample, NavTrace};
 use crate::math::units::ARCSEC_PER_RAD;
 use crate::record::sink::Saved;
@@ -91,6 +91,10 @@ pub fn table(traces: &[NavTrace], wall_s: f64) -> String {
     s
 }
 
+/// `--hours`: > 0 and at most 30 days (`scenario::MAX_DURATION_S`, a scenario's longest).
+pub const HOURS: crate::io::validity::Range =
+    crate::io::validity::Range::positive(crate::scenario::MAX_DURATION_S / 3600.0, "h", "a simulated duration");
+
 /// What `modulation` reports.
 pub struct ModulationReport {
     /// The three variants side by side (with what a stop cut short said first).
@@ -106,9 +110,7 @@ pub struct ModulationReport {
 /// # Errors
 /// `hours` out of range, a sink that cannot be opened or written.
 pub fn execute(hours: f64, recording: &RecordingRequest, stop: &AtomicBool) -> Result<ModulationReport, Failure> {
-    if !(hours.is_finite() && hours > 0.0 && hours <= 24.0 * 30.0) {
-        return Err(Failure::input(format!("--hours {hours}: must be > 0 and at most 720 h")));
-    }
+    crate::io::validity::check_number(hours, &HOURS).map_err(|e| Failure::input(format!("--hours {e}")))?;
     let sinks = recording.open(RecordingName { name: "rotation-modulation", kind: None, seed: None })?;
     let started = std::time::Instant::now();
     errln!("rinscope: simulating {hours} h three times in parallel (no rotation, continuous azimuth, 16-position)...");
@@ -123,7 +125,7 @@ pub fn execute(hours: f64, recording: &RecordingRequest, stop: &AtomicBool) -> R
         );
     }
     logged(crate::record::modulation::log(&sinks.stream(), &traces, &text))?;
-    Ok(ModulationReport { table: text, saved: sinks.finish()?, interrupted })
+    Ok(ModulationReport { table: text, saved: finish(sinks)?, interrupted })
 }
 
 #[cfg(test)]

@@ -96,18 +96,20 @@ pub fn write_json(flag: &str, path: &Path, value: &impl serde::Serialize) -> Res
     write_atomically(path, json.as_bytes()).map_err(|e| Failure::output(flag, &e))
 }
 
-/// An error if a viewer failed and no file kept the data.
+/// Finishes a command's recording (see [`OpenSinks::finish`]); an error if a viewer failed and no
+/// file kept the data.
 ///
 /// # Errors
-/// Nothing kept this run's data.
-pub fn kept(saved: &Saved) -> Result<(), Failure> {
+/// The recording could not be completed, or nothing kept this run's data.
+pub fn finish(sinks: OpenSinks) -> Result<Saved, Failure> {
+    let saved = sinks.finish()?;
     if saved.recording.is_none() && !saved.viewer_problems.is_empty() {
         return Err(Failure::run(format!(
             "nothing kept this run's data: {} (add --save FILE)",
             saved.viewer_problems.join("; ")
         )));
     }
-    Ok(())
+    Ok(saved)
 }
 
 /// Logging into a recording that failed, as a failure of the run.

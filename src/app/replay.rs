@@ -11,7 +11,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::failure::Failure;
-use super::outputs::{RecordingName, RecordingRequest, check_output, kept, write_json};
+use super::outputs::{RecordingName, RecordingRequest, check_output, finish, write_json};
 use super::playback::{AlignmentReport, Gap, Playback, PlaybackError};
 use super::run::{NavSummary, RmsPeak};
 use crate::ins::pipeline::InsView;
@@ -523,9 +523,8 @@ pub fn execute(
     log.recording_params(1.0)?;
     let sinks = req.recording.open(RecordingName { name: &log.name, kind: Some("replay"), seed: None })?;
     let mut summary = replay_recorded(log, &compensation, &sinks, stop, bar)?;
-    let saved = sinks.finish()?;
+    let saved = finish(sinks)?;
     (summary.recording_path, summary.recording_bytes) = saved.recording_fields();
-    kept(&saved)?;
     if let Some(path) = &req.summary_json {
         write_json("--summary-json", path, &summary)?;
     }

@@ -8,7 +8,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::app::failure::Failure;
-use crate::app::outputs::{RecordingName, RecordingRequest, check_output, kept, write_json};
+use crate::app::outputs::{RecordingName, RecordingRequest, check_output, finish, write_json};
 use crate::ins::core::SampleOut;
 use crate::ins::pipeline::{InsRun, InsView};
 use crate::math::stats::RunningStat;
@@ -561,10 +561,9 @@ pub fn execute(req: &RunRequest, stop: &AtomicBool) -> Result<RunReport, Failure
     let sinks =
         req.recording.open(RecordingName { name: &params.meta.name, kind: None, seed: Some(params.meta.seed) })?;
     let mut summary = run_recorded(params, &sinks, stop, req.progress)?;
-    let saved = sinks.finish()?;
+    let saved = finish(sinks)?;
     (summary.recording_path, summary.recording_bytes) = saved.recording_fields();
     summary.peak_rss_mb = crate::app::bench::peak_rss_bytes() as f64 / 1e6;
-    kept(&saved)?;
     if let Some(path) = &req.summary_json {
         write_json("--summary-json", path, &summary)?;
     }

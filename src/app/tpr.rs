@@ -5,7 +5,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::app::failure::Failure;
-use crate::app::outputs::{RecordingName, RecordingRequest, check_output, logged, write_json};
+use crate::app::outputs::{RecordingName, RecordingRequest, check_output, finish, logged, write_json};
 use crate::ins::pipeline::InsRun;
 use crate::ins::reset::{
     BRANCHES, ResetSample, SweepRow, TprResult, azimuth_error_at_second_fix, azimuth_error_level_corrected,
@@ -266,7 +266,7 @@ pub fn execute(req: &TprRequest, stop: &AtomicBool) -> Result<TprReport, Failure
     let result = compare_resets(params, 60.0, stop).map_err(|e| Failure::input(format!("tpr: {e}")))?;
     let text = result.text();
     logged(crate::record::tpr::log(&sinks.stream(), params, &result, &text))?;
-    let saved = sinks.finish()?;
+    let saved = finish(sinks)?;
     if let Some(path) = &req.json {
         write_json("--json", path, &result)?;
     }

@@ -110,7 +110,7 @@ pub(super) fn allan(args: &AllanArgs) -> Result<(), Failure> {
     );
     print_tables(&report.exported);
     if let Some(saved) = &report.saved {
-        print_saved(saved)?;
+        print_saved(saved);
     }
     if report.interrupted {
         return Err(Failure::interrupted("the analysis above is of the part of the log gathered before the stop"));

@@ -7,7 +7,7 @@ use super::{
     CalibrateArgs, Failure, LiveArgs, ModulationArgs, MonteCarloAction, MonteCarloArgs, RunArgs, ScenarioSource,
     TprArgs,
 };
-use crate::app::outputs::{check_output, kept, write_json};
+use crate::app::outputs::{check_output, write_json};
 use crate::app::terminate::stop_flag;
 use crate::app::{live, modulation, reproduce};
 use crate::calib::montecarlo::Shard;
@@ -93,21 +93,20 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
 pub(super) fn modulation(args: &ModulationArgs) -> Result<(), Failure> {
     let report = modulation::execute(args.hours, &args.sinks.recording()?, &stop_flag())?;
     out!("{}", report.table);
-    print_saved(&report.saved)?;
+    print_saved(&report.saved);
     if report.interrupted {
         return Err(Failure::interrupted("the table and the recording cover the simulated part only"));
     }
     Ok(())
 }
 
-/// The line that tells where a saved recording is and how to open it; an error if the only
-/// destination was a viewer that failed (nothing kept the data).
-pub(super) fn print_saved(saved: &sink::Saved) -> Result<(), Failure> {
+/// The line that tells where a saved recording is and how to open it (the owner refused a run
+/// whose data nothing kept: `app::outputs::finish`).
+pub(super) fn print_saved(saved: &sink::Saved) {
     if let Some((p, bytes)) = &saved.recording {
         outln!("recording: {} ({:.2} MB) — open with `rerun {}`", p.display(), *bytes as f64 / 1e6, p.display());
     }
     print_exported(saved);
-    kept(saved)
 }
 
 /// The lines that tell where the export tables and the figures are.
@@ -144,7 +143,7 @@ pub(super) fn calibrate(args: &CalibrateArgs) -> Result<(), Failure> {
     let report = execute(&CalibrateRequest { input, recording, json: args.json.clone() }, &stop_flag())?;
     out!("{}", report.text);
     if let Some(saved) = &report.saved {
-        print_saved(saved)?;
+        print_saved(saved);
     }
     if report.interrupted {
         return Err(Failure::interrupted(
@@ -228,7 +227,7 @@ pub(super) fn tpr(args: &TprArgs) -> Result<(), Failure> {
     let request = TprRequest { params, recording: args.sinks.recording()?, json: args.json.clone(), seeds: args.seeds };
     let report = execute(&request, &stop_flag())?;
     out!("{}", report.text);
-    print_saved(&report.saved)?;
+    print_saved(&report.saved);
     if let Some((table, wall_s)) = &report.sweep {
         out!("{table}");
         outln!("  {} runs of {:.1} h in {wall_s:.1} s", args.seeds.unwrap_or(0), request.params.duration_s / 3600.0);

@@ -157,7 +157,7 @@ pub(super) fn replay(args: &ReplayArgs) -> Result<(), Failure> {
     }
     let report = report?;
     out!("{}", report.summary.text());
-    print_saved(&report.saved)?;
+    print_saved(&report.saved);
     if report.summary.interrupted {
         return Err(Failure::interrupted("the recording is complete up to that moment"));
     }

@@ -16,16 +16,12 @@ use crate::scenario;
 /// `simulation.duration_s`).
 pub(super) const DURATION_S: Range =
     Range::positive(scenario::MAX_DURATION_S, "s", "a simulated duration (30 days at most, as simulation.duration_s)");
-/// `modulation --hours`: the same 30 days, in hours.
-pub(super) const HOURS: Range = Range::positive(scenario::MAX_DURATION_S / 3600.0, "h", "a simulated duration");
-/// `selfcal --navigate-hours`: 0 (skip) to 30 days, in hours (`app::selfcal::check_navigate_hours`).
-pub(super) const NAVIGATE_HOURS: Range = Range::closed(0.0, 720.0, "h", "a navigation time");
-/// `live --speed`: simulated seconds per wall-clock second, > 0 and at most 10 000 (the command's
-/// own bound: faster, a step's drawing no longer keeps up).
-pub(super) const SPEED: Range = Range::positive(10_000.0, "× real time", "a speed");
-/// `--ci-sigma`: > 0 and at most 3 normal sigmas (99.7 %; `app::allan::options`' bound: wider
-/// intervals say nothing more of a curve).
-pub(super) const CI_SIGMA: Range = Range::positive(3.0, "σ", "a confidence half-width");
+/// The ranges the commands' owners hold their requests to (the parser answers first, with the
+/// same words; Python's calls meet the owners' checks).
+pub(super) use crate::app::allan::CI_SIGMA;
+pub(super) use crate::app::live::SPEED;
+pub(super) use crate::app::modulation::HOURS;
+pub(super) use crate::app::selfcal::NAVIGATE_HOURS;
 /// `replay --align-s`: > 0 and at most a day (a manifest's `initial.alignment_s`).
 pub(super) const ALIGN_S: Range = Range::positive(86_400.0, "s", "an alignment time");
 /// One of `--attitude-deg` / `--reference-attitude-deg`: within ±360° (each angle's own bound,

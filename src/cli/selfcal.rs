@@ -27,7 +27,7 @@ pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
     let report = execute(&SelfcalRequest { input, recording, json: args.json.clone() }, &stop_flag())?;
     out!("{}", report.text);
     if let Some(saved) = &report.saved {
-        print_saved(saved)?;
+        print_saved(saved);
     }
     Ok(())
 }

@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use super::{AllanRequest, check_scenario, log_set, options, series, simulate};
 use crate::app::failure::Failure;
-use crate::app::outputs::{RecordingName, RecordingRequest, check_output, logged, write_json};
+use crate::app::outputs::{RecordingName, RecordingRequest, check_output, finish, logged, write_json};
 use crate::ins::allan::ImuAllan;
 use crate::io::series::{Sampling, SeriesColumn};
 use crate::record::export::{ExportFormat, Exporter};
@@ -117,7 +117,7 @@ pub fn execute(req: &AllanCommand, stop: &AtomicBool, progress: &dyn Fn(u64)) ->
     let saved = match sinks {
         Some(s) => {
             logged(crate::record::allan::log(&s.stream(), &result, &description))?;
-            Some(s.finish()?)
+            Some(finish(s)?)
         }
         None => None,
     };

@@ -172,6 +172,11 @@ impl Gather {
     }
 }
 
+/// `--ci-sigma`: > 0 and at most 3 normal sigmas (99.7 %: wider intervals say nothing more of a
+/// curve).
+pub const CI_SIGMA: crate::io::validity::Range =
+    crate::io::validity::Range::positive(3.0, "σ", "a confidence half-width");
+
 /// The analysis options of a request, checked.
 ///
 /// # Errors
@@ -180,12 +185,8 @@ pub fn options(req: &AllanRequest) -> Result<AllanOptions, AllanRunError> {
     if req.decimate == 0 || req.decimate > 1_000_000 {
         return Err(AllanRunError::Config(format!("--decimate {}: must be 1 ..= 1000000 samples", req.decimate)));
     }
-    if !(req.ci_sigma > 0.0 && req.ci_sigma <= 3.0) {
-        return Err(AllanRunError::Config(format!(
-            "--ci-sigma {}: must be > 0 and <= 3 (normal sigmas)",
-            crate::io::short_number(req.ci_sigma)
-        )));
-    }
+    crate::io::validity::check_number(req.ci_sigma, &CI_SIGMA)
+        .map_err(|e| AllanRunError::Config(format!("--ci-sigma {e}")))?;
     if req.spacing == TauSpacing::PerDecade(0) {
         return Err(AllanRunError::Config(
             "--taus 0: give at least 1 cluster time per decade (or octave, decade, all)".into(),

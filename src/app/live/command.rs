@@ -7,9 +7,14 @@ use std::sync::atomic::AtomicBool;
 
 use crate::app::failure::Failure;
 use crate::app::outputs::RecordingName;
+use crate::io::validity::{Range, check_number};
 use crate::record::APPLICATION_ID;
 use crate::record::sink::{self, SinkRequest};
 use crate::scenario::{self, presets};
+
+/// `--speed`: simulated seconds per wall-clock second, > 0 and at most 10 000 (faster, a step's
+/// drawing no longer keeps up).
+pub const SPEED: Range = Range::positive(10_000.0, "× real time", "a speed");
 
 /// `rinscope live`.
 pub struct LiveRequest {
@@ -69,10 +74,8 @@ pub fn execute(req: &LiveRequest, stop: &Arc<AtomicBool>) -> Result<LiveReport, 
         }
     };
     let params = scenario::load_file(&path)?;
-    if let Some(s) = req.speed
-        && !(s.is_finite() && s > 0.0 && s <= 10_000.0)
-    {
-        return Err(Failure::input(format!("--speed {s}: must be > 0 and <= 10000 (x real time)")));
+    if let Some(s) = req.speed {
+        check_number(s, &SPEED).map_err(|e| Failure::input(format!("--speed {e}")))?;
     }
     let viewer_given =
         req.sinks.spawn || req.sinks.connect.is_some() || req.sinks.serve.is_some() || req.sinks.serve_web.is_some();

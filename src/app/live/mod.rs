@@ -23,7 +23,7 @@ use crate::math::timeline::decimation;
 use crate::record::{LiveOutput, Recorder, Stream};
 use crate::scenario::{Params, RawConfig};
 use crate::sim::StepOutput;
-pub use command::{LiveReport, LiveRequest, execute};
+pub use command::{LiveReport, LiveRequest, SPEED, execute};
 pub use session::{LiveSim, describe_changes};
 use watch::WatchEvent;
 

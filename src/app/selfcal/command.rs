@@ -9,7 +9,7 @@ use super::{
     setup,
 };
 use crate::app::failure::Failure;
-use crate::app::outputs::{RecordingName, RecordingRequest, check_output, logged, write_json};
+use crate::app::outputs::{RecordingName, RecordingRequest, check_output, finish, logged, write_json};
 use crate::record::selfcal::SelfcalView;
 use crate::record::sink::Saved;
 use crate::scenario::Params;
@@ -109,7 +109,7 @@ pub fn execute(req: &SelfcalRequest, stop: &AtomicBool) -> Result<SelfcalReport,
             let saved = match sinks {
                 Some(s) => {
                     logged(crate::record::selfcal::log(&s.stream(), &report.view(&params.meta.name)))?;
-                    Some(s.finish()?)
+                    Some(finish(s)?)
                 }
                 None => None,
             };
@@ -151,7 +151,7 @@ pub fn execute(req: &SelfcalRequest, stop: &AtomicBool) -> Result<SelfcalReport,
                         navigation: Vec::new(),
                     };
                     logged(crate::record::selfcal::log(&s.stream(), &view))?;
-                    Some(s.finish()?)
+                    Some(finish(s)?)
                 }
                 None => None,
             };

@@ -57,12 +57,12 @@ pub const MONTE_CARLO_RUNS: std::ops::RangeInclusive<u64> = 2..=10_000;
 /// # Errors
 /// Not finite, negative, or over 720 h.
 pub fn check_navigate_hours(hours: f64) -> std::result::Result<f64, String> {
-    if hours.is_finite() && (0.0..=720.0).contains(&hours) {
-        Ok(hours)
-    } else {
-        Err(format!("{hours}: must be 0 (skip) to 720 h"))
-    }
+    crate::io::validity::check_number(hours, &NAVIGATE_HOURS)
 }
+
+/// The free-inertial comparison's length, h: 0 (skip) to 30 days.
+pub const NAVIGATE_HOURS: crate::io::validity::Range =
+    crate::io::validity::Range::closed(0.0, 720.0, "h", "a navigation time (0 skips it)");
 
 /// What the documents say of their numbers' units.
 pub const JSON_UNITS: &str = "SI (rad/s, m/s², dimensionless gains)";
