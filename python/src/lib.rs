@@ -348,7 +348,7 @@ fn allan(
     })?;
     let specs: Vec<_> = specs
         .iter()
-        .map(|s| rinscope::io::series::SeriesColumn::parse(s).map_err(|e| Failure::Input(format!("allan: {e}"))))
+        .map(|s| rinscope::io::imu::series::SeriesColumn::parse(s).map_err(|e| Failure::Input(format!("allan: {e}"))))
         .collect::<Result<_, _>>()?;
     if specs.len() != columns.len() {
         return Err(PyValueError::new_err(format!(
@@ -361,7 +361,7 @@ fn allan(
         columns.iter().zip(&specs).map(|(b, s)| floats(b, &s.col.to_string())).collect::<Result<_, _>>()?;
     let times = time_s.map(|b| floats(&b, "time_s")).transpose()?;
     let out = interruptible(py, |stop| -> Result<Output, Failure> {
-        let data = rinscope::io::series::series_in_memory(&specs, values, rate_hz, times.as_deref())
+        let data = rinscope::io::imu::series::series_in_memory(&specs, values, rate_hz, times.as_deref())
             .map_err(|e| Failure::Input(format!("allan: {e}")))?;
         let result = analyze_series(data, "arrays from Python", &request, 0.0)
             .map_err(|e| Failure::Input(format!("allan: {e}")))?;

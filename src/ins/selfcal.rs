@@ -66,7 +66,7 @@ impl Kind {
         }
     }
 
-    /// The unit as an entity or column name suffix (`crate::io::units`): `deg_per_h`, `ppm`,
+    /// The unit as an entity or column name suffix (`crate::io::imu::units`): `deg_per_h`, `ppm`,
     /// `arcsec`, `ug`.
     #[must_use]
     pub fn unit_key(self) -> &'static str {

@@ -21,7 +21,7 @@ use std::path::Path;
 pub const MAX_RATE_RAD_PER_S: f64 = 100.0 * std::f64::consts::TAU;
 
 /// The largest specific force any IMU's accelerometers measure: 1000 g, m/s².
-pub const MAX_SPECIFIC_FORCE_MPS2: f64 = 1000.0 * crate::io::units::STANDARD_GRAVITY_MPS2;
+pub const MAX_SPECIFIC_FORCE_MPS2: f64 = 1000.0 * crate::io::imu::units::STANDARD_GRAVITY_MPS2;
 
 /// The largest angle an encoder or reference file may hold, rad: beyond 1e8 rad an f64 resolves
 /// no better than 1.5e-8 rad (0.003″), and no table turns 16 million times in one log.

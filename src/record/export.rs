@@ -104,7 +104,7 @@ pub type SharedExporter = Arc<Mutex<Exporter>>;
 /// (`attitude_error_arcsec/pitch` → arcsec).
 #[must_use]
 pub fn unit_of(entity: &str) -> Option<&'static str> {
-    entity.rsplit('/').find_map(|seg| crate::io::units::split_unit(seg).map(|(_, u)| u.suffix))
+    entity.rsplit('/').find_map(|seg| crate::io::imu::units::split_unit(seg).map(|(_, u)| u.suffix))
 }
 
 /// A series name as a column name: lower-case letters, digits and `_` (`+3σ` → `plus_3_sigma`,

@@ -8,7 +8,7 @@ use super::{AllanRequest, check_scenario, log_set, options, series, simulate};
 use crate::app::failure::Failure;
 use crate::app::outputs::{RecordingName, RecordingRequest, check_output, finish, logged, write_json};
 use crate::ins::allan::ImuAllan;
-use crate::io::series::{Sampling, SeriesColumn};
+use crate::io::imu::series::{Sampling, SeriesColumn};
 use crate::record::export::{ExportFormat, Exporter};
 use crate::record::sink::Saved;
 use crate::scenario::Params;

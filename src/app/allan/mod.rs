@@ -13,8 +13,8 @@ use nalgebra::Vector3;
 use super::playback::{ImuItem, ImuSamples, PlaybackError};
 use crate::ins::InsParams;
 use crate::ins::allan::{ChannelError, ImuAllan, Sensor, Truth, analyze_channel, analyze_imu};
-use crate::io::series::{Sampling, SeriesColumn, read_series_until};
-use crate::io::units::Quantity;
+use crate::io::imu::series::{Sampling, SeriesColumn, read_series_until};
+use crate::io::imu::units::Quantity;
 use crate::math::allan::estimators::Estimator;
 use crate::math::allan::{AllanOptions, MIN_SAMPLES, Phase, TauSpacing, averaging_factors};
 use crate::math::units::RAD_PER_DEG;
@@ -427,7 +427,7 @@ pub fn series(
     options(req)?;
     let started = Instant::now();
     let data = read_series_until(path, columns, sampling, stop).map_err(|e| match e {
-        crate::io::series::SeriesError::Interrupted { rows, .. } => AllanRunError::Interrupted(rows),
+        crate::io::imu::series::SeriesError::Interrupted { rows, .. } => AllanRunError::Interrupted(rows),
         e => AllanRunError::Config(e.to_string()),
     })?;
     let source = format!("series {}", path.display());
@@ -440,7 +440,7 @@ pub fn series(
 /// # Errors
 /// A request out of range, a channel with too few samples.
 pub fn analyze_series(
-    data: crate::io::series::Series,
+    data: crate::io::imu::series::Series,
     source: &str,
     req: &AllanRequest,
     gather_s: f64,

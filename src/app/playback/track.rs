@@ -223,8 +223,8 @@ pub(super) fn open_track(
         let mut to_si = Vec::new();
         for name in names {
             let found = all.iter().find_map(|a| {
-                crate::io::units::split_unit(a)
-                    .filter(|(base, u)| base == name && u.quantity == crate::io::units::Quantity::Angle)
+                crate::io::imu::units::split_unit(a)
+                    .filter(|(base, u)| base == name && u.quantity == crate::io::imu::units::Quantity::Angle)
                     .map(|(_, u)| (a.clone(), u.to_si))
             });
             let Some((col, f)) = found else {

@@ -12,7 +12,7 @@
 //! Writing: non-nullable float64 columns, snappy-compressed, one row group per 65 536 rows.
 
 use crate::io::error::{Location, LogError, Result};
-use crate::io::table::Source;
+use crate::io::formats::table::Source;
 use arrow_array::cast::AsArray;
 use arrow_array::types::{
     Float32Type, Float64Type, Int32Type, Int64Type, TimestampMicrosecondType, TimestampMillisecondType,

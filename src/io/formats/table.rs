@@ -1,8 +1,8 @@
 //! The streaming column reader: open a file, name the columns wanted, get rows of f64 one at a time.
 
 use crate::io::error::{Location, LogError, Result};
-use crate::io::psins_imu::PsinsHeader;
-use crate::io::sniff::{Format, detect_format};
+use crate::io::formats::psins_imu::PsinsHeader;
+use crate::io::formats::sniff::{Format, detect_format};
 use std::fmt;
 use std::path::{Path, PathBuf};
 
@@ -165,12 +165,12 @@ impl ColumnReader {
         let mut source: Box<dyn Source + Send> = guarded(path, format, || {
             Ok(match format {
                 Format::Text => {
-                    Box::new(crate::io::text::TextSource::open(path, options.header)?) as Box<dyn Source + Send>
+                    Box::new(crate::io::formats::text::TextSource::open(path, options.header)?) as Box<dyn Source + Send>
                 }
-                Format::Npy => Box::new(crate::io::npy::NpySource::open(path)?),
-                Format::Parquet => Box::new(crate::io::parquet_io::ParquetSource::open(path)?),
-                Format::PsinsImu => Box::new(crate::io::psins_imu::PsinsSource::open(path)?),
-                Format::Mcap => Box::new(crate::io::mcap_imu::McapImuSource::open(path, options.topic.as_deref())?),
+                Format::Npy => Box::new(crate::io::formats::npy::NpySource::open(path)?),
+                Format::Parquet => Box::new(crate::io::formats::parquet_io::ParquetSource::open(path)?),
+                Format::PsinsImu => Box::new(crate::io::formats::psins_imu::PsinsSource::open(path)?),
+                Format::Mcap => Box::new(crate::io::formats::mcap_imu::McapImuSource::open(path, options.topic.as_deref())?),
             })
         })?;
         let all = source.all_columns();

@@ -3,7 +3,7 @@
 //! # Layouts
 //!
 //! **rinscope** ([`Layout::Rinscope`], CSV or Parquet with a header; also what MCAP yields): units in
-//! the column names (see [`crate::io::units`]). One time column, `t_s`, `t_ms`, `t_us`, `t_ns` or
+//! the column names (see [`crate::io::imu::units`]). One time column, `t_s`, `t_ms`, `t_us`, `t_ns` or
 //! `gps_sow_s` (GPS seconds of week), and either rates
 //! `gyro_{x,y,z}_<rad_per_s|deg_per_s|deg_per_h>` + `accel_{x,y,z}_<mps2|g|mg|ug>`, or increments
 //! over the previous sample `dtheta_{x,y,z}_<rad|mrad|urad|deg|arcsec>` + `dv_{x,y,z}_<mps>`.
@@ -59,13 +59,21 @@
 //! first eight intervals) is an error ([`GapPolicy::Refuse`]) or an [`ImuEvent::Gap`]
 //! ([`GapPolicy::Split`]). NaN and infinite values are errors naming row and column.
 
-use crate::io::clock::{Clock, RawStamp};
-pub use crate::io::clock::{GPS_WEEK_S, StartTime, TimeUnit};
+pub mod axes;
+pub(crate) mod clock;
+pub mod guess;
+pub(crate) mod layout;
+pub mod plausibility;
+pub mod series;
+pub mod units;
+
+use crate::io::imu::clock::{Clock, RawStamp};
+pub use crate::io::imu::clock::{GPS_WEEK_S, StartTime, TimeUnit};
 use crate::io::error::{Location, LogError, Result};
-use crate::io::frames::Frame;
-use crate::io::layout::{plan_for, read_options};
-use crate::io::psins_imu::PsinsHeader;
-use crate::io::table::ColumnReader;
+use crate::io::imu::axes::Frame;
+use crate::io::imu::layout::{plan_for, read_options};
+use crate::io::formats::psins_imu::PsinsHeader;
+use crate::io::formats::table::ColumnReader;
 use crate::io::validity::{Sensor, check_imu_value};
 use nalgebra::{Matrix3, Vector3};
 use std::collections::VecDeque;
@@ -118,15 +126,15 @@ pub enum Layout {
 }
 
 /// The columns of a foreign or headerless file, as a log set's `[imu.columns]` describes them:
-/// each by header name or 0-based position, with its unit (the suffixes of [`crate::io::units`]:
+/// each by header name or 0-based position, with its unit (the suffixes of [`crate::io::imu::units`]:
 /// `deg_per_s`, `rad`, `g`, `mps`, ...). Angle and velocity units make increments, rate and
 /// acceleration units rates; the two triads must agree.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ColumnMap {
     /// The time column and its unit.
-    pub time: (crate::io::table::Col, TimeUnit),
+    pub time: (crate::io::formats::table::Col, TimeUnit),
     /// Gyro x, y, z then accelerometer x, y, z: the column and its unit suffix.
-    pub sensors: [(crate::io::table::Col, String); 6],
+    pub sensors: [(crate::io::formats::table::Col, String); 6],
 }
 
 /// What to do with a gap in the time stamps.
@@ -155,7 +163,7 @@ impl Default for StaticCheck {
         Self {
             duration_s: 5.0,
             gravity_tolerance: 0.1,
-            max_gyro_rad_per_s: 5.0 * crate::io::plausibility::EARTH_RATE_RAD_PER_S,
+            max_gyro_rad_per_s: 5.0 * crate::io::imu::plausibility::EARTH_RATE_RAD_PER_S,
         }
     }
 }
@@ -276,7 +284,7 @@ impl ImuReader {
     pub fn open(path: impl AsRef<Path>, options: &ImuOptions) -> Result<Self> {
         let path = path.as_ref();
         if let Some(check) = &options.static_check {
-            let report = crate::io::plausibility::check_static(path, options, check)?;
+            let report = crate::io::imu::plausibility::check_static(path, options, check)?;
             if !report.problems.is_empty() {
                 return Err(LogError::Implausible { file: path.to_path_buf(), message: report.problems.join("; ") });
             }

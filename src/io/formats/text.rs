@@ -15,7 +15,7 @@
 //! * Lines are read one at a time (at most 1 MiB each): memory does not grow with the file.
 
 use crate::io::error::{Location, LogError, Result, cell_text};
-use crate::io::table::{HeaderMode, Source};
+use crate::io::formats::table::{HeaderMode, Source};
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};

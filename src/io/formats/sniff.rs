@@ -77,7 +77,7 @@ fn classify(head: &[u8]) -> (Option<Format>, String) {
     if text_like {
         let line = head.split(|&b| b == b'\n').next().unwrap_or(head);
         let first_line: String = String::from_utf8_lossy(line).trim_end_matches('\r').chars().take(60).collect();
-        if crate::io::psins_imu::names_psins_simu(line) {
+        if crate::io::formats::psins_imu::names_psins_simu(line) {
             return (
                 Some(Format::PsinsImu),
                 format!("its first line {first_line:?} is a PSINS SIMU file's (imufile.m)"),

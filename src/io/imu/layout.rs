@@ -2,10 +2,10 @@
 
 use crate::io::error::{LogError, Result};
 use crate::io::imu::{ColumnMap, ImuOptions, Layout, SampleKind, TimeUnit};
-use crate::io::psins_imu::{first_line, not_psins};
-use crate::io::sniff::{Format, detect_format};
-use crate::io::table::{Col, ColumnReader, HeaderMode, ReadOptions};
-use crate::io::units::{Quantity, split_unit, suffixes_for};
+use crate::io::formats::psins_imu::{first_line, not_psins};
+use crate::io::formats::sniff::{Format, detect_format};
+use crate::io::formats::table::{Col, ColumnReader, HeaderMode, ReadOptions};
+use crate::io::imu::units::{Quantity, split_unit, suffixes_for};
 use std::path::Path;
 
 /// The resolved columns of a layout.

@@ -10,7 +10,7 @@
 
 use crate::io::error::Result;
 use crate::io::imu::{ImuEvent, ImuOptions, ImuReader, Layout, SampleKind, StaticCheck};
-use crate::io::units::STANDARD_GRAVITY_MPS2 as G0;
+use crate::io::imu::units::STANDARD_GRAVITY_MPS2 as G0;
 use nalgebra::Vector3;
 use std::path::Path;
 

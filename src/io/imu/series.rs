@@ -14,8 +14,8 @@ use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::io::error::{Location, LogError};
-use crate::io::table::{Col, ColumnReader, ReadOptions};
-use crate::io::units::{Quantity, Unit, unit_named, units_for};
+use crate::io::formats::table::{Col, ColumnReader, ReadOptions};
+use crate::io::imu::units::{Quantity, Unit, unit_named, units_for};
 
 /// What the values of a column are.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -16,8 +16,8 @@
 //! when finished (the header keeps its length, so the data do not move).
 
 use crate::io::error::{Location, LogError, Result};
-use crate::io::sniff::NPY_MAGIC;
-use crate::io::table::Source;
+use crate::io::formats::sniff::NPY_MAGIC;
+use crate::io::formats::table::Source;
 use std::fs::File;
 use std::io::{BufReader, BufWriter, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};

@@ -3,7 +3,7 @@
 //! `--imu-layout`).
 
 use crate::io::error::{LogError, Result};
-use crate::io::sniff::Format;
+use crate::io::formats::sniff::Format;
 use std::io::Read;
 use std::path::Path;
 
@@ -21,7 +21,7 @@ pub fn guess_layout(path: &Path) -> Result<&'static str> {
         Some(Format::Parquet) => return Ok("rinscope"),
         _ => {}
     }
-    if crate::io::sniff::detect_format(path)? == Format::PsinsImu {
+    if crate::io::formats::sniff::detect_format(path)? == Format::PsinsImu {
         return Ok("psins-imu");
     }
     let head = read_head(path)?;

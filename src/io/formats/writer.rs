@@ -6,7 +6,7 @@
 //! unfinished, the partial is removed and an existing `PATH` is left untouched. A `PATH` that is
 //! a symlink or a directory is refused.
 //!
-//! Columns: `t_s` first, then f64 columns whose names carry their unit (see [`crate::io::units`]),
+//! Columns: `t_s` first, then f64 columns whose names carry their unit (see [`crate::io::imu::units`]),
 //! made of ASCII letters, digits and `_`. Memory stays flat: CSV and .npy stream through a
 //! buffer, Parquet holds one row group (65 536 rows).
 //!
@@ -18,10 +18,10 @@
 
 use crate::io::error::{LogError, Result};
 use crate::io::files::PartialFile;
-use crate::io::npy::NpyWriter;
-use crate::io::parquet_io::ParquetWriter;
-use crate::io::sniff::Format;
-use crate::io::units::split_unit;
+use crate::io::formats::npy::NpyWriter;
+use crate::io::formats::parquet_io::ParquetWriter;
+use crate::io::formats::sniff::Format;
+use crate::io::imu::units::split_unit;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};

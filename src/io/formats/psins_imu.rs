@@ -31,8 +31,8 @@
 //! and SIMU: `imufile.m` checks the names, and MATLAB's `load` refuses any other text line.
 
 use crate::io::error::{Location, LogError, Result, cell_text};
-use crate::io::table::Source;
-use crate::io::text::{Delimiter, Line, LineReader, field, is_blank, split};
+use crate::io::formats::table::Source;
+use crate::io::formats::text::{Delimiter, Line, LineReader, field, is_blank, split};
 use std::path::{Path, PathBuf};
 
 /// The columns of the stream: `imufile.m`'s `[wm vm t]` in SI units.
