@@ -6,7 +6,7 @@
 use std::sync::atomic::AtomicBool;
 
 use rinscope::app::selfcal::{SequenceChoice, monte_carlo, run_one, setup, target};
-use rinscope::ins::selfcal::{N_PARAMS, Sequence, observability, param};
+use rinscope::calib::selfcal::{N_PARAMS, Sequence, observability, param};
 use rinscope::scenario::presets;
 
 fn nav_grade(s: Sequence) -> rinscope::app::selfcal::Setup {

@@ -25,7 +25,7 @@ pub(crate) fn simulate(
     label: &str,
     sample_s: f64,
     stop: &AtomicBool,
-    compensation: Option<crate::ins::selfcal::ImuErrors>,
+    compensation: Option<crate::calib::selfcal::ImuErrors>,
 ) -> NavTrace {
     let mut trace = NavTrace { label: label.to_owned(), samples: Vec::new() };
     let Some(mut ins) = p.ins_run() else { return trace };

@@ -359,7 +359,7 @@ pub fn record_run(
             }),
             closed_form_peak_rad: peak(&stats.closed_form_deviation),
         };
-        recorder.frame_plots(params, ranges)?;
+        recorder.fit_plots(params, ranges)?;
     }
     recorder.finish()?;
     Ok(summary)

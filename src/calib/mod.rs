@@ -1,4 +1,5 @@
-//! Static calibration of the turntable's swing cones and non-orthogonality (Jiang et al. 2017 §5-6), by the
+//! Calibration. The IMU's system-level self-calibration on its own gimbals is [`selfcal`]; this
+//! module is the static calibration of the turntable's swing cones and non-orthogonality (Jiang et al. 2017 §5-6), by the
 //! paper's static Kalman filter and by nonlinear least squares on the exact chain
 //! (docs/calibration.md).
 //!
@@ -29,6 +30,7 @@ pub mod alias;
 mod estimate;
 pub mod montecarlo;
 pub mod report;
+pub mod selfcal;
 
 pub use estimate::{Calibration, Estimate, History, Snapshot, calibrate};
 

@@ -1,5 +1,5 @@
 //! `rinscope selfcal`: the IMU's self-calibration on its own gimbals, simulated or from a log set
-//! (the command's owner is `app::selfcal::execute`, the estimator `ins::selfcal`).
+//! (the command's owner is `app::selfcal::execute`, the estimator `calib::selfcal`).
 
 use super::commands::print_saved;
 use super::{Failure, SelfcalArgs};

@@ -4,15 +4,15 @@
 
 pub mod align;
 pub mod allan;
-pub mod closed_form;
 pub mod coning;
 pub mod core;
 pub mod fir;
+pub mod imu_errors;
 pub mod nav;
 pub mod noise;
+pub mod phasor_truth;
 pub mod pipeline;
 pub mod reset;
-pub mod selfcal;
 pub mod sensor;
 pub mod strapdown;
 pub mod trace;

@@ -69,7 +69,7 @@ pub struct InsRun {
     chains: ChainMemo,
     /// IMU errors the computer removes from every sample before using it (a self-calibration's
     /// estimates), if any.
-    compensation: Option<super::selfcal::ImuErrors>,
+    compensation: Option<super::imu_errors::ImuErrors>,
     /// The instant sample 0 ends at, s (0, or where a computer at another rate took over).
     t0_s: f64,
     /// The site and the noise seed it was built with (a computer at another rate takes them on).
@@ -232,17 +232,17 @@ impl InsRun {
 
     /// From the next sample on, the computer removes the IMU errors `c` from every sample
     /// (`(I + K)⁻¹(measured − b·h)`), or nothing with None.
-    pub fn set_imu_compensation(&mut self, c: Option<super::selfcal::ImuErrors>) {
+    pub fn set_imu_compensation(&mut self, c: Option<super::imu_errors::ImuErrors>) {
         self.compensation = c;
     }
 
     /// The IMU's drawn constant errors (gyro bias rad/s, gain error; accelerometer bias m/s², gain
     /// error), for comparing a calibration with the truth.
     #[must_use]
-    pub fn drawn_imu_errors(&self) -> super::selfcal::ImuErrors {
+    pub fn drawn_imu_errors(&self) -> super::imu_errors::ImuErrors {
         let (bg, ba) = self.sensors.drawn_bias;
         let (kg, ka) = self.sensors.drawn_gain_errors();
-        super::selfcal::ImuErrors { bg, kg, ba, ka }
+        super::imu_errors::ImuErrors { bg, kg, ba, ka }
     }
 
     /// Samples the sensors' saturation clipped so far, per axis: (gyros, accelerometers).

@@ -4,7 +4,7 @@
 
 use nalgebra::{UnitQuaternion, Vector3};
 
-use super::closed_form::ClosedForm;
+use super::phasor_truth::PhasorTruth;
 use crate::math::frames::axis_angle;
 use crate::math::frames::{N, Rot, S};
 use crate::model::earth::Earth;
@@ -36,7 +36,7 @@ pub struct TruthImu {
     last: Option<TruthPoint>,
     next_break: f64,
     /// The current piece's closed form, when its rotations all turn at constant rates.
-    closed: Option<ClosedForm>,
+    closed: Option<PhasorTruth>,
     /// Fastest oscillation or rotation of the motion, rad/s (sets the quadrature panels).
     max_omega: f64,
     /// With the vehicle at rest, the last gimbal state and its truth (a dwell of an indexed
@@ -132,7 +132,7 @@ impl TruthImu {
     /// Starts the piece of motion that begins at `t_s`: its end, and its closed form if it has one.
     fn start_piece(&mut self, t_s: f64) {
         self.next_break = self.breakpoint_after(t_s);
-        self.closed = self.closed_form(t_s, self.next_break);
+        self.closed = self.phasor_truth(t_s, self.next_break);
     }
 
     /// The closed form of the piece [`t_s`, `end_s`), if its rotations all turn at constant rates. The
@@ -140,7 +140,7 @@ impl TruthImu {
     /// with rounding may still see the previous piece); its angles at its start (τ = 0 there, so that
     /// the phases stay small).
     #[must_use]
-    pub fn closed_form(&self, t_s: f64, end_s: f64) -> Option<ClosedForm> {
+    pub fn phasor_truth(&self, t_s: f64, end_s: f64) -> Option<PhasorTruth> {
         let m = &self.model;
         let t_mid = if end_s.is_finite() { 0.5 * (t_s + end_s) } else { t_s + 1.0 };
         if !m.scheme.constant_rates_at(t_mid - m.scheme_t0_s) {
@@ -150,7 +150,7 @@ impl TruthImu {
         let angles = m.scheme.state(t_s - m.scheme_t0_s).0;
         let rates = m.scheme.state(t_mid - m.scheme_t0_s).1;
         links.extend(m.chain.links(m.truth_rotations(), &angles, &rates));
-        ClosedForm::new(&links, self.earth.omega_ie_n, -self.earth.gravity_n, t_s)
+        PhasorTruth::new(&links, self.earth.omega_ie_n, -self.earth.gravity_n, t_s)
     }
 
     /// The model.
@@ -167,7 +167,7 @@ impl TruthImu {
 
     /// True when the current piece of motion is integrated in closed form.
     #[must_use]
-    pub fn is_closed_form(&self) -> bool {
+    pub fn is_phasor_truth(&self) -> bool {
         self.closed.is_some()
     }
 

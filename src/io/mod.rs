@@ -26,15 +26,15 @@ pub mod validity;
 mod error;
 
 pub use error::{FrameError, Location, LogError, Result, fixed_number, short_number};
-pub use imu::axes::{Frame, frame_matrix};
-pub use imu::guess::guess_layout;
-pub use imu::{
-    BlockEnd, ColumnMap, GPS_WEEK_S, GapPolicy, ImuEvent, ImuOptions, ImuReader, ImuSample, Layout, RATE_TOLERANCE,
-    SampleKind, StartTime, StaticCheck, TimeUnit,
-};
 pub use formats::mcap_imu::MCAP_IMU_COLUMNS;
-pub use imu::plausibility::{EARTH_RATE_RAD_PER_S, StaticReport, check_static};
 pub use formats::psins_imu::{PsinsHeader, read_psins_header};
 pub use formats::sniff::{Format, detect_format};
 pub use formats::table::{Col, ColumnReader, HeaderMode, ReadOptions};
 pub use formats::writer::TableWriter;
+pub use imu::axes::{Frame, frame_matrix};
+pub use imu::guess::guess_layout;
+pub use imu::plausibility::{EARTH_RATE_RAD_PER_S, StaticReport, check_static};
+pub use imu::{
+    BlockEnd, ColumnMap, GPS_WEEK_S, GapPolicy, ImuEvent, ImuOptions, ImuReader, ImuSample, Layout, RATE_TOLERANCE,
+    SampleKind, StartTime, StaticCheck, TimeUnit,
+};

@@ -153,7 +153,7 @@ impl AngleUnit {
 }
 
 /// The half-range of a symmetric plot for a signal of `peak` (in the plot's unit): the smallest of
-/// 1, 2, 3 × 10^k at or above 1.05 × peak. Drawn at ±1.25 × that (`record::layout::symmetric_range`),
+/// 1, 2, 3 × 10^k at or above 1.05 × peak. Drawn at ±1.25 × that (`record::blueprint::symmetric_range`),
 /// a plot's power-of-ten grid labels 3, 5 or 7 ticks (a span of 1.2 × 10^k would show one, 5 × 10^k
 /// none but 0 in a plot 170 px high).
 #[must_use]

@@ -2,7 +2,7 @@
 //! table whose shafts do not accelerate are a chain `C(τ) = L_1(τ) · L_2(τ) ⋯ L_m(τ)` of such links:
 //! the Euler angles of a ramp, the two phases of a cone, the shafts of a continuous scheme or of a
 //! cruise, and the constant rotations between them. The IMU truth integrates such a chain in closed
-//! form (`ins::closed_form`).
+//! form (`ins::phasor_truth`).
 
 use nalgebra::{UnitQuaternion, Vector3};
 

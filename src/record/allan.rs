@@ -8,8 +8,8 @@
 use rerun::blueprint::components::ContainerKind;
 use rerun::{RecordingStreamResult, TimeColumn};
 
+use super::blueprint::{self, LegendCorner, Node};
 use super::export::Exporter;
-use super::layout::{self, LegendCorner, Node};
 use super::palette::rgb;
 use super::{APPLICATION_ID, Stream};
 use crate::ins::allan::{Channel, ImuAllan, Sensor};
@@ -267,9 +267,9 @@ fn plot_range(drawn: &[(f64, f64)], x: (f64, f64)) -> PlotRange {
 /// A log-log plot of `entity` showing `range`.
 fn plot_view(title: String, entity: String, range: &PlotRange) -> Node {
     Node::view("TimeSeries", title, entity)
-        .with_property("TimeAxis", &layout::time_axis_range(range.x.0, range.x.1))
-        .with_property("ScalarAxis", &layout::scalar_range(range.y.0, range.y.1))
-        .with_property("PlotLegend", &layout::legend_at(range.legend))
+        .with_property("TimeAxis", &blueprint::time_axis_range(range.x.0, range.x.1))
+        .with_property("ScalarAxis", &blueprint::scalar_range(range.y.0, range.y.1))
+        .with_property("PlotLegend", &blueprint::legend_at(range.legend))
 }
 
 /// What a plot shows, log10 units, and where its legend goes.
@@ -380,11 +380,11 @@ pub fn log(stream: &Stream, r: &ImuAllan, description: &str) -> RecordingStreamR
     rows.push(Node::container(ContainerKind::Tabs, tabs, &[]));
     shares.push(0.62);
     let root = Node::container(ContainerKind::Vertical, rows, &shares);
-    layout::send(
+    blueprint::send(
         rec,
         APPLICATION_ID,
         &root,
-        &layout::Playback { timeline: LOG10_TAU_TIMELINE, speed: 1.0, follow: true },
+        &blueprint::Playback { timeline: LOG10_TAU_TIMELINE, speed: 1.0, follow: true },
     )
 }
 

@@ -4,7 +4,7 @@
 use rerun::RecordingStreamResult;
 
 use super::palette::{colors, rgb, rgba};
-use super::{Recorder, Stream, to_rerun_quaternion};
+use super::{Stream, to_rerun_quaternion};
 use crate::ins::pipeline::InsView;
 
 /// The INS's body axes.
@@ -35,8 +35,8 @@ impl BodyScene {
         }
     }
 
-    /// Sends the buffered rows at `times`.
-    pub(crate) fn flush(&mut self, stream: &Stream, times: &[f64]) -> RecordingStreamResult<()> {
+    /// Sends the buffered rows at `times`; returns the chunks sent.
+    pub(crate) fn flush(&mut self, stream: &Stream, times: &[f64]) -> RecordingStreamResult<usize> {
         let reference = self.reference.as_mut().map(std::mem::take);
         for (path, q) in [(INS_BODY, Some(std::mem::take(&mut self.ins))), (REFERENCE_BODY, reference)] {
             let Some(q) = q.filter(|q| !q.is_empty()) else { continue };
@@ -46,16 +46,13 @@ impl BodyScene {
                 rerun::Transform3D::update_fields().with_many_quaternion(q).columns_of_unit_batches()?,
             )?;
         }
-        Ok(())
+        Ok(1)
     }
-}
 
-impl Recorder {
     /// The body's static parts: an IMU case and its three axes (x right, y forward, z up), and the
     /// reference's axes in grey.
-    pub(crate) fn log_body_once(&self) -> RecordingStreamResult<()> {
-        let Some(body) = &self.body else { return Ok(()) };
-        let rec = &self.rec;
+    pub(crate) fn log_static(&self, stream: &Stream) -> RecordingStreamResult<()> {
+        let rec = stream.rec();
         rec.log_static(INS_BODY, &rerun::Transform3D::IDENTITY)?;
         rec.log_static(
             format!("{INS_BODY}/case"),
@@ -78,7 +75,7 @@ impl Recorder {
                 .with_colors(colors::SENSOR.map(super::palette::label))
                 .with_radii([0.002]),
         )?;
-        if body.reference.is_some() {
+        if self.reference.is_some() {
             rec.log_static(REFERENCE_BODY, &rerun::Transform3D::IDENTITY)?;
             let longer = tips.map(|[x, y, z]| [x * 1.3, y * 1.3, z * 1.3]);
             rec.log_static(

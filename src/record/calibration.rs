@@ -6,7 +6,7 @@ use nalgebra::Vector3;
 use rerun::RecordingStreamResult;
 use rerun::blueprint::components::ContainerKind;
 
-use super::layout::{self, Node};
+use super::blueprint::{self, Node};
 use super::palette::{albedo, p3, rgb, rgba};
 use super::scene::{cone, ring_radius};
 use super::{CustomLayout, Recorder, Stream, TIMELINE};
@@ -41,7 +41,7 @@ pub fn log(
     let set = &cal.set;
     let table: Vec<(usize, Param)> = set.params.iter().copied().enumerate().filter(|(_, p)| p.is_table()).collect();
     let plot = |name: String, origin: String| {
-        Node::view("TimeSeries", name, origin).with_property("TimeAxis", &layout::whole_run_time_axis())
+        Node::view("TimeSeries", name, origin).with_property("TimeAxis", &blueprint::whole_run_time_axis())
     };
     // Each state's plot is framed on where the filter ends: the final estimate ± 4 × its 3σ band
     // (at least ±1″), widened to include the true value; the prior's ±3σ start falls off the top.
@@ -52,14 +52,14 @@ pub fn log(
             let (x, sd, t) =
                 (cal.kf.theta[*i] * ARCSEC_PER_RAD, cal.kf.sigma(*i) * ARCSEC_PER_RAD, truth[*i] * ARCSEC_PER_RAD);
             // On the viewer's power-of-ten grid: a centre on a tick and ±1.25 × a 1-2-3 half range,
-            // so that the plot labels 3-7 ticks (layout::symmetric_range).
+            // so that the plot labels 3-7 ticks (blueprint::symmetric_range).
             let h = crate::math::units::nice_half_range((12.0 * sd).max(1.0).max(1.5 * (x - t).abs()));
             let tick = 10f64.powf(h.log10().floor());
             let centre = (x / tick).round() * tick;
             // The key is in the calibration document (the grid's cells are too narrow for it).
             plot(format!("{} (″)", p.label(chain)), format!("calibration/state_arcsec/{}", p.key(chain)))
-                .with_property("ScalarAxis", &layout::scalar_range(centre - 1.25 * h, centre + 1.25 * h))
-                .with_property("PlotLegend", &layout::no_legend())
+                .with_property("ScalarAxis", &blueprint::scalar_range(centre - 1.25 * h, centre + 1.25 * h))
+                .with_property("PlotLegend", &blueprint::no_legend())
         })
         .collect();
     // Keyed in the title (a legend would cover the first trough); KF wide under LSQ thin, since
@@ -71,7 +71,7 @@ pub fn log(
                 format!("{a} error (″) — red before, yellow (wide) after static KF, blue after exact LSQ"),
                 format!("calibration/error_arcsec/{a}"),
             )
-            .with_property("PlotLegend", &layout::no_legend())
+            .with_property("PlotLegend", &blueprint::no_legend())
         })
         .collect();
     let right = Node::container(
@@ -159,7 +159,9 @@ pub fn log(
     }
 
     // Ghost cones and estimated rotor axes, once per second of the test.
-    let x = recorder.factors.swing; // the swing cones' drawing factor (drawing_factors)
+    // The ghosts stand in the table's scene, beside its true cones and axes.
+    let Some(scene) = recorder.table_scene() else { return Ok(recorder) };
+    let x = scene.factors.swing; // the swing cones' drawing factor (drawing_factors)
     let n = chain.axes().len();
     // Once a second, and at most GHOST_FRAMES times over the test (a mesh each: a 100-h test must
     // not write 360 000 of them).
@@ -187,7 +189,7 @@ pub fn log(
                 continue;
             }
             let (mesh, rims) = cone(g.axis, g.e1, g.e2, alpha * x, half * 1.02);
-            let mount = &recorder.paths.mounts[k];
+            let mount = &scene.paths.mounts[k];
             rec.log(
                 format!("{mount}/estimated_cone"),
                 &rerun::Mesh3D::new(mesh.0).with_triangle_indices(mesh.1).with_albedo_factor(albedo(GHOST, 35)),
@@ -201,7 +203,7 @@ pub fn log(
             let w_est = rotvec::exp(&(chain.swing_vector(k, &est.axes[k], 0.0) * x));
             let dir: Vector3<f64> = (w_true.inverse() * w_est) * g.axis;
             rec.log(
-                format!("{}/estimated_axis", recorder.paths.gimbals[k]),
+                format!("{}/estimated_axis", scene.paths.gimbals[k]),
                 &rerun::LineStrips3D::new([[p3(-dir * half * 1.1), p3(dir * half * 1.1)]])
                     .with_colors([rgb(GHOST)])
                     .with_radii([0.006]),

@@ -1,109 +1,164 @@
-//! What a run with the INS in the loop adds to a recording: the INS error plots' styles, the raw and
-//! filtered gyro signals of the first moments, the FIR's amplitude response and the trace of the
-//! true and computed IMU axes beside the table.
+//! What a run with the INS in the loop adds to a recording beside its plots: the raw and filtered
+//! gyro signals of the first moments, the FIR's amplitude response, the drift dial and the trace
+//! of the true and computed IMU axes beside the table.
 
+use nalgebra::{UnitQuaternion, Vector3};
 use rerun::RecordingStreamResult;
 
 use super::palette::{colors, rgb, rgba};
-use super::{Recorder, SERIES_CHUNK_ROWS, rows};
+use super::plots::InsSeries;
+use super::{ReplayKind, SERIES_CHUNK_ROWS, Stream};
 use crate::ins::core::SampleOut;
-use crate::math::units::DEG_PER_RAD;
-use crate::sim::ERROR_AXES;
+use crate::ins::pipeline::InsView;
+use crate::math::rotvec;
+use crate::math::units::{ARCSEC_PER_RAD, DEG_PER_RAD};
+use crate::scenario::Params;
 
-/// What a run with an IMU in the loop adds to the recording.
-pub(crate) struct InsLayout {
+/// The INS's view in the 3D scene and beside it: the trace of the true and computed IMU axes, the
+/// drift dial, the FIR's amplitude response and the raw and filtered gyro signals of the first
+/// moments. It owns those entities.
+pub(crate) struct InsScene {
     pub(crate) algorithms: Vec<String>,
-    /// The attitude errors per algorithm are recorded (a simulation, a replay with a reference).
-    pub(crate) errors: bool,
+    /// The algorithms not shown (`[recording.show]`), by name: their needles stand at zero.
+    pub(crate) hidden: Vec<String>,
     /// The trace of the true and computed IMU axes beside the table (not for a strapdown IMU).
-    pub(crate) trace: bool,
-    pub(crate) signal_t: Vec<f64>,
-    pub(crate) raw: Vec<f64>,
-    pub(crate) filtered: Vec<f64>,
+    trace: bool,
+    signal_t: Vec<f64>,
+    raw: Vec<f64>,
+    filtered: Vec<f64>,
     /// Per buffered scene frame, the true IMU axes then the computed ones (six arrows).
-    pub(crate) trace_axes: Vec<[f32; 3]>,
+    trace_axes: Vec<[f32; 3]>,
     pub(crate) exaggeration: f64,
     pub(crate) fir_taps: Vec<f64>,
-    pub(crate) rate_hz: f64,
+    rate_hz: f64,
     pub(crate) signal_window_s: f64,
     /// Largest |rate| in the raw and the filtered gyro window, deg/s (their plots' framing).
     pub(crate) signal_peak_deg_per_s: [f64; 2],
-    /// Pure coning: each algorithm's analytic drift about the cone axis, drawn beside its
-    /// measured error on the log10 drift plot.
-    pub(crate) coning_log: Option<ConingLines>,
-    /// With two algorithms or more: the drift dial, a needle per algorithm.
-    pub(crate) dial_on: bool,
-    /// The algorithms not shown (`[recording.show]`), by name.
-    pub(crate) hidden: Vec<String>,
+    /// With two algorithms or more and their errors recorded: the drift dial, a needle per algorithm.
+    dial_on: bool,
     /// Per buffered dial frame (at most [`DIAL_HZ`]: the errors grow slowly; at the scene's rate
     /// the dial would add 13 MB/h), each algorithm's needle.
-    pub(crate) dial: Vec<[f32; 3]>,
+    dial: Vec<[f32; 3]>,
     /// The dial's frame times, s, and the time of the next.
-    pub(crate) dial_t: Vec<f64>,
-    pub(crate) dial_next_t: f64,
+    dial_t: Vec<f64>,
+    dial_next_t: f64,
 }
 
-/// Pure coning's analytic drift lines: each algorithm's |heading error| grows at its rate
-/// (`ins::coning::coning_drift_rate`, arcsec/s); in a live session whose cone or sample rate
-/// changed, from what it had reached at the change (`base` at `since_s`) at the new rate.
-#[derive(Debug, Clone)]
-pub(crate) struct ConingLines {
-    /// Each algorithm's analytic drift rate now, arcsec/s.
-    pub(crate) rates: Vec<f64>,
-    /// Since when, s.
-    pub(crate) since_s: f64,
-    /// Each line's value then, arcsec.
-    pub(crate) base: Vec<f64>,
-}
-
-impl ConingLines {
-    /// Lines from t = 0 at `rates`.
-    pub(crate) fn new(rates: Vec<f64>) -> Self {
-        let base = vec![0.0; rates.len()];
-        Self { rates, since_s: 0.0, base }
+impl InsScene {
+    /// The INS's view of a run of `params` (`replay`: of a replayed log of that kind), whose plots
+    /// are `plots` (the algorithms, whether their errors are recorded, pure coning's lines).
+    pub(crate) fn new(params: &Params, replay: Option<ReplayKind>, plots: &InsSeries) -> Option<Self> {
+        let cfg = params.ins.as_ref()?;
+        // The INS trace and the drift dial draw the INS's error ×N: where the largest error of
+        // the run is known in advance (pure coning: the analytic drifts), N is lowered to the
+        // largest 1-2-5 factor that keeps it under 150°, so the picture never wraps round.
+        let exaggeration = plots.coning.as_ref().map_or(params.recording.exaggeration, |lines| {
+            let worst_rad = lines.rates.iter().fold(0.0_f64, |m, r| m.max(*r)) * params.duration_s / ARCSEC_PER_RAD;
+            let limit = 150.0 * crate::math::units::RAD_PER_DEG;
+            if worst_rad * params.recording.exaggeration <= limit {
+                return params.recording.exaggeration;
+            }
+            crate::math::units::nice_at_most(limit / worst_rad).max(1e-3)
+        });
+        Some(Self {
+            algorithms: plots.algorithms.clone(),
+            hidden: plots.hidden.clone(),
+            // A strapdown IMU's axes are drawn as the body (`body_view`), not as a trace beside a table.
+            trace: replay.is_none_or(|k| k.table),
+            signal_t: Vec::new(),
+            raw: Vec::new(),
+            filtered: Vec::new(),
+            trace_axes: Vec::new(),
+            // The dial turns by the errors: none without them.
+            dial_on: plots.algorithms.len() >= 2 && plots.errors,
+            dial: Vec::new(),
+            dial_t: Vec::new(),
+            dial_next_t: f64::NEG_INFINITY,
+            exaggeration,
+            fir_taps: cfg.fir_taps.clone(),
+            rate_hz: params.step_hz,
+            signal_window_s: cfg.signal_window_s.max(0.01),
+            signal_peak_deg_per_s: [0.0; 2],
+        })
     }
 
-    /// Algorithm `j`'s analytic |heading error| at `t_s`, arcsec.
-    pub(crate) fn at(&self, j: usize, t_s: f64) -> f64 {
-        self.base[j] + self.rates[j] * (t_s - self.since_s)
+    /// Whether anything of it moves with the scene (the trace, the dial).
+    pub(crate) fn in_scene(&self) -> bool {
+        self.trace || self.dial_on
     }
 
-    /// From `t_s` on, the lines grow at `rates` from where they are.
-    pub(crate) fn change(&mut self, t_s: f64, rates: Vec<f64>) {
-        self.base = (0..self.rates.len()).map(|j| self.at(j, t_s)).collect();
-        self.since_s = t_s;
-        self.rates = rates;
+    /// Buffers one scene frame: the trace's true and computed axes (without an INS view, or
+    /// without its truth, it stands still at the identity) and, when due, the dial's needles.
+    pub(crate) fn push_scene(&mut self, t_s: f64, ins: Option<&InsView>) {
+        if self.trace {
+            let (t, c) = ins
+                .and_then(|v| Some((*v.imu_true?.quaternion(), *v.imu_ins.quaternion())))
+                .unwrap_or((UnitQuaternion::identity(), UnitQuaternion::identity()));
+            let err = rotvec::log(&(c * t.inverse())) * self.exaggeration;
+            let ins_q = rotvec::exp(&err) * t;
+            // The true axes, then the computed ones, as arrows in the trace's (unturned) frame.
+            for q in [t, ins_q] {
+                for axis in [Vector3::x(), Vector3::y(), Vector3::z()] {
+                    let v = q * (axis * TRACE_AXIS_LENGTH);
+                    self.trace_axes.push([v.x as f32, v.y as f32, v.z as f32]);
+                }
+            }
+        }
+        // The needles turn clockwise by the size of each algorithm's attitude error (whichever
+        // axis it is on: heading for a cone about z, pitch for Li et al. 2014's wobble), ×N.
+        if self.dial_on && t_s >= self.dial_next_t {
+            self.dial_t.push(t_s);
+            self.dial_next_t = t_s + 1.0 / DIAL_HZ - 1e-9;
+            for (k, name) in self.algorithms.iter().enumerate() {
+                let size = ins
+                    .and_then(|v| v.errors.get(k))
+                    .filter(|_| !self.hidden.contains(name))
+                    .map_or(0.0, |e| e.as_array().iter().map(|x| x * x).sum::<f64>().sqrt());
+                self.dial.push(needle(-size * self.exaggeration));
+            }
+        }
     }
-}
 
-/// Each algorithm's analytic drift rate about the cone axis for the pure cone of `params` at its
-/// step rate, arcsec/s (None without one).
-pub(crate) fn coning_rates(
-    params: &crate::scenario::Params,
-    algorithms: &[crate::ins::coning::Algorithm],
-) -> Option<Vec<f64>> {
-    let cone = params.table.vehicle.pure_coning()?;
-    let freq_hz = cone.omega_rad_per_s / std::f64::consts::TAU;
-    Some(
-        algorithms
-            .iter()
-            .map(|a| {
-                crate::ins::coning::coning_drift_rate(*a, cone.half_angle_rad, freq_hz, 1.0 / params.step_hz).abs()
-                    * crate::math::units::ARCSEC_PER_RAD
-            })
-            .collect(),
-    )
+    /// Sends the trace's buffered frames at `times`; returns the chunks sent.
+    pub(crate) fn flush_scene(&mut self, stream: &Stream, times: &[f64]) -> RecordingStreamResult<usize> {
+        let trace = std::mem::take(&mut self.trace_axes);
+        if trace.is_empty() {
+            return Ok(0);
+        }
+        debug_assert_eq!(trace.len(), 6 * times.len());
+        stream.rec().send_columns(
+            TRACE_AXES_PATH,
+            stream.time_columns(times),
+            rerun::Arrows3D::update_fields().with_vectors(trace).columns(std::iter::repeat_n(6, times.len()))?,
+        )?;
+        Ok(1)
+    }
+
+    /// Sends the drift dial's buffered frames (with the plots: the needles turn with the errors);
+    /// returns the chunks sent.
+    pub(crate) fn flush_dial(&mut self, stream: &Stream) -> RecordingStreamResult<usize> {
+        let dial_t = std::mem::take(&mut self.dial_t);
+        let needles = std::mem::take(&mut self.dial);
+        if dial_t.is_empty() {
+            return Ok(0);
+        }
+        let k = self.algorithms.len();
+        stream.rec().send_columns(
+            DIAL_NEEDLES_PATH,
+            stream.time_columns(&dial_t),
+            rerun::Arrows3D::update_fields().with_vectors(needles).columns(std::iter::repeat_n(k, dial_t.len()))?,
+        )?;
+        Ok(1)
+    }
+
+    /// Live mode: the algorithms shown (`[recording.show]`).
+    pub(crate) fn set_hidden(&mut self, hidden: &[String]) {
+        self.hidden = hidden.to_vec();
+    }
 }
 
 /// Frames per second of the drift dial, at most.
 pub(crate) const DIAL_HZ: f64 = 4.0;
-
-impl InsLayout {
-    /// Whether the drift dial is drawn.
-    pub(crate) fn dial_shown(&self) -> bool {
-        self.dial_on
-    }
-}
 
 /// The needles of the drift dial (one arrow per algorithm, in the dial's frame).
 pub(crate) const DIAL_NEEDLES_PATH: &str = "world/drift_dial/needles";
@@ -126,9 +181,6 @@ pub(crate) const TRACE_AXIS_LENGTH: f64 = 0.6;
 /// Where the drift dial (one needle per algorithm, turned by the size of its attitude error ×N) stands.
 pub(crate) const DIAL_OFFSET: [f32; 3] = [2.3, 0.2, -0.5];
 
-/// The log10 plot of the coning drift: each algorithm's |heading error| beside its analytic rate × t.
-pub(crate) const CONING_LOG_PATH: &str = "ins/coning_drift_log10_arcsec";
-
 /// The raw gyro signal of the first moments.
 pub(crate) const GYRO_RAW_PATH: &str = "ins/gyro_raw_deg_per_s";
 /// The gyro signal after the FIR (with a FIR only).
@@ -140,104 +192,42 @@ const GYRO_NAMES: [&str; 3] = ["gyro x", "gyro y", "gyro z"];
 /// Where the INS trace (true and computed IMU axes) is drawn, beside the table.
 pub(crate) const TRACE_OFFSET: [f32; 3] = [1.3, 1.3, -0.5];
 
-impl Recorder {
+impl InsScene {
     /// Buffers one raw and filtered gyro sample (the signal window at the IMU rate).
-    pub fn push_signal(&mut self, s: &SampleOut) -> RecordingStreamResult<()> {
-        let Some(layout) = self.ins.as_mut() else { return Ok(()) };
+    pub(crate) fn push_signal(&mut self, s: &SampleOut, stream: &Stream) -> RecordingStreamResult<()> {
+        let layout = self;
         layout.signal_t.push(s.t_s);
         layout.raw.extend(s.raw_rate_s.iter().map(|x| x * DEG_PER_RAD));
         layout.filtered.extend(s.filtered_rate_s.iter().map(|x| x * DEG_PER_RAD));
         layout.signal_peak_deg_per_s[0] = layout.signal_peak_deg_per_s[0].max(s.raw_rate_s.amax() * DEG_PER_RAD);
         layout.signal_peak_deg_per_s[1] = layout.signal_peak_deg_per_s[1].max(s.filtered_rate_s.amax() * DEG_PER_RAD);
         if layout.signal_t.len() >= SERIES_CHUNK_ROWS {
-            self.flush_signal()?;
+            layout.flush_signal(stream)?;
         }
         Ok(())
     }
 
-    pub(crate) fn flush_signal(&mut self) -> RecordingStreamResult<()> {
-        let Some(layout) = self.ins.as_mut() else { return Ok(()) };
+    /// Sends the buffered gyro samples.
+    pub(crate) fn flush_signal(&mut self, stream: &Stream) -> RecordingStreamResult<()> {
+        let layout = self;
         if layout.signal_t.is_empty() {
             return Ok(());
         }
         let times = std::mem::take(&mut layout.signal_t);
         let names = GYRO_NAMES.map(String::from);
         let (raw, filtered) = (std::mem::take(&mut layout.raw), std::mem::take(&mut layout.filtered));
-        self.stream.send_series(GYRO_RAW_PATH, &names, &times, raw, 3)?;
+        stream.send_series(GYRO_RAW_PATH, &names, &times, raw, 3)?;
         // Without a FIR the filtered signal is the raw one.
         if layout.fir_taps.len() > 1 {
-            self.stream.send_series(GYRO_FILTERED_PATH, &names, &times, filtered, 3)?;
+            stream.send_series(GYRO_FILTERED_PATH, &names, &times, filtered, 3)?;
         }
         Ok(())
     }
 
-    /// Which algorithms' lines are shown (`[recording.show]`): the whole line of a hidden one, on
-    /// every INS error plot and the coning plot (its needle on the dial stands at zero).
-    pub(crate) fn log_shown_algorithms(&self) -> RecordingStreamResult<()> {
-        let Some(layout) = &self.ins else { return Ok(()) };
-        let shown: Vec<bool> = layout.algorithms.iter().map(|a| !layout.hidden.contains(a)).collect();
-        for axis in ERROR_AXES.iter().filter(|_| layout.errors && layout.algorithms.len() > 1) {
-            self.rec.log_static(
-                format!("ins/attitude_error_arcsec/{axis}"),
-                &rerun::SeriesLines::update_fields().with_visible_series(shown.iter().copied()),
-            )?;
-        }
-        if layout.coning_log.is_some() {
-            self.rec.log_static(
-                CONING_LOG_PATH,
-                &rerun::SeriesLines::update_fields().with_visible_series(shown.iter().flat_map(|v| [*v; 2])),
-            )?;
-        }
-        Ok(())
-    }
-
-    /// Static parts of an INS run: series styles, the FIR's amplitude response, the trace's axes.
-    pub(crate) fn log_ins_once(&self) -> RecordingStreamResult<()> {
-        let Some(layout) = &self.ins else { return Ok(()) };
-        let rec = &self.rec;
-        // Each algorithm keeps its colour in every recording (by identity, not by position).
-        let algo_colors: Vec<rerun::Color> =
-            layout.algorithms.iter().map(|name| rgb(colors::algorithm(name))).collect();
-        for axis in ERROR_AXES.iter().filter(|_| layout.errors) {
-            let path = format!("ins/attitude_error_arcsec/{axis}");
-            rec.log_static(
-                path.as_str(),
-                &rerun::SeriesLines::new().with_colors(algo_colors.clone()).with_names(self.series_names(&path)),
-            )?;
-        }
-        if layout.coning_log.is_some() {
-            // Measured: the algorithm's colour, wide; analytic: the same colour, thin.
-            let colors: Vec<rerun::Color> =
-                layout.algorithms.iter().flat_map(|name| [rgb(colors::algorithm(name)); 2]).collect();
-            let widths: Vec<f32> = layout.algorithms.iter().flat_map(|_| [2.5, 1.0]).collect();
-            rec.log_static(
-                CONING_LOG_PATH,
-                &rerun::SeriesLines::new()
-                    .with_colors(colors)
-                    .with_widths(widths)
-                    .with_names(self.series_names(CONING_LOG_PATH)),
-            )?;
-        }
-        self.log_shown_algorithms()?;
-        // Pitch/roll/heading and east/north/up: red, green, blue.
-        let three = [
-            "ins/position_error_m",
-            "ins/velocity_error_mps",
-            rows::BODY_ATTITUDE_PATH,
-            rows::VELOCITY_PATH,
-            rows::POSITION_PATH,
-            rows::LAT_LON_PATH,
-            rows::HEIGHT_PATH,
-        ];
-        for path in three.into_iter().filter(|p| self.has_series(p)) {
-            let names = self.series_names(path);
-            rec.log_static(
-                path,
-                &rerun::SeriesLines::new()
-                    .with_colors(colors::EULER[..names.len()].iter().map(|c| rgb(*c)))
-                    .with_names(names),
-            )?;
-        }
+    /// Its static parts: the gyro plots' styles, the FIR's amplitude response, the dial, the trace's axes.
+    pub(crate) fn log_static(&self, stream: &Stream) -> RecordingStreamResult<()> {
+        let layout = self;
+        let rec = stream.rec();
         for path in [GYRO_RAW_PATH, GYRO_FILTERED_PATH].into_iter().take(if layout.fir_taps.len() > 1 { 2 } else { 1 })
         {
             rec.log_static(

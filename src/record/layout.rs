@@ -1,250 +1,265 @@
-//! The viewer layout sent with every recording: a small declarative blueprint that, unlike the SDK's
-//! `rerun::blueprint` builders (0.36), can also set view properties — the 3D eye and the plots' time
-//! range — so the recording opens ready to read.
+//! The layout a run's recording opens with: the 3D scene and its documents on the left, the error
+//! plots on the right (the INS's when it is in the loop, the table-only ones in tabs; a replay
+//! without a reference leads with the INS's own solution). Only entities the recording has are
+//! laid out.
 
-use rerun::blueprint::components::{ContainerKind, PanelState, PlayState, RootContainer};
-use rerun::external::re_log_types::{BlueprintActivationCommand, LogMsg};
-use rerun::external::re_sdk_types::blueprint::archetypes as bp;
-use rerun::external::re_sdk_types::blueprint::components as bpc;
-use rerun::external::re_sdk_types::datatypes;
-use rerun::{AsComponents, RecordingStream, RecordingStreamBuilder, RecordingStreamResult};
+use rerun::RecordingStreamResult;
+use rerun::blueprint::components::ContainerKind;
 
-/// A view or a container of the layout.
-#[derive(Clone)]
-pub enum Node {
-    /// A container of children.
-    Container {
-        /// Tabs, horizontal, vertical or grid.
-        kind: ContainerKind,
-        /// Children in order.
-        children: Vec<Node>,
-        /// Relative sizes along the container's axis (empty: equal).
-        shares: Vec<f32>,
-    },
-    /// A view.
-    View {
-        /// "3D", "TimeSeries", "TextDocument", "TextLog".
-        class: &'static str,
-        /// Title.
-        name: String,
-        /// Space origin (entity path).
-        origin: String,
-        /// (property archetype name, its components).
-        properties: Vec<(&'static str, Vec<rerun::SerializedComponentBatch>)>,
-    },
-}
+use super::blueprint::{self, Node};
+use super::plots::Quantity;
+use super::plots::coning::CONING_LOG_PATH;
+use super::plots::series as rows;
+use super::{APPLICATION_ID, CustomLayout, Recorder, TIMELINE};
+use crate::scenario::Params;
+use crate::sim::ERROR_AXES;
 
-impl Node {
-    /// A container.
-    #[must_use]
-    pub fn container(kind: ContainerKind, children: Vec<Node>, shares: &[f32]) -> Self {
-        Self::Container { kind, children, shares: shares.to_vec() }
-    }
-
-    /// A view with no properties.
-    #[must_use]
-    pub fn view(class: &'static str, name: impl Into<String>, origin: impl Into<String>) -> Self {
-        Self::View { class, name: name.into(), origin: origin.into(), properties: Vec::new() }
-    }
-
-    /// Gives every time-series view under this node that has no value range the range `range`
-    /// returns for its space origin (None: left to the viewer).
-    pub fn frame_plots_without_range(&mut self, range: &dyn Fn(&str) -> Option<(f64, f64)>) {
-        match self {
-            Self::Container { children, .. } => {
-                for c in children {
-                    c.frame_plots_without_range(range);
-                }
+impl Recorder {
+    pub(crate) fn send_blueprint(&self, p: &Params, custom: Option<CustomLayout>) -> RecordingStreamResult<()> {
+        let plot = |name: String, origin: &str| {
+            Node::view("TimeSeries", name, origin).with_property("TimeAxis", &blueprint::whole_run_time_axis())
+        };
+        let unit = self.error_unit();
+        // Symmetric ranges once the run's peaks are known, with labelled ticks.
+        let framed = |node: Node, peak: Option<f64>| match peak {
+            Some(p) if p > 0.0 => {
+                let h = crate::math::units::nice_half_range(p);
+                node.with_property("ScalarAxis", &blueprint::symmetric_range(h))
             }
-            Self::View { class, origin, properties, .. } => {
-                if *class == "TimeSeries"
-                    && !properties.iter().any(|(n, _)| *n == "ScalarAxis")
-                    && let Some((lo, hi)) = range(origin)
-                {
-                    properties.push(("ScalarAxis", scalar_range(lo, hi).as_serialized_batches()));
-                }
+            _ => node,
+        };
+        let table_peak = |a: usize| self.ranges.map(|r| super::floored_peak(r.table_peak_rad, a) * unit.per_rad());
+        // The legend would sit over the data: the title says which line is which.
+        let key = match self.replay {
+            None => "red: uncompensated, blue: closed form, green: compensated",
+            Some(k) if k.reference => "red: nominal table, green: compensated",
+            Some(_) => "nominal − compensated table",
+        };
+        let error_view = |a: usize, axis: &str| {
+            framed(
+                plot(format!("{axis} error ({}) — {key}", unit.suffix()), &super::error_path(unit, axis)),
+                table_peak(a),
+            )
+            .with_property("PlotLegend", &blueprint::no_legend())
+        };
+        let x = p.recording.exaggeration;
+        let own = self.table.as_ref().map(|t| super::own_factors(&t.factors, x)).unwrap_or_default();
+        let scale = if own.is_empty() { format!("errors ×{x}") } else { format!("errors ×{x}, {}", own.join(", ")) };
+        let scene = match (&self.body, &self.ins) {
+            (Some(_), _) => Node::view(
+                "3D",
+                format!(
+                    "3D: the IMU (body) axes at the INS attitude{}",
+                    if self.replay.is_some_and(|k| k.reference) { "; grey: the reference" } else { "" }
+                ),
+                "world",
+            )
+            .with_property("EyeControls3D", &blueprint::eye([2.4, -2.6, 1.5], [0.0, 0.1, -0.1])),
+            // With an INS, the trace stands beside the table: step back to frame both.
+            (None, Some(_)) => Node::view("3D", format!("3D: gimbal chain ({scale})"), "world")
+                .with_property("EyeControls3D", &blueprint::eye([3.6, -1.7, 1.5], [0.7, 0.7, -0.3])),
+            (None, None) => Node::view("3D", format!("3D: gimbal chain ({scale})"), "world")
+                .with_property("EyeControls3D", &blueprint::eye([2.6, -1.1, 0.95], [0.0, 0.1, -0.2])),
+        };
+        let (custom_right, mut doc_tabs) = match custom {
+            Some(c) => (Some(c.right), c.docs),
+            None => (None, Vec::new()),
+        };
+        doc_tabs.extend([
+            Node::view("TextDocument", "scenario", "docs/scenario"),
+            Node::view("TextDocument", "config", "docs/config"),
+            Node::view("TextLog", "events", "events"),
+        ]);
+        let docs = Node::container(ContainerKind::Tabs, doc_tabs, &[]);
+        let left = Node::container(ContainerKind::Vertical, vec![scene, docs], &[3.0, 1.3]);
+        let mut more = Vec::new();
+        if self.plots.has(super::CLOSED_FORM_PATH) {
+            let peak = self.ranges.map(|r| {
+                r.closed_form_peak_rad.iter().fold(0.0_f64, |m, x| m.max(*x)) * crate::math::units::ARCSEC_PER_RAD
+            });
+            more.push(
+                framed(
+                    plot(
+                        "closed form − exact (arcsec) — red pitch, green roll, blue heading".into(),
+                        super::CLOSED_FORM_PATH,
+                    ),
+                    peak,
+                )
+                .with_property("PlotLegend", &blueprint::no_legend()),
+            );
+        }
+        for (title, path) in
+            [("gimbal angles (deg)", "gimbal_angle_deg"), ("vehicle attitude (deg)", "vehicle_attitude_deg")]
+        {
+            if self.plots.has(path) {
+                more.push(plot(title.into(), path));
             }
         }
-    }
-
-    /// Adds a view property (e.g. `EyeControls3D`, `TimeAxis`).
-    #[must_use]
-    pub fn with_property(mut self, name: &'static str, archetype: &dyn AsComponents) -> Self {
-        if let Self::View { properties, .. } = &mut self {
-            properties.push((name, archetype.as_serialized_batches()));
+        if self.plots.any(|q| matches!(q, Quantity::Swing(_))) {
+            more.push(plot("swing angles (arcsec)".into(), "swing_arcsec"));
         }
-        self
-    }
-}
-
-/// A plot that always shows the whole run, not a window around the time cursor.
-#[must_use]
-pub fn whole_run_time_axis() -> bp::TimeAxis {
-    bp::TimeAxis::new().with_view_range(bpc::TimeRange(datatypes::TimeRange::EVERYTHING))
-}
-
-/// A plot of the first `seconds` of the run only (signals recorded over a short window).
-#[must_use]
-pub fn window_time_axis(seconds: f64) -> bp::TimeAxis {
-    let end = datatypes::TimeInt((seconds * 1e9) as i64);
-    bp::TimeAxis::new().with_view_range(bpc::TimeRange(datatypes::TimeRange {
-        start: datatypes::TimeRangeBoundary::Absolute(datatypes::TimeInt(0)),
-        end: datatypes::TimeRangeBoundary::Absolute(end),
-    }))
-}
-
-/// A plot of the timeline's range `[lo_s, hi_s]` (s, or whatever the timeline's seconds stand for).
-#[must_use]
-pub fn time_axis_range(lo_s: f64, hi_s: f64) -> bp::TimeAxis {
-    let at = |s: f64| datatypes::TimeRangeBoundary::Absolute(datatypes::TimeInt((s * 1e9) as i64));
-    bp::TimeAxis::new().with_view_range(bpc::TimeRange(datatypes::TimeRange { start: at(lo_s), end: at(hi_s) }))
-}
-
-/// A plot's value axis fixed to `[lo, hi]` (a filter's prior would otherwise set the scale).
-#[must_use]
-pub fn scalar_range(lo: f64, hi: f64) -> bp::ScalarAxis {
-    bp::ScalarAxis::new().with_range(rerun::components::Range1D(datatypes::Range1D([lo, hi])))
-}
-
-/// A symmetric plot range for data within ±`h` (a [`crate::math::units::nice_half_range`]):
-/// ±1.25 h. The plot labels its grid at powers of ten only, and drops the labels on the border,
-/// so ±h itself (h = 10^k) would show "0" alone; at ±1.25 h the ticks at ±h are inside. Measured
-/// in the viewer at 1600×1000 (plots ~170 px high): h = 1, 2, 3 × 10^k give 3, 5 and 7 labelled
-/// ticks.
-pub fn symmetric_range(h: f64) -> bp::ScalarAxis {
-    scalar_range(-1.25 * h, 1.25 * h)
-}
-
-/// No legend (the view's title names the lines).
-#[must_use]
-pub fn no_legend() -> bp::PlotLegend {
-    bp::PlotLegend::new().with_visible(false)
-}
-
-pub use bpc::Corner2D as LegendCorner;
-
-/// The legend in a corner of the plot.
-#[must_use]
-pub fn legend_at(corner: LegendCorner) -> bp::PlotLegend {
-    bp::PlotLegend::new().with_corner(corner)
-}
-
-/// A 3D eye looking at `target` from `position` with +z up.
-#[must_use]
-pub fn eye(position: [f32; 3], target: [f32; 3]) -> bp::EyeControls3D {
-    bp::EyeControls3D::new()
-        .with_kind(bpc::Eye3DKind::Orbital)
-        .with_position(position)
-        .with_look_target(target)
-        .with_eye_up([0.0, 0.0, 1.0])
-}
-
-/// Deterministic UUID-shaped ids: the same scenario gives the same blueprint.
-struct Ids(u64);
-
-impl Ids {
-    fn next(&mut self) -> String {
-        self.0 += 1;
-        format!("00000000-0000-4000-8000-{:012x}", self.0)
-    }
-
-    /// The bytes of the id `next` last returned.
-    fn last_bytes(&self) -> [u8; 16] {
-        let mut b = [0u8; 16];
-        b[6] = 0x40;
-        b[8] = 0x80;
-        b[10..].copy_from_slice(&self.0.to_be_bytes()[2..]);
-        b
-    }
-}
-
-fn log_node(node: &Node, stream: &RecordingStream, ids: &mut Ids) -> RecordingStreamResult<String> {
-    match node {
-        Node::View { class, name, origin, properties } => {
-            let path = format!("view/{}", ids.next());
-            stream.log(
-                format!("{path}/ViewContents"),
-                &bp::ViewContents::new([bpc::QueryExpression("$origin/**".into())]),
-            )?;
-            stream.log(
-                path.as_str(),
-                &bp::ViewBlueprint::new(bpc::ViewClass((*class).into()))
-                    .with_display_name(name.as_str())
-                    .with_space_origin(origin.as_str()),
-            )?;
-            for (prop, batches) in properties {
-                stream.log_serialized_batches(format!("{path}/{prop}"), false, batches.iter().cloned())?;
+        let has_table_errors = self.plots.has(&super::error_path(unit, "pitch"));
+        let right = match (self.plots.ins.as_ref().zip(self.ins.as_ref()), custom_right) {
+            (_, Some(right)) => right,
+            (None, None) => {
+                let more = Node::container(ContainerKind::Tabs, more, &[]);
+                Node::container(
+                    ContainerKind::Vertical,
+                    vec![error_view(0, "pitch"), error_view(1, "roll"), error_view(2, "heading"), more],
+                    &[],
+                )
             }
-            Ok(path)
-        }
-        Node::Container { kind, children, shares } => {
-            let mut child_paths = Vec::new();
-            for c in children {
-                child_paths.push(log_node(c, stream, ids)?);
-            }
-            let path = format!("container/{}", ids.next());
-            let mut arch = bp::ContainerBlueprint::new(*kind)
-                .with_contents(child_paths.iter().map(|p| bpc::IncludedContent(p.as_str().into())));
-            if !shares.is_empty() {
-                let s = shares.iter().map(|&x| bpc::ColumnShare(datatypes::Float32(x)));
-                let r = shares.iter().map(|&x| bpc::RowShare(datatypes::Float32(x)));
-                arch = match kind {
-                    ContainerKind::Horizontal => arch.with_col_shares(s),
-                    _ => arch.with_row_shares(r),
+            (Some((layout, signal)), None) => {
+                // The INS leads (its errors, else its own solution); the turntable-only (ideal-INS)
+                // plots go into the tabs.
+                let ins_peak = |a: usize| {
+                    self.ranges
+                        .and_then(|r| r.ins_peak_rad)
+                        .map(|p| super::floored_peak(p, a) * crate::math::units::ARCSEC_PER_RAD)
                 };
+                // The legend would sit over the data: the first plot's title gives each
+                // algorithm's colour (short, so that it is not cut), the others refer to it.
+                let algorithm_key = layout
+                    .algorithms
+                    .iter()
+                    .map(|a| format!("{} {}", super::palette::colors::algorithm_colour_name(a), short_name(a)))
+                    .collect::<Vec<_>>()
+                    .join(" · ");
+                let ins_view = |a: usize, axis: &str| {
+                    let title = match (a, layout.algorithms.len()) {
+                        (_, 1) => format!("INS {axis} error (arcsec)"),
+                        (0, _) => format!("INS {axis} error (arcsec) — {algorithm_key}"),
+                        _ => format!("INS {axis} error (arcsec), colours as above"),
+                    };
+                    framed(plot(title, &format!("ins/attitude_error_arcsec/{axis}")), ins_peak(a))
+                        .with_property("PlotLegend", &blueprint::no_legend())
+                };
+                // A replay's own solution, keyed in the titles (a legend would cover the curves).
+                let primary = layout.algorithms.first().map_or("", String::as_str);
+                let solution: Vec<Node> = [
+                    (
+                        rows::BODY_ATTITUDE_PATH,
+                        format!("INS body attitude (deg), {primary} — red pitch, green roll, blue heading"),
+                    ),
+                    (
+                        rows::VELOCITY_PATH,
+                        format!(
+                            "INS velocity (m/s) — red east, green north{}",
+                            if self.plots.names(rows::VELOCITY_PATH).len() > 2 { ", blue up" } else { "" }
+                        ),
+                    ),
+                    (rows::POSITION_PATH, "INS position from the start (m) — red east, green north".to_owned()),
+                    (rows::LAT_LON_PATH, "INS latitude, longitude (deg) — red latitude, green longitude".to_owned()),
+                    (rows::HEIGHT_PATH, "INS height (m)".to_owned()),
+                ]
+                .into_iter()
+                .filter(|(path, _)| self.plots.has(path))
+                .map(|(path, title)| plot(title, path).with_property("PlotLegend", &blueprint::no_legend()))
+                .collect();
+                let (lead, mut tabs): (Vec<Node>, Vec<Node>) = if layout.errors {
+                    (vec![ins_view(0, "pitch"), ins_view(1, "roll"), ins_view(2, "heading")], solution)
+                } else if has_table_errors {
+                    (vec![error_view(0, "pitch"), error_view(1, "roll"), error_view(2, "heading")], solution)
+                } else {
+                    // A strapdown IMU without a reference: its attitude, velocity and position lead.
+                    let mut s = solution;
+                    let rest = s.split_off(s.len().min(3));
+                    (s, rest)
+                };
+                if let Some(rates) = layout.coning.as_ref().map(|l| &l.rates) {
+                    // Whole decades, from a tenth of the run (the lines' left part is their steep
+                    // start) to the end, of the slowest to the fastest analytic drift.
+                    let logs = rates.iter().filter(|r| **r > 0.0).map(|r| (r * p.duration_s).log10());
+                    let (lo, hi) = logs.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)));
+                    let view = plot(
+                        "coning drift: log10 |heading error in ″|, thick measured, thin analytic rate × t".to_owned(),
+                        CONING_LOG_PATH,
+                    )
+                    .with_property("PlotLegend", &blueprint::no_legend());
+                    // Once measured lines exist, their whole extent (their steep start too: no
+                    // fixed range hides a series); before, the analytic lines'.
+                    // (A viewer watching live fits it itself: the session has no length to frame on.)
+                    let range = if self.live.is_some_and(super::LiveOutput::watched) {
+                        None
+                    } else {
+                        self.plots
+                            .data_range(CONING_LOG_PATH)
+                            .or_else(|| lo.is_finite().then(|| ((lo - 1.0).floor(), hi.ceil())))
+                    };
+                    tabs.push(match range {
+                        Some((a, b)) => view.with_property("ScalarAxis", &blueprint::scalar_range(a, b)),
+                        None => view,
+                    });
+                }
+                if self.plots.has("ins/position_error_m") {
+                    // Keyed in the titles: a legend would cover the curves.
+                    tabs.push(
+                        plot("position error (m) — red east, green north, blue radial".into(), "ins/position_error_m")
+                            .with_property("PlotLegend", &blueprint::no_legend()),
+                    );
+                    tabs.push(
+                        plot("velocity error (m/s) — red east, green north, blue up".into(), "ins/velocity_error_mps")
+                            .with_property("PlotLegend", &blueprint::no_legend()),
+                    );
+                }
+                let window = |name: &str, origin: &str| {
+                    Node::view("TimeSeries", name, origin)
+                        .with_property("TimeAxis", &blueprint::window_time_axis(signal.signal_window_s))
+                };
+                // Keyed in the title: a legend would sit over the signal.
+                // Framed on the window's peak once the run is over (labelled ticks, like the errors).
+                let peaks = signal.signal_peak_deg_per_s;
+                let gyro = |name: String, origin: &str, k: usize| {
+                    framed(window(&name, origin), self.ranges.map(|_| peaks[k]))
+                        .with_property("PlotLegend", &blueprint::no_legend())
+                };
+                let first = format!("the first {} s", signal.signal_window_s);
+                tabs.push(gyro(
+                    format!("gyro raw (deg/s), {first} — red x, green y, blue z"),
+                    super::ins_view::GYRO_RAW_PATH,
+                    0,
+                ));
+                if signal.fir_taps.len() > 1 {
+                    tabs.push(gyro(
+                        format!("gyro after FIR (deg/s), {first} — red x, green y, blue z"),
+                        super::ins_view::GYRO_FILTERED_PATH,
+                        1,
+                    ));
+                    tabs.push(Node::view("2D", "FIR response (x: Hz, y: −5·dB)", "ins/fir_response"));
+                }
+                if has_table_errors && layout.errors {
+                    for (a, axis) in ERROR_AXES.iter().enumerate() {
+                        tabs.push(framed(
+                            plot(format!("table only: {axis} ({})", unit.suffix()), &super::error_path(unit, axis)),
+                            table_peak(a),
+                        ));
+                    }
+                }
+                tabs.append(&mut more);
+                let mut column = lead;
+                column.push(Node::container(ContainerKind::Tabs, tabs, &[]));
+                Node::container(ContainerKind::Vertical, column, &[])
             }
-            stream.log(path.as_str(), &arch)?;
-            Ok(path)
+        };
+        let mut root = Node::container(ContainerKind::Horizontal, vec![left, right], &[1.1, 1.0]);
+        if self.live == Some(super::LiveOutput::File) {
+            // A saved session's plots framed on its data, as a run's are (a viewer watching live
+            // fits each plot's value axis to the data as they arrive: no range is sent to it).
+            root.fit_plots_without_range(&|origin| self.plots.data_range(origin));
         }
+        // Play a whole run in about a minute; a live session follows the newest data.
+        let speed = if self.live.is_some() { 1.0 } else { (p.duration_s / 60.0).max(1.0).round() };
+        blueprint::send(
+            self.stream.rec(),
+            APPLICATION_ID,
+            &root,
+            &blueprint::Playback { timeline: TIMELINE, speed, follow: self.live.is_some() || p.recording.open_at_end },
+        )
     }
 }
 
-/// Time-panel settings.
-pub struct Playback {
-    /// Timeline name.
-    pub timeline: &'static str,
-    /// Playback speed multiplier.
-    pub speed: f64,
-    /// Follow the newest data (live sessions) instead of playing from the start.
-    pub follow: bool,
-}
-
-/// Sends `root` as the active and default layout of `rec`'s application.
-pub fn send(
-    rec: &RecordingStream,
-    application_id: &'static str,
-    root: &Node,
-    playback: &Playback,
-) -> RecordingStreamResult<()> {
-    let (bp_stream, storage) = RecordingStreamBuilder::new(application_id).blueprint().memory()?;
-    bp_stream.set_time_sequence("blueprint", 0);
-    let mut ids = Ids(0);
-    // The root is a container, logged last, so its id is the last one handed out.
-    log_node(root, &bp_stream, &mut ids)?;
-    let root_uuid = datatypes::Uuid { bytes: ids.last_bytes() };
-    bp_stream.log(
-        "viewport",
-        &bp::ViewportBlueprint::new()
-            .with_root_container(RootContainer(root_uuid))
-            .with_auto_layout(false)
-            .with_auto_views(false),
-    )?;
-    bp_stream.log("blueprint_panel", &bp::PanelBlueprint::new().with_state(PanelState::Collapsed))?;
-    bp_stream.log("selection_panel", &bp::PanelBlueprint::new().with_state(PanelState::Collapsed))?;
-    bp_stream.log(
-        "time_panel",
-        &bp::TimePanelBlueprint::new()
-            .with_state(PanelState::Collapsed)
-            .with_timeline(bpc::TimelineName(playback.timeline.into()))
-            .with_playback_speed(bpc::PlaybackSpeed(datatypes::Float64(playback.speed)))
-            .with_play_state(if playback.follow { PlayState::Following } else { PlayState::Playing }),
-    )?;
-    // The memory sink is read after a flush; a flush failure only loses the layout, never data.
-    let _ = bp_stream.flush_blocking();
-    let msgs: Vec<LogMsg> = storage.take();
-    let Some(blueprint_id) = msgs.first().map(|m| m.store_id().clone()) else {
-        return Ok(());
-    };
-    rec.send_blueprint(msgs, BlueprintActivationCommand { blueprint_id, make_active: true, make_default: true });
-    Ok(())
+/// A coning algorithm's name as a colour key spells it (short enough that a plot title holds five):
+/// "single-sample" → "single", "two-sample" → "two", "two-sample-p1" → "p1", "three-sample" → "three".
+fn short_name(name: &str) -> String {
+    name.strip_prefix("two-sample-").map_or_else(|| name.replace("-sample", ""), str::to_owned)
 }

@@ -3,7 +3,7 @@
 
 use rerun::RecordingStreamResult;
 
-use super::{Recorder, Stream, drawing_factors, error_path, ins_view};
+use super::{Recorder, Stream, error_path};
 use crate::scenario::Params;
 use crate::sim::ERROR_AXES;
 
@@ -13,7 +13,7 @@ pub enum LiveOutput {
     /// Viewers watching as it runs: small chunks sent at a wall-clock cadence
     /// ([`Recorder::flush_series_held`]); the layout is sent once, each plot's value axis left to
     /// the viewer, which fits it to the data as they arrive (error plots held at symmetric ranges
-    /// by two invisible points, `frames.rs`).
+    /// by two invisible points, `plots/extents.rs`).
     Viewer,
     /// The session so far for viewers that open it late (the class page's `/history.rrd`):
     /// full-size chunks, flushed when asked for, and what a viewer watching from the start has
@@ -35,7 +35,7 @@ impl Recorder {
     /// A recorder for live mode feeding `output`: everything that a reload can change is logged
     /// on the timeline.
     pub fn new_live(stream: Stream, params: &Params, output: LiveOutput) -> RecordingStreamResult<Self> {
-        Self::build(stream, params, Some(output), None)
+        Self::build(stream, params, Some(output), None, None)
     }
 
     /// True for a live session's recorder.
@@ -47,44 +47,31 @@ impl Recorder {
     /// Live mode: new parameters apply from simulated time `t_s` on (buffered rows go out first).
     pub fn reconfigure(&mut self, t_s: f64, params: &Params) -> RecordingStreamResult<()> {
         self.flush_now()?;
-        self.truth = params.table.truth.clone();
-        let factors = drawing_factors(&self.truth, params.recording.exaggeration);
         // The 3D view's title names each class's drawing factor: the layout follows a change of it.
-        let retitle = factors != self.factors
+        let refactored =
+            self.table.as_mut().is_some_and(|t| t.set_truth(&params.table.truth, params.recording.exaggeration));
+        let retitle = refactored
             || self.live_params.as_ref().is_some_and(|p| p.recording.exaggeration != params.recording.exaggeration);
-        self.factors = factors;
-        self.drawing = self.chain.error_rotations(&self.truth.exaggerated(&self.factors));
         let old = self.live_params.replace(Box::new(params.clone()));
-        // Pure coning: the drawn cone and its label, and the analytic drift lines, follow a new
-        // cone or sample rate (the lines from where they stand: the drift goes on at the new rate).
+        // Pure coning: the drawn cone and its label follow a new cone.
         let alpha = |p: &Params| p.table.vehicle.pure_coning().map_or(0.0, |c| c.half_angle_rad);
         if let Some(gizmo) = self.cone.as_mut()
             && old.as_ref().is_none_or(|p| alpha(p) != alpha(params))
         {
-            gizmo.reshape(&self.rec, alpha(params), t_s)?;
+            gizmo.reshape(self.stream.rec(), alpha(params), t_s)?;
         }
-        if let Some(layout) = self.ins.as_mut() {
-            let algorithms = params.ins.as_ref().map(crate::ins::InsParams::algorithms).unwrap_or_default();
-            if let (Some(lines), Some(rates)) =
-                (layout.coning_log.as_mut(), ins_view::coning_rates(params, &algorithms))
-                && rates != lines.rates
-            {
-                lines.change(t_s, rates);
-            }
-            let hidden: Vec<String> =
-                layout.algorithms.iter().filter(|a| !params.recording.shows(a)).cloned().collect();
-            if hidden != layout.hidden {
-                layout.hidden = hidden;
-                self.log_shown_algorithms()?;
-            }
+        self.plots.reconfigure(&self.stream, t_s, params)?;
+        if let (Some(scene), Some(series)) = (self.ins.as_mut(), self.plots.ins.as_ref()) {
+            scene.set_hidden(&series.hidden);
         }
         if retitle {
             self.send_blueprint(params, self.custom.clone())?;
         }
         // Where the parameters changed, on every error plot (at 0: the plots' range is not known).
+        let unit = self.error_unit();
         for axis in ERROR_AXES {
-            self.stream.mark_events(&error_path(self.error_unit, axis), "reloads", "config reloaded", &[t_s], 0.0)?;
-            if self.ins.as_ref().is_some_and(|l| l.errors) {
+            self.stream.mark_events(&error_path(unit, axis), "reloads", "config reloaded", &[t_s], 0.0)?;
+            if self.ins_errors() {
                 self.stream.mark_events(
                     &format!("ins/attitude_error_arcsec/{axis}"),
                     "reloads",
@@ -94,7 +81,7 @@ impl Recorder {
                 )?;
             }
         }
-        self.log_error_geometry(params, self.geometry_at(t_s))
+        self.log_errors(params, self.geometry_at(t_s))
     }
 
     /// Sends the buffered time-series rows to viewers watching live: a series whose rows all

@@ -13,29 +13,27 @@
 //! the time and row-id columns of one entity per line.
 //! - `docs/scenario` (markdown), `docs/config` (the resolved TOML), `events` (text log).
 
-use nalgebra::{UnitQuaternion, Vector3};
+use nalgebra::UnitQuaternion;
 use rerun::{RecordingStream, RecordingStreamResult, TimeColumn};
 
-use layout::Node;
+use blueprint::Node;
 
 pub mod allan;
 mod blueprint;
 mod body_view;
 pub mod calibration;
 mod cone;
+mod documents;
 mod drawing;
 pub mod export;
 pub mod figures;
 mod ins_view;
 mod layout;
 mod live;
-pub use live::LiveOutput;
-mod frames;
 pub mod modulation;
 mod palette;
+pub(crate) mod plots;
 pub mod read;
-use frames::Frames;
-mod rows;
 mod scene;
 pub mod selfcal;
 pub mod sink;
@@ -43,18 +41,19 @@ pub mod tpr;
 
 pub use drawing::drawing_factors;
 use drawing::{floored_peak, own_factors};
+pub use live::LiveOutput;
+pub use plots::Solution;
 
 use crate::ins::pipeline::InsView;
-use crate::math::rotvec;
 use crate::math::units::ARCSEC_PER_RAD;
-use crate::model::gimbal::{Chain, ClassFactors, ErrorRotations, TableErrors};
 use crate::scenario::Params;
 use crate::sim::{ERROR_AXES, StepOutput};
+use body_view::BodyScene;
+use cone::ConeGizmo;
 use export::SharedExporter;
-use ins_view::InsLayout;
-use rows::Series;
-pub use rows::Solution;
-use scene::ChainPaths;
+use ins_view::InsScene;
+use plots::Plots;
+use scene::TableScene;
 
 /// A recording stream and, with `--export`, the tables its series also go to: what the commands
 /// hand from the sinks to the recorders (the rest of the crate names Rerun's types only here).
@@ -122,6 +121,46 @@ impl Stream {
             rerun::Scalars::new(values).columns(std::iter::repeat_n(width, times.len()))?,
         )?;
         Ok(())
+    }
+
+    /// Logs `arch` at `path`: static in a plain run (`at = None`), at simulated time `at` in live mode,
+    /// where a reload can change it and the saved session must show the history.
+    pub(crate) fn put(
+        &self,
+        at: Option<f64>,
+        path: impl Into<rerun::EntityPath>,
+        arch: &dyn rerun::AsComponents,
+    ) -> RecordingStreamResult<()> {
+        match at {
+            None => self.rec.log_static(path, arch),
+            Some(t) => {
+                self.rec.set_duration_secs(TIMELINE, t);
+                self.rec.log(path, arch)
+            }
+        }
+    }
+
+    /// Removes what `put` drew at `path` (live mode: an error set back to zero).
+    pub(crate) fn clear(&self, at: Option<f64>, path: impl Into<rerun::EntityPath>) -> RecordingStreamResult<()> {
+        match at {
+            None => Ok(()),
+            Some(t) => {
+                self.rec.set_duration_secs(TIMELINE, t);
+                self.rec.log(path, &rerun::Clear::recursive())
+            }
+        }
+    }
+
+    /// Text labels at points (Points3D with tiny dots): labels sit exactly where they belong.
+    pub(crate) fn label(&self, at: Option<f64>, path: &str, items: &[([f32; 3], &str)]) -> RecordingStreamResult<()> {
+        self.put(
+            at,
+            path,
+            &rerun::Points3D::new(items.iter().map(|(p, _)| *p))
+                .with_labels(items.iter().map(|(_, t)| *t))
+                .with_radii([0.002])
+                .with_colors([palette::label([230, 230, 230])]),
+        )
     }
 
     /// Marks events on the plot of `plot_path` where they happen: ▼ markers named `label` at
@@ -193,51 +232,37 @@ pub fn to_rerun_quaternion(q: &UnitQuaternion<f64>) -> rerun::Quaternion {
     rerun::Quaternion::from_xyzw([q.i as f32, q.j as f32, q.k as f32, q.w as f32])
 }
 
-/// Streams a run into a Rerun recording.
+/// Streams a run into a Rerun recording: a composition of views, each owning its entities —
+/// the table's scene ([`TableScene`]) or a strapdown IMU's body ([`BodyScene`]), pure coning's
+/// cone ([`ConeGizmo`]), the INS's trace, dial and gyro window ([`InsScene`]), every time series
+/// ([`Plots`]) — plus the documents and the layout, which it sends itself.
 pub struct Recorder {
-    rec: RecordingStream,
-    /// The same stream, with the export tables.
+    /// The stream, with the export tables.
     stream: Stream,
-    chain: Chain,
-    /// The true errors (the swing plots, the labels).
-    truth: TableErrors,
-    /// The true errors exaggerated for drawing.
-    drawing: ErrorRotations,
-    /// The drawing factor of each error class ([`drawing_factors`]).
-    factors: ClassFactors,
-    paths: ChainPaths,
-    axis_names: Vec<String>,
-    series: Vec<Series>,
-    series_t: Vec<f64>,
-    scene_t: Vec<f64>,
-    scene_vehicle: Vec<rerun::Quaternion>,
-    scene_gimbals: Vec<Vec<rerun::Quaternion>>,
+    /// The table (None for a strapdown IMU).
+    table: Option<TableScene>,
+    /// A strapdown IMU: its (body) axes at the INS's attitude, instead of a table.
+    body: Option<BodyScene>,
     /// Pure coning: the body axis on its magnified cone, beside the table.
-    cone: Option<cone::ConeGizmo>,
+    cone: Option<ConeGizmo>,
+    /// With an IMU in the loop.
+    ins: Option<InsScene>,
+    plots: Plots,
+    /// The buffered scene frames' times, s.
+    scene_t: Vec<f64>,
     /// Chunks sent since the sinks last caught up.
     chunks_in_flight: usize,
     /// Live mode (geometry on the timeline instead of static), and what this recorder feeds.
     live: Option<LiveOutput>,
     /// A live session's parameters in force (its final layout is framed on them).
     live_params: Option<Box<Params>>,
-    /// The last frame sent of each moving transform (vehicle, then gimbals): a transform that has
-    /// not moved since is not sent again (a vehicle at rest, a gimbal the scheme holds still).
-    last_motion: Vec<Option<rerun::Quaternion>>,
     /// A replayed log (None: a simulation): what it has decides the series and the scene.
     replay: Option<ReplayKind>,
-    /// With an IMU in the loop.
-    ins: Option<InsLayout>,
-    /// A strapdown IMU: its (body) axes at the INS's attitude, instead of a table.
-    body: Option<body_view::BodyScene>,
-    /// Unit of the attitude-error plots.
-    error_unit: crate::math::units::AngleUnit,
-    /// Symmetric half-ranges of the error plots once known (table per axis, in `error_unit`; INS
-    /// per axis, arcsec).
+    /// Symmetric half-ranges of the error plots once known (table per axis, in the plots' error
+    /// unit; INS per axis, arcsec).
     ranges: Option<PlotRanges>,
     /// The command's own panels, kept for when the layout is sent again.
     custom: Option<CustomLayout>,
-    /// Each series' extent (the plots framed on their data).
-    frames: Frames,
 }
 
 /// The error plots' symmetric ranges, from a run's peaks (see [`crate::math::units::nice_half_range`]).
@@ -272,76 +297,55 @@ pub(crate) struct CustomLayout {
 impl Recorder {
     /// Logs everything static (documents, styles, geometry, blueprint) and prepares the buffers.
     pub fn new(stream: Stream, params: &Params) -> RecordingStreamResult<Self> {
-        Self::build(stream, params, None, None)
+        Self::build(stream, params, None, None, None)
     }
 
     /// A recorder whose layout has `custom.right` as its right column and `custom.docs` as extra
     /// document tabs (commands that add their own panels to the table's 3D scene).
     pub(crate) fn with_layout(stream: Stream, params: &Params, custom: CustomLayout) -> RecordingStreamResult<Self> {
-        Self::build(stream, params, None, Some(custom))
+        Self::build(stream, params, None, None, Some(custom))
+    }
+
+    /// A recorder for a replayed log of `kind`: through a table, the same scene and plots as a run,
+    /// the demodulations named for what they are (the nominal and the compensated table, against
+    /// the log's reference); a strapdown IMU, its axes at the INS's attitude and the INS's plots
+    /// only. Both add the INS's own solution (attitude, velocity, position).
+    pub fn new_replay(stream: Stream, params: &Params, kind: ReplayKind) -> RecordingStreamResult<Self> {
+        Self::build(stream, params, None, Some(kind), None)
     }
 
     fn build(
         stream: Stream,
         params: &Params,
         live: Option<LiveOutput>,
-        custom: Option<CustomLayout>,
-    ) -> RecordingStreamResult<Self> {
-        Self::build_with(stream, params, live, None, custom)
-    }
-
-    fn build_with(
-        stream: Stream,
-        params: &Params,
-        live: Option<LiveOutput>,
         replay: Option<ReplayKind>,
         custom: Option<CustomLayout>,
     ) -> RecordingStreamResult<Self> {
-        let rec = stream.rec.clone();
-        let chain = params.table.chain.clone();
-        let factors = drawing_factors(&params.table.truth, params.recording.exaggeration);
-        let drawing = chain.error_rotations(&params.table.truth.exaggerated(&factors));
-        let axis_names: Vec<String> = params.table.chain.axes().iter().map(|a| a.name.clone()).collect();
-        let paths = ChainPaths::new(&axis_names);
-        let unit = params.recording.error_unit;
-        let mut series = rows::table_series(&chain, replay, unit);
-        let ins = rows::ins_layout(params, replay, &mut series);
+        let plots = Plots::new(params, replay);
+        let ins = plots.ins.as_ref().and_then(|series| InsScene::new(params, replay, series));
         // A strapdown IMU: its axes are drawn as the body, nothing of the stand-in table.
-        let body = replay.filter(|k| !k.table).map(|k| body_view::BodyScene::new(k.reference));
-        let n = if body.is_some() { 0 } else { axis_names.len() };
+        let body = replay.filter(|k| !k.table).map(|k| BodyScene::new(k.reference));
         let mut me = Self {
-            rec,
-            stream,
-            chain,
-            truth: params.table.truth.clone(),
-            drawing,
-            factors,
-            paths,
-            axis_names,
-            series,
-            series_t: Vec::new(),
-            scene_t: Vec::new(),
-            scene_vehicle: Vec::new(),
-            scene_gimbals: vec![Vec::new(); n],
+            table: body.is_none().then(|| TableScene::new(params)),
+            body,
             cone: None,
+            ins,
+            plots,
+            scene_t: Vec::new(),
             chunks_in_flight: 0,
             live,
             live_params: live.map(|_| Box::new(params.clone())),
-            last_motion: vec![None; 1 + n],
             replay,
-            ins,
-            body,
-            error_unit: unit,
             ranges: None,
             custom: custom.clone(),
-            frames: Frames::default(),
+            stream,
         };
         me.log_once(params)?;
-        me.log_ins_once()?;
+        let at = me.geometry_at(0.0);
         if let Some(c) = params.table.vehicle.pure_coning().filter(|c| c.half_angle_rad > 0.0) {
-            me.cone = Some(cone::ConeGizmo::new(&me.rec, c.half_angle_rad, me.geometry_at(0.0))?);
+            me.cone = Some(ConeGizmo::new(me.stream.rec(), c.half_angle_rad, at)?);
         }
-        me.log_error_geometry(params, me.geometry_at(0.0))?;
+        me.log_errors(params, at)?;
         me.send_blueprint(params, custom)?;
         let started = if live.is_some() {
             // A live session has no length of its own: it runs until it is stopped.
@@ -359,12 +363,50 @@ impl Recorder {
         Ok(me)
     }
 
-    /// A recorder for a replayed log of `kind`: through a table, the same scene and plots as a run,
-    /// the demodulations named for what they are (the nominal and the compensated table, against
-    /// the log's reference); a strapdown IMU, its axes at the INS's attitude and the INS's plots
-    /// only. Both add the INS's own solution (attitude, velocity, position).
-    pub fn new_replay(stream: Stream, params: &Params, kind: ReplayKind) -> RecordingStreamResult<Self> {
-        Self::build_with(stream, params, None, Some(kind), None)
+    /// Logs what never changes during a run: the recording's name and properties, the plots'
+    /// styles, the world's axes and compass, and each view's fixed parts.
+    fn log_once(&self, p: &Params) -> RecordingStreamResult<()> {
+        let rec = self.stream.rec();
+        rec.send_recording_name(format!("rinscope: {}", p.meta.name))?;
+        rec.send_property(
+            "rinscope",
+            &rerun::AnyValues::default()
+                .with_component::<rerun::components::Text>("scenario", [p.meta.name.clone()])
+                .with_component::<rerun::components::Text>("seed", [p.meta.seed.to_string()])
+                .with_component::<rerun::components::Text>("version", [env!("CARGO_PKG_VERSION").to_owned()]),
+        )?;
+        self.plots.log_styles(&self.stream)?;
+        rec.log_static("world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
+        // East and North on the floor: under the table's deck, or just under a strapdown IMU's case.
+        let floor = if self.body.is_some() { -0.4 } else { -1.4 };
+        rec.log_static(
+            "world/compass",
+            &rerun::Arrows3D::from_vectors([[1.6, 0.0, 0.0], [0.0, 1.6, 0.0]])
+                .with_origins([[0.0, 0.0, floor]; 2])
+                .with_colors([palette::rgba([120, 120, 120], 160); 2])
+                .with_radii([0.006]),
+        )?;
+        self.stream.label(None, "world/compass/labels", &[([1.7, 0.0, floor], "E"), ([0.0, 1.7, floor], "N")])?;
+        if let Some(body) = &self.body {
+            body.log_static(&self.stream)?;
+        }
+        if let Some(table) = &self.table {
+            table.log_static(&self.stream)?;
+        }
+        if let Some(ins) = &self.ins {
+            ins.log_static(&self.stream)?;
+        }
+        Ok(())
+    }
+
+    /// Everything that depends on the error values (in live mode at `at` on the timeline): the
+    /// documents and the table's error geometry.
+    fn log_errors(&self, p: &Params, at: Option<f64>) -> RecordingStreamResult<()> {
+        documents::log_documents(&self.stream, p, self.replay, at)?;
+        match &self.table {
+            Some(table) => table.log_errors(&self.stream, p, at),
+            None => Ok(()),
+        }
     }
 
     /// A replay's t = 0 on the IMU file's own clock, s: the series also go on the timeline
@@ -384,10 +426,10 @@ impl Recorder {
         self.send_blueprint(params, self.custom.clone())
     }
 
-    /// Frames the error plots on the run's peaks (symmetric, labelled ticks) and sends the layout
+    /// Fits the error plots to the run's peaks (symmetric, labelled ticks) and sends the layout
     /// again: noise of 1e-5″ on a compensated line does not fill a plot and look like a drift.
-    pub fn frame_plots(&mut self, params: &Params, ranges: PlotRanges) -> RecordingStreamResult<()> {
-        // Every row out first: the plots framed on their data take the whole extent.
+    pub fn fit_plots(&mut self, params: &Params, ranges: PlotRanges) -> RecordingStreamResult<()> {
+        // Every row out first: the plots fitted to their data take the whole extent.
         self.flush_series()?;
         self.ranges = Some(ranges);
         self.mark_moves(params, &ranges)?;
@@ -406,12 +448,13 @@ impl Recorder {
             let p = floored_peak(peaks, a) * per_rad;
             if p > 0.0 { 1.1 * crate::math::units::nice_half_range(p) } else { 0.0 }
         };
+        let unit = self.error_unit();
         for (a, axis) in ERROR_AXES.iter().enumerate() {
-            let y = top(ranges.table_peak_rad, a, self.error_unit.per_rad());
-            if self.has_series(&error_path(self.error_unit, axis)) {
-                self.stream.mark_events(&error_path(self.error_unit, axis), "moves", "scheme moves", &starts, y)?;
+            let y = top(ranges.table_peak_rad, a, unit.per_rad());
+            if self.plots.has(&error_path(unit, axis)) {
+                self.stream.mark_events(&error_path(unit, axis), "moves", "scheme moves", &starts, y)?;
             }
-            if let Some(ins) = ranges.ins_peak_rad.filter(|_| self.ins.as_ref().is_some_and(|l| l.errors)) {
+            if let Some(ins) = ranges.ins_peak_rad.filter(|_| self.ins_errors()) {
                 self.stream.mark_events(
                     &format!("ins/attitude_error_arcsec/{axis}"),
                     "moves",
@@ -424,10 +467,15 @@ impl Recorder {
         Ok(())
     }
 
+    /// Whether the INS's attitude errors are plotted.
+    fn ins_errors(&self) -> bool {
+        self.plots.ins.as_ref().is_some_and(|l| l.errors)
+    }
+
     /// The error plots' unit.
     #[must_use]
     pub fn error_unit(&self) -> crate::math::units::AngleUnit {
-        self.error_unit
+        self.plots.error_unit()
     }
 
     /// Sends every buffered row now (live mode: low latency over large chunks).
@@ -437,15 +485,23 @@ impl Recorder {
         self.flush_scene()
     }
 
+    /// The table's view (None for a strapdown IMU): a command's own drawings beside its parts.
+    pub(crate) fn table_scene(&self) -> Option<&TableScene> {
+        self.table.as_ref()
+    }
+
+    /// Sends the buffered gyro samples of the signal window.
+    pub(crate) fn flush_signal(&mut self) -> RecordingStreamResult<()> {
+        match self.ins.as_mut() {
+            Some(ins) => ins.flush_signal(&self.stream),
+            None => Ok(()),
+        }
+    }
+
     /// The underlying stream (for flushing and sinks).
     #[must_use]
     pub fn stream(&self) -> &Stream {
         &self.stream
-    }
-
-    /// The line names of the series at `path` (its legend).
-    pub(crate) fn series_names(&self, path: &str) -> Vec<String> {
-        self.series.iter().find(|s| s.path == path).map(|s| s.names.clone()).unwrap_or_default()
     }
 
     /// Buffers one time-series row; sends a chunk when the buffer is full.
@@ -475,12 +531,19 @@ impl Recorder {
         ins: Option<&InsView>,
         solution: Option<&Solution>,
     ) -> RecordingStreamResult<()> {
-        self.push_values(out, ins, solution);
-        self.series_t.push(out.t_s);
-        if self.series_t.len() >= SERIES_CHUNK_ROWS {
+        self.plots.push(out, ins, solution);
+        if self.plots.buffered() >= SERIES_CHUNK_ROWS {
             self.flush_series()?;
         }
         Ok(())
+    }
+
+    /// Buffers one raw and filtered gyro sample (the signal window at the IMU rate).
+    pub fn push_signal(&mut self, s: &crate::ins::core::SampleOut) -> RecordingStreamResult<()> {
+        match self.ins.as_mut() {
+            Some(ins) => ins.push_signal(s, &self.stream),
+            None => Ok(()),
+        }
     }
 
     /// Buffers one scene frame; sends a chunk when the buffer is full.
@@ -492,49 +555,17 @@ impl Recorder {
     /// computed one's error exaggerated).
     pub fn push_scene_row(&mut self, out: &StepOutput, ins: Option<&InsView>) -> RecordingStreamResult<()> {
         self.scene_t.push(out.t_s);
-        match self.body.as_mut() {
-            Some(body) => body.push(ins),
-            None => {
-                let links = self.chain.link_rotations(&self.drawing, &out.gimbal_rad);
-                self.scene_vehicle.push(to_rerun_quaternion(out.n_from_b.quaternion()));
-                for (k, col) in self.scene_gimbals.iter_mut().enumerate() {
-                    col.push(to_rerun_quaternion(&links.gimbal[k]));
-                }
-            }
+        if let Some(body) = self.body.as_mut() {
+            body.push(ins);
+        }
+        if let Some(table) = self.table.as_mut() {
+            table.push(out);
         }
         if let Some(c) = self.cone.as_mut() {
             c.push(&out.n_from_b);
         }
-        if let Some(layout) = self.ins.as_mut().filter(|l| l.trace || l.dial_shown()) {
-            // Without an INS view (or without its truth) the trace stands still at the identity.
-            if layout.trace {
-                let (t, c) = ins
-                    .and_then(|v| Some((*v.imu_true?.quaternion(), *v.imu_ins.quaternion())))
-                    .unwrap_or((UnitQuaternion::identity(), UnitQuaternion::identity()));
-                let err = rotvec::log(&(c * t.inverse())) * layout.exaggeration;
-                let ins_q = rotvec::exp(&err) * t;
-                // The true axes, then the computed ones, as arrows in the trace's (unturned) frame.
-                for q in [t, ins_q] {
-                    for axis in [Vector3::x(), Vector3::y(), Vector3::z()] {
-                        let v = q * (axis * ins_view::TRACE_AXIS_LENGTH);
-                        layout.trace_axes.push([v.x as f32, v.y as f32, v.z as f32]);
-                    }
-                }
-            }
-            // The needles turn clockwise by the size of each algorithm's attitude error (whichever
-            // axis it is on: heading for a cone about z, pitch for Li et al. 2014's wobble), ×N.
-            let due = layout.dial_shown() && out.t_s >= layout.dial_next_t;
-            if due {
-                layout.dial_t.push(out.t_s);
-                layout.dial_next_t = out.t_s + 1.0 / ins_view::DIAL_HZ - 1e-9;
-                for (k, name) in layout.algorithms.iter().enumerate() {
-                    let size = ins
-                        .and_then(|v| v.errors.get(k))
-                        .filter(|_| !layout.hidden.contains(name))
-                        .map_or(0.0, |e| e.as_array().iter().map(|x| x * x).sum::<f64>().sqrt());
-                    layout.dial.push(ins_view::needle(-size * layout.exaggeration));
-                }
-            }
+        if let Some(view) = self.ins.as_mut().filter(|v| v.in_scene()) {
+            view.push_scene(out.t_s, ins);
         }
         if self.scene_t.len() >= SERIES_CHUNK_ROWS {
             self.flush_scene()?;
@@ -550,7 +581,7 @@ impl Recorder {
         if self.chunks_in_flight >= MAX_CHUNKS_IN_FLIGHT {
             // A sink that cannot flush (a viewer gone away) must not stop the run; data keeps flowing
             // to the other sinks.
-            let _ = self.rec.flush_with_timeout(std::time::Duration::from_secs(2));
+            let _ = self.stream.rec().flush_with_timeout(std::time::Duration::from_secs(2));
             self.chunks_in_flight = 0;
         }
     }
@@ -561,53 +592,20 @@ impl Recorder {
     }
 
     fn flush_series_with(&mut self, hold: Option<std::time::Duration>) -> RecordingStreamResult<()> {
-        self.flush_dial()?;
-        if self.series_t.is_empty() {
-            return Ok(());
+        if let Some(ins) = self.ins.as_mut() {
+            let sent = ins.flush_dial(&self.stream)?;
+            self.throttle(sent);
         }
-        let hold = hold.filter(|_| !self.stream.exports());
-        let times = std::mem::take(&mut self.series_t);
-        let now = std::time::Instant::now();
-        let mut sent = 0;
-        for s in &mut self.series {
-            let values = std::mem::take(&mut s.values);
-            let width = s.width();
-            debug_assert_eq!(values.len(), width * times.len());
-            self.frames.observe(&s.path, &values);
-            let last_row = values.len().checked_sub(width).map(|i| values[i..].to_vec()).unwrap_or_default();
-            let (t, v) = match (hold, &s.last_sent) {
-                (Some(hold), Some((row, at))) if values.chunks(width).all(|r| rows::same_row(r, row)) => {
-                    if now.duration_since(*at) < hold {
-                        s.held_until_s = times.last().copied();
-                        continue;
-                    }
-                    (vec![times[times.len() - 1]], last_row.clone())
-                }
-                // After rows held back, the newest of them first: the line stays flat up to it
-                // instead of sloping from the last row sent to the first new one.
-                (_, Some((row, _))) if s.held_until_s.is_some() => {
-                    let held = s.held_until_s.unwrap_or_default();
-                    (
-                        std::iter::once(held).chain(times.iter().copied()).collect(),
-                        row.iter().copied().chain(values).collect(),
-                    )
-                }
-                _ => (times.clone(), values),
-            };
-            s.held_until_s = None;
-            self.stream.send_series(&s.path, &s.names, &t, v, width)?;
-            s.last_sent = Some((last_row, now));
-            sent += 1;
-        }
+        let newest = self.plots.newest();
+        let sent = self.plots.flush(&self.stream, hold)?;
         self.throttle(sent);
-        match (self.live, times.last()) {
-            (Some(out), Some(&t)) if out.watched() => self.hold_live_frames(t),
+        match (self.live, newest) {
+            (Some(out), Some(t)) if out.watched() => self.plots.hold_extents(&self.stream, t),
             _ => Ok(()),
         }
     }
 
-    /// Sends the buffered scene frames. A transform that has not moved since the frame last sent
-    /// of it is not sent again (a vehicle at rest, a gimbal the scheme holds still).
+    /// Sends the buffered scene frames.
     pub fn flush_scene(&mut self) -> RecordingStreamResult<()> {
         if self.scene_t.is_empty() {
             return Ok(());
@@ -619,68 +617,26 @@ impl Recorder {
             sent += 1;
         }
         if let Some(body) = self.body.as_mut() {
-            body.flush(&self.stream, &times)?;
-            sent += 1;
+            sent += body.flush(&self.stream, &times)?;
         }
-        let motion = std::iter::once((self.paths.vehicle.as_str(), std::mem::take(&mut self.scene_vehicle))).chain(
-            self.paths.gimbals.iter().map(String::as_str).zip(self.scene_gimbals.iter_mut().map(std::mem::take)),
-        );
-        for ((path, q), last) in motion.zip(self.last_motion.iter_mut()) {
-            let Some(newest) = q.last().copied() else { continue };
-            if q.iter().all(|x| Some(*x) == *last) {
-                continue;
-            }
-            *last = Some(newest);
-            self.rec.send_columns(
-                path,
-                self.stream.time_columns(&times),
-                rerun::Transform3D::update_fields().with_many_quaternion(q).columns_of_unit_batches()?,
-            )?;
-            sent += 1;
+        if let Some(table) = self.table.as_mut() {
+            sent += table.flush(&self.stream, &times)?;
         }
-        if let Some(layout) = self.ins.as_mut() {
-            let trace = std::mem::take(&mut layout.trace_axes);
-            if !trace.is_empty() {
-                debug_assert_eq!(trace.len(), 6 * times.len());
-                self.rec.send_columns(
-                    ins_view::TRACE_AXES_PATH,
-                    self.stream.time_columns(&times),
-                    rerun::Arrows3D::update_fields()
-                        .with_vectors(trace)
-                        .columns(std::iter::repeat_n(6, times.len()))?,
-                )?;
-                sent += 1;
-            }
+        if let Some(ins) = self.ins.as_mut() {
+            sent += ins.flush_scene(&self.stream, &times)?;
         }
         self.throttle(sent);
         Ok(())
     }
 
-    /// Sends the drift dial's buffered frames (with the plots: the needles turn with the errors).
-    fn flush_dial(&mut self) -> RecordingStreamResult<()> {
-        let Some(layout) = self.ins.as_mut() else { return Ok(()) };
-        let dial_t = std::mem::take(&mut layout.dial_t);
-        let needles = std::mem::take(&mut layout.dial);
-        if dial_t.is_empty() {
-            return Ok(());
-        }
-        let k = layout.algorithms.len();
-        self.rec.send_columns(
-            ins_view::DIAL_NEEDLES_PATH,
-            self.stream.time_columns(&dial_t),
-            rerun::Arrows3D::update_fields().with_vectors(needles).columns(std::iter::repeat_n(k, dial_t.len()))?,
-        )?;
-        self.throttle(1);
-        Ok(())
-    }
-
     /// A text-log entry at simulated time `t_s`.
     pub fn event(&self, t_s: f64, text: &str, level: &str) -> RecordingStreamResult<()> {
-        self.rec.set_duration_secs(TIMELINE, t_s);
+        let rec = self.stream.rec();
+        rec.set_duration_secs(TIMELINE, t_s);
         if let Some(t0) = self.stream.file_clock_s {
-            self.rec.set_duration_secs(FILE_CLOCK_TIMELINE, t0 + t_s);
+            rec.set_duration_secs(FILE_CLOCK_TIMELINE, t0 + t_s);
         }
-        self.rec.log("events", &rerun::TextLog::new(text).with_level(level))
+        rec.log("events", &rerun::TextLog::new(text).with_level(level))
     }
 
     /// Sends everything still buffered; a saved live session's layout again, every plot framed on

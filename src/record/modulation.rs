@@ -3,7 +3,7 @@
 use rerun::RecordingStreamResult;
 use rerun::blueprint::components::ContainerKind;
 
-use super::layout::{self, Node};
+use super::blueprint::{self, Node};
 use super::palette::rgb;
 use super::{APPLICATION_ID, Stream, TIMELINE};
 use crate::ins::trace::{NavSample, NavTrace};
@@ -64,8 +64,8 @@ pub fn log(stream: &Stream, traces: &[NavTrace], table: &str) -> RecordingStream
     let key = names.iter().zip(COLOR_NAMES).map(|(n, c)| format!("{c} {n}")).collect::<Vec<_>>().join(" · ");
     let plot = |name: &str, origin: &str| {
         Node::view("TimeSeries", name, origin)
-            .with_property("TimeAxis", &layout::whole_run_time_axis())
-            .with_property("PlotLegend", &layout::no_legend())
+            .with_property("TimeAxis", &blueprint::whole_run_time_axis())
+            .with_property("PlotLegend", &blueprint::no_legend())
     };
     let root = Node::container(
         ContainerKind::Horizontal,
@@ -91,5 +91,10 @@ pub fn log(stream: &Stream, traces: &[NavTrace], table: &str) -> RecordingStream
         ],
         &[1.4, 1.0],
     );
-    layout::send(rec, APPLICATION_ID, &root, &layout::Playback { timeline: TIMELINE, speed: 3600.0, follow: true })
+    blueprint::send(
+        rec,
+        APPLICATION_ID,
+        &root,
+        &blueprint::Playback { timeline: TIMELINE, speed: 3600.0, follow: true },
+    )
 }

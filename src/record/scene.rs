@@ -1,16 +1,16 @@
-//! The 3D scene of a run: the gimbal chain as an entity tree of transforms, rings and axes, the
-//! exaggerated error geometry (swing cones, non-orthogonality and installation wedges) with labels,
-//! the vehicle's deck and compass.
+//! The table's view in the 3D scene: the gimbal chain as an entity tree of transforms, rings and
+//! axes, the exaggerated error geometry (swing cones, non-orthogonality and installation wedges)
+//! with their key, the vehicle's deck.
 
 use nalgebra::{UnitQuaternion, Vector3};
 use rerun::RecordingStreamResult;
 
 use super::palette::{albedo, colors, p3, rgb, rgba};
-use super::rows::Quantity;
-use super::{Recorder, ReplayKind, TIMELINE, to_rerun_quaternion};
+use super::{Stream, drawing_factors, to_rerun_quaternion};
 use crate::math::units::{ARCSEC_PER_RAD, DEG_PER_RAD, fmt_angle};
-use crate::model::gimbal::AxisGeometry;
+use crate::model::gimbal::{AxisGeometry, Chain, ClassFactors, ErrorRotations, TableErrors};
 use crate::scenario::Params;
+use crate::sim::StepOutput;
 
 /// Entity paths of the chain.
 #[derive(Debug, Clone)]
@@ -42,72 +42,89 @@ impl ChainPaths {
     }
 }
 
-impl Recorder {
-    /// Logs what never changes during a run: names, properties, series styles and the fixed geometry.
-    pub(crate) fn log_once(&self, p: &Params) -> RecordingStreamResult<()> {
-        let rec = &self.rec;
-        rec.send_recording_name(format!("rinscope: {}", p.meta.name))?;
-        rec.send_property(
-            "rinscope",
-            &rerun::AnyValues::default()
-                .with_component::<rerun::components::Text>("scenario", [p.meta.name.clone()])
-                .with_component::<rerun::components::Text>("seed", [p.meta.seed.to_string()])
-                .with_component::<rerun::components::Text>("version", [env!("CARGO_PKG_VERSION").to_owned()]),
-        )?;
+/// The table in the 3D scene: the gimbal chain as an entity tree of transforms (moving with the
+/// gimbal angles), its rings and axes, the vehicle's deck, the IMU, and the exaggerated error
+/// geometry (swing cones, non-orthogonality and installation wedges) with their key. It owns
+/// `world/vehicle/…` and `world/key`.
+pub(crate) struct TableScene {
+    chain: Chain,
+    /// The true errors exaggerated for drawing.
+    drawing: ErrorRotations,
+    /// The drawing factor of each error class ([`drawing_factors`]).
+    pub(crate) factors: ClassFactors,
+    pub(crate) paths: ChainPaths,
+    axis_names: Vec<String>,
+    /// Per buffered scene frame: the vehicle's attitude, and each gimbal's rotation.
+    vehicle: Vec<rerun::Quaternion>,
+    gimbals: Vec<Vec<rerun::Quaternion>>,
+    /// The last frame sent of each moving transform (vehicle, then gimbals): a transform that has
+    /// not moved since is not sent again (a vehicle at rest, a gimbal the scheme holds still).
+    last_motion: Vec<Option<rerun::Quaternion>>,
+}
 
-        // Series styles, once (the INS's: `log_ins_once`).
-        for series in &self.series {
-            let names = series.names.clone();
-            let path = series.path.as_str();
-            match series.what {
-                Quantity::TableError(_) => {
-                    // Uncompensated wide and translucent under the closed form's thin bright line, so
-                    // both read where they coincide; their difference has its own plot.
-                    let [u, c, f] = colors::VARIANT;
-                    let n = names.len();
-                    rec.log_static(
-                        path,
-                        &rerun::SeriesLines::new()
-                            .with_colors([rgba(u, 140), rgb(c), rgb(f)].into_iter().take(n))
-                            .with_names(names)
-                            .with_widths([5.0, 2.0, 1.5].into_iter().take(n)),
-                    )?;
-                }
-                Quantity::ClosedForm | Quantity::VehicleAttitude => rec.log_static(
-                    path,
-                    &rerun::SeriesLines::new().with_colors(colors::EULER.map(rgb)).with_names(names),
-                )?,
-                Quantity::GimbalAngles => rec.log_static(
-                    path,
-                    &rerun::SeriesLines::new()
-                        .with_colors(colors::AXES[..names.len()].iter().map(|c| rgb(*c)))
-                        .with_names(names),
-                )?,
-                Quantity::Swing(k) => {
-                    let light = colors::AXES[k].map(|c| c / 2 + 60);
-                    rec.log_static(
-                        path,
-                        &rerun::SeriesLines::new().with_colors([rgb(colors::AXES[k]), rgb(light)]).with_names(names),
-                    )?;
-                }
-                _ => {}
+impl TableScene {
+    /// The table of `params`.
+    pub(crate) fn new(params: &Params) -> Self {
+        let chain = params.table.chain.clone();
+        let factors = drawing_factors(&params.table.truth, params.recording.exaggeration);
+        let drawing = chain.error_rotations(&params.table.truth.exaggerated(&factors));
+        let axis_names: Vec<String> = chain.axes().iter().map(|a| a.name.clone()).collect();
+        let n = axis_names.len();
+        Self {
+            paths: ChainPaths::new(&axis_names),
+            chain,
+            drawing,
+            factors,
+            axis_names,
+            vehicle: Vec::new(),
+            gimbals: vec![Vec::new(); n],
+            last_motion: vec![None; 1 + n],
+        }
+    }
+
+    /// New true errors (a live reload): the drawing follows them; true if a drawing factor changed.
+    pub(crate) fn set_truth(&mut self, truth: &TableErrors, exaggeration: f64) -> bool {
+        let factors = drawing_factors(truth, exaggeration);
+        let changed = factors != self.factors;
+        self.factors = factors;
+        self.drawing = self.chain.error_rotations(&truth.exaggerated(&self.factors));
+        changed
+    }
+
+    /// Buffers one scene frame: the vehicle's attitude and the gimbals' rotations.
+    pub(crate) fn push(&mut self, out: &StepOutput) {
+        let links = self.chain.link_rotations(&self.drawing, &out.gimbal_rad);
+        self.vehicle.push(to_rerun_quaternion(out.n_from_b.quaternion()));
+        for (k, col) in self.gimbals.iter_mut().enumerate() {
+            col.push(to_rerun_quaternion(&links.gimbal[k]));
+        }
+    }
+
+    /// Sends the buffered frames at `times`; returns the chunks sent. A transform that has not
+    /// moved since the frame last sent of it is not sent again.
+    pub(crate) fn flush(&mut self, stream: &Stream, times: &[f64]) -> RecordingStreamResult<usize> {
+        let mut sent = 0;
+        let motion = std::iter::once((self.paths.vehicle.as_str(), std::mem::take(&mut self.vehicle)))
+            .chain(self.paths.gimbals.iter().map(String::as_str).zip(self.gimbals.iter_mut().map(std::mem::take)));
+        for ((path, q), last) in motion.zip(self.last_motion.iter_mut()) {
+            let Some(newest) = q.last().copied() else { continue };
+            if q.iter().all(|x| Some(*x) == *last) {
+                continue;
             }
+            *last = Some(newest);
+            stream.rec().send_columns(
+                path,
+                stream.time_columns(times),
+                rerun::Transform3D::update_fields().with_many_quaternion(q).columns_of_unit_batches()?,
+            )?;
+            sent += 1;
         }
+        Ok(sent)
+    }
 
-        rec.log_static("world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
-        // East and North on the floor: under the table's deck, or just under a strapdown IMU's case.
-        let floor = if self.body.is_some() { -0.4 } else { -1.4 };
-        rec.log_static(
-            "world/compass",
-            &rerun::Arrows3D::from_vectors([[1.6, 0.0, 0.0], [0.0, 1.6, 0.0]])
-                .with_origins([[0.0, 0.0, floor]; 2])
-                .with_colors([rgba([120, 120, 120], 160); 2])
-                .with_radii([0.006]),
-        )?;
-        self.label(None, "world/compass/labels", &[([1.7, 0.0, floor], "E"), ([0.0, 1.7, floor], "N")])?;
-        if self.body.is_some() {
-            return self.log_body_once();
-        }
+    /// Logs what never changes during a run: the deck, the rings and axes, the IMU.
+    pub(crate) fn log_static(&self, stream: &Stream) -> RecordingStreamResult<()> {
+        let rec = stream.rec();
         // Vehicle: a deck plate under the table and the body axes.
         rec.log_static(
             format!("{}/deck", self.paths.vehicle),
@@ -173,110 +190,21 @@ impl Recorder {
         Ok(())
     }
 
-    /// Logs `arch` at `path`: static in a plain run (`at = None`), at simulated time `at` in live mode,
-    /// where a reload can change it and the saved session must show the history.
-    pub(crate) fn put(
-        &self,
-        at: Option<f64>,
-        path: impl Into<rerun::EntityPath>,
-        arch: &dyn rerun::AsComponents,
-    ) -> RecordingStreamResult<()> {
-        match at {
-            None => self.rec.log_static(path, arch),
-            Some(t) => {
-                self.rec.set_duration_secs(TIMELINE, t);
-                self.rec.log(path, arch)
-            }
-        }
-    }
-
-    /// Removes what `put` drew at `path` (live mode: an error set back to zero).
-    pub(crate) fn clear(&self, at: Option<f64>, path: impl Into<rerun::EntityPath>) -> RecordingStreamResult<()> {
-        match at {
-            None => Ok(()),
-            Some(t) => {
-                self.rec.set_duration_secs(TIMELINE, t);
-                self.rec.log(path, &rerun::Clear::recursive())
-            }
-        }
-    }
-
-    /// Text labels at points (Points3D with tiny dots): labels sit exactly where they belong.
-    pub(crate) fn label(&self, at: Option<f64>, path: &str, items: &[([f32; 3], &str)]) -> RecordingStreamResult<()> {
-        self.put(
-            at,
-            path,
-            &rerun::Points3D::new(items.iter().map(|(p, _)| *p))
-                .with_labels(items.iter().map(|(_, t)| *t))
-                .with_radii([0.002])
-                .with_colors([super::palette::label([230, 230, 230])]),
-        )
-    }
-
-    /// Everything that depends on the error values: the documents, the exaggerated base, mount and
-    /// IMU transforms, the swing cones and the wedges.
-    pub(crate) fn log_error_geometry(&self, p: &Params, at: Option<f64>) -> RecordingStreamResult<()> {
-        // Documents: the scenario explains itself; the resolved config makes the run reproducible.
-        let mut doc = format!("# {}\n\n*{}*\n\n{}\n", p.meta.name, p.meta.title, p.meta.description.trim());
-        let replayed = "The INS's own solution is in `ins/body_attitude_deg` (the primary algorithm's body attitude, heading in (−180°, 180°]) \
-             and, navigating, `ins/velocity_enu_mps`, `ins/position_from_start_m` and `ins/latitude_longitude_deg`. \
-             Time: seconds after the replay's start on `sim_time`, the IMU file's own clock on the timeline `file_clock` (docs/export.md).";
-        let plots = match self.replay {
-            None => {
-                "Plots: red = uncompensated (nominal table model), green = compensated (`[compensation]` parameters), \
-             blue = closed form (first-order theory, docs/closed-form.md)."
-                    .to_owned()
-            }
-            Some(ReplayKind { table: false, reference }) => format!(
-                "A replayed **strapdown** IMU (no table): the 3D view shows its axes (= the body's: x right, y forward, z up) turning with the INS's attitude{}. {}",
-                if reference {
-                    ", the reference's in grey; the error plots are the INS's attitude against the reference, per algorithm"
-                } else {
-                    " (no reference: nothing to compare it with)"
-                },
-                replayed
-            ),
-            Some(ReplayKind { reference, .. }) => format!(
-                "Plots (a replayed log): {} {replayed}",
-                if reference {
-                    "red = the INS attitude demodulated through the nominal table, green = through the compensated table, each against the log's reference attitude."
-                } else {
-                    "no reference: the table error plots show the nominal − the compensated demodulation."
-                }
-            ),
-        };
-        if self.body.is_some() {
-            doc.push_str(&format!("\n---\n{plots}\n"));
-        } else {
-            doc.push_str(&format!(
-                "\n---\nError angles in the 3D view are drawn **×{}**. {plots} Seed {}.\n",
-                p.recording.exaggeration, p.meta.seed
-            ));
-        }
-        if self.replay.is_none() {
-            doc.push_str(&errors_in_force(p, at));
-        }
-        self.put(at, "docs/scenario", &rerun::TextDocument::from_markdown(doc))?;
-        self.put(
-            at,
-            "docs/config",
-            &rerun::TextDocument::from_markdown(format!("```toml\n{}\n```\n", p.resolved_toml)),
-        )?;
-        if self.body.is_some() {
-            return Ok(());
-        }
-
+    /// Everything that depends on the error values (in live mode at `at` on the timeline: a
+    /// reload can change them): the exaggerated base, mount and IMU transforms, the swing cones,
+    /// the wedges and the key.
+    pub(crate) fn log_errors(&self, stream: &Stream, p: &Params, at: Option<f64>) -> RecordingStreamResult<()> {
         // The drawing factors are in the 3D view's title ("errors ×100, swing ×500"): a label in the
         // scene saying so sat where the wedges' labels go (installation over it in the wobble preset).
         let (x, f) = (p.recording.exaggeration, self.factors);
         // The base, mount and IMU links do not depend on the gimbal angles.
         let draw = self.chain.link_rotations(&self.drawing, &[0.0; crate::model::scheme::MAX_AXES]);
         let t = |q: &UnitQuaternion<f64>| rerun::Transform3D::from_rotation(to_rerun_quaternion(q));
-        self.put(at, self.paths.base.as_str(), &t(&draw.base))?;
+        stream.put(at, self.paths.base.as_str(), &t(&draw.base))?;
         for k in 0..self.axis_names.len() {
-            self.put(at, self.paths.mounts[k].as_str(), &t(&draw.mount[k]))?;
+            stream.put(at, self.paths.mounts[k].as_str(), &t(&draw.mount[k]))?;
         }
-        self.put(at, self.paths.imu.as_str(), &t(&draw.imu))?;
+        stream.put(at, self.paths.imu.as_str(), &t(&draw.imu))?;
 
         let n = self.axis_names.len();
         let axes = self.chain.axes();
@@ -288,6 +216,7 @@ impl Recorder {
         let mut key: Vec<(String, [u8; 3])> = Vec::new();
         let wedge = |radii: (f64, f64), both_ends: bool| Wedge { radii, both_ends };
         key.extend(self.log_wedge(
+            stream,
             at,
             &format!("{}/installation", self.paths.vehicle),
             axes[0].axis,
@@ -305,12 +234,12 @@ impl Recorder {
             let cone_path = format!("{}/swing_cone", self.paths.mounts[k]);
             if alpha > 0.0 {
                 let (mesh, rims) = cone(g.axis, g.e1, g.e2, alpha, half);
-                self.put(
+                stream.put(
                     at,
                     cone_path.as_str(),
                     &rerun::Mesh3D::new(mesh.0).with_triangle_indices(mesh.1).with_albedo_factor(albedo(color, 60)),
                 )?;
-                self.put(
+                stream.put(
                     at,
                     format!("{cone_path}/rims"),
                     &rerun::LineStrips3D::new(rims).with_colors([rgba(color, 200)]).with_radii([0.004]),
@@ -325,7 +254,7 @@ impl Recorder {
                 );
                 key.push((text, color));
             } else {
-                self.clear(at, cone_path.as_str())?;
+                stream.clear(at, cone_path.as_str())?;
             }
             // Non-orthogonality: a wedge, in the previous rotor, between the normal to the previous
             // axis and this axis, at both ends of the axis beyond everything on it — its swing
@@ -342,6 +271,7 @@ impl Recorder {
                 // the default eye, passes just left of the key's middle).
                 let what = format!("{} η", g.name);
                 key.extend(self.log_wedge(
+                    stream,
                     at,
                     &format!("{}/non_orthogonality", self.paths.gimbals[k - 1]),
                     g.axis,
@@ -353,7 +283,7 @@ impl Recorder {
                 )?);
             }
         }
-        self.log_key(at, &key)
+        self.log_key(stream, at, &key)
     }
 
     /// A translucent wedge from `ideal` to `tilted` (both unit, same frame) over `shape`'s radii;
@@ -361,6 +291,7 @@ impl Recorder {
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn log_wedge(
         &self,
+        stream: &Stream,
         at: Option<f64>,
         path: &str,
         ideal: Vector3<f64>,
@@ -371,7 +302,7 @@ impl Recorder {
         what: &str,
     ) -> RecordingStreamResult<Option<(String, [u8; 3])>> {
         if true_arcsec == 0.0 {
-            self.clear(at, path)?;
+            stream.clear(at, path)?;
             return Ok(None);
         }
         let (r0, r1) = shape.radii;
@@ -394,14 +325,14 @@ impl Recorder {
                 [p3(sign * tilted * r0), p3(sign * tilted * r1)],
             ]);
         }
-        self.put(
+        stream.put(
             at,
             format!("{path}/wedge"),
             &rerun::Mesh3D::new(positions).with_triangle_indices(triangles).with_albedo_factor(albedo(WEDGE, 110)),
         )?;
         let edge_colors: Vec<rerun::Color> =
             (0..edges.len()).map(|i| if i % 2 == 0 { rgb([255, 255, 255]) } else { rgb(WEDGE) }).collect();
-        self.put(
+        stream.put(
             at,
             format!("{path}/edges"),
             &rerun::LineStrips3D::new(edges).with_colors(edge_colors).with_radii([0.004]),
@@ -413,13 +344,13 @@ impl Recorder {
     /// The key of the error classes drawn: one line each, in its object's colour, in a fixed column
     /// of the world beside the table. Labels on the objects rode with the gimbals into the middle
     /// of the scene, where five of them piled up (seed preset jiang2017-calibration after 40 s).
-    fn log_key(&self, at: Option<f64>, entries: &[(String, [u8; 3])]) -> RecordingStreamResult<()> {
+    fn log_key(&self, stream: &Stream, at: Option<f64>, entries: &[(String, [u8; 3])]) -> RecordingStreamResult<()> {
         if entries.is_empty() {
-            return self.clear(at, KEY_PATH);
+            return stream.clear(at, KEY_PATH);
         }
         let positions: Vec<[f32; 3]> =
             (0..entries.len()).map(|i| [KEY_AT[0], KEY_AT[1], KEY_AT[2] - KEY_STEP * i as f32]).collect();
-        self.put(
+        stream.put(
             at,
             KEY_PATH,
             &rerun::Points3D::new(positions)
@@ -461,38 +392,6 @@ const KEY_AT: [f32; 3] = [-0.9, 1.6, 1.25];
 const KEY_STEP: f32 = 0.2;
 /// The wedges' colour.
 const WEDGE: [u8; 3] = [255, 200, 60];
-
-/// The table's true errors as a markdown table, from the parameters in force: the description
-/// above was written for the preset's values, this follows every live reload.
-fn errors_in_force(p: &Params, at: Option<f64>) -> String {
-    let t = &p.table.truth;
-    let when = at.map_or(String::new(), |t_s| format!(" since t = {t_s:.1} s"));
-    let mut s = format!(
-        "\n**Errors in force{when}** (true values; `[compensation]` is what the compensated line assumes)\n\n| axis | swing α | swing φ | η | encoder offset | scale | delay | noise 1σ |\n|---|---:|---:|---:|---:|---:|---:|---:|\n"
-    );
-    for (g, e) in p.table.chain.axes().iter().zip(&t.axes) {
-        s.push_str(&format!(
-            "| {} | {} | {:.1}° | {} | {} | {:.0} ppm | {:.2} ms | {} |\n",
-            g.name,
-            fmt_angle(e.swing_half_angle_rad),
-            e.swing_phase_rad * DEG_PER_RAD,
-            fmt_angle(e.non_orthogonality_rad),
-            fmt_angle(e.encoder_offset_rad),
-            e.encoder_scale * 1e6,
-            e.encoder_delay_s * 1e3,
-            fmt_angle(e.encoder_noise_rad)
-        ));
-    }
-    let v = |x: &nalgebra::Vector3<f64>| {
-        format!("({:.1}, {:.1}, {:.1})″", x.x * ARCSEC_PER_RAD, x.y * ARCSEC_PER_RAD, x.z * ARCSEC_PER_RAD)
-    };
-    s.push_str(&format!(
-        "\nInstallation about (x, y, z): {}; IMU mounting: {}.\n",
-        v(&t.installation_rad),
-        v(&t.imu_mount_rad)
-    ));
-    s
-}
 
 /// "x", "y" or "z" for a coordinate unit vector.
 pub(crate) fn axis_letter(v: &Vector3<f64>) -> &'static str {

@@ -8,10 +8,10 @@ use nalgebra::UnitQuaternion;
 use rerun::RecordingStreamResult;
 use rerun::blueprint::components::ContainerKind;
 
-use super::layout::{self, Node};
+use super::blueprint::{self, Node};
 use super::palette::{self, rgb};
 use super::{APPLICATION_ID, Stream, TIMELINE, to_rerun_quaternion};
-use crate::ins::selfcal::{HistoryRow, N_PARAMS, param};
+use crate::calib::selfcal::{HistoryRow, N_PARAMS, param};
 
 /// What the recording shows.
 pub struct SelfcalView<'a> {
@@ -43,7 +43,7 @@ pub struct NavLine<'a> {
     pub trace: &'a crate::ins::trace::NavTrace,
 }
 
-/// The groups of parameters, one plot each: the group's name ([`crate::ins::selfcal::Kind::group`]),
+/// The groups of parameters, one plot each: the group's name ([`crate::calib::selfcal::Kind::group`]),
 /// the entity's, and the plot's title (short enough for a third of the plots' width at 1600×1000).
 const GROUPS: [(&str, &str, &str); 4] = [
     ("gyro bias", "gyro_bias", "gyro bias: log10 σ/σ0"),
@@ -132,7 +132,7 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
     }
     let t: Vec<f64> = v.history.iter().map(|r| r.t_s).collect();
     // The sequence's plots show the sequence (the free-inertial runs after it share the timeline).
-    let seq_axis = layout::time_axis_range(0.0, t.last().copied().unwrap_or(1.0));
+    let seq_axis = blueprint::time_axis_range(0.0, t.last().copied().unwrap_or(1.0));
     let mut tabs = Vec::new();
     let mut observability = Vec::new();
     for (group, slug, title) in GROUPS {
@@ -152,7 +152,7 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
         observability.push(
             Node::view("TimeSeries", title, path)
                 .with_property("TimeAxis", &seq_axis)
-                .with_property("PlotLegend", &layout::no_legend()),
+                .with_property("PlotLegend", &blueprint::no_legend()),
         );
         for &k in &members {
             let (kind, name) = param(k);
@@ -182,8 +182,8 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
             tabs.push(
                 Node::view("TimeSeries", format!("{name} {what} ({unit}), ±3σ grey"), path)
                     .with_property("TimeAxis", &seq_axis)
-                    .with_property("PlotLegend", &layout::no_legend())
-                    .with_property("ScalarAxis", &layout::symmetric_range(h)),
+                    .with_property("PlotLegend", &blueprint::no_legend())
+                    .with_property("ScalarAxis", &blueprint::symmetric_range(h)),
             );
         }
     }
@@ -214,7 +214,7 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
         ContainerKind::Vertical,
         vec![
             Node::view("3D", "the IMU turning through the sequence (true attitude; the grid is level)", "world")
-                .with_property("EyeControls3D", &layout::eye([1.5, -1.7, 1.0], [0.0, 0.0, 0.0])),
+                .with_property("EyeControls3D", &blueprint::eye([1.5, -1.7, 1.0], [0.0, 0.0, 0.0])),
             Node::view("TextDocument", "result", "docs/selfcal"),
         ],
         &[1.0, 1.2],
@@ -225,7 +225,7 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
         &[1.2, 1.0],
     );
     let root = Node::container(ContainerKind::Horizontal, vec![left, right], &[1.0, 1.5]);
-    layout::send(rec, APPLICATION_ID, &root, &layout::Playback { timeline: TIMELINE, speed: 60.0, follow: false })
+    blueprint::send(rec, APPLICATION_ID, &root, &blueprint::Playback { timeline: TIMELINE, speed: 60.0, follow: false })
 }
 
 /// The colour of a motion's `i`-th run (none, estimated, true: red, green, blue, as uncompensated,
@@ -277,12 +277,12 @@ fn log_navigation(stream: &Stream, lines: &[NavLine<'_>], motions: &[&str]) -> R
             rerun::Scalars::new(values).columns(std::iter::repeat_n(names.len(), n))?,
         )?;
         let mut plot = Node::view("TimeSeries", format!("{motion}: log10 error (m)"), path)
-            .with_property("TimeAxis", &layout::whole_run_time_axis())
+            .with_property("TimeAxis", &blueprint::whole_run_time_axis())
             // Below the lines once they have left 0 m: the legend covers none of them.
-            .with_property("PlotLegend", &layout::legend_at(layout::LegendCorner::RightBottom));
+            .with_property("PlotLegend", &blueprint::legend_at(blueprint::LegendCorner::RightBottom));
         if lo.is_finite() {
             // A whole decade of room under the lowest value, for the legend.
-            plot = plot.with_property("ScalarAxis", &layout::scalar_range(lo.floor() - 1.0, hi.ceil()));
+            plot = plot.with_property("ScalarAxis", &blueprint::scalar_range(lo.floor() - 1.0, hi.ceil()));
         }
         plots.push(plot);
     }

@@ -1,4 +1,6 @@
 use super::*;
+use nalgebra::Vector3;
+use scene::ChainPaths;
 
 #[test]
 fn quaternion_reordering_puts_w_last() {

@@ -4,7 +4,7 @@
 use rerun::RecordingStreamResult;
 use rerun::blueprint::components::ContainerKind;
 
-use super::layout::{self, Node};
+use super::blueprint::{self, Node};
 use super::palette::rgb;
 use super::{APPLICATION_ID, Stream, TIMELINE};
 use crate::ins::reset::{BRANCH_NAMES, BRANCHES, PAPER_RADIAL_M, TprResult};
@@ -74,8 +74,8 @@ pub fn log(stream: &Stream, params: &Params, r: &TprResult, table: &str) -> Reco
     // Legends would sit over the data: the first title gives the colours.
     let plot = |name: &str, origin: &str| {
         Node::view("TimeSeries", name, origin)
-            .with_property("TimeAxis", &layout::whole_run_time_axis())
-            .with_property("PlotLegend", &layout::no_legend())
+            .with_property("TimeAxis", &blueprint::whole_run_time_axis())
+            .with_property("PlotLegend", &blueprint::no_legend())
     };
     let key = format!("red {} · green {} · blue {} · ▼ fixes", BRANCH_NAMES[0], BRANCH_NAMES[1], BRANCH_NAMES[2]);
     let root = Node::container(
@@ -110,5 +110,10 @@ pub fn log(stream: &Stream, params: &Params, r: &TprResult, table: &str) -> Reco
         ],
         &[1.4, 1.0],
     );
-    layout::send(rec, APPLICATION_ID, &root, &layout::Playback { timeline: TIMELINE, speed: 3600.0, follow: true })
+    blueprint::send(
+        rec,
+        APPLICATION_ID,
+        &root,
+        &blueprint::Playback { timeline: TIMELINE, speed: 3600.0, follow: true },
+    )
 }

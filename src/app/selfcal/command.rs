@@ -128,7 +128,7 @@ pub fn execute(req: &SelfcalRequest, stop: &AtomicBool) -> Result<SelfcalReport,
                     Failure::input(format!("selfcal --log: {e:#}"))
                 }
             })?;
-            let seen = crate::ins::selfcal::observability(&estimate);
+            let seen = crate::calib::selfcal::observability(&estimate);
             let hours = estimate.history.last().map_or(0.0, |r| r.t_s) / 3600.0;
             let head = format!(
                 "self-calibration of the log set {}: {hours:.2} h at {:.0} Hz; estimated in {estimation_s:.2} s (no truth: a log)",
@@ -136,7 +136,7 @@ pub fn execute(req: &SelfcalRequest, stop: &AtomicBool) -> Result<SelfcalReport,
                 log.imu.rate_hz
             );
             let text = estimates_table(format!("{head}\n\n"), &estimate, None, &seen, &[], None);
-            let names = crate::ins::selfcal::param_names();
+            let names = crate::calib::selfcal::param_names();
             let document = serde_json::json!({ "log": log.dir.display().to_string(), "parameters": names, "units": JSON_UNITS, "estimate": estimate.params, "sigma": estimate.sigma, "estimation_s": estimation_s, "observability": seen });
             let saved = match sinks {
                 Some(s) => {

@@ -1,6 +1,6 @@
 //! `rinscope selfcal`: the scenario's table turns its IMU through a calibration sequence, the
 //! simulated IMU (with the scenario's errors) feeds the self-calibration filter
-//! ([`crate::ins::selfcal`]), and the estimates are compared with the drawn truth; the plan (what
+//! ([`crate::calib::selfcal`]), and the estimates are compared with the drawn truth; the plan (what
 //! the sequence can see) is computed before, on the sequence's noise-free motion; a Monte Carlo
 //! over random IMUs checks the reported 1σ against the spread.
 
@@ -15,7 +15,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use anyhow::{Result, anyhow, bail};
 use rayon::prelude::*;
 
-use crate::ins::selfcal::{self, Config, Estimate, ImuErrors, Kind, N_PARAMS, SelfCal, Sequence};
+use crate::calib::selfcal::{self, Config, Estimate, ImuErrors, Kind, N_PARAMS, SelfCal, Sequence};
 use crate::ins::sensor::ImuErrorSpec;
 use crate::ins::truth::TruthImu;
 use crate::model::earth::Earth;

@@ -14,8 +14,8 @@
 //! overruns the chunk; found by the garbage tests.) Memory is bounded by one chunk (at most
 //! 256 MiB, as recorders write them: typically 1–4 MiB), never by the file.
 
-use crate::io::formats::cdr::decode_imu;
 use crate::io::error::{Location, LogError, Result};
+use crate::io::formats::cdr::decode_imu;
 use crate::io::formats::table::Source;
 use mcap::records::{Record, op};
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};

@@ -164,13 +164,14 @@ impl ColumnReader {
         let format = detect_format(path)?;
         let mut source: Box<dyn Source + Send> = guarded(path, format, || {
             Ok(match format {
-                Format::Text => {
-                    Box::new(crate::io::formats::text::TextSource::open(path, options.header)?) as Box<dyn Source + Send>
-                }
+                Format::Text => Box::new(crate::io::formats::text::TextSource::open(path, options.header)?)
+                    as Box<dyn Source + Send>,
                 Format::Npy => Box::new(crate::io::formats::npy::NpySource::open(path)?),
                 Format::Parquet => Box::new(crate::io::formats::parquet_io::ParquetSource::open(path)?),
                 Format::PsinsImu => Box::new(crate::io::formats::psins_imu::PsinsSource::open(path)?),
-                Format::Mcap => Box::new(crate::io::formats::mcap_imu::McapImuSource::open(path, options.topic.as_deref())?),
+                Format::Mcap => {
+                    Box::new(crate::io::formats::mcap_imu::McapImuSource::open(path, options.topic.as_deref())?)
+                }
             })
         })?;
         let all = source.all_columns();

@@ -1,11 +1,11 @@
 //! Resolving a [`Layout`] to the columns, units, kind and default frame of a file.
 
 use crate::io::error::{LogError, Result};
-use crate::io::imu::{ColumnMap, ImuOptions, Layout, SampleKind, TimeUnit};
 use crate::io::formats::psins_imu::{first_line, not_psins};
 use crate::io::formats::sniff::{Format, detect_format};
 use crate::io::formats::table::{Col, ColumnReader, HeaderMode, ReadOptions};
 use crate::io::imu::units::{Quantity, split_unit, suffixes_for};
+use crate::io::imu::{ColumnMap, ImuOptions, Layout, SampleKind, TimeUnit};
 use std::path::Path;
 
 /// The resolved columns of a layout.

@@ -67,13 +67,13 @@ pub mod plausibility;
 pub mod series;
 pub mod units;
 
-use crate::io::imu::clock::{Clock, RawStamp};
-pub use crate::io::imu::clock::{GPS_WEEK_S, StartTime, TimeUnit};
 use crate::io::error::{Location, LogError, Result};
-use crate::io::imu::axes::Frame;
-use crate::io::imu::layout::{plan_for, read_options};
 use crate::io::formats::psins_imu::PsinsHeader;
 use crate::io::formats::table::ColumnReader;
+use crate::io::imu::axes::Frame;
+use crate::io::imu::clock::{Clock, RawStamp};
+pub use crate::io::imu::clock::{GPS_WEEK_S, StartTime, TimeUnit};
+use crate::io::imu::layout::{plan_for, read_options};
 use crate::io::validity::{Sensor, check_imu_value};
 use nalgebra::{Matrix3, Vector3};
 use std::collections::VecDeque;

@@ -9,8 +9,8 @@
 //! without Earth rate reads as little at rest.)
 
 use crate::io::error::Result;
-use crate::io::imu::{ImuEvent, ImuOptions, ImuReader, Layout, SampleKind, StaticCheck};
 use crate::io::imu::units::STANDARD_GRAVITY_MPS2 as G0;
+use crate::io::imu::{ImuEvent, ImuOptions, ImuReader, Layout, SampleKind, StaticCheck};
 use nalgebra::Vector3;
 use std::path::Path;
 

@@ -1,19 +1,17 @@
-//! The plotted series of a recording: which entities exist — decided once, from the scenario and
-//! what is recorded (a simulation, a replay through a table, a strapdown replay) — and what each
-//! row adds to each of them. What does not exist is neither logged, exported nor laid out.
+//! Which series a recording plots — decided once, from the scenario and what is recorded (a
+//! simulation, a replay through a table, a strapdown replay). What does not exist is neither
+//! logged, exported nor laid out.
 
 use nalgebra::Vector3;
 
-use super::ins_view::{self, InsLayout};
-use super::{CLOSED_FORM_PATH, Recorder, ReplayKind, error_path};
-use crate::ins::core::NavError;
+use super::coning::{self, ConingLines};
 use crate::ins::nav::{NavState, Vertical};
-use crate::ins::pipeline::InsView;
 use crate::math::attitude::Attitude;
-use crate::math::units::{ARCSEC_PER_RAD, AngleUnit, DEG_PER_RAD};
+use crate::math::units::AngleUnit;
 use crate::model::gimbal::Chain;
+use crate::record::{CLOSED_FORM_PATH, ReplayKind, error_path};
 use crate::scenario::Params;
-use crate::sim::{DEMODULATIONS, ERROR_AXES, StepOutput};
+use crate::sim::{DEMODULATIONS, ERROR_AXES};
 
 /// The INS's own solution at a recorded row of a replay (a simulation records the truth and the
 /// INS's errors instead).
@@ -82,7 +80,7 @@ pub(crate) fn same_row(a: &[f64], b: &[f64]) -> bool {
 }
 
 impl Series {
-    fn new(path: impl Into<String>, names: Vec<String>, what: Quantity) -> Self {
+    pub(crate) fn new(path: impl Into<String>, names: Vec<String>, what: Quantity) -> Self {
         Self { path: path.into(), names, values: Vec::new(), what, last_sent: None, held_until_s: None }
     }
 
@@ -129,7 +127,7 @@ pub(crate) fn table_series(chain: &Chain, replay: Option<ReplayKind>, unit: Angl
         series.push(Series::new("vehicle_attitude_deg", names(&ERROR_AXES), Quantity::VehicleAttitude));
     }
     for (k, (name, g)) in axis_names.iter().zip(chain.axes()).enumerate() {
-        let about = |v: &Vector3<f64>| format!("{name} swing about {}", super::scene::axis_letter(v));
+        let about = |v: &Vector3<f64>| format!("{name} swing about {}", crate::record::scene::axis_letter(v));
         series.push(Series::new(format!("swing_arcsec/{name}"), vec![about(&g.e1), about(&g.e2)], Quantity::Swing(k)));
     }
     // The closed form's residual against the exact chain, where the two lines lie on each other.
@@ -139,11 +137,23 @@ pub(crate) fn table_series(chain: &Chain, replay: Option<ReplayKind>, unit: Angl
     series
 }
 
-/// The INS's series (appended to `series`) and what its recording adds, when `params` has an IMU.
-pub(crate) fn ins_layout(params: &Params, replay: Option<ReplayKind>, series: &mut Vec<Series>) -> Option<InsLayout> {
+/// The INS's plots: which algorithms, which of them are hidden, whether their errors are plotted,
+/// pure coning's analytic lines.
+pub(crate) struct InsSeries {
+    pub(crate) algorithms: Vec<String>,
+    /// The algorithms not shown (`[recording.show]`), by name.
+    pub(crate) hidden: Vec<String>,
+    /// The attitude errors per algorithm are recorded (a simulation, a replay with a reference).
+    pub(crate) errors: bool,
+    /// Pure coning: each algorithm's analytic drift about the cone axis, drawn beside its
+    /// measured error on the log10 drift plot.
+    pub(crate) coning: Option<ConingLines>,
+}
+
+/// The INS's series (appended to `series`), when `params` has an IMU.
+pub(crate) fn ins_series(params: &Params, replay: Option<ReplayKind>, series: &mut Vec<Series>) -> Option<InsSeries> {
     let cfg = params.ins.as_ref()?;
     let algorithms: Vec<String> = cfg.algorithms().iter().map(|a| a.name().to_owned()).collect();
-    let n_algorithms = algorithms.len();
     // A replay without a reference has no errors to plot (they would be zero).
     let errors = replay.is_none_or(|k| k.reference);
     if errors {
@@ -191,114 +201,13 @@ pub(crate) fn ins_layout(params: &Params, replay: Option<ReplayKind>, series: &m
                 .iter()
                 .flat_map(|a| [format!("{a}: log10 |heading error|"), format!("{a}: analytic coning drift")])
                 .collect();
-            series.push(Series::new(ins_view::CONING_LOG_PATH, lines, Quantity::ConingLog));
-            ins_view::coning_rates(params, &cfg.algorithms()).map(ins_view::ConingLines::new)
+            series.push(Series::new(coning::CONING_LOG_PATH, lines, Quantity::ConingLog));
+            coning::coning_rates(params, &cfg.algorithms()).map(ConingLines::new)
         });
-    // The INS trace and the drift dial draw the INS's error ×N: where the largest error of
-    // the run is known in advance (pure coning: the analytic drifts), N is lowered to the
-    // largest 1-2-5 factor that keeps it under 150°, so the picture never wraps round.
-    let exaggeration = coning_log.as_ref().map_or(params.recording.exaggeration, |lines| {
-        let worst_rad = lines.rates.iter().fold(0.0_f64, |m, r| m.max(*r)) * params.duration_s / ARCSEC_PER_RAD;
-        let limit = 150.0 * crate::math::units::RAD_PER_DEG;
-        if worst_rad * params.recording.exaggeration <= limit {
-            return params.recording.exaggeration;
-        }
-        crate::math::units::nice_at_most(limit / worst_rad).max(1e-3)
-    });
-    Some(InsLayout {
+    Some(InsSeries {
         hidden: algorithms.iter().filter(|a| !params.recording.shows(a)).cloned().collect(),
         algorithms,
         errors,
-        // A strapdown IMU's axes are drawn as the body (`body_view`), not as a trace beside a table.
-        trace: replay.is_none_or(|k| k.table),
-        signal_t: Vec::new(),
-        raw: Vec::new(),
-        filtered: Vec::new(),
-        trace_axes: Vec::new(),
-        // The dial turns by the errors: none without them.
-        dial_on: n_algorithms >= 2 && errors,
-        dial: Vec::new(),
-        dial_t: Vec::new(),
-        dial_next_t: f64::NEG_INFINITY,
-        exaggeration,
-        fir_taps: cfg.fir_taps.clone(),
-        rate_hz: params.step_hz,
-        signal_window_s: cfg.signal_window_s.max(0.01),
-        coning_log,
-        signal_peak_deg_per_s: [0.0; 2],
+        coning: coning_log,
     })
-}
-
-/// What a row without a navigation view shows.
-const NO_NAV: NavError = NavError {
-    east_m: f64::NAN,
-    north_m: f64::NAN,
-    radial_m: f64::NAN,
-    velocity_enu_mps: Vector3::new(f64::NAN, f64::NAN, f64::NAN),
-};
-
-impl Recorder {
-    /// Buffers one row of every series from the table's step `out`, the INS's view `ins` (errors,
-    /// navigation) and, in a replay, its own `solution`.
-    pub(crate) fn push_values(&mut self, out: &StepOutput, ins: Option<&InsView>, solution: Option<&Solution>) {
-        let Self { series, chain, truth, error_unit, ins: layout, .. } = self;
-        let per_rad = error_unit.per_rad();
-        let lines = layout.as_ref().and_then(|l| l.coning_log.as_ref());
-        let nav = ins.and_then(|v| v.nav).unwrap_or(NO_NAV);
-        let state = solution.and_then(|s| s.nav);
-        for s in series.iter_mut() {
-            let width = s.width();
-            let v = &mut s.values;
-            match s.what {
-                Quantity::TableError(a) => v.extend(out.errors[..width].iter().map(|e| e.as_array()[a] * per_rad)),
-                Quantity::ClosedForm => {
-                    let (exact, closed) = (out.errors[0].as_array(), out.errors[2].as_array());
-                    v.extend((0..3).map(|a| (closed[a] - exact[a]) * ARCSEC_PER_RAD));
-                }
-                Quantity::GimbalAngles => v.extend(out.gimbal_rad[..width].iter().map(|x| x * DEG_PER_RAD)),
-                Quantity::VehicleAttitude => v.extend(
-                    [out.attitude.pitch_rad, out.attitude.roll_rad, out.attitude.heading_rad].map(|x| x * DEG_PER_RAD),
-                ),
-                Quantity::Swing(k) => {
-                    let g = &chain.axes()[k];
-                    let sw = chain.swing_vector(k, &truth.axes[k], out.gimbal_rad[k]);
-                    v.extend([sw.dot(&g.e1) * ARCSEC_PER_RAD, sw.dot(&g.e2) * ARCSEC_PER_RAD]);
-                }
-                Quantity::InsError(a) => match ins {
-                    Some(view) => v.extend(view.errors.iter().map(|e| e.as_array()[a] * ARCSEC_PER_RAD)),
-                    None => v.extend(std::iter::repeat_n(f64::NAN, width)),
-                },
-                Quantity::ConingLog => {
-                    let log10 = |x: f64| if x > 0.0 && x.is_finite() { x.log10() } else { f64::NAN };
-                    for j in 0..lines.map_or(0, |l| l.rates.len()) {
-                        let measured =
-                            ins.map_or(f64::NAN, |view| log10(view.errors[j].heading_rad.abs() * ARCSEC_PER_RAD));
-                        v.extend([measured, log10(lines.map_or(f64::NAN, |l| l.at(j, out.t_s)))]);
-                    }
-                }
-                Quantity::PositionError => v.extend([nav.east_m, nav.north_m, nav.radial_m]),
-                Quantity::VelocityError => v.extend(nav.velocity_enu_mps.iter()),
-                Quantity::BodyAttitude => match solution {
-                    // Heading in (−180°, 180°]: a vehicle pointing North (most tests) does not jump by 360°.
-                    Some(s) => {
-                        v.extend([s.body.pitch_rad, s.body.roll_rad, s.body.heading_rad].map(|x| x * DEG_PER_RAD))
-                    }
-                    None => v.extend([f64::NAN; 3]),
-                },
-                Quantity::Velocity => {
-                    v.extend(state.map_or([f64::NAN; 3], |n| [n.v_n.x, n.v_n.y, n.v_n.z])[..width].iter())
-                }
-                Quantity::PositionFromStart => v.extend([nav.east_m, nav.north_m]),
-                Quantity::LatitudeLongitude => v.extend(
-                    state.map_or([f64::NAN; 2], |n| [n.latitude_rad * DEG_PER_RAD, n.longitude_rad * DEG_PER_RAD]),
-                ),
-                Quantity::Height => v.push(state.map_or(f64::NAN, |n| n.height_m)),
-            }
-        }
-    }
-
-    /// True if the recording has the entity `path`.
-    pub(crate) fn has_series(&self, path: &str) -> bool {
-        self.series.iter().any(|s| s.path == path)
-    }
 }

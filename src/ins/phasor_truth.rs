@@ -1,5 +1,5 @@
-//! Closed-form IMU increments over a piece of motion whose rotations all turn at constant rates
-//! (a dwell, a continuous scheme, a cruise, a ramp, pure coning; `model::turning`).
+//! The phasor truth: exact IMU increments, in closed form, over a piece of motion whose rotations
+//! all turn at constant rates (a dwell, a continuous scheme, a cruise, a ramp, pure coning; `model::turning`).
 //!
 //! With `n_from_s(τ) = L_1(τ) ⋯ L_m(τ)` and `L_k = R(a_k, φ_k + ω_k τ)` or constant, the sensor
 //! frame's rate and specific force at a fixed site are
@@ -90,7 +90,7 @@ pub const REANCHOR: u32 = 128;
 
 /// The closed form of one piece of motion.
 #[derive(Debug, Clone)]
-pub struct ClosedForm {
+pub struct PhasorTruth {
     /// The instant τ = 0, s.
     t_anchor_s: f64,
     /// The constant (ν = 0) parts of ω_is^s and f^s.
@@ -145,7 +145,7 @@ fn rotate_back(terms: &mut Terms, q: &nalgebra::UnitQuaternion<f64>) {
     }
 }
 
-impl ClosedForm {
+impl PhasorTruth {
     /// The closed form of `n_from_s = L_1 ⋯ L_m` (`links`, τ counted from `t_anchor_s`) at a site with
     /// Earth rate `omega_ie_n` and specific force `f_n` (the reaction to gravity). None when the
     /// chain has more than [`MAX_TERMS`] frequencies.
@@ -420,7 +420,7 @@ mod tests {
             let t0 = rng.random_range(0.0..0.3);
             let h = rng.random_range(1e-4..2e-2);
             let mut imu = TruthImu::new(model, earth, t0);
-            if !imu.is_closed_form() {
+            if !imu.is_phasor_truth() {
                 continue;
             }
             closed += 1;
@@ -450,7 +450,7 @@ mod tests {
             let h = 1.0 / [100.0, 200.0, 2000.0][rng.random_range(0..3usize)];
             let i0 = (1.0 / h) as u64;
             let mut imu = TruthImu::new(model, earth, i0 as f64 * h);
-            let Some(anchored) = imu.closed_form(i0 as f64 * h, f64::INFINITY) else { continue };
+            let Some(anchored) = imu.phasor_truth(i0 as f64 * h, f64::INFINITY) else { continue };
             closed += 1;
             let mut reference = imu.clone();
             for i in i0 + 1..i0 + 600 {
