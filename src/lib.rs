@@ -9,16 +9,18 @@
 //!    opening inputs (`io::files`), the plausibility of a log's numbers.
 //! 2. [`model`] — the gimbal chain with its exact errors, rotation schemes, vehicle motion, Earth.
 //! 3. [`sim`] — the turntable step: truth, encoders, three demodulations (pure).
-//! 4. [`ins`], [`calib`] — the INS in the loop (IMU truth, sensors, algorithms, navigation,
-//!    resets, self-calibration) and the table's calibration estimators; each takes the parameter
-//!    struct it owns.
-//! 5. [`scenario`] — the only code that knows the TOML: raw structs, validation, presets, log sets.
-//! 6. [`record`] — the only door to Rerun: entity tree, series, layout, sinks; it never steps a model.
-//! 7. [`app`] — one owner per command: each command is one function taking a request and a stop
+//! 4. [`ins`] — the INS in the loop: IMU truth, sensors and their error model, algorithms,
+//!    navigation, alignment, resets; each takes the parameter struct it owns.
+//! 5. [`calib`] — the estimators: the table's static calibration and the IMU's system-level
+//!    self-calibration (on the INS's own error model).
+//! 6. [`scenario`] — the only code that knows the TOML: raw structs, validation, presets, log sets.
+//! 7. [`record`] — the only door to Rerun: the views (table, body, cone, INS, plots), documents,
+//!    layout, sinks; it never steps a model.
+//! 8. [`app`] — one owner per command: each command is one function taking a request and a stop
 //!    flag and returning a report (`app::run::execute`, `app::calibrate::execute`, ...), with one
 //!    termination policy (`app::failure`) and one way to open, check and write outputs
 //!    (`app::outputs`); threads, channels and progress live here.
-//! 8. [`cli`] — clap: arguments into requests, reports into text, failures into exit codes
+//! 9. [`cli`] — clap: arguments into requests, reports into text, failures into exit codes
 //!    (`python/` does the same for Python).
 
 /// `print!` for what a command outputs: stdout may be a pipe whose reader has gone

@@ -13,11 +13,11 @@ const LAYERS: &[(&str, u32)] = &[
     ("model", 2),
     ("sim", 3),
     ("ins", 4),
-    ("calib", 4),
-    ("scenario", 5),
-    ("record", 6),
-    ("app", 7),
-    ("cli", 8),
+    ("calib", 5),
+    ("scenario", 6),
+    ("record", 7),
+    ("app", 8),
+    ("cli", 9),
 ];
 
 /// A source file longer than this is a god file in the making: split it by responsibility.

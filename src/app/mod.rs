@@ -1,4 +1,4 @@
-//! Layer 7, one owner per command (each `execute(request, stop) -> report`): a recorded run (simulation thread → channel → recorder),
+//! Layer 8, one owner per command (each `execute(request, stop) -> report`): a recorded run (simulation thread → channel → recorder),
 //! live mode, calibration and its Monte Carlo, the position-reset comparison, rotation modulation,
 //! the paper reproductions and the benchmarks. Threads, channels, progress bars and files live
 //! here, above the pure layers and the recorder.
@@ -8,6 +8,7 @@ pub mod bench;
 pub mod calibrate;
 pub mod export_log;
 pub mod failure;
+pub mod inspect;
 pub mod live;
 pub mod modulation;
 pub mod montecarlo;

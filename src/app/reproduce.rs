@@ -3,6 +3,11 @@
 //! Each row states the quantity, the paper's value as printed, rinscope's value and the tolerance
 //! band it must fall in. Later issues add rows; docs/reproduce.md keeps the latest table.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use crate::app::failure::Failure;
+use crate::app::outputs::check_output;
+use crate::io::files::write_atomically;
 use crate::math::stats::RunningStat;
 use crate::math::units::{ARCSEC_PER_RAD, DEG_PER_RAD};
 use crate::scenario::Params;
@@ -220,13 +225,41 @@ fn closed_form_row(source: &str, name: &str, p: &Params, stats: &crate::sim::Err
     )
 }
 
+/// `rinscope reproduce`'s owner: every reproducing scenario run, the table written as markdown
+/// to `markdown` (checked before anything runs). A table with a row outside its band is a
+/// report, not a failure: the caller says so.
+///
+/// # Errors
+/// An output that cannot be written, a preset that does not load, a signal (between scenarios:
+/// within the longest one's time, a few seconds).
+pub fn execute(markdown: Option<&std::path::Path>, stop: &AtomicBool) -> Result<Table, Failure> {
+    check_output("--markdown", markdown)?;
+    let table = match run_all(stop) {
+        Ok(t) => t,
+        Err(_) if stop.load(Ordering::SeqCst) => {
+            return Err(Failure::interrupted("the reproductions did not finish; nothing written"));
+        }
+        Err(e) => return Err(Failure::from(e)),
+    };
+    if let Some(path) = markdown {
+        write_atomically(path, table.markdown().as_bytes()).map_err(|e| Failure::output("--markdown", &e))?;
+    }
+    Ok(table)
+}
+
+/// An error once `stop` is set (checked between the scenarios).
+fn go_on(stop: &AtomicBool) -> anyhow::Result<()> {
+    if stop.load(Ordering::SeqCst) { Err(anyhow::anyhow!("interrupted")) } else { Ok(()) }
+}
+
 /// Runs every reproducing scenario (no recording) and builds the table.
-pub fn run_all() -> anyhow::Result<Table> {
+pub fn run_all(stop: &AtomicBool) -> anyhow::Result<Table> {
     let mut rows = Vec::new();
     let rad_per_arcmin = crate::math::units::RAD_PER_ARCMIN;
 
     // The rotary-table paper §5, installation error 5′/5′: the paper's "reach 0.1 degrees", printed to one
     // significant digit ([0.05, 0.15]).
+    go_on(stop)?;
     let p = presets::load("rotary-table-2016-installation")?;
     let stats = run_stats(&p.table_model(), &p.timeline());
     rows.push(Row::new(
@@ -243,6 +276,7 @@ pub fn run_all() -> anyhow::Result<Table> {
     // The rotary-table paper §5, wobble θ = 0.01 rad at azimuth 30°: in the 180° dwell of a level vehicle the board
     // is tilted by 2θ toward azimuth 30°, so the largest Euler error is 2θ·cos 30° (first order; the
     // neglected terms are θ² relative).
+    go_on(stop)?;
     let p = presets::load("rotary-table-2016-wobble")?;
     let stats = run_stats(&p.table_model(), &p.timeline());
     let mut level = p.clone();
@@ -277,6 +311,7 @@ pub fn run_all() -> anyhow::Result<Table> {
 
     // The rotary-table paper §5, encoder (angular) error 1′: a heading error of 1′ while level, shared with roll
     // and pitch when tilted; its peak over the run is 1′ to second order (1′² relative).
+    go_on(stop)?;
     let p = presets::load("rotary-table-2016-angular")?;
     let stats = run_stats(&p.table_model(), &p.timeline());
     let one_arcmin_deg = rad_per_arcmin * DEG_PER_RAD;
@@ -299,6 +334,7 @@ pub fn run_all() -> anyhow::Result<Table> {
 
     // Jiang et al. 2017: the closed form of eq. 28 (re-derived) against the exact model at Table 2's values;
     // absolute residual of order α², α the largest error angle.
+    go_on(stop)?;
     let p = presets::load("jiang2017-dual-axis")?;
     let stats = run_stats(&p.table_model(), &p.timeline());
     let dev = stats.closed_form_deviation.iter().map(|s| s.peak()).fold(0.0, f64::max) * ARCSEC_PER_RAD;
@@ -320,6 +356,7 @@ pub fn run_all() -> anyhow::Result<Table> {
     // Li et al. 2014 §3 eq. 16/19 and Figure 10: 7°, 0.5 Hz azimuth wobble, 6.25 ms lag. Theorem: the
     // error is A·ω·τ·cos; neglected: (ωτ)²/2 = 2e-4 and the 100-Hz sampling of the peak,
     // (π f/fs)²/2 = 1.2e-4 relative.
+    go_on(stop)?;
     let base = presets::load("li2014-phase-lag")?;
     let stats = ins_stats(&base, 2.0);
     let (amp, omega, tau) = (7.0, std::f64::consts::TAU * 0.5, 6.25e-3);
@@ -384,6 +421,7 @@ pub fn run_all() -> anyhow::Result<Table> {
         rows.push(row);
     }
     // Li et al. 2014 Table 1: the single-sample (the paper's "quaternion") algorithm's coning drift.
+    go_on(stop)?;
     let p = presets::load("li2014-coning")?;
     let stats = ins_stats(&p, 0.0);
     let single = crate::ins::coning::Algorithm::SingleSample;
@@ -405,6 +443,7 @@ pub fn run_all() -> anyhow::Result<Table> {
     );
     // Li et al. 2014 §4.2 / Table 6: the DAMS reaches 20″ (1σ) under three-axis wobbling.
     for name in ["li2014-wobble-1", "li2014-wobble-2"] {
+        go_on(stop)?;
         let p = presets::load(name)?;
         let stats = ins_stats(&p, 0.0);
         let worst = stats[0].iter().map(sigma).fold(0.0, f64::max) * ARCSEC_PER_RAD;
@@ -421,15 +460,16 @@ pub fn run_all() -> anyhow::Result<Table> {
             .not_reproduced("the paper's 7.3-20.7″ include its turntable's and alignment errors, which this scenario does not have; rinscope's value is the algorithms' and the sensors' part"),
         );
     }
-    calibration_rows(&mut rows)?;
+    calibration_rows(&mut rows, stop)?;
     Ok(Table { rows })
 }
 
 /// Jiang et al. 2017 §6: what compensation with the calibrated parameters leaves, and the Monte Carlo.
-fn calibration_rows(rows: &mut Vec<Row>) -> anyhow::Result<()> {
-    let stop = std::sync::atomic::AtomicBool::new(false);
+fn calibration_rows(rows: &mut Vec<Row>, stop: &AtomicBool) -> anyhow::Result<()> {
+    go_on(stop)?;
     let p = presets::load("jiang2017-calibration")?;
-    let outcome = crate::app::calibrate::calibrate_scenario(&p, false, &stop)?;
+    let outcome = crate::app::calibrate::calibrate_scenario(&p, false, stop)?;
+    go_on(stop)?;
     // The least-squares compensation against compensating with the true values, on the independent
     // run: RMS² adds, so the ratio is √(1 + (3σ/floor)²) at most, σ the largest estimate 1σ; fitting
     // the noise could lower it by no more than p/n.
@@ -475,8 +515,8 @@ fn calibration_rows(rows: &mut Vec<Row>) -> anyhow::Result<()> {
     // (app::calibrate::encoder_noise_floor), 3σ of an RMS over n samples: 3/√(2n) relative.
     let mut ideal = p.clone();
     ideal.ins = None;
-    let outcome = crate::app::calibrate::calibrate_scenario(&ideal, false, &stop)?;
-    let analytic = crate::app::calibrate::encoder_noise_floor(&ideal, &stop)?;
+    let outcome = crate::app::calibrate::calibrate_scenario(&ideal, false, stop)?;
+    let analytic = crate::app::calibrate::encoder_noise_floor(&ideal, stop)?;
     if let Some(c) = outcome.report.compensation {
         let n = outcome.cal.samples.max(1) as f64;
         for (axis, name) in ["pitch", "roll", "heading"].iter().enumerate() {
@@ -498,7 +538,7 @@ fn calibration_rows(rows: &mut Vec<Row>) -> anyhow::Result<()> {
     }
     // Jiang et al. 2017 Table 3: mean calibration errors over many runs; rinscope's mean |error| of each
     // identifiable quantity, against the spread the filter reports for it: E|x| = σ·√(2/π).
-    let mc = crate::app::calibrate::monte_carlo(&p, 200, &|| {}, &stop)?;
+    let mc = crate::app::calibrate::monte_carlo(&p, 200, &|| {}, stop)?;
     let worst = mc
         .rows
         .iter()
@@ -528,7 +568,7 @@ mod tests {
     fn every_paper_number_is_reproduced_within_its_band() {
         // The bands and the papers' values are in `run_all`; this fails if a model change moves a
         // reproduction out of agreement (the same check `rinscope reproduce` makes with exit code 1).
-        let table = run_all().expect("scenarios load");
+        let table = run_all(&AtomicBool::new(false)).expect("scenarios load");
         assert!(table.rows.len() >= 7);
         for r in table.rows.iter().filter(|r| r.not_reproduced.is_none()) {
             assert!(r.agrees(), "{} / {}: {} not in {:?}", r.scenario, r.quantity, r.value, r.band);

@@ -79,7 +79,7 @@ pub(super) fn allan(args: &AllanArgs) -> Result<(), Failure> {
         (None, None) => {
             let mut params = args.source.load(DEFAULT_SCENARIO)?;
             if let Some(d) = args.duration_s {
-                params.set_duration(super::commands::duration_flag(d)?);
+                params.set_duration(d); // held to `scenario::DURATION` by the parser
             }
             AllanSource::Scenario(Box::new(params))
         }

@@ -7,24 +7,19 @@ use super::{
     CalibrateArgs, Failure, LiveArgs, ModulationArgs, MonteCarloAction, MonteCarloArgs, RunArgs, ScenarioSource,
     TprArgs,
 };
-use crate::app::outputs::{check_output, write_json};
 use crate::app::terminate::stop_flag;
 use crate::app::{live, modulation, reproduce};
 use crate::calib::montecarlo::Shard;
 use crate::record::sink;
-use crate::scenario::{self, Params, presets};
+use crate::scenario::{Params, presets};
 
 fn load(args: &RunArgs) -> Result<Params, Failure> {
     let mut params = args.source.load(presets::DEFAULT_SCENARIO)?;
     if let Some(d) = args.duration_s {
-        params.set_duration(duration_flag(d)?);
+        // The parser held it to `scenario::DURATION`.
+        params.set_duration(d);
     }
     Ok(params)
-}
-
-/// `--duration-s`, checked.
-pub(super) fn duration_flag(d: f64) -> Result<f64, Failure> {
-    scenario::check_duration(d).map_err(|e| Failure::input(format!("--duration-s {e}")))
 }
 
 /// `rinscope run`.
@@ -51,9 +46,6 @@ pub(super) fn run(args: &RunArgs) -> Result<(), Failure> {
 
 /// `rinscope live`.
 pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
-    if let Some(d) = args.duration_s {
-        duration_flag(d)?;
-    }
     let request = live::LiveRequest {
         config: args.config.clone(),
         scenario: args.scenario.clone(),
@@ -240,8 +232,7 @@ pub(super) fn tpr(args: &TprArgs) -> Result<(), Failure> {
 
 /// `rinscope events`.
 pub(super) fn events(file: &Path) -> Result<(), Failure> {
-    let events = crate::record::read::events(file).map_err(|e| Failure::input(format!("{e:#}")))?;
-    for e in events {
+    for e in crate::app::inspect::events(file)? {
         match e.t_s {
             Some(t) => outln!("{t:>10.3} s  {:<5} {}", e.level, e.text),
             None => outln!("{:>12}  {:<5} {}", "static", e.level, e.text),
@@ -252,10 +243,10 @@ pub(super) fn events(file: &Path) -> Result<(), Failure> {
 
 /// `rinscope scenarios`.
 pub(super) fn list_scenarios() {
-    for (name, _) in presets::PRESETS {
-        match presets::load(name) {
+    for (name, loaded) in crate::app::inspect::scenarios() {
+        match loaded {
             Ok(p) => {
-                let mark = if *name == presets::DEFAULT_SCENARIO { " (default)" } else { "" };
+                let mark = if name == presets::DEFAULT_SCENARIO { " (default)" } else { "" };
                 outln!("{name}{mark}\n    {}", p.meta.title);
             }
             Err(e) => outln!("{name}\n    BROKEN: {e}"),
@@ -265,7 +256,7 @@ pub(super) fn list_scenarios() {
 
 /// `rinscope check-config`.
 pub(super) fn check_config(file: &Path) -> Result<(), Failure> {
-    let p = scenario::load_file(file)?;
+    let p = crate::app::inspect::check_config(file)?;
     let axes: Vec<String> = p.table.chain.axes().iter().map(|a| a.name.clone()).collect();
     outln!(
         "{}: ok — scenario \"{}\", {} s at {} Hz ({} steps), axes {:?}, seed {}",
@@ -282,12 +273,8 @@ pub(super) fn check_config(file: &Path) -> Result<(), Failure> {
 
 /// `rinscope reproduce`.
 pub(super) fn reproduce(markdown: Option<&Path>) -> Result<(), Failure> {
-    let table = reproduce::run_all()?;
+    let table = reproduce::execute(markdown, &stop_flag())?;
     out!("{}", table.text());
-    if let Some(path) = markdown {
-        crate::io::files::write_atomically(path, table.markdown().as_bytes())
-            .map_err(|e| Failure::output("--markdown", &e))?;
-    }
     if table.all_agree() {
         Ok(())
     } else {
@@ -295,67 +282,10 @@ pub(super) fn reproduce(markdown: Option<&Path>) -> Result<(), Failure> {
     }
 }
 
-/// `bench`.
-pub(super) fn bench(steps: u64, json: Option<&std::path::Path>, only: &[String]) -> Result<(), Failure> {
-    check_output("--json", json)?;
-    let stop = stop_flag();
-    let figures = match crate::app::bench::run_benchmarks(steps, only, &stop) {
-        Ok(f) => f,
-        Err(_) if stop.load(std::sync::atomic::Ordering::SeqCst) => {
-            return Err(Failure::interrupted("the figures printed so far are not a whole benchmark; none written"));
-        }
-        Err(e) => return Err(Failure::from(e)),
-    };
-    if let Some(path) = json {
-        write_json("--json", path, &figures)?;
-    }
-    Ok(())
-}
-
-/// `bench --peer allantools`.
-pub(super) fn bench_allantools(
-    python: &std::path::Path,
-    rounds: usize,
-    samples: u64,
-    json: Option<&std::path::Path>,
-) -> Result<(), Failure> {
-    use crate::app::bench::allantools;
-    check_output("--json", json)?;
-    let stop = stop_flag();
-    let reports = match allantools::compare(python, samples, rounds, &stop) {
-        Ok(r) => r,
-        Err(_) if stop.load(std::sync::atomic::Ordering::SeqCst) => {
-            return Err(Failure::interrupted("the comparison did not finish; nothing written"));
-        }
-        Err(e) => return Err(Failure::run(format!("{e:#}"))),
-    };
-    out!("{}", allantools::text(&reports, samples));
-    if let Some(path) = json {
-        write_json("--json", path, &reports)?;
-    }
-    Ok(())
-}
-
-/// `bench --peer pyins`.
-pub(super) fn bench_peer(
-    python: PathBuf,
-    rounds: usize,
-    samples: u64,
-    json: Option<&std::path::Path>,
-) -> Result<(), Failure> {
-    use crate::app::bench::peer;
-    check_output("--json", json)?;
-    let stop = stop_flag();
-    let reports = match peer::compare(&peer::PeerOptions { python, rounds, samples }, &stop) {
-        Ok(r) => r,
-        Err(_) if stop.load(std::sync::atomic::Ordering::SeqCst) => {
-            return Err(Failure::interrupted("the comparison did not finish; nothing written"));
-        }
-        Err(e) => return Err(Failure::run(format!("{e:#}"))),
-    };
-    out!("{}", peer::text(&reports));
-    if let Some(path) = json {
-        write_json("--json", path, &reports)?;
-    }
+/// `rinscope bench` (with `--peer`: against another tool).
+pub(super) fn bench(benchmark: crate::app::bench::Benchmark, json: Option<PathBuf>) -> Result<(), Failure> {
+    use crate::app::bench::{BenchRequest, execute};
+    let report = execute(&BenchRequest { benchmark, json }, &stop_flag())?;
+    out!("{}", report.text());
     Ok(())
 }

@@ -1,4 +1,4 @@
-//! Layer 8, the command line: clap's view of every command, the sink flags declared once and
+//! Layer 9, the command line: clap's view of every command, the sink flags declared once and
 //! flattened into each command that records, exit codes. `main` parses and dispatches; the
 //! commands' work is in [`commands`] and the layers below.
 //!
@@ -552,6 +552,9 @@ struct SelfcalArgs {
     json: Option<PathBuf>,
 }
 
+use crate::app::bench::Benchmark;
+use crate::app::bench::peer::PeerOptions;
+
 /// Parses the command line, runs the command, maps its outcome to an exit code.
 #[must_use]
 pub fn main() -> ExitCode {
@@ -586,12 +589,12 @@ where
         }
         Command::CheckConfig { file } => commands::check_config(&file),
         Command::Reproduce { markdown } => commands::reproduce(markdown.as_deref()),
-        Command::Bench { steps, peer: None, json, only, .. } => commands::bench(steps, json.as_deref(), &only),
+        Command::Bench { steps, peer: None, json, only, .. } => commands::bench(Benchmark::Own { steps, only }, json),
         Command::Bench { peer: Some(peer), python, rounds, samples, json, .. } if peer == "allantools" => {
-            commands::bench_allantools(&python, rounds, samples, json.as_deref())
+            commands::bench(Benchmark::Allantools { python, rounds, samples }, json)
         }
         Command::Bench { peer: Some(_), python, rounds, samples, json, .. } => {
-            commands::bench_peer(python, rounds, samples, json.as_deref())
+            commands::bench(Benchmark::Pyins(PeerOptions { python, rounds, samples }), json)
         }
     };
     match result {

@@ -12,10 +12,8 @@ use crate::scenario;
 // `invalid value '-10' for '--duration-s <DURATION_S>': ...`, naming the option. The ranges, and
 // why:
 
-/// A simulated duration, s: > 0 and at most 30 days (`scenario::MAX_DURATION_S`, the bound of
-/// `simulation.duration_s`).
-pub(super) const DURATION_S: Range =
-    Range::positive(scenario::MAX_DURATION_S, "s", "a simulated duration (30 days at most, as simulation.duration_s)");
+/// A simulated duration, s: the rule of `simulation.duration_s` ([`scenario::DURATION`]).
+pub(super) const DURATION_S: Range = scenario::DURATION;
 /// The ranges the commands' owners hold their requests to (the parser answers first, with the
 /// same words; Python's calls meet the owners' checks).
 pub(super) use crate::app::allan::CI_SIGMA;

@@ -1,5 +1,10 @@
-//! The only module that talks to Rerun: the entity tree of the gimbal chain, the time series, the
-//! documents and the blueprint. It turns [`StepOutput`]s into Rerun calls.
+//! Layer 7, the only module that talks to Rerun. A [`Recorder`] is a composition of views, each
+//! owning its entities: the table's scene (`scene.rs`, `world/vehicle/…`), a strapdown IMU's body
+//! (`body_view.rs`), pure coning's cone (`cone.rs`), the INS's trace, dial and gyro window
+//! (`ins_view.rs`), every time series (`plots/`: which series exist, their rows, styles and
+//! extents); it sends the documents (`documents.rs`) and the layout (`layout.rs`, built of the
+//! blueprint primitives in `blueprint.rs`) itself. Commands with their own recordings (allan,
+//! calibration, selfcal, tpr, modulation) use the same primitives.
 //!
 //! Layout of a recording (see docs/recording.md):
 //! - `world/vehicle/base/<axis>_mount/<axis>/…/imu`: the chain as `Transform3D`s (errors exaggerated);

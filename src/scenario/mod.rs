@@ -1,4 +1,4 @@
-//! Layer 5, the scenario: the only code that knows the TOML. The file is parsed strictly
+//! Layer 6, the scenario: the only code that knows the TOML. The file is parsed strictly
 //! ([`raw`]), validated once and converted once into SI [`Params`] made of the lower layers' own
 //! parameter structs ([`validate`], [`instruments`]); [`presets`] embeds the shipped scenarios.
 //!
@@ -7,20 +7,21 @@
 /// The longest simulation a scenario (or `--duration-s`) may ask for: 30 days, s.
 pub const MAX_DURATION_S: f64 = 30.0 * 86_400.0;
 
-/// Checks a run length a user gives beside the file (`--duration-s`, Python's `duration_s`); the
-/// message says the value and the range, the caller names the flag.
+/// A simulated duration, s: > 0 and at most 30 days — the rule of `simulation.duration_s` and of
+/// every run length given beside a file (`--duration-s`, Python's `duration_s`), written once.
+pub const DURATION: crate::io::validity::Range = crate::io::validity::Range::positive(
+    MAX_DURATION_S,
+    "s",
+    "a simulated duration (30 days at most, as simulation.duration_s)",
+);
+
+/// Checks a run length a user gives beside the file against [`DURATION`]; the message says the
+/// value and the range, the caller names the flag.
 ///
 /// # Errors
 /// Not finite, not positive, or over [`MAX_DURATION_S`].
 pub fn check_duration(duration_s: f64) -> Result<f64, String> {
-    if duration_s.is_finite() && duration_s > 0.0 && duration_s <= MAX_DURATION_S {
-        Ok(duration_s)
-    } else {
-        Err(format!(
-            "{} s: must be > 0 and at most {MAX_DURATION_S} s (30 days), as simulation.duration_s",
-            crate::io::short_number(duration_s)
-        ))
-    }
+    crate::io::validity::check_number(duration_s, &DURATION)
 }
 
 pub mod instruments;

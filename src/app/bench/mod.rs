@@ -2,6 +2,7 @@
 //! `bench --peer pyins` (peer.rs) against another INS.
 
 pub mod allantools;
+mod command;
 mod logs;
 pub mod peer;
 
@@ -9,6 +10,8 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use serde::Serialize;
+
+pub use command::{BenchReport, BenchRequest, Benchmark, execute};
 
 use crate::record::sink::{self, SinkRequest};
 use crate::scenario::presets;

@@ -22,6 +22,7 @@ const MAKE_STREAM: &str = include_str!("../../../assets/bench/pyins/make_stream.
 const PYINS_BENCH: &str = include_str!("../../../assets/bench/pyins/pyins_bench.py");
 
 /// What `bench --peer pyins` runs.
+#[derive(Debug, Clone)]
 pub struct PeerOptions {
     /// The Python interpreter that has `python-ins==1.0.1` (and numpy).
     pub python: PathBuf,
