@@ -361,27 +361,22 @@ fn allan(
         columns.iter().zip(&specs).map(|(b, s)| floats(b, &s.col.to_string())).collect::<Result<_, _>>()?;
     let times = time_s.map(|b| floats(&b, "time_s")).transpose()?;
     let out = interruptible(py, |stop| -> Result<Output, Failure> {
+        use rinscope::app::allan::{AllanCommand, AllanExport, AllanSource, execute};
         let data = rinscope::io::imu::series::series_in_memory(&specs, values, rate_hz, times.as_deref())
             .map_err(|e| Failure::Input(format!("allan: {e}")))?;
-        let result = analyze_series(data, "arrays from Python", &request, 0.0)
-            .map_err(|e| Failure::Input(format!("allan: {e}")))?;
-        let mut tables = rinscope::record::export::Exporter::in_memory();
-        rinscope::record::allan::export(&mut tables, &result).map_err(|e| Failure::Run(e.to_string()))?;
-        let tables = tables.finish().map_err(|e| Failure::Run(e.to_string()))?.tables;
-        if let Some(path) = save {
-            let sinks = sink::open(
-                &SinkRequest { save: Some(path), stop_on_failure: Some(Arc::clone(stop)), ..Default::default() },
-                APPLICATION_ID,
-                "python-allan",
-            )?;
-            rinscope::app::outputs::logged(rinscope::record::allan::log(
-                &sinks.stream(),
-                &result,
-                description.as_deref().unwrap_or("Arrays analysed from Python."),
-            ))?;
-            sinks.finish()?;
-        }
-        Ok((result.json().to_string(), tables.into_iter().map(ipc).collect::<Result<_, _>>()?))
+        let description = description.unwrap_or_else(|| "Arrays analysed from Python.".to_owned());
+        let command = AllanCommand {
+            source: AllanSource::Arrays(Box::new(data), description),
+            analysis: request,
+            recording: save.map(|path| RecordingRequest {
+                sinks: SinkRequest { save: Some(path), stop_on_failure: Some(Arc::clone(stop)), ..Default::default() },
+                save_by_default: false,
+            }),
+            export: Some(AllanExport::Memory),
+            json: None,
+        };
+        let report = execute(command, stop, &|_| {})?;
+        Ok((report.result.json().to_string(), report.tables.into_iter().map(ipc).collect::<Result<_, _>>()?))
     })??;
     Ok(to_python(py, out))
 }

@@ -3,7 +3,7 @@
 
 use super::commands::{print_saved, print_tables};
 use super::{AllanArgs, Failure};
-use crate::app::allan::{self, AllanCommand, AllanRequest, AllanSource};
+use crate::app::allan::{self, AllanCommand, AllanExport, AllanRequest, AllanSource};
 use crate::app::terminate::stop_flag;
 use crate::io::Col;
 use crate::io::imu::series::{Sampling, SeriesColumn};
@@ -85,8 +85,13 @@ pub(super) fn allan(args: &AllanArgs) -> Result<(), Failure> {
         }
     };
     let recording = if args.no_recording { None } else { Some(args.sinks.recording()?) };
-    let command =
-        AllanCommand { source, analysis, recording, export: args.sinks.export_request()?, json: args.json.clone() };
+    let command = AllanCommand {
+        source,
+        analysis,
+        recording,
+        export: args.sinks.export_request()?.map(|(dir, format)| AllanExport::Dir(dir, format)),
+        json: args.json.clone(),
+    };
     let bar = std::io::IsTerminal::is_terminal(&std::io::stderr()).then(|| {
         let bar = indicatif::ProgressBar::new_spinner();
         bar.enable_steady_tick(std::time::Duration::from_millis(200));
@@ -97,7 +102,7 @@ pub(super) fn allan(args: &AllanArgs) -> Result<(), Failure> {
             b.set_message(format!("{:.2} M samples gathered", n as f64 / 1e6));
         }
     };
-    let report = allan::execute(&command, &stop_flag(), &progress);
+    let report = allan::execute(command, &stop_flag(), &progress);
     if let Some(b) = &bar {
         b.finish_and_clear();
     }

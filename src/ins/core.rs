@@ -209,13 +209,6 @@ impl InsCore {
         Ok(())
     }
 
-    /// Replaces the primary attitude.
-    pub fn set_primary_attitude(&mut self, n_from_s: Rot<N, S>) {
-        if let Some(i) = self.integrators.first_mut() {
-            i.n_from_s = n_from_s;
-        }
-    }
-
     /// Position fix: the navigation's latitude and longitude set to the truth (the site), velocity
     /// and the attitude relative to local level kept (the usual reset; docs/tpr.md).
     pub fn reset_position(&mut self) {

@@ -6,7 +6,7 @@
 //! measured clockwise from North (the forward axis has East component sin(heading)), pitch is the
 //! nose-up angle and roll turns the right wing down.
 
-use nalgebra::{UnitQuaternion, Vector3};
+use nalgebra::Vector3;
 
 use crate::math::frames::{B, N, Rot, V3, axis_angle};
 use crate::math::units::wrap_pi;
@@ -96,12 +96,6 @@ impl AttitudeError {
         let phi_hy = sh * phi_n.v.x + ch * phi_n.v.y;
         Self { pitch_rad: phi_hx, roll_rad: phi_hy / cos_pitch, heading_rad: c21 / cos_pitch * phi_hy - phi_n.v.z }
     }
-}
-
-/// The quaternion of C_b^n, for callers outside the typed world (the recorder).
-#[must_use]
-pub fn quaternion_of(att: &Attitude) -> UnitQuaternion<f64> {
-    *att.n_from_b().quaternion()
 }
 
 #[cfg(test)]

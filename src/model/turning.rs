@@ -59,9 +59,3 @@ impl Link {
         }
     }
 }
-
-/// The whole chain's rotation at `tau_s` (first link outermost: `L_1 · L_2 ⋯`).
-#[must_use]
-pub fn chain_rotation(links: &[Link], tau_s: f64) -> UnitQuaternion<f64> {
-    links.iter().fold(UnitQuaternion::identity(), |q, l| q * l.rotation(tau_s))
-}

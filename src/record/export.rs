@@ -251,12 +251,23 @@ impl Exporter {
     /// Finishes every table, in the order of their names: the files' paths, or the tables kept in
     /// memory (the first failed write, if any, instead: the unfinished files are then removed).
     pub fn finish(&mut self) -> Result<Finished, LogError> {
+        self.finish_until(&std::sync::atomic::AtomicBool::new(false))
+    }
+
+    /// [`Self::finish`], stopping between tables once `stop` is set: the tables finished until
+    /// then are whole, the others are removed (never half-written) and counted in
+    /// [`Finished::left`].
+    pub fn finish_until(&mut self, stop: &std::sync::atomic::AtomicBool) -> Result<Finished, LogError> {
         let tables = std::mem::take(&mut self.tables);
         if let Some(e) = self.failed.take() {
             return Err(e);
         }
         let mut done = Finished::default();
         for table in tables.into_values() {
+            if stop.load(std::sync::atomic::Ordering::SeqCst) {
+                done.left += 1;
+                continue;
+            }
             match table {
                 Open::File(writer) => {
                     let path = writer.path().to_path_buf();
@@ -277,6 +288,8 @@ pub struct Finished {
     pub files: Vec<PathBuf>,
     /// The tables kept in memory.
     pub tables: Vec<Table>,
+    /// Tables not finished: a stop came first ([`Exporter::finish_until`]).
+    pub left: usize,
 }
 
 /// A table's name, which is its file's name without the extension: the entity path with `/` as
@@ -340,6 +353,33 @@ mod tests {
         let heading = tables.iter().find(|t| t.entity == "attitude_error_arcsec/heading").expect("heading");
         assert_eq!(heading.columns, ["t_s", "t_file_s", "uncompensated_arcsec", "uncompensated_3_arcsec"]);
         assert_eq!(heading.values[1], [100.0, 100.5, 101.0]);
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn a_stop_while_the_tables_are_finished_keeps_whole_ones_and_removes_the_rest() {
+        use std::sync::atomic::{AtomicBool, Ordering};
+        let dir = std::env::temp_dir().join(format!("rinscope-export-stop-{}", std::process::id()));
+        std::fs::remove_dir_all(&dir).ok();
+        let names = ["a".to_owned()];
+        let write_two = || {
+            let mut e = Exporter::new(&dir, ExportFormat::Csv).expect("folder");
+            e.write("x/first_m", "m", &names, &[0.0, 1.0], &[1.0, 2.0]);
+            e.write("x/second_m", "m", &names, &[0.0, 1.0], &[3.0, 4.0]);
+            e
+        };
+        // Not stopped: both tables, whole.
+        let done = write_two().finish_until(&AtomicBool::new(false)).expect("finished");
+        assert_eq!((done.files.len(), done.left), (2, 0));
+        std::fs::remove_dir_all(&dir).ok();
+        // Stopped before the first: none written, nothing half-written left behind.
+        let stop = AtomicBool::new(false);
+        let mut e = write_two();
+        stop.store(true, Ordering::SeqCst);
+        let done = e.finish_until(&stop).expect("finished");
+        assert_eq!((done.files.len(), done.left), (0, 2));
+        let left: Vec<_> = std::fs::read_dir(&dir).expect("folder").flatten().map(|f| f.file_name()).collect();
+        assert!(left.is_empty(), "{left:?}");
         std::fs::remove_dir_all(&dir).ok();
     }
 }

@@ -509,11 +509,6 @@ impl Recorder {
         &self.stream
     }
 
-    /// Buffers one time-series row; sends a chunk when the buffer is full.
-    pub fn push_series(&mut self, out: &StepOutput) -> RecordingStreamResult<()> {
-        self.push_row(out, None)
-    }
-
     /// Buffers one row: the turntable-only variants and, with an IMU in the loop, the INS's view.
     pub fn push_row(&mut self, out: &StepOutput, ins: Option<&InsView>) -> RecordingStreamResult<()> {
         self.push_row_with(out, ins, None)

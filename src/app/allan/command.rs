@@ -4,12 +4,12 @@
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use super::{AllanRequest, check_scenario, log_set, options, series, simulate};
+use super::{AllanRequest, analyze_series, check_scenario, log_set, options, series, simulate};
 use crate::app::failure::Failure;
 use crate::app::outputs::{RecordingName, RecordingRequest, check_output, finish, logged, write_json};
 use crate::ins::allan::ImuAllan;
 use crate::io::imu::series::{Sampling, SeriesColumn};
-use crate::record::export::{ExportFormat, Exporter};
+use crate::record::export::{ExportFormat, Exporter, Table};
 use crate::record::sink::Saved;
 use crate::scenario::Params;
 use crate::scenario::logset::LogSet;
@@ -22,6 +22,16 @@ pub enum AllanSource {
     Scenario(Box<Params>),
     /// Any table file's columns (and how they were given, for the recording's description).
     Series(PathBuf, Vec<SeriesColumn>, Sampling, String),
+    /// Columns already in memory (Python's arrays), with the recording's description.
+    Arrays(Box<crate::io::imu::series::Series>, String),
+}
+
+/// Where `allan`'s tables go.
+pub enum AllanExport {
+    /// `--export DIR`: files of `format`.
+    Dir(PathBuf, ExportFormat),
+    /// Kept in memory and returned in the report (Python's DataFrames).
+    Memory,
 }
 
 /// `rinscope allan`.
@@ -33,8 +43,8 @@ pub struct AllanCommand {
     /// The recording's sinks (its `export` is ignored: the curves are exported as tables of
     /// their own); `None`: no recording.
     pub recording: Option<RecordingRequest>,
-    /// `--export`: the curves and the fits as tables.
-    pub export: Option<(PathBuf, ExportFormat)>,
+    /// The curves and the fits as tables.
+    pub export: Option<AllanExport>,
     /// `--json`.
     pub json: Option<PathBuf>,
 }
@@ -45,6 +55,8 @@ pub struct AllanReport {
     pub result: ImuAllan,
     /// The tables `--export` wrote.
     pub exported: Vec<PathBuf>,
+    /// The tables kept in memory ([`AllanExport::Memory`]).
+    pub tables: Vec<Table>,
     /// The recording kept.
     pub saved: Option<Saved>,
     /// Stopped early: the analysis is of the part gathered before the stop.
@@ -55,7 +67,7 @@ pub struct AllanReport {
 ///
 /// # Errors
 /// Bad input or data, an output that cannot be written.
-pub fn execute(req: &AllanCommand, stop: &AtomicBool, progress: &dyn Fn(u64)) -> Result<AllanReport, Failure> {
+pub fn execute(req: AllanCommand, stop: &AtomicBool, progress: &dyn Fn(u64)) -> Result<AllanReport, Failure> {
     check_output("--json", req.json.as_deref())?;
     options(&req.analysis)?;
     let (name, description) = match &req.source {
@@ -64,6 +76,7 @@ pub fn execute(req: &AllanCommand, stop: &AtomicBool, progress: &dyn Fn(u64)) ->
             format!("Series `{}`, columns {given}.", file.display()),
         ),
         AllanSource::Log(log) => (log.name.clone(), log.description.clone()),
+        AllanSource::Arrays(_, description) => ("arrays".to_owned(), description.clone()),
         AllanSource::Scenario(p) => {
             check_scenario(p)?;
             (p.meta.name.clone(), format!("*{}*\n\n{}", p.meta.title, p.meta.description))
@@ -71,9 +84,10 @@ pub fn execute(req: &AllanCommand, stop: &AtomicBool, progress: &dyn Fn(u64)) ->
     };
     let mut exporter = match &req.export {
         None => None,
-        Some((dir, format)) => {
+        Some(AllanExport::Dir(dir, format)) => {
             Some(Exporter::new(dir, *format).map_err(|e| Failure::input(format!("--export {}: {e}", dir.display())))?)
         }
+        Some(AllanExport::Memory) => Some(Exporter::in_memory()),
     };
     let sinks = match &req.recording {
         None => None,
@@ -83,14 +97,15 @@ pub fn execute(req: &AllanCommand, stop: &AtomicBool, progress: &dyn Fn(u64)) ->
             Some(r.open(RecordingName { name: &name, kind: Some("allan"), seed: None })?)
         }
     };
-    let result = match &req.source {
+    let result = match req.source {
+        AllanSource::Arrays(data, _) => analyze_series(*data, "arrays from Python", &req.analysis, 0.0),
         AllanSource::Log(log) => {
             errln!("rinscope: reading {} ...", log.imu.path.display());
-            log_set(log, &req.analysis, stop, progress)
+            log_set(&log, &req.analysis, stop, progress)
         }
         AllanSource::Series(file, columns, sampling, _) => {
             errln!("rinscope: reading {} ...", file.display());
-            series(file, columns, sampling, &req.analysis, stop)
+            series(&file, &columns, &sampling, &req.analysis, stop)
         }
         AllanSource::Scenario(p) => {
             errln!(
@@ -99,20 +114,20 @@ pub fn execute(req: &AllanCommand, stop: &AtomicBool, progress: &dyn Fn(u64)) ->
                 p.meta.name,
                 p.step_hz
             );
-            simulate(p, &req.analysis, stop, progress)
+            simulate(&p, &req.analysis, stop, progress)
         }
     }?;
     if let Some(path) = &req.json {
         write_json("--json", path, &result.json())?;
     }
-    let exported = match exporter.as_mut() {
+    let (exported, tables) = match exporter.as_mut() {
         Some(e) => {
-            crate::record::allan::export(e, &result)
+            let done = crate::record::allan::export(e, &result)
                 .and_then(|()| e.finish())
-                .map_err(|e| Failure::run(format!("--export: {e}")))?
-                .files
+                .map_err(|e| Failure::run(format!("--export: {e}")))?;
+            (done.files, done.tables)
         }
-        None => Vec::new(),
+        None => (Vec::new(), Vec::new()),
     };
     let saved = match sinks {
         Some(s) => {
@@ -122,5 +137,5 @@ pub fn execute(req: &AllanCommand, stop: &AtomicBool, progress: &dyn Fn(u64)) ->
         None => None,
     };
     let interrupted = result.interrupted || stop.load(Ordering::SeqCst);
-    Ok(AllanReport { result, exported, saved, interrupted })
+    Ok(AllanReport { result, exported, tables, saved, interrupted })
 }

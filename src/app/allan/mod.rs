@@ -3,7 +3,7 @@
 //! docs/allan.md). Memory: 8 bytes per sample and channel (10 h at 200 Hz: 346 MB).
 
 mod command;
-pub use command::{AllanCommand, AllanReport, AllanSource, execute};
+pub use command::{AllanCommand, AllanExport, AllanReport, AllanSource, execute};
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;

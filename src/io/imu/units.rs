@@ -37,21 +37,7 @@ pub enum Quantity {
     Dimensionless,
 }
 
-impl Quantity {
-    /// The SI unit, as text.
-    #[must_use]
-    pub fn si_unit(self) -> &'static str {
-        match self {
-            Self::Angle => "rad",
-            Self::AngularRate => "rad/s",
-            Self::Velocity => "m/s",
-            Self::Acceleration => "m/s²",
-            Self::Time => "s",
-            Self::Length => "m",
-            Self::Dimensionless => "1",
-        }
-    }
-}
+impl Quantity {}
 
 /// A unit recognised in a column name.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -220,16 +220,6 @@ impl RrdFile {
         Ok((Self { out, tx, shared, thread: Some(thread) }, sink))
     }
 
-    /// The final path.
-    pub(super) fn path(&self) -> PathBuf {
-        self.out.path().to_path_buf()
-    }
-
-    /// The first write error, if any.
-    pub(super) fn error(&self) -> Option<String> {
-        self.shared.error()
-    }
-
     /// Writes the footer, checks everything went to disk, reads the footer back and renames the
     /// partial onto the final path; returns (path, bytes). On error nothing is replaced.
     pub(super) fn finish(mut self) -> Result<(PathBuf, u64), String> {

@@ -402,12 +402,6 @@ impl OpenSinks {
         Stream::new(self.rec.clone(), self.export.clone())
     }
 
-    /// The saved file's first write error, if any (the run was told to stop).
-    #[must_use]
-    pub fn write_error(&self) -> Option<String> {
-        self.file.as_ref().and_then(file::RrdFile::error)
-    }
-
     /// Flushes, closes every sink, verifies the saved file and moves it to its final name, and
     /// finishes the export tables.
     ///
@@ -428,14 +422,25 @@ impl OpenSinks {
             None => None,
             Some(f) => Some(f.finish().map_err(SinkError::Write)?),
         };
-        let crate::record::export::Finished { files: exported, tables } = match export {
+        // A stop during the run: every table holds the run until then, and is finished. One that
+        // comes while they are finished ends that phase (those done are whole, the rest removed).
+        let crate::record::export::Finished { files: exported, tables, left } = match export {
             None => Default::default(),
-            Some(e) => e
-                .lock()
-                .unwrap_or_else(std::sync::PoisonError::into_inner)
-                .finish()
-                .map_err(|e| SinkError::ExportWrite(e.to_string()))?,
+            Some(e) => {
+                let mut e = e.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+                if stopped_before { e.finish() } else { e.finish_until(stop_flag) }
+                    .map_err(|e| SinkError::ExportWrite(e.to_string()))?
+            }
         };
+        if left > 0 {
+            return Err(SinkError::Interrupted(format!(
+                "--export: stopped after {} tables (each whole; {left} not written){}",
+                exported.len(),
+                recording
+                    .as_ref()
+                    .map_or(String::new(), |(path, _)| format!("; the recording {} was saved", path.display()))
+            )));
+        }
         let viewer_problems = viewer_problems.lock().unwrap_or_else(std::sync::PoisonError::into_inner).clone();
         let figures = match (&figures, &recording) {
             (Some(dir), Some((path, _))) => Some(
@@ -466,11 +471,5 @@ impl OpenSinks {
         }
         drop(rec);
         Ok(Saved { recording, exported, tables, viewer_problems, figures })
-    }
-
-    /// The path the recording will be saved to, if any.
-    #[must_use]
-    pub fn save_path(&self) -> Option<PathBuf> {
-        self.file.as_ref().map(file::RrdFile::path)
     }
 }
