@@ -81,6 +81,22 @@ const CASES: &[Case] = &[
         after: Duration::from_millis(1500),
     },
     Case {
+        name: "reproduce",
+        args: &["reproduce", "--markdown", "{dir}/r.md"],
+        document: None,
+        says_interrupted: false,
+        begun: None,
+        after: Duration::from_millis(1500),
+    },
+    Case {
+        name: "bench",
+        args: &["bench", "--steps", "1000000000", "--json", "{dir}/b.json"],
+        document: None,
+        says_interrupted: false,
+        begun: None,
+        after: Duration::from_millis(1500),
+    },
+    Case {
         name: "tpr-sweeping",
         args: &["tpr", "--seeds", "500", "--save", "{dir}/t.rrd", "--json", "{dir}/t.json"],
         document: Some("t.json"),

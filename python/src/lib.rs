@@ -165,11 +165,9 @@ fn output<S: Serialize>(summary: S, saved: sink::Saved) -> Result<Output, Failur
 /// The presets: (name, title) pairs, in the order `rinscope scenarios` lists them.
 #[pyfunction]
 fn scenarios() -> Vec<(String, String)> {
-    presets::PRESETS
-        .iter()
-        .map(|(name, _)| {
-            ((*name).to_owned(), presets::load(name).map(|p| p.meta.title).unwrap_or_else(|e| format!("BROKEN: {e}")))
-        })
+    rinscope::app::inspect::scenarios()
+        .into_iter()
+        .map(|(name, p)| (name.to_owned(), p.map(|p| p.meta.title).unwrap_or_else(|e| format!("BROKEN: {e}"))))
         .collect()
 }
 

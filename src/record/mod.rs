@@ -12,7 +12,7 @@
 //! - `gimbal_angle_deg` (one series per axis), `vehicle_attitude_deg` (pitch, roll, heading),
 //!   `swing_arcsec/<axis>` (the swing rotation vector's two components);
 //! - a replay: the INS's own solution (`ins/body_attitude_deg`, `ins/velocity_enu_mps`, ...); a
-//!   strapdown replay nothing of a table, its axes at `world/ins_body` (`rows`, `body_view`);
+//!   strapdown replay nothing of a table, its axes at `world/ins_body` (`plots/series.rs`, `body_view.rs`);
 //!
 //! Series that share a plot share an entity (one `Scalars` of several values per row): a third of
 //! the time and row-id columns of one entity per line.

@@ -178,6 +178,10 @@ fn simulation_speed(steps: u64, figs: &mut Figures, stop: &AtomicBool) -> anyhow
             checksum = 0.0;
             let started = Instant::now();
             for i in 0..steps {
+                // A million steps take a fraction of a second: a signal is answered within it.
+                if i % (1 << 20) == 0 {
+                    check(stop)?;
+                }
                 let out = step(&model, &mut state, i as f64 / p.step_hz);
                 checksum += out.errors[0].heading_rad + out.errors[1].pitch_rad + out.errors[2].roll_rad;
             }
