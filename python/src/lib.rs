@@ -18,7 +18,6 @@ use rinscope::app::allan::AllanRequest;
 use rinscope::calib::MonteCarloConfig;
 
 use rinscope::app::outputs::RecordingRequest;
-use rinscope::record::APPLICATION_ID;
 use rinscope::record::export::Table;
 use rinscope::record::sink::{self, SinkRequest};
 use rinscope::scenario::{self, Params, logset, presets};
@@ -334,7 +333,7 @@ fn allan(
     save: Option<PathBuf>,
     description: Option<String>,
 ) -> PyResult<PyOutput> {
-    use rinscope::app::allan::{analyze_series, options, parse_estimators, parse_taus};
+    use rinscope::app::allan::{options, parse_estimators, parse_taus};
     let spacing = parse_taus(taus).map_err(|e| Failure::Input(format!("allan: taus {e}")))?;
     let estimators = parse_estimators(estimators).map_err(|e| Failure::Input(format!("allan: estimators {e}")))?;
     let request = AllanRequest { spacing, estimators, decimate, ci_sigma, errors_only: false };
