@@ -206,10 +206,30 @@ pub fn assumed_gyro_bias(random_walk_rad_per_sqrt_s: f64) -> f64 {
 }
 
 /// The accelerometer bias 1σ assumed when none is given: 30 √s × the velocity random walk
-/// (navigation grade 10 µg/√Hz → 300 µg; MEMS 100 µg/√Hz → 3 mg).
+/// (navigation grade 10 µg/√Hz → 300 µg; MEMS 100 µg/√Hz → 3 mg), at most the bias of the class
+/// of sensor the gyros show ([`accel_bias_of_class`]): a parked vehicle's engine and people shake
+/// the accelerometers far above their white noise (a ring-laser IMU in a car, PSINS's
+/// `lasergyro.imu`, measures 1 760 µg/√Hz: 30× that, 53 mg, let the filter turn 7 mg of a level
+/// into a bias).
 #[must_use]
-pub fn assumed_accel_bias(random_walk_mps_per_sqrt_s: f64) -> f64 {
-    (30.0 * random_walk_mps_per_sqrt_s).max(1e-6)
+pub fn assumed_accel_bias(random_walk_mps_per_sqrt_s: f64, gyro_random_walk_rad_per_sqrt_s: f64) -> f64 {
+    (30.0 * random_walk_mps_per_sqrt_s).clamp(1e-6, accel_bias_of_class(gyro_random_walk_rad_per_sqrt_s))
+}
+
+/// The accelerometer bias 1σ typical of the class of IMU whose gyros have this angle random walk
+/// (rad/√s), m/s², taken at the top of the class: up to 0.02 °/√h (navigation grade: ring-laser,
+/// fibre-optic gyros) 300 µg; up to 0.5 °/√h (tactical) 3 mg; above (MEMS) 30 mg.
+#[must_use]
+pub fn accel_bias_of_class(gyro_random_walk_rad_per_sqrt_s: f64) -> f64 {
+    let arw_deg_per_sqrt_h = gyro_random_walk_rad_per_sqrt_s.to_degrees() * 60.0;
+    let ug = if arw_deg_per_sqrt_h <= 0.02 {
+        300.0
+    } else if arw_deg_per_sqrt_h <= 0.5 {
+        3_000.0
+    } else {
+        30_000.0
+    };
+    ug * crate::math::units::MPS2_PER_UG
 }
 
 /// C_n^{i0}(t): the navigation frame at time t seen from the navigation frame at the start, both
@@ -438,7 +458,7 @@ pub fn fine(samples: &[Increment], cfg: &AlignConfig) -> Result<Alignment, Align
         given: cfg.gyro_bias_sigma_rad_per_s.is_some(),
     };
     let db0 = Assumed {
-        value: cfg.accel_bias_sigma_mps2.unwrap_or_else(|| assumed_accel_bias(vrw.value)),
+        value: cfg.accel_bias_sigma_mps2.unwrap_or_else(|| assumed_accel_bias(vrw.value, arw.value)),
         given: cfg.accel_bias_sigma_mps2.is_some(),
     };
     let cos_lat = cfg.latitude_rad.cos().max(1e-3);

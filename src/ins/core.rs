@@ -11,6 +11,7 @@ use nalgebra::Vector3;
 use super::InsParams;
 use super::coning::Algorithm;
 use super::fir::Fir;
+use super::imu_errors::ImuErrors;
 use super::nav::{NavState, Navigator};
 use super::strapdown::AttitudeIntegrator;
 use crate::math::attitude::Attitude;
@@ -86,6 +87,9 @@ pub struct InsCore {
     pub fir_delay_s: f64,
     /// Zero-order-hold delay, s.
     pub zoh_delay_s: f64,
+    /// The sensor errors removed from every sample before anything else (a replay: the biases its
+    /// alignment estimated, a calibration's estimates), or None.
+    compensation: Option<ImuErrors>,
 }
 
 impl InsCore {
@@ -148,8 +152,15 @@ impl InsCore {
             upd_len: 0,
             fir_delay_s,
             zoh_delay_s,
+            compensation: None,
             cfg,
         }
+    }
+
+    /// From the next sample on, the computer removes the sensor errors `c` from every sample
+    /// (`(I + K)⁻¹(measured − b·h)`), or nothing with None.
+    pub fn set_compensation(&mut self, c: Option<ImuErrors>) {
+        self.compensation = c;
     }
 
     /// The configuration.
@@ -235,6 +246,10 @@ impl InsCore {
 
     /// One measured IMU sample (Δθ, Δv in s) ending at `t1`.
     pub fn push(&mut self, t1: f64, g_meas: Vector3<f64>, a_meas: Vector3<f64>) -> SampleOut {
+        let (g_meas, a_meas) = match &self.compensation {
+            Some(c) => c.compensate(&(g_meas, a_meas), self.h),
+            None => (g_meas, a_meas),
+        };
         let g_filt = self.fir_g.push(g_meas);
         let a_filt = self.fir_a.push(a_meas);
         let out = SampleOut {

@@ -104,6 +104,12 @@ pub struct ImuErrors {
 }
 
 impl ImuErrors {
+    /// Biases alone (gyro rad/s, accelerometer m/s²; no gain errors): what an alignment estimates.
+    #[must_use]
+    pub fn biases(bg: Vector3<f64>, ba: Vector3<f64>) -> Self {
+        Self { bg, kg: Matrix3::zeros(), ba, ka: Matrix3::zeros() }
+    }
+
     /// The same IMU described in the frame its accelerometer triad defines (K_a upper
     /// triangular): both gains change by the same small rotation [ρ×] (the rest is the IMU's
     /// attitude, which no calibration on the IMU's own motion can tell from the errors).

@@ -345,6 +345,15 @@ fn default_vertical() -> String {
     "held".into()
 }
 
+impl RawNavigation {
+    /// `[navigation]` at its defaults: the vertical channel held, no damping, no initial error —
+    /// what a log's table description without the section navigates with.
+    #[must_use]
+    pub fn held() -> Self {
+        Self { vertical: default_vertical(), velocity_damping: false, initial_attitude_error_arcmin: [0.0; 3] }
+    }
+}
+
 /// `[live]`: read by `rinscope live` only.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]

@@ -21,6 +21,7 @@ use crate::ins::core::{InsCore, SampleOut};
 use crate::io::{BlockEnd, ImuEvent, ImuOptions, ImuReader, ImuSample, LogError, SampleKind, StartTime};
 use crate::math::attitude::Attitude;
 use crate::math::frames::{Rot, S};
+use crate::math::units::{MPS2_PER_UG, RAD_PER_S_PER_DEG_PER_H};
 use crate::model::gimbal::TableErrors;
 use crate::model::scheme::{AxisValues, MAX_AXES};
 use crate::scenario::logset::{Initial, LogSet, Reference};
@@ -270,13 +271,24 @@ impl Playback {
         if matches!(log.reference, Reference::Static(_)) {
             check_units_at_rest(log, 5.0)?;
         }
+        if log.table.navigation_defaulted {
+            me.notes.push(
+                "the table description has no [navigation]: navigated with its defaults (the vertical channel held, no damping)"
+                    .to_owned(),
+            );
+        }
         let pre = InsCore::pre_roll_samples(cfg);
         let mut velocity = log.initial_velocity_enu_mps;
-        let (start_attitude, pre_roll) = match log.initial {
+        let (start_attitude, pre_roll, biases) = match log.initial {
             Initial::Alignment { duration_s } => match start::aligned(&mut me, log, compensation, duration_s, pre)? {
-                Some((attitude, pre_roll, report)) => {
+                Some((attitude, pre_roll, report, biases)) => {
+                    let (g, a) = (biases.bg / RAD_PER_S_PER_DEG_PER_H, biases.ba / MPS2_PER_UG);
+                    me.notes.push(format!(
+                        "the navigation removes the biases the alignment estimated (gyro {:.4}, {:.4}, {:.4} °/h; accelerometer {:.0}, {:.0}, {:.0} µg; sensor axes): they and its attitude are one solution of the data at rest",
+                        g.x, g.y, g.z, a.x, a.y, a.z
+                    ));
                     me.alignment = Some(report);
-                    (attitude, pre_roll)
+                    (attitude, pre_roll, Some(biases))
                 }
                 // Moving at the start, and the file's header says how it started (a PSINS .imu).
                 None => {
@@ -292,12 +304,22 @@ impl Playback {
                         h.velocity_enu_mps[2]
                     ));
                     velocity.get_or_insert(h.velocity_enu_mps);
-                    me.given_start(log, compensation, &Initial::BodyAttitude(h.attitude), pre)?
+                    let (attitude, pre_roll) =
+                        me.given_start(log, compensation, &Initial::BodyAttitude(h.attitude), pre)?;
+                    (attitude, pre_roll, None)
                 }
             },
-            given => me.given_start(log, compensation, &given, pre)?,
+            given => {
+                let (attitude, pre_roll) = me.given_start(log, compensation, &given, pre)?;
+                (attitude, pre_roll, None)
+            }
+        };
+        let pre_roll: Vec<IncrementPair> = match &biases {
+            Some(c) => pre_roll.iter().map(|x| c.compensate(x, 1.0 / cfg.rate_hz)).collect(),
+            None => pre_roll,
         };
         me.core = InsCore::new(cfg, log.table.site, start_attitude, &pre_roll);
+        me.core.set_compensation(biases);
         if let Some(v) = velocity {
             me.core.set_velocity(Vector3::from(v));
         }

@@ -3,6 +3,7 @@
 //! with its 1σ, the window, the disturbance and the latitude the data imply — with a warning where the
 //! data contradict rest or the site.
 
+use crate::ins::imu_errors::ImuErrors;
 use std::collections::VecDeque;
 
 use nalgebra::Vector3;
@@ -173,7 +174,10 @@ const ALIGN_MAX_HZ: f64 = 400.0;
 /// None: the vehicle moves at the start and the log's header gives a start (the samples read are put
 /// back for the INS).
 /// What [`aligned`] finds: C_s^n at the window's end, the pre-roll, the report.
-pub(super) type Aligned = (Rot<N, S>, Vec<Increment>, AlignmentReport);
+/// An alignment's start: C_s^n at the window's end, the pre-roll, the report, and the biases it
+/// estimated (the navigation removes them: the attitude and these biases are one solution of the
+/// zero-velocity data, and the attitude alone leaves the bias estimate as a force error).
+pub(super) type Aligned = (Rot<N, S>, Vec<Increment>, AlignmentReport, ImuErrors);
 
 pub(super) fn aligned(
     pb: &mut Playback,
@@ -373,5 +377,6 @@ pub(super) fn aligned(
         }),
         warnings,
     };
-    Ok(Some((a.n_from_s, pre_roll, report)))
+    let biases = ImuErrors::biases(a.gyro_bias_rad_per_s.0, a.accel_bias_mps2.0);
+    Ok(Some((a.n_from_s, pre_roll, report, biases)))
 }

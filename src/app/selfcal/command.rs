@@ -137,7 +137,13 @@ pub fn execute(req: &SelfcalRequest, stop: &AtomicBool) -> Result<SelfcalReport,
             );
             let text = estimates_table(format!("{head}\n\n"), &estimate, None, &seen, &[], None);
             let names = crate::calib::selfcal::param_names();
-            let document = serde_json::json!({ "log": log.dir.display().to_string(), "parameters": names, "units": JSON_UNITS, "estimate": estimate.params, "sigma": estimate.sigma, "estimation_s": estimation_s, "observability": seen });
+            // A parameter the log's motion does not separate is reported as not observable: no
+            // estimate, no 1σ (null), never the prior's number or the noise's.
+            let hidden = |k: usize| seen.unobservable.contains(&names[k]);
+            let shown = |v: &[f64; crate::calib::selfcal::N_PARAMS]| -> Vec<Option<f64>> {
+                (0..v.len()).map(|k| (!hidden(k)).then_some(v[k])).collect()
+            };
+            let document = serde_json::json!({ "log": log.dir.display().to_string(), "parameters": names, "units": JSON_UNITS, "estimate": shown(&estimate.params), "sigma": shown(&estimate.sigma), "estimation_s": estimation_s, "observability": seen });
             let saved = match sinks {
                 Some(s) => {
                     let view = SelfcalView {

@@ -376,7 +376,7 @@ pub fn run_log(log: &crate::scenario::logset::LogSet, stop: &AtomicBool) -> Resu
             break;
         }
         let turned: nalgebra::Vector3<f64> = piece.iter().map(|m| m.0).sum();
-        if turned.norm() / (piece.len() as f64 * h) > 0.5 * crate::math::units::RAD_PER_DEG {
+        if turned.norm() / (piece.len() as f64 * h) > MOVE_RATE_RAD_PER_S {
             moving = piece;
             break;
         }
@@ -390,8 +390,36 @@ pub fn run_log(log: &crate::scenario::logset::LogSet, stop: &AtomicBool) -> Resu
         );
     }
     let config = Config::for_datasheet(&log.table.ins.errors, h, Earth::at(log.table.site), align.len());
-    estimate(config, &align, moving.into_iter().map(Ok).chain(std::iter::from_fn(next)), stop)
+    // How far the IMU turned after its rest (samples faster than the move threshold): a log with
+    // no calibration sequence — a parked vehicle — separates none of the gains, and its biases only
+    // in combinations; it is refused, not estimated.
+    let turned = std::cell::Cell::new(0.0_f64);
+    let sequence = moving.into_iter().map(Ok).chain(std::iter::from_fn(next)).inspect(|m| {
+        if let Ok((dtheta, _)) = m
+            && dtheta.norm() / h > MOVE_RATE_RAD_PER_S
+        {
+            turned.set(turned.get() + dtheta.norm());
+        }
+    });
+    let result = estimate(config, &align, sequence, stop)?;
+    if turned.get() < MIN_TURN_RAD {
+        bail!(
+            "{}: no calibration sequence: after {:.1} s at rest the IMU turned {:.1}° in all (faster than {:.1}°/s); a self-calibration needs rotations about at least two axes (the built-in sequences turn 90° and 180° about each, docs/selfcal.md): nothing is estimated from a parked vehicle",
+            log.imu.path.display(),
+            align.len() as f64 * h,
+            turned.get().to_degrees(),
+            MOVE_RATE_RAD_PER_S.to_degrees()
+        );
+    }
+    Ok(result)
 }
+
+/// A sample turning faster than this is part of a move (the Earth turns at 0.004°/s), rad/s.
+const MOVE_RATE_RAD_PER_S: f64 = 0.5 * crate::math::units::RAD_PER_DEG;
+
+/// The least total rotation after the rest for a log to hold a calibration sequence: one quarter
+/// turn (every built-in sequence turns many), rad.
+const MIN_TURN_RAD: f64 = 90.0 * crate::math::units::RAD_PER_DEG;
 
 /// The least rest at the start of a logged sequence (the coarse alignment's data), s.
 pub const LOG_ALIGN_S: f64 = 60.0;

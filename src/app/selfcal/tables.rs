@@ -168,9 +168,14 @@ pub fn estimates_table(
             Seen::From(t) => format!("from {t:.0} s"),
             Seen::Never => "NO".to_owned(),
         };
+        // What the data cannot see gets no number (it would be the prior's, or noise).
+        let (estimate, sigma) = match c.seen {
+            Seen::Never => ("—".to_owned(), "—".to_owned()),
+            _ => (format!("{:.4}", c.estimate), format!("{:.4}", c.sigma)),
+        };
         out.push_str(&format!(
-            "  {:<8} {:>5} {:>11} {:>11.4} {:>9.4} {:>7} {:>8.1e} {:>10}  {:<14}",
-            c.name, c.unit, c.truth, c.estimate, c.sigma, c.z, c.ratio, c.target, seen
+            "  {:<8} {:>5} {:>11} {:>11} {:>9} {:>7} {:>8.1e} {:>10}  {:<14}",
+            c.name, c.unit, c.truth, estimate, sigma, c.z, c.ratio, c.target, seen
         ));
         if let Some((spread, ratio)) = c.monte_carlo {
             out.push_str(&format!(" {spread:>12.4} {ratio:>10.2}"));

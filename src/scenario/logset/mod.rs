@@ -128,6 +128,8 @@ pub struct TableDescription {
     /// No turntable: a strapdown IMU whose axes are the body's (`chain` is a stand-in axis that
     /// never turns; nothing of a table is shown or exported).
     pub strapdown: bool,
+    /// No `[navigation]` section: the log is navigated with its defaults (the replay says so).
+    pub navigation_defaulted: bool,
 }
 
 /// A validated log set.
@@ -228,11 +230,7 @@ impl RawTable {
             turntable: None,
             compensation: RawCompensation::default(),
             imu: None,
-            navigation: Some(RawNavigation {
-                vertical: "held".into(),
-                velocity_damping: false,
-                initial_attitude_error_arcmin: [0.0; 3],
-            }),
+            navigation: Some(RawNavigation::held()),
             calibration: None,
         }
     }
@@ -568,9 +566,10 @@ fn table_description(c: &Checker<'_>, raw: &RawTable, rate_hz: f64) -> Result<Ta
     let (chain, stated) = validate::turntable(c, &turntable)?;
     let (compensation, resolved_comp) =
         validate::validate_compensation(c, &raw.compensation, &turntable, &chain, &stated)?;
-    let ins =
-        instruments::validate_ins(c, Some(&raw.imu.clone().unwrap_or_default()), raw.navigation.as_ref(), rate_hz)?
-            .unwrap_or_else(|| InsParams::ideal(rate_hz, crate::ins::coning::Algorithm::TwoSampleP1));
+    // A log is navigated: without `[navigation]`, with its defaults (the replay says so).
+    let navigation = raw.navigation.clone().unwrap_or_else(RawNavigation::held);
+    let ins = instruments::validate_ins(c, Some(&raw.imu.clone().unwrap_or_default()), Some(&navigation), rate_hz)?
+        .unwrap_or_else(|| InsParams::ideal(rate_hz, crate::ins::coning::Algorithm::TwoSampleP1));
     // The calibration allows for the INS error the [imu] section states (a datasheet's), if any.
     let calibration = instruments::validate_calibration(
         c,
@@ -600,6 +599,7 @@ fn table_description(c: &Checker<'_>, raw: &RawTable, rate_hz: f64) -> Result<Ta
         recording,
         resolved_toml,
         strapdown: raw.turntable.is_none(),
+        navigation_defaulted: raw.navigation.is_none(),
     })
 }
 
