@@ -21,7 +21,7 @@ fn export(dir: &std::path::Path, seconds: f64) -> std::path::PathBuf {
     std::fs::write(dir.join("parked.toml"), parked(seconds)).expect("write");
     let log = dir.join("log");
     let out = rinscope()
-        .args(["export-log", "--config", "parked.toml", "--format", "npy", "--out", "log"])
+        .args(["export-log", "--config", "parked.toml", "--out", "log"])
         .current_dir(dir)
         .output()
         .expect("runs");
@@ -56,7 +56,7 @@ fn a_parked_log_read_with_no_option_navigates_with_its_alignment_estimates() {
     let t = s["duration_s"].as_f64().expect("duration");
     // The Schuler model: a constant horizontal force error δf gives R (δf/g)(1 − cos ω_s t); a
     // constant rate error ε gives R ε (t − sin ω_s t / ω_s).
-    let (r, g) = (6_371_000.0, 9.80665);
+    let (r, g): (f64, f64) = (6_371_000.0, 9.80665);
     let w = (g / r).sqrt();
     let force = |df: f64| r * (df / g) * (1.0 - (w * t).cos());
     let rate = |e: f64| r * e * (t - (w * t).sin() / w);
@@ -71,10 +71,12 @@ fn a_parked_log_read_with_no_option_navigates_with_its_alignment_estimates() {
     let of_estimate = force(horizontal("accel_bias_ug", ug));
     // Of the residual, each at 3σ: the accelerometer noise averaged over the 300 s window, the gyro
     // bias estimate's reported 1σ, the angle random walk's tilt over the run.
-    let of_residual = force(3.0 * 10.0 * ug / 300f64.sqrt())
+    let of_residual = force(3.0 * 10.0 * ug / 300_f64.sqrt())
         + rate(3.0 * horizontal("gyro_bias_sigma_deg_per_h", deg_per_h))
         + r * 3.0 * 0.001 * std::f64::consts::PI / 180.0 / 60.0 * t.sqrt();
-    eprintln!("drift {drift:.0} m in {t:.0} s; Schuler of the estimate {of_estimate:.0} m, of the residual ≤ {of_residual:.0} m");
+    eprintln!(
+        "drift {drift:.0} m in {t:.0} s; Schuler of the estimate {of_estimate:.0} m, of the residual ≤ {of_residual:.0} m"
+    );
     assert!(drift < of_residual, "{drift} m");
     assert!(drift < 0.3 * of_estimate, "{drift} m against the estimate's {of_estimate} m");
 }
@@ -94,4 +96,98 @@ fn a_log_without_a_calibration_sequence_is_refused_by_selfcal() {
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("no calibration sequence") && err.contains("turned 0.0°"), "{err}");
     assert!(!dir.join("s.json").exists(), "an estimate was written");
+}
+
+/// `selfcal`'s estimates as the IMU part of a compensation document (`estimated_imu_compensation`),
+/// and the same document made of the simulation's truth (the `truth` it reports, in its 21
+/// parameters' order: gyro bias, K_g row-major, accelerometer bias, K_a's upper triangle).
+fn truth_document(selfcal: &serde_json::Value) -> String {
+    let t: Vec<f64> = selfcal["truth"].as_array().expect("truth").iter().map(|x| x.as_f64().expect("number")).collect();
+    let deg_per_h = std::f64::consts::PI / 180.0 / 3600.0;
+    let ug = 9.80665e-6;
+    let kg: Vec<Vec<f64>> = (0..3).map(|i| (0..3).map(|j| t[3 + 3 * i + j] * 1e6).collect()).collect();
+    let mut ka = vec![vec![0.0; 3]; 3];
+    for (u, (i, j)) in [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)].into_iter().enumerate() {
+        ka[i][j] = t[15 + u] * 1e6;
+    }
+    serde_json::json!({ "estimated_imu_compensation": {
+        "frame": selfcal["estimated_imu_compensation"]["frame"],
+        "gyro_bias_deg_per_h": (0..3).map(|i| t[i] / deg_per_h).collect::<Vec<_>>(),
+        "gyro_gain_ppm": kg,
+        "accel_bias_ug": (0..3).map(|i| t[12 + i] / ug).collect::<Vec<_>>(),
+        "accel_gain_ppm": ka,
+    }})
+    .to_string()
+}
+
+#[test]
+fn the_imu_calibrated_by_selfcal_is_compensated_in_a_replay_as_well_as_by_the_truth() {
+    let dir = scratch("issue32-compensation");
+    // 1. Self-calibration of the preset's IMU (its built-in sequence).
+    let out = rinscope()
+        .args(["selfcal", "--navigate-hours", "0", "--no-recording", "--json", "sc.json"])
+        .current_dir(&dir)
+        .output()
+        .expect("runs");
+    assert!(out.status.success(), "{}", stderr(&out));
+    let sc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("sc.json")).expect("json")).expect("json");
+    assert!(sc["estimated_imu_compensation"]["gyro_gain_ppm"].is_array(), "{sc}");
+    std::fs::write(dir.join("truth.json"), truth_document(&sc)).expect("write");
+    // 2. The same IMU (same preset, same seed) on the table indexing through the preset's
+    //    8-position scheme, repeated, 30 minutes, as a log set.
+    let preset =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenarios/selfcal-nav-grade.toml"))
+            .expect("preset");
+    let scenario =
+        preset.replace("duration_s = 5400.0", "duration_s = 1800.0").replace("repeat = false", "repeat = true")
+            + "\n[navigation]\nvertical = \"held\"\n";
+    std::fs::write(dir.join("rot.toml"), scenario).expect("write");
+    let out = rinscope()
+        .args(["export-log", "--config", "rot.toml", "--format", "npy", "--out", "log"])
+        .current_dir(&dir)
+        .output()
+        .expect("runs");
+    assert!(out.status.success(), "{}", stderr(&out));
+    // 3. Replayed with no IMU compensation, the estimates', the truth's.
+    let replay = |document: Option<&str>| {
+        let mut cmd = rinscope();
+        cmd.args(["replay", "log", "--save", "r.rrd", "--summary-json", "s.json"]).current_dir(&dir);
+        if let Some(d) = document {
+            cmd.args(["--compensation", d]);
+        }
+        let out = cmd.output().expect("runs");
+        assert!(out.status.success(), "{}", stderr(&out));
+        let s: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("s.json")).expect("json")).expect("json");
+        let heading = s["attitude_error_arcsec"]["compensated"]["heading"]["rms_arcsec"].as_f64().expect("heading");
+        let drift = s["navigation"]["peak_radial_m"].as_f64().expect("navigated");
+        (heading, drift, s["notes"].to_string())
+    };
+    let none = replay(None);
+    let estimated = replay(Some("sc.json"));
+    let truth = replay(Some("truth.json"));
+    eprintln!(
+        "heading RMS / peak drift: none {:.1}″ {:.0} m, estimated {:.1}″ {:.0} m, truth {:.1}″ {:.0} m",
+        none.0, none.1, estimated.0, estimated.1, truth.0, truth.1
+    );
+    assert!(estimated.2.contains("the IMU is compensated with sc.json's estimates"), "{}", estimated.2);
+    // The estimates' 1σ are a few per cent of the errors (sc.json): compensated with them, the
+    // replay is the truth-compensated one within the noise, and far from the uncompensated one.
+    assert!(estimated.0 < 0.5 * none.0 && estimated.1 < 0.6 * none.1, "{estimated:?} against {none:?}");
+    assert!(estimated.0 < 1.2 * truth.0 && estimated.1 < 1.2 * truth.1, "{estimated:?} against {truth:?}");
+    // A document with an impossible number is refused, naming the key, before anything runs.
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).expect("truth")).expect("json");
+    doc["estimated_imu_compensation"]["gyro_gain_ppm"][1][2] = serde_json::json!(1e9);
+    std::fs::write(dir.join("bad.json"), doc.to_string()).expect("write");
+    let out = rinscope()
+        .args(["replay", "log", "--save", "b.rrd", "--compensation", "bad.json"])
+        .current_dir(&dir)
+        .output()
+        .expect("runs");
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("estimated_imu_compensation.gyro_gain_ppm[1][2]") && err.contains("1e9"), "{err}");
+    assert!(!dir.join("b.rrd").exists(), "a recording of a refused replay");
 }

@@ -514,15 +514,39 @@ pub fn execute(
     stop: &AtomicBool,
     bar: Option<&indicatif::ProgressBar>,
 ) -> Result<ReplayReport, Failure> {
-    let log = &req.log;
     check_output("--summary-json", req.summary_json.as_deref())?;
+    // One compensation model: the table's (`calibrate --json`'s estimates) and the IMU's
+    // (`selfcal --json`'s), from the same document or either alone.
+    let mut log = req.log.clone();
+    let mut imu_note = None;
     let compensation = match &req.compensation {
         None => log.table.compensation.clone(),
-        Some((text, origin)) => crate::scenario::logset::compensation_from_calibration(&log.raw_table, text, origin)?,
+        Some((text, origin)) => {
+            let imu = crate::scenario::imu_compensation::from_document(text, origin)?;
+            let table =
+                crate::scenario::logset::compensation_from_calibration(&log.raw_table, text, origin, imu.is_some())?;
+            if let Some(c) = &imu {
+                imu_note = Some(format!(
+                    "the IMU is compensated with {origin}'s estimates (gyro bias {:.4}, {:.4}, {:.4} °/h; accelerometer bias {:.0}, {:.0}, {:.0} µg; gains too; in the accelerometer triad's frame) before anything else: the alignment works on the compensated IMU",
+                    c.bg.x / crate::math::units::RAD_PER_S_PER_DEG_PER_H,
+                    c.bg.y / crate::math::units::RAD_PER_S_PER_DEG_PER_H,
+                    c.bg.z / crate::math::units::RAD_PER_S_PER_DEG_PER_H,
+                    c.ba.x / crate::math::units::MPS2_PER_UG,
+                    c.ba.y / crate::math::units::MPS2_PER_UG,
+                    c.ba.z / crate::math::units::MPS2_PER_UG
+                ));
+            }
+            log.imu_compensation = imu;
+            table
+        }
     };
+    let log = &log;
     log.recording_params(1.0)?;
     let sinks = req.recording.open(RecordingName { name: &log.name, kind: Some("replay"), seed: None })?;
     let mut summary = replay_recorded(log, &compensation, &sinks, stop, bar)?;
+    if let Some(note) = imu_note {
+        summary.notes.insert(0, note);
+    }
     let saved = finish(sinks)?;
     (summary.recording_path, summary.recording_bytes) = saved.recording_fields();
     if let Some(path) = &req.summary_json {

@@ -521,6 +521,8 @@ pub struct ImuSamples {
     nominal_s: f64,
     last_t: Option<f64>,
     pending_gap: bool,
+    /// The IMU errors removed from every sample ([`LogSet::imu_compensation`]).
+    compensation: Option<crate::ins::imu_errors::ImuErrors>,
 }
 
 impl ImuSamples {
@@ -559,7 +561,8 @@ impl ImuSamples {
         let kind = imu.kind();
         let start = imu.start_time().ok_or_else(|| data_err(format!("{}: no IMU samples", f.path.display())))?;
         let imu = ImuStream::spawn(imu)?;
-        Ok((Self { imu, kind, nominal_s: 1.0 / f.rate_hz, last_t: None, pending_gap: false }, start))
+        let compensation = log.imu_compensation;
+        Ok((Self { imu, kind, nominal_s: 1.0 / f.rate_hz, last_t: None, pending_gap: false, compensation }, start))
     }
 
     /// The next sample or gap; None at the end of the file.
@@ -585,6 +588,11 @@ impl ImuSamples {
                 };
                 self.pending_gap = false;
                 self.last_t = Some(s.t_s);
+                // The compensated IMU: (I + K)⁻¹(measured − b·h) over the nominal interval.
+                let (dtheta, dv) = match &self.compensation {
+                    Some(c) => c.compensate(&(dtheta, dv), self.nominal_s),
+                    None => (dtheta, dv),
+                };
                 Ok(Some(ImuItem::Sample { t_s: s.t_s, dtheta, dv }))
             }
         }

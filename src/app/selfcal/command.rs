@@ -143,7 +143,7 @@ pub fn execute(req: &SelfcalRequest, stop: &AtomicBool) -> Result<SelfcalReport,
             let shown = |v: &[f64; crate::calib::selfcal::N_PARAMS]| -> Vec<Option<f64>> {
                 (0..v.len()).map(|k| (!hidden(k)).then_some(v[k])).collect()
             };
-            let document = serde_json::json!({ "log": log.dir.display().to_string(), "parameters": names, "units": JSON_UNITS, "estimate": shown(&estimate.params), "sigma": shown(&estimate.sigma), "estimation_s": estimation_s, "observability": seen });
+            let document = serde_json::json!({ "log": log.dir.display().to_string(), "parameters": names, "units": JSON_UNITS, "estimate": shown(&estimate.params), "sigma": shown(&estimate.sigma), "estimation_s": estimation_s, "observability": seen, "estimated_imu_compensation": super::imu_compensation(&estimate, &seen.unobservable) });
             let saved = match sinks {
                 Some(s) => {
                     let view = SelfcalView {

@@ -166,8 +166,28 @@ impl Report {
             "observability": self.plan,
             "monte_carlo": self.monte_carlo,
             "navigation": self.navigation,
+            "estimated_imu_compensation": imu_compensation(&self.outcome.estimate, &self.plan.unobservable),
         })
     }
+}
+
+/// The estimate `e` as the IMU part of a compensation document (`replay --compensation`): the
+/// parameters in `unobservable` are left at zero, named, never compensated with a number the data
+/// did not determine.
+#[must_use]
+pub fn imu_compensation(
+    e: &Estimate,
+    unobservable: &[String],
+) -> crate::scenario::imu_compensation::RawImuCompensation {
+    let names = selfcal::param_names();
+    let seen = |v: &[f64; selfcal::N_PARAMS]| -> [f64; selfcal::N_PARAMS] {
+        std::array::from_fn(|k| if unobservable.contains(&names[k]) { 0.0 } else { v[k] })
+    };
+    crate::scenario::imu_compensation::RawImuCompensation::from_errors(
+        &selfcal::ImuErrors::from_params(&seen(&e.params)),
+        Some(&selfcal::ImuErrors::from_params(&seen(&e.sigma))),
+        unobservable.to_vec(),
+    )
 }
 
 /// A self-calibration set up: the table with its sequence, the IMU's errors, the filter's knowledge.

@@ -297,8 +297,8 @@ impl ImuReader {
                 return Err(LogError::Layout {
                     file: path.to_path_buf(),
                     problem: format!(
-                        "the {:?} layout has no standard body frame: set ImuOptions::frame (e.g. \"frd\", \"flu\", \"rfu\")",
-                        options.layout
+                        "a headerless table (layout {}) says nothing of its axes: give its body frame, `imu.frame` in log.toml or `--imu-frame` (\"rfu\": x right, y forward, z up; \"frd\", \"flu\", ...)",
+                        options.layout.name()
                     ),
                 });
             }

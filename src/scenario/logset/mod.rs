@@ -164,6 +164,10 @@ pub struct LogSet {
     pub table: TableDescription,
     /// The table description as written (for the recording's scenario view and `--compensation`).
     pub raw_table: RawTable,
+    /// The IMU errors removed from every sample as it is read (a self-calibration's estimates,
+    /// `replay --compensation`): everything downstream, the alignment first, sees the compensated
+    /// IMU. None: the samples as logged.
+    pub imu_compensation: Option<crate::ins::imu_errors::ImuErrors>,
 }
 
 /// The manifest's file name in a log set's folder.
@@ -410,6 +414,7 @@ fn validate_manifest_for(
         span_s,
         table,
         raw_table: raw_table.clone(),
+        imu_compensation: None,
     })
 }
 
@@ -647,24 +652,37 @@ impl LogSet {
 
 /// The `estimated_compensation` of a calibration JSON (`rinscope calibrate --json`) as the table errors of
 /// `table`: its keys are `[compensation]`'s, and the table's own values fill what it leaves out.
+///
+/// `has_imu`: the document also holds an IMU compensation (`selfcal --json`), and may then have no
+/// table part (the table's own compensation stands).
 pub fn compensation_from_calibration(
     table: &RawTable,
     json_text: &str,
     origin: &str,
+    has_imu: bool,
 ) -> Result<TableErrors, ConfigError> {
     #[derive(Deserialize)]
     struct WithCompensation {
-        estimated_compensation: RawCompensation,
+        estimated_compensation: Option<RawCompensation>,
     }
     let parsed: WithCompensation = serde_json::from_str(json_text).map_err(|e| ConfigError::Parse {
         origin: origin.to_owned(),
-        message: format!("not a calibration of `rinscope calibrate --json` ({e})"),
+        message: format!("not a compensation document of `rinscope calibrate --json` or `selfcal --json` ({e})"),
     })?;
     let c = Checker { origin };
     let turntable = table.turntable.clone().unwrap_or_else(RawTurntable::strapdown);
     let (chain, stated) = validate::turntable(&c, &turntable)?;
     let mut merged = table.compensation.clone();
-    let given = parsed.estimated_compensation;
+    let given = match parsed.estimated_compensation {
+        Some(g) => g,
+        None if has_imu => RawCompensation::default(),
+        None => {
+            return Err(ConfigError::Parse {
+                origin: origin.to_owned(),
+                message: "holds neither `estimated_compensation` (the table's, from `rinscope calibrate --json`) nor `estimated_imu_compensation` (the IMU's, from `rinscope selfcal --json`)".to_owned(),
+            });
+        }
+    };
     merged.enabled = given.enabled.or(merged.enabled);
     for (k, v) in given.axis {
         merged.axis.insert(k, v);

@@ -1,0 +1,117 @@
+//! The IMU's part of a compensation document: what `selfcal --json` writes as
+//! `estimated_imu_compensation` and `replay --compensation FILE` reads beside the table's
+//! `estimated_compensation` (`calibrate --json`). One model for the whole RINS: the table's errors
+//! and the IMU's, each with its 1σ, each in a stated frame (docs/selfcal.md).
+//!
+//! measured = (I + K)·true + b, per triad; the compensation applied to every sample is
+//! (I + K)⁻¹(measured − b·h). The frame is the accelerometer triad's (K_a upper triangular: a
+//! rotation of both triads together is the IMU's attitude, which a replay's alignment finds in the
+//! compensated frame).
+
+use serde::{Deserialize, Serialize};
+
+use crate::ins::imu_errors::ImuErrors;
+use crate::io::validity::{Range, check_number};
+use crate::math::units::{MPS2_PER_UG, RAD_PER_S_PER_DEG_PER_H};
+use crate::scenario::ConfigError;
+
+/// The frame every estimate of the IMU is stated in.
+pub const FRAME: &str = "accelerometer triad (K_a upper triangular; docs/selfcal.md)";
+
+/// `estimated_imu_compensation`: biases in °/h and µg, gains in ppm (row i, column j: K_ij), with
+/// their 1σ where the calibration gives them; the parameters it could not see are zero and named.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawImuCompensation {
+    /// The frame the compensated increments are in ([`FRAME`]).
+    pub frame: String,
+    /// Gyro bias, °/h.
+    pub gyro_bias_deg_per_h: [f64; 3],
+    /// Gyro gain error (scale factors on the diagonal, misalignments off it), ppm.
+    pub gyro_gain_ppm: [[f64; 3]; 3],
+    /// Accelerometer bias, µg.
+    pub accel_bias_ug: [f64; 3],
+    /// Accelerometer gain error, ppm.
+    pub accel_gain_ppm: [[f64; 3]; 3],
+    /// The 1σ of each, in the same units and layout (absent: not stated).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sigma: Option<Box<RawImuCompensation>>,
+    /// Parameters the calibration could not see: left at zero (not compensated).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub not_compensated: Vec<String>,
+}
+
+/// A gyro bias a compensation may state: up to 1 °/s (3600 °/h).
+const GYRO_BIAS: Range = Range::symmetric(3600.0, "°/h", "a gyro bias");
+/// An accelerometer bias: up to 0.1 g.
+const ACCEL_BIAS: Range = Range::symmetric(1e5, "µg", "an accelerometer bias");
+/// A gain error: up to 10 %.
+const GAIN: Range = Range::symmetric(1e5, "ppm", "a gain error (scale factor or misalignment)");
+
+impl RawImuCompensation {
+    /// `e` (and its 1σ `sigma`) as the document states them; `hidden` names what is not compensated.
+    #[must_use]
+    pub fn from_errors(e: &ImuErrors, sigma: Option<&ImuErrors>, hidden: Vec<String>) -> Self {
+        let m = |k: &nalgebra::Matrix3<f64>| std::array::from_fn(|i| std::array::from_fn(|j| k[(i, j)] * 1e6));
+        let v = |x: &nalgebra::Vector3<f64>, unit: f64| [x.x / unit, x.y / unit, x.z / unit];
+        Self {
+            frame: FRAME.to_owned(),
+            gyro_bias_deg_per_h: v(&e.bg, RAD_PER_S_PER_DEG_PER_H),
+            gyro_gain_ppm: m(&e.kg),
+            accel_bias_ug: v(&e.ba, MPS2_PER_UG),
+            accel_gain_ppm: m(&e.ka),
+            sigma: sigma.map(|s| Box::new(Self::from_errors(s, None, Vec::new()))),
+            not_compensated: hidden,
+        }
+    }
+
+    /// The errors to remove, every number held to its range (`origin` names the document).
+    ///
+    /// # Errors
+    /// A number that is not finite or out of its range, named by its key and index.
+    pub fn validate(&self, origin: &str) -> Result<ImuErrors, ConfigError> {
+        let bad = |key: String, e: String| ConfigError::Invalid {
+            origin: origin.to_owned(),
+            key: format!("estimated_imu_compensation.{key}"),
+            message: e,
+        };
+        let vector = |key: &str, v: &[f64; 3], range: &Range, unit: f64| {
+            let mut out = nalgebra::Vector3::zeros();
+            for i in 0..3 {
+                out[i] = check_number(v[i], range).map_err(|e| bad(format!("{key}[{i}]"), e))? * unit;
+            }
+            Ok::<_, ConfigError>(out)
+        };
+        let matrix = |key: &str, k: &[[f64; 3]; 3]| {
+            let mut out = nalgebra::Matrix3::zeros();
+            for i in 0..3 {
+                for j in 0..3 {
+                    out[(i, j)] = check_number(k[i][j], &GAIN).map_err(|e| bad(format!("{key}[{i}][{j}]"), e))? * 1e-6;
+                }
+            }
+            Ok::<_, ConfigError>(out)
+        };
+        Ok(ImuErrors {
+            bg: vector("gyro_bias_deg_per_h", &self.gyro_bias_deg_per_h, &GYRO_BIAS, RAD_PER_S_PER_DEG_PER_H)?,
+            kg: matrix("gyro_gain_ppm", &self.gyro_gain_ppm)?,
+            ba: vector("accel_bias_ug", &self.accel_bias_ug, &ACCEL_BIAS, MPS2_PER_UG)?,
+            ka: matrix("accel_gain_ppm", &self.accel_gain_ppm)?,
+        })
+    }
+}
+
+/// The IMU compensation of a compensation document (`selfcal --json`), if it has one.
+///
+/// # Errors
+/// Not JSON, or an `estimated_imu_compensation` with a bad number.
+pub fn from_document(json_text: &str, origin: &str) -> Result<Option<ImuErrors>, ConfigError> {
+    #[derive(Deserialize)]
+    struct Document {
+        estimated_imu_compensation: Option<RawImuCompensation>,
+    }
+    let doc: Document = serde_json::from_str(json_text).map_err(|e| ConfigError::Parse {
+        origin: origin.to_owned(),
+        message: format!("not a compensation document of `rinscope calibrate --json` or `selfcal --json` ({e})"),
+    })?;
+    doc.estimated_imu_compensation.map(|c| c.validate(origin)).transpose()
+}
