@@ -522,9 +522,13 @@ pub fn execute(
     let compensation = match &req.compensation {
         None => log.table.compensation.clone(),
         Some((text, origin)) => {
-            let imu = crate::scenario::imu_compensation::from_document(text, origin)?;
-            let table =
-                crate::scenario::logset::compensation_from_calibration(&log.raw_table, text, origin, imu.is_some())?;
+            let imu = crate::scenario::compensation::from_document(text, origin)?;
+            let table = crate::scenario::compensation::compensation_from_calibration(
+                &log.raw_table,
+                text,
+                origin,
+                imu.is_some(),
+            )?;
             if let Some(c) = &imu {
                 imu_note = Some(format!(
                     "the IMU is compensated with {origin}'s estimates (gyro bias {:.4}, {:.4}, {:.4} °/h; accelerometer bias {:.0}, {:.0}, {:.0} µg; gains too; in the accelerometer triad's frame) before anything else: the alignment works on the compensated IMU",

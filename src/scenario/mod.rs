@@ -24,7 +24,7 @@ pub fn check_duration(duration_s: f64) -> Result<f64, String> {
     crate::io::validity::check_number(duration_s, &DURATION)
 }
 
-pub mod imu_compensation;
+pub mod compensation;
 pub mod instruments;
 pub mod logset;
 pub mod presets;

@@ -175,15 +175,12 @@ impl Report {
 /// parameters in `unobservable` are left at zero, named, never compensated with a number the data
 /// did not determine.
 #[must_use]
-pub fn imu_compensation(
-    e: &Estimate,
-    unobservable: &[String],
-) -> crate::scenario::imu_compensation::RawImuCompensation {
+pub fn imu_compensation(e: &Estimate, unobservable: &[String]) -> crate::scenario::compensation::RawImuCompensation {
     let names = selfcal::param_names();
     let seen = |v: &[f64; selfcal::N_PARAMS]| -> [f64; selfcal::N_PARAMS] {
         std::array::from_fn(|k| if unobservable.contains(&names[k]) { 0.0 } else { v[k] })
     };
-    crate::scenario::imu_compensation::RawImuCompensation::from_errors(
+    crate::scenario::compensation::RawImuCompensation::from_errors(
         &selfcal::ImuErrors::from_params(&seen(&e.params)),
         Some(&selfcal::ImuErrors::from_params(&seen(&e.sigma))),
         unobservable.to_vec(),

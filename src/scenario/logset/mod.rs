@@ -6,8 +6,6 @@
 
 use std::path::{Path, PathBuf};
 
-use serde::Deserialize;
-
 use super::raw::{RawCompensation, RawNavigation, RawRecording, RawSite, RawTurntable};
 use super::validate::{self, Checker};
 use super::{ConfigError, RecordingParams, instruments};
@@ -648,57 +646,6 @@ impl LogSet {
         p.resolved_toml = self.table.resolved_toml.clone();
         Ok(p)
     }
-}
-
-/// The `estimated_compensation` of a calibration JSON (`rinscope calibrate --json`) as the table errors of
-/// `table`: its keys are `[compensation]`'s, and the table's own values fill what it leaves out.
-///
-/// `has_imu`: the document also holds an IMU compensation (`selfcal --json`), and may then have no
-/// table part (the table's own compensation stands).
-pub fn compensation_from_calibration(
-    table: &RawTable,
-    json_text: &str,
-    origin: &str,
-    has_imu: bool,
-) -> Result<TableErrors, ConfigError> {
-    #[derive(Deserialize)]
-    struct WithCompensation {
-        estimated_compensation: Option<RawCompensation>,
-    }
-    let parsed: WithCompensation = serde_json::from_str(json_text).map_err(|e| ConfigError::Parse {
-        origin: origin.to_owned(),
-        message: format!("not a compensation document of `rinscope calibrate --json` or `selfcal --json` ({e})"),
-    })?;
-    let c = Checker { origin };
-    let turntable = table.turntable.clone().unwrap_or_else(RawTurntable::strapdown);
-    let (chain, stated) = validate::turntable(&c, &turntable)?;
-    let mut merged = table.compensation.clone();
-    let given = match parsed.estimated_compensation {
-        Some(g) => g,
-        None if has_imu => RawCompensation::default(),
-        None => {
-            return Err(ConfigError::Parse {
-                origin: origin.to_owned(),
-                message: "holds neither `estimated_compensation` (the table's, from `rinscope calibrate --json`) nor `estimated_imu_compensation` (the IMU's, from `rinscope selfcal --json`)".to_owned(),
-            });
-        }
-    };
-    merged.enabled = given.enabled.or(merged.enabled);
-    for (k, v) in given.axis {
-        merged.axis.insert(k, v);
-    }
-    macro_rules! take {
-        ($($f:ident),*) => { $( if given.$f.is_some() { merged.$f = given.$f; } )* };
-    }
-    take!(
-        installation_x_arcsec,
-        installation_y_arcsec,
-        installation_z_arcsec,
-        imu_mount_x_arcsec,
-        imu_mount_y_arcsec,
-        imu_mount_z_arcsec
-    );
-    Ok(validate::validate_compensation(&c, &merged, &turntable, &chain, &stated)?.0)
 }
 
 #[cfg(test)]

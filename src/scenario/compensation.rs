@@ -1,7 +1,7 @@
-//! The IMU's part of a compensation document: what `selfcal --json` writes as
-//! `estimated_imu_compensation` and `replay --compensation FILE` reads beside the table's
-//! `estimated_compensation` (`calibrate --json`). One model for the whole RINS: the table's errors
-//! and the IMU's, each with its 1σ, each in a stated frame (docs/selfcal.md).
+//! A compensation document, one model for the whole RINS: the table's errors
+//! (`estimated_compensation`, what `calibrate --json` writes, as `[compensation]` keys) and the IMU's
+//! (`estimated_imu_compensation`, what `selfcal --json` writes), each with its 1σ, each in a stated
+//! frame; `replay --compensation FILE` reads either or both (docs/selfcal.md, docs/calibration.md).
 //!
 //! measured = (I + K)·true + b, per triad; the compensation applied to every sample is
 //! (I + K)⁻¹(measured − b·h). The frame is the accelerometer triad's (K_a upper triangular: a
@@ -9,6 +9,11 @@
 //! compensated frame).
 
 use serde::{Deserialize, Serialize};
+
+use super::logset::RawTable;
+use super::raw::{RawCompensation, RawTurntable};
+use super::validate::{self, Checker};
+use crate::model::gimbal::TableErrors;
 
 use crate::ins::imu_errors::ImuErrors;
 use crate::io::validity::{Range, check_number};
@@ -114,4 +119,55 @@ pub fn from_document(json_text: &str, origin: &str) -> Result<Option<ImuErrors>,
         message: format!("not a compensation document of `rinscope calibrate --json` or `selfcal --json` ({e})"),
     })?;
     doc.estimated_imu_compensation.map(|c| c.validate(origin)).transpose()
+}
+
+/// The `estimated_compensation` of a calibration JSON (`rinscope calibrate --json`) as the table errors of
+/// `table`: its keys are `[compensation]`'s, and the table's own values fill what it leaves out.
+///
+/// `has_imu`: the document also holds an IMU compensation (`selfcal --json`), and may then have no
+/// table part (the table's own compensation stands).
+pub fn compensation_from_calibration(
+    table: &RawTable,
+    json_text: &str,
+    origin: &str,
+    has_imu: bool,
+) -> Result<TableErrors, ConfigError> {
+    #[derive(Deserialize)]
+    struct WithCompensation {
+        estimated_compensation: Option<RawCompensation>,
+    }
+    let parsed: WithCompensation = serde_json::from_str(json_text).map_err(|e| ConfigError::Parse {
+        origin: origin.to_owned(),
+        message: format!("not a compensation document of `rinscope calibrate --json` or `selfcal --json` ({e})"),
+    })?;
+    let c = Checker { origin };
+    let turntable = table.turntable.clone().unwrap_or_else(RawTurntable::strapdown);
+    let (chain, stated) = validate::turntable(&c, &turntable)?;
+    let mut merged = table.compensation.clone();
+    let given = match parsed.estimated_compensation {
+        Some(g) => g,
+        None if has_imu => RawCompensation::default(),
+        None => {
+            return Err(ConfigError::Parse {
+                origin: origin.to_owned(),
+                message: "holds neither `estimated_compensation` (the table's, from `rinscope calibrate --json`) nor `estimated_imu_compensation` (the IMU's, from `rinscope selfcal --json`)".to_owned(),
+            });
+        }
+    };
+    merged.enabled = given.enabled.or(merged.enabled);
+    for (k, v) in given.axis {
+        merged.axis.insert(k, v);
+    }
+    macro_rules! take {
+        ($($f:ident),*) => { $( if given.$f.is_some() { merged.$f = given.$f; } )* };
+    }
+    take!(
+        installation_x_arcsec,
+        installation_y_arcsec,
+        installation_z_arcsec,
+        imu_mount_x_arcsec,
+        imu_mount_y_arcsec,
+        imu_mount_z_arcsec
+    );
+    Ok(validate::validate_compensation(&c, &merged, &turntable, &chain, &stated)?.0)
 }
