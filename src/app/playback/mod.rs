@@ -271,9 +271,9 @@ impl Playback {
         if matches!(log.reference, Reference::Static(_)) {
             check_units_at_rest(log, 5.0)?;
         }
-        if log.table.navigation_defaulted {
+        if log.table.navigation_absent {
             me.notes.push(
-                "the table description has no [navigation]: navigated with its defaults (the vertical channel held, no damping)"
+                "not navigated: the table description has no [navigation] (the INS integrates the attitude only, as the scenario it describes does in the loop); add `[navigation]` (e.g. vertical = \"held\") for position and velocity"
                     .to_owned(),
             );
         }

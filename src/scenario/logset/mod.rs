@@ -126,8 +126,8 @@ pub struct TableDescription {
     /// No turntable: a strapdown IMU whose axes are the body's (`chain` is a stand-in axis that
     /// never turns; nothing of a table is shown or exported).
     pub strapdown: bool,
-    /// No `[navigation]` section: the log is navigated with its defaults (the replay says so).
-    pub navigation_defaulted: bool,
+    /// No `[navigation]` section: the INS integrates the attitude only (the replay says so).
+    pub navigation_absent: bool,
 }
 
 /// A validated log set.
@@ -569,10 +569,11 @@ fn table_description(c: &Checker<'_>, raw: &RawTable, rate_hz: f64) -> Result<Ta
     let (chain, stated) = validate::turntable(c, &turntable)?;
     let (compensation, resolved_comp) =
         validate::validate_compensation(c, &raw.compensation, &turntable, &chain, &stated)?;
-    // A log is navigated: without `[navigation]`, with its defaults (the replay says so).
-    let navigation = raw.navigation.clone().unwrap_or_else(RawNavigation::held);
-    let ins = instruments::validate_ins(c, Some(&raw.imu.clone().unwrap_or_default()), Some(&navigation), rate_hz)?
-        .unwrap_or_else(|| InsParams::ideal(rate_hz, crate::ins::coning::Algorithm::TwoSampleP1));
+    // Without `[navigation]` the INS integrates the attitude only, as the scenario it describes
+    // does in the loop (a replay of an exported scenario reproduces its run); the replay says so.
+    let ins =
+        instruments::validate_ins(c, Some(&raw.imu.clone().unwrap_or_default()), raw.navigation.as_ref(), rate_hz)?
+            .unwrap_or_else(|| InsParams::ideal(rate_hz, crate::ins::coning::Algorithm::TwoSampleP1));
     // The calibration allows for the INS error the [imu] section states (a datasheet's), if any.
     let calibration = instruments::validate_calibration(
         c,
@@ -602,7 +603,7 @@ fn table_description(c: &Checker<'_>, raw: &RawTable, rate_hz: f64) -> Result<Ta
         recording,
         resolved_toml,
         strapdown: raw.turntable.is_none(),
-        navigation_defaulted: raw.navigation.is_none(),
+        navigation_absent: raw.navigation.is_none(),
     })
 }
 
