@@ -38,12 +38,7 @@ fn drift(
     let cfg = params.ins.as_ref().expect("[imu]");
     let biases = ImuErrors::biases(a.gyro_bias_rad_per_s.0, a.accel_bias_mps2.0);
     let h = 1.0 / RATE_HZ;
-    let pre: Vec<Increment> =
-        if with_biases { pre_roll.iter().map(|x| biases.compensate(x, h)).collect() } else { pre_roll.to_vec() };
-    let mut core = InsCore::new(cfg, params.site, a.n_from_s, &pre);
-    if with_biases {
-        core.set_compensation(Some(biases));
-    }
+    let mut core = InsCore::compensated(cfg, params.site, a.n_from_s, pre_roll, with_biases.then_some(biases));
     for (k, (g, f)) in samples.iter().enumerate() {
         core.push((k + 1) as f64 * h, *g, *f);
     }

@@ -104,6 +104,20 @@ impl InsCore {
     /// C_s^n starting at `start` (the filtered stream's instant, −d).
     #[must_use]
     pub fn new(cfg: &InsParams, site: Site, start: Rot<N, S>, pre_roll: &[(Vector3<f64>, Vector3<f64>)]) -> Self {
+        Self::compensated(cfg, site, start, pre_roll, None)
+    }
+
+    /// [`Self::new`] for a computer that removes the sensor errors `compensation` from every sample
+    /// (`(I + K)⁻¹(measured − b·h)`), the pre-roll's included (a replay: the biases its alignment
+    /// estimated).
+    #[must_use]
+    pub fn compensated(
+        cfg: &InsParams,
+        site: Site,
+        start: Rot<N, S>,
+        pre_roll: &[(Vector3<f64>, Vector3<f64>)],
+        compensation: Option<ImuErrors>,
+    ) -> Self {
         let cfg = cfg.clone();
         let h = 1.0 / cfg.rate_hz;
         let earth = Earth::at(site);
@@ -113,10 +127,14 @@ impl InsCore {
         let zoh_delay_s = if cfg.zero_order_hold { 0.5 * h } else { 0.0 };
         let mut primed = Vec::new();
         let mut acc = (Vector3::zeros(), 0);
-        for (g, a) in pre_roll {
-            acc.0 += fir_g.push(*g);
+        for sample in pre_roll {
+            let (g, a) = match &compensation {
+                Some(c) => c.compensate(sample, h),
+                None => *sample,
+            };
+            acc.0 += fir_g.push(g);
             acc.1 += 1;
-            fir_a.push(*a);
+            fir_a.push(a);
             if acc.1 == cfg.decimation {
                 primed.push(acc.0);
                 acc = (Vector3::zeros(), 0);
@@ -152,15 +170,9 @@ impl InsCore {
             upd_len: 0,
             fir_delay_s,
             zoh_delay_s,
-            compensation: None,
+            compensation,
             cfg,
         }
-    }
-
-    /// From the next sample on, the computer removes the sensor errors `c` from every sample
-    /// (`(I + K)⁻¹(measured − b·h)`), or nothing with None.
-    pub fn set_compensation(&mut self, c: Option<ImuErrors>) {
-        self.compensation = c;
     }
 
     /// The configuration.

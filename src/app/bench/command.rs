@@ -75,30 +75,21 @@ impl BenchReport {
 /// signal.
 pub fn execute(req: &BenchRequest, stop: &AtomicBool) -> Result<BenchReport, Failure> {
     check_output("--json", req.json.as_deref())?;
-    let stopped = |what: &str| Failure::interrupted(what);
+    // A benchmark stopped by a signal is no benchmark: nothing is written, and that is said.
+    let ended = |e: anyhow::Error, what: &str| {
+        if stop.load(Ordering::SeqCst) { Failure::interrupted(what) } else { Failure::run(format!("{e:#}")) }
+    };
+    let unfinished = "the comparison did not finish; nothing written";
     let report = match &req.benchmark {
-        Benchmark::Own { steps, only } => match super::run_benchmarks(*steps, only, stop) {
-            Ok(f) => BenchReport::Own(f),
-            Err(_) if stop.load(Ordering::SeqCst) => {
-                return Err(stopped("the figures printed so far are not a whole benchmark; none written"));
-            }
-            Err(e) => return Err(Failure::from(e)),
-        },
-        Benchmark::Allantools { python, rounds, samples } => match allantools::compare(python, *samples, *rounds, stop)
-        {
-            Ok(reports) => BenchReport::Allantools { reports, samples: *samples },
-            Err(_) if stop.load(Ordering::SeqCst) => {
-                return Err(stopped("the comparison did not finish; nothing written"));
-            }
-            Err(e) => return Err(Failure::run(format!("{e:#}"))),
-        },
-        Benchmark::Pyins(opts) => match peer::compare(opts, stop) {
-            Ok(reports) => BenchReport::Pyins(reports),
-            Err(_) if stop.load(Ordering::SeqCst) => {
-                return Err(stopped("the comparison did not finish; nothing written"));
-            }
-            Err(e) => return Err(Failure::run(format!("{e:#}"))),
-        },
+        Benchmark::Own { steps, only } => super::run_benchmarks(*steps, only, stop)
+            .map(BenchReport::Own)
+            .map_err(|e| ended(e, "the figures printed so far are not a whole benchmark; none written"))?,
+        Benchmark::Allantools { python, rounds, samples } => allantools::compare(python, *samples, *rounds, stop)
+            .map(|reports| BenchReport::Allantools { reports, samples: *samples })
+            .map_err(|e| ended(e, unfinished))?,
+        Benchmark::Pyins(opts) => {
+            peer::compare(opts, stop).map(BenchReport::Pyins).map_err(|e| ended(e, unfinished))?
+        }
     };
     if let Some(path) = &req.json {
         match &report {

@@ -314,12 +314,7 @@ impl Playback {
                 (attitude, pre_roll, None)
             }
         };
-        let pre_roll: Vec<IncrementPair> = match &biases {
-            Some(c) => pre_roll.iter().map(|x| c.compensate(x, 1.0 / cfg.rate_hz)).collect(),
-            None => pre_roll,
-        };
-        me.core = InsCore::new(cfg, log.table.site, start_attitude, &pre_roll);
-        me.core.set_compensation(biases);
+        me.core = InsCore::compensated(cfg, log.table.site, start_attitude, &pre_roll, biases);
         if let Some(v) = velocity {
             me.core.set_velocity(Vector3::from(v));
         }

@@ -99,18 +99,13 @@ const COMPENSATED_AXIS_FIELDS: [&str; 6] = [
     "encoder_delay_ms",
 ];
 
-fn slider(label: String, key: &str, unit: &'static str, (min, max): (f64, f64), step: f64) -> Control {
-    Control::Slider {
-        label,
-        keys: vec![KeyPath::parse(key)],
-        unit,
-        min,
-        max,
-        step,
-        log: false,
-        value: 0.0,
-        initial: 0.0,
-    }
+fn slider(label: String, key: &str, unit: &'static str, range: (f64, f64), step: f64) -> Control {
+    slider_of(label, vec![KeyPath::parse(key)], unit, range, step)
+}
+
+/// A linear slider that writes every one of `keys` (one value for several axes).
+fn slider_of(label: String, keys: Vec<KeyPath>, unit: &'static str, (min, max): (f64, f64), step: f64) -> Control {
+    Control::Slider { label, keys, unit, min, max, step, log: false, value: 0.0, initial: 0.0 }
 }
 
 impl Panel {
@@ -285,17 +280,7 @@ impl Panel {
             let all = |field: &str| {
                 (0..v.wobble.len()).map(|j| KeyPath::parse(&format!("vehicle.wobble[{j}].{field}"))).collect::<Vec<_>>()
             };
-            let many = |label: &str, keys, unit, (min, max), step| Control::Slider {
-                label: label.into(),
-                keys,
-                unit,
-                min,
-                max,
-                step,
-                log: false,
-                value: 0.0,
-                initial: 0.0,
-            };
+            let many = |label: &str, keys, unit, range, step| slider_of(label.into(), keys, unit, range, step);
             controls.push(many("wobble amplitude (every axis)", all("amplitude_deg"), "°", (0.0, 20.0), 0.5));
             controls.push(many("wobble frequency (every axis)", all("frequency_hz"), " Hz", (0.1, 20.0), 0.1));
         }
