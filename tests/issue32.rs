@@ -98,25 +98,49 @@ fn a_log_without_a_calibration_sequence_is_refused_by_selfcal() {
     assert!(!dir.join("s.json").exists(), "an estimate was written");
 }
 
-/// `selfcal`'s estimates as the IMU part of a compensation document (`estimated_imu_compensation`),
-/// and the same document made of the simulation's truth (the `truth` it reports, in its 21
-/// parameters' order: gyro bias, K_g row-major, accelerometer bias, K_a's upper triangle).
+/// The compensation document of the simulation's truth as `selfcal` reports it (its `truth`, in its
+/// parameters' order): the IMU part (gyro bias, K_g row-major, accelerometer bias, K_a's upper
+/// triangle) and the table part, the true table folded as the encoders see it (per axis the
+/// constant rotation after the shaft as a swing cone, the encoder's scale and delay; what folds into
+/// them stated as zero), both in the accelerometer triad's frame — the frame of the estimates.
 fn truth_document(selfcal: &serde_json::Value) -> String {
     let t: Vec<f64> = selfcal["truth"].as_array().expect("truth").iter().map(|x| x.as_f64().expect("number")).collect();
+    let names: Vec<&str> =
+        selfcal["parameters"].as_array().expect("names").iter().map(|n| n.as_str().expect("name")).collect();
+    let at = |name: &str| t[names.iter().position(|n| *n == name).expect(name)];
     let deg_per_h = std::f64::consts::PI / 180.0 / 3600.0;
-    let ug = 9.80665e-6;
+    let (ug, arcsec) = (9.80665e-6, std::f64::consts::PI / 180.0 / 3600.0);
     let kg: Vec<Vec<f64>> = (0..3).map(|i| (0..3).map(|j| t[3 + 3 * i + j] * 1e6).collect()).collect();
     let mut ka = vec![vec![0.0; 3]; 3];
     for (u, (i, j)) in [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)].into_iter().enumerate() {
         ka[i][j] = t[15 + u] * 1e6;
     }
-    serde_json::json!({ "estimated_imu_compensation": {
-        "frame": selfcal["estimated_imu_compensation"]["frame"],
-        "gyro_bias_deg_per_h": (0..3).map(|i| t[i] / deg_per_h).collect::<Vec<_>>(),
-        "gyro_gain_ppm": kg,
-        "accel_bias_ug": (0..3).map(|i| t[12 + i] / ug).collect::<Vec<_>>(),
-        "accel_gain_ppm": ka,
-    }})
+    // The outer axis is y (its swing's directions z, x), the inner z (x, y).
+    let axis = |name: &str, e1: &str, e2: &str| {
+        let (x, y) = (at(&format!("{name}.swing_{e1}")), at(&format!("{name}.swing_{e2}")));
+        serde_json::json!({
+            "swing_half_angle_arcsec": x.hypot(y) / arcsec,
+            "swing_phase_deg": y.atan2(x).to_degrees(),
+            "encoder_scale_ppm": at(&format!("{name}.encoder_scale")) * 1e6,
+            "encoder_delay_ms": at(&format!("{name}.encoder_delay")) * 1e3,
+        })
+    };
+    let mut inner = axis("inner", "x", "y");
+    inner["non_orthogonality_arcsec"] = serde_json::json!(0.0);
+    inner["encoder_offset_arcsec"] = serde_json::json!(0.0);
+    serde_json::json!({
+        "estimated_compensation": {
+            "enabled": true, "imu_mount_x_arcsec": 0.0, "imu_mount_y_arcsec": 0.0, "imu_mount_z_arcsec": 0.0,
+            "axis": { "outer": axis("outer", "z", "x"), "inner": inner },
+        },
+        "estimated_imu_compensation": {
+            "frame": selfcal["estimated_imu_compensation"]["frame"],
+            "gyro_bias_deg_per_h": (0..3).map(|i| t[i] / deg_per_h).collect::<Vec<_>>(),
+            "gyro_gain_ppm": kg,
+            "accel_bias_ug": (0..3).map(|i| t[12 + i] / ug).collect::<Vec<_>>(),
+            "accel_gain_ppm": ka,
+        },
+    })
     .to_string()
 }
 
@@ -164,14 +188,23 @@ fn the_imu_calibrated_by_selfcal_is_compensated_in_a_replay_as_well_as_by_the_tr
         let drift = s["navigation"]["peak_radial_m"].as_f64().expect("navigated");
         (heading, drift, s["notes"].to_string())
     };
+    // The whole RINS uncompensated: no IMU compensation and the nominal table (the log's table
+    // description compensates with the table's true errors, which is the "true" table part).
+    std::fs::write(dir.join("nothing.json"), r#"{"estimated_compensation": {"enabled": false}}"#).expect("write");
+    let nothing = replay(Some("nothing.json"));
     let none = replay(None);
     let estimated = replay(Some("sc.json"));
     let truth = replay(Some("truth.json"));
     eprintln!(
-        "heading RMS / peak drift: none {:.1}″ {:.0} m, estimated {:.1}″ {:.0} m, truth {:.1}″ {:.0} m",
-        none.0, none.1, estimated.0, estimated.1, truth.0, truth.1
+        "heading RMS / peak drift: nothing {:.1}″ {:.0} m, IMU none {:.1}″ {:.0} m, estimated (IMU and table) {:.1}″ {:.0} m, truth {:.1}″ {:.0} m",
+        nothing.0, nothing.1, none.0, none.1, estimated.0, estimated.1, truth.0, truth.1
     );
     assert!(estimated.2.contains("the IMU is compensated with sc.json's estimates"), "{}", estimated.2);
+    // The table's part: selfcal's folded table (sc.json's estimated_compensation) demodulates as
+    // well as the table's true errors do — against the nominal table, whose 600″ swing alone puts
+    // arcminutes into the heading.
+    assert!(sc["estimated_compensation"]["axis"]["inner"]["encoder_scale_ppm"].is_number(), "{sc}");
+    assert!(estimated.0 < 0.1 * nothing.0, "{estimated:?} against the nominal table {nothing:?}");
     // The estimates' 1σ are a few per cent of the errors (sc.json): compensated with them, the
     // replay is the truth-compensated one within the noise, and far from the uncompensated one.
     assert!(estimated.0 < 0.5 * none.0 && estimated.1 < 0.6 * none.1, "{estimated:?} against {none:?}");

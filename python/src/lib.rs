@@ -440,8 +440,14 @@ fn selfcal(
         )));
     }
     let sequence = SequenceChoice::parse(sequence).map_err(|e| PyValueError::new_err(format!("sequence {e}")))?;
-    let input =
-        SelfcalInput::Scenario { params: Box::new(params), sequence, monte_carlo, navigate_hours, plan_only: false };
+    let input = SelfcalInput::Scenario {
+        params: Box::new(params),
+        sequence,
+        monte_carlo,
+        navigate_hours,
+        plan_only: false,
+        encoders: true,
+    };
     let out = interruptible(py, move |stop| -> Result<Output, Failure> {
         let report = execute(&SelfcalRequest { input, recording: Some(recording(save, stop)), json: None }, stop)?;
         let mut json = report.document;

@@ -31,6 +31,8 @@ mod estimate;
 pub mod montecarlo;
 pub mod report;
 pub mod selfcal;
+pub mod selfcal_table;
+mod sequence;
 
 pub use estimate::{Calibration, Estimate, History, Snapshot, calibrate};
 

@@ -12,6 +12,11 @@
 //! navigation estimates anyway; the accelerometer triad therefore defines the IMU frame
 //! ([`ImuErrors::in_accelerometer_frame`]).
 //!
+//! With the table's encoder readings the filter also measures the IMU's attitude on the base
+//! (`selfcal_table`): the navigation's attitude error φ directly, and the table's errors in the
+//! combinations the shafts' motion separates (per axis: the rotation after the shaft across it,
+//! the encoder's scale and delay), with the base's own attitude ψ as a nuisance.
+//!
 //! Why a filter and no smoother: every calibrated parameter is a constant, and for a linear
 //! Gaussian model the forward filter's final estimate of a constant is its smoothed estimate (the
 //! backward pass changes only the time-varying navigation states). The estimator never reads the
@@ -19,141 +24,28 @@
 
 use nalgebra::{SMatrix, SVector, UnitQuaternion, Vector3};
 
+use super::selfcal_table::{MAX_TABLE, TableStates, measurement_variance};
+pub use super::sequence::{INITIAL_DWELL_S, Sequence};
 use crate::ins::align::Increment;
 use crate::ins::imu_errors::KA_UPPER;
 pub use crate::ins::imu_errors::{ImuErrors, Kind, N_PARAMS, param, param_names};
 use crate::ins::sensor::{ImuErrorSpec, Spec};
 use crate::math::rotvec;
-use crate::math::units::{ARCSEC_PER_RAD, MPS2_PER_UG, RAD_PER_DEG, RAD_PER_S_PER_DEG_PER_H};
+use crate::math::units::{ARCSEC_PER_RAD, MPS2_PER_UG, RAD_PER_S_PER_DEG_PER_H};
 use crate::model::earth::Earth;
-use crate::model::scheme::IndexedStep;
+use crate::model::scheme::AxisValues;
 
+/// The parameters: the IMU's 21, the table's (at most [`MAX_TABLE`]; unused ones have no
+/// variance) and the base's attitude ψ (3).
+const NP: usize = N_PARAMS + MAX_TABLE + 3;
 /// Filter states: φ, δv, then the parameters.
-const N: usize = 6 + N_PARAMS;
+const N: usize = 6 + NP;
+/// Where the table's states start, and ψ's.
+const TABLE0: usize = 6 + N_PARAMS;
+const PSI0: usize = TABLE0 + MAX_TABLE;
 type Mat = SMatrix<f64, N, N>;
-type Vec27 = SVector<f64, N>;
+type StateVec = SVector<f64, N>;
 type Block = SMatrix<f64, 6, N_PARAMS>;
-
-/// A built-in calibration sequence of a dual-axis table (outer axis first in the chain, the inner
-/// one carrying the IMU about its z): table moves and dwells.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Sequence {
-    /// 19 positions joined by 18 rotations of 90° and 180° about each IMU axis (z while
-    /// horizontal), in both senses, 240 s at each, after PSINS's systematic calibration
-    /// (`sysclbt`); 1.4 h.
-    Positions19,
-    /// 29 positions: about the IMU's z (held horizontal), y and x in turn, four quarter turns
-    /// forward and four back, 160 s at each (the kind of sequence Cai et al. 2016 and Ren et al.
-    /// 2019 use); 1.4 h.
-    DualAxis29,
-    /// Only the inner (azimuth) axis turns: what it cannot see is the point (a degenerate case).
-    AzimuthOnly,
-}
-
-impl Sequence {
-    /// Every built-in, with its command-line name.
-    pub const ALL: [(Self, &'static str); 3] =
-        [(Self::Positions19, "positions-19"), (Self::DualAxis29, "dual-axis-29"), (Self::AzimuthOnly, "azimuth-only")];
-
-    /// By its command-line name.
-    #[must_use]
-    pub fn named(name: &str) -> Option<Self> {
-        Self::ALL.iter().find(|(_, n)| *n == name).map(|(s, _)| *s)
-    }
-
-    /// Its command-line name.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        Self::ALL.iter().find(|(s, _)| *s == self).map_or("", |(_, n)| n)
-    }
-
-    /// The table moves (outer axis 0, inner axis 1) and the dwell before the first move, s.
-    #[must_use]
-    pub fn steps(self) -> (f64, Vec<IndexedStep>) {
-        // (axis, degrees): the inner axis is the IMU's z; the outer turns the IMU about its y
-        // with the inner at 0° or 180°, about its x with the inner at ±90°.
-        let (z, o) = (1usize, 0usize);
-        let (moves, dwell): (Vec<(usize, f64)>, f64) = match self {
-            Self::Positions19 => (
-                vec![
-                    (o, 90.0), // z horizontal
-                    (z, 90.0),
-                    (z, 90.0),
-                    (z, 90.0),
-                    (z, 90.0), // about z, gravity sweeping the x-y plane
-                    (o, 90.0),
-                    (o, 90.0),
-                    (o, 90.0), // about y: z down, horizontal, up
-                    (z, 90.0), // x onto the outer axis
-                    (o, 90.0),
-                    (o, 90.0),
-                    (o, 90.0),
-                    (o, 90.0), // about x
-                    (o, -180.0),
-                    (o, 180.0), // about x, back and forth
-                    (z, -90.0), // y onto the outer axis
-                    (o, -180.0),
-                    (o, 180.0), // about y, back and forth
-                ],
-                240.0,
-            ),
-            Self::DualAxis29 => {
-                let mut m = vec![(o, 90.0)];
-                // About z with z horizontal (a z scale error then tilts the IMU, which the
-                // accelerometers see; about a vertical z it would only turn the heading).
-                m.extend(std::iter::repeat_n((z, 90.0), 4));
-                m.extend(std::iter::repeat_n((z, -90.0), 4));
-                m.push((o, -90.0));
-                // About y (inner at 0°), then about x (inner at 90°).
-                m.extend(std::iter::repeat_n((o, 90.0), 4));
-                m.extend(std::iter::repeat_n((o, -90.0), 4));
-                m.push((z, 90.0));
-                m.extend(std::iter::repeat_n((o, 90.0), 4));
-                m.extend(std::iter::repeat_n((o, -90.0), 4));
-                m.push((z, -90.0));
-                (m, 160.0)
-            }
-            Self::AzimuthOnly => (
-                std::iter::repeat_n((z, 90.0), 4)
-                    .chain(std::iter::repeat_n((z, -90.0), 4))
-                    .chain(std::iter::repeat_n((z, 90.0), 4))
-                    .collect(),
-                300.0,
-            ),
-        };
-        let rate = 10.0 * RAD_PER_DEG;
-        let steps = moves
-            .into_iter()
-            .map(|(axis, deg)| IndexedStep {
-                axis,
-                angle_rad: deg * RAD_PER_DEG,
-                rate_rad_per_s: rate,
-                dwell_s: dwell,
-                accel_rad_per_s2: rate,
-            })
-            .collect();
-        (INITIAL_DWELL_S, steps)
-    }
-}
-
-impl Sequence {
-    /// The table's motion through the sequence (outer and inner axis from 0°, not repeated).
-    #[must_use]
-    pub fn scheme(self) -> crate::model::scheme::Scheme {
-        let (dwell, steps) = self.steps();
-        crate::model::scheme::Scheme::indexed(vec![0.0; 2], dwell, steps, false)
-    }
-
-    /// Its length, s: the first dwell and every move with its dwell.
-    #[must_use]
-    pub fn duration_s(self) -> f64 {
-        let scheme = self.scheme();
-        self.steps().0 + scheme.period_s()
-    }
-}
-
-/// The dwell before the first move: the coarse alignment's data, s.
-pub const INITIAL_DWELL_S: f64 = 300.0;
 
 /// What the filter knows beyond the data.
 #[derive(Debug, Clone, Copy)]
@@ -231,6 +123,40 @@ pub struct HistoryRow {
     pub estimate: [f64; N_PARAMS],
     /// 1σ, SI.
     pub sigma: [f64; N_PARAMS],
+    /// The table's estimates and 1σ, SI (empty without encoders).
+    pub table_estimate: Vec<f64>,
+    /// Their 1σ.
+    pub table_sigma: Vec<f64>,
+}
+
+/// What the filter knows of the table: its chain (the states) and its encoders' noise.
+#[derive(Debug, Clone)]
+pub struct TableConfig {
+    /// The states of the table's chain.
+    pub states: TableStates,
+    /// Each encoder's reading noise, 1σ, rad (the table's datasheet).
+    pub encoder_sigma_rad: Vec<f64>,
+    /// The states' prior mean (empty: zero). An extended Kalman filter's first updates are
+    /// linearized about its prior, and a constant keeps their error: a second pass about the
+    /// first's result removes it (the prior's 1σ stays as wide, so the data still decide).
+    pub linearized_at: Vec<f64>,
+}
+
+/// The table's part of an estimate.
+#[derive(Debug, Clone)]
+pub struct TableEstimate {
+    /// The states (the chain they belong to).
+    pub states: TableStates,
+    /// The states' names.
+    pub names: Vec<String>,
+    /// The estimates, SI.
+    pub params: Vec<f64>,
+    /// Their 1σ.
+    pub sigma: Vec<f64>,
+    /// The priors' 1σ.
+    pub prior: Vec<f64>,
+    /// The covariance of the IMU's 21 and the table's states together (correlations: aliasing).
+    pub covariance: nalgebra::DMatrix<f64>,
 }
 
 /// The self-calibration filter: feed it the IMU's increments in order.
@@ -239,7 +165,9 @@ pub struct SelfCal {
     /// C_s^n of the navigation and its velocity (ENU), m/s.
     q: UnitQuaternion<f64>,
     v: Vector3<f64>,
-    x: Vec27,
+    /// The last sample's Δθ (the coning correction).
+    last_dtheta: Vector3<f64>,
+    x: StateVec,
     p: Mat,
     /// F of (φ, δv) (constant at rest: f^n = −g^n).
     f_nn: SMatrix<f64, 6, 6>,
@@ -252,6 +180,12 @@ pub struct SelfCal {
     t_s: f64,
     history: Vec<HistoryRow>,
     next_history_s: f64,
+    /// The table's states, and the encoder readings of the last 2m + 1 samples with the
+    /// navigation's attitude at each (newest last).
+    table: Option<TableConfig>,
+    readings: std::collections::VecDeque<(AxisValues, UnitQuaternion<f64>)>,
+    /// The base's attitude the encoder measurements are referred to (the first's).
+    c_ref: Option<UnitQuaternion<f64>>,
 }
 
 /// What the filter found.
@@ -267,13 +201,16 @@ pub struct Estimate {
     pub prior: [f64; N_PARAMS],
     /// 1σ and estimates at 1 Hz.
     pub history: Vec<HistoryRow>,
+    /// The table's part (with encoder readings).
+    pub table: Option<TableEstimate>,
 }
 
 impl SelfCal {
     /// Aligned on `align` (the first samples of the initial dwell, coarse alignment); None if they
     /// cannot give an attitude (too few, or no Earth-rate signature).
+    /// With `table`, every sample comes with its encoder readings ([`Self::push_with_encoders`]).
     #[must_use]
-    pub fn new(cfg: Config, align: &[Increment]) -> Option<Self> {
+    pub fn new(cfg: Config, table: Option<TableConfig>, align: &[Increment]) -> Option<Self> {
         let align_cfg = crate::ins::align::AlignConfig {
             latitude_rad: cfg.earth.site.latitude_rad,
             height_m: cfg.earth.site.height_m,
@@ -294,6 +231,7 @@ impl SelfCal {
         let ft = f_nn * big_t;
         let a = SMatrix::<f64, 6, 6>::identity() + ft + ft * ft * 0.5 + ft * ft * ft / 6.0;
         let mut p = Mat::zeros();
+        let mut x = StateVec::zeros();
         // Coarse alignment: tilt to ~accelerometer bias / g, heading to ~gyro bias / Earth rate.
         for (i, s) in [3e-4, 3e-4, 3e-3, 1e-3, 1e-3, 1e-3].into_iter().enumerate() {
             p[(i, i)] = s * s;
@@ -301,11 +239,25 @@ impl SelfCal {
         for k in 0..N_PARAMS {
             p[(6 + k, 6 + k)] = cfg.prior[k] * cfg.prior[k];
         }
+        if let Some(t) = &table {
+            for (j, s) in t.states.priors().into_iter().enumerate() {
+                p[(TABLE0 + j, TABLE0 + j)] = s * s;
+            }
+            for (j, m) in t.linearized_at.iter().enumerate() {
+                x[TABLE0 + j] = *m;
+            }
+            // The base's attitude: anything up to half a degree (installation, first encoder's
+            // offset, the coarse alignment's error).
+            for i in 0..3 {
+                p[(PSI0 + i, PSI0 + i)] = 1e-2 * 1e-2;
+            }
+        }
         Some(Self {
             cfg,
             q,
             v: Vector3::zeros(),
-            x: Vec27::zeros(),
+            last_dtheta: Vector3::zeros(),
+            x,
             p,
             f_nn,
             a,
@@ -315,16 +267,54 @@ impl SelfCal {
             t_s: 0.0,
             history: Vec::new(),
             next_history_s: 0.0,
+            table,
+            readings: std::collections::VecDeque::new(),
+            c_ref: None,
         })
     }
 
+    /// Takes one sample's (Δθ, Δv) and the encoders' readings at its end, rad (used by a filter
+    /// made with a table).
+    pub fn push_with_encoders(&mut self, m: &Increment, readings: &AxisValues) {
+        self.integrate(m);
+        if self.readings.len() == 2 * self.half_window() + 1 {
+            self.readings.pop_front();
+        }
+        self.readings.push_back((*readings, self.q));
+        self.step_if_due();
+    }
+
     /// Takes one sample's (Δθ, Δv).
-    pub fn push(&mut self, (dtheta, dv): &Increment) {
+    pub fn push(&mut self, m: &Increment) {
+        self.integrate(m);
+        self.step_if_due();
+    }
+
+    /// m: the encoder measurement is made m samples back, its shafts' rates from the readings m
+    /// samples either side (20 ms).
+    fn half_window(&self) -> usize {
+        ((0.02 / self.cfg.h).round() as usize).max(1)
+    }
+
+    fn step_if_due(&mut self) {
+        if self.k == self.cfg.samples_per_update {
+            self.step();
+        }
+    }
+
+    /// The navigation and the parameters' input matrices over one sample.
+    fn integrate(&mut self, (dtheta, dv): &Increment) {
         let h = self.cfg.h;
         let c = (self.q * rotvec::exp(&(dtheta * 0.5))).to_rotation_matrix().into_inner();
         // The navigation at the site: C_s^n turned by the IMU and by the Earth under it.
         self.v += c * dv + (self.cfg.earth.gravity_n - 2.0 * self.cfg.earth.omega_ie_n.cross(&self.v)) * h;
-        self.q = rotvec::exp(&(-self.cfg.earth.omega_ie_n * h)) * self.q * rotvec::exp(dtheta);
+        // The attitude by the rotation vector of the sample, not its increment: a gyro's Δθ is ∫ω dt,
+        // and while a shaft turns the Earth's rate turns with it in the IMU's axes (coning; the
+        // one-sample-back correction Δθ + Δθ₋₁ × Δθ / 12, Savage 1998). Uncorrected it is 0.05″ a
+        // move, which biased the encoder scales.
+        let rotation = dtheta + self.last_dtheta.cross(dtheta) / 12.0;
+        self.last_dtheta = *dtheta;
+        self.q = rotvec::exp(&(-self.cfg.earth.omega_ie_n * h)) * self.q * rotvec::exp(&rotation);
         // How the parameters drive φ (−C δω) and δv (C δf) over this sample, and weighted by the
         // time left in the step (their effect on δv through f^n × φ).
         let weight = h * (self.cfg.samples_per_update - self.k) as f64 - 0.5 * h;
@@ -353,9 +343,6 @@ impl SelfCal {
         }
         self.k += 1;
         self.t_s += h;
-        if self.k == self.cfg.samples_per_update {
-            self.step();
-        }
     }
 
     /// One filter step: propagation over the step, the zero-velocity update, the reset of φ and
@@ -365,19 +352,21 @@ impl SelfCal {
         let b = self.s + self.f_nn * self.w;
         let a = self.a;
         let p = &mut self.p;
+        // Only the IMU's parameters drive φ and δv: Φ = [[A, B, 0], [0, I, 0], [0, 0, I]].
         let pnn = p.fixed_view::<6, 6>(0, 0).into_owned();
-        let pnp = p.fixed_view::<6, N_PARAMS>(0, 6).into_owned();
-        let ppp = p.fixed_view::<N_PARAMS, N_PARAMS>(6, 6).into_owned();
-        let pnp_new = a * pnp + b * ppp;
-        let mut pnn_new = (a * pnn + b * pnp.transpose()) * a.transpose() + pnp_new * b.transpose();
+        let pnp = p.fixed_view::<6, NP>(0, 6).into_owned();
+        let pimu = p.fixed_view::<N_PARAMS, NP>(6, 6).into_owned();
+        let pnp_new = a * pnp + b * pimu;
+        let mut pnn_new = (a * pnn + b * pnp.fixed_columns::<N_PARAMS>(0).transpose()) * a.transpose()
+            + pnp_new.fixed_columns::<N_PARAMS>(0) * b.transpose();
         let (arw, vrw) = self.cfg.random_walk;
         for i in 0..3 {
             pnn_new[(i, i)] += arw * arw * big_t;
             pnn_new[(3 + i, 3 + i)] += vrw * vrw * big_t;
         }
         p.fixed_view_mut::<6, 6>(0, 0).copy_from(&pnn_new);
-        p.fixed_view_mut::<6, N_PARAMS>(0, 6).copy_from(&pnp_new);
-        p.fixed_view_mut::<N_PARAMS, 6>(6, 0).copy_from(&pnp_new.transpose());
+        p.fixed_view_mut::<6, NP>(0, 6).copy_from(&pnp_new);
+        p.fixed_view_mut::<NP, 6>(6, 0).copy_from(&pnp_new.transpose());
         // The navigation errors the parameter estimates predict (φ and δv were reset to 0).
         let xp = self.x.fixed_rows::<N_PARAMS>(6).into_owned();
         let xn = b * xp;
@@ -396,18 +385,91 @@ impl SelfCal {
             *p -= gain * ph.transpose();
             *p = (*p + p.transpose()) * 0.5;
         }
+        self.encoder_update();
         // Feedback: C_s^n ← exp(φ) C̃, v ← ṽ − δv.
         let phi = self.x.fixed_rows::<3>(0).into_owned();
-        self.q = rotvec::exp(&phi) * self.q;
+        let turn = rotvec::exp(&phi);
+        self.q = turn * self.q;
+        for (_, q) in &mut self.readings {
+            *q = turn * *q;
+        }
         self.v -= self.x.fixed_rows::<3>(3);
         self.x.fixed_rows_mut::<6>(0).fill(0.0);
         self.s = Block::zeros();
         self.w = Block::zeros();
         self.k = 0;
         if self.t_s + 1e-9 >= self.next_history_s {
-            self.history.push(HistoryRow { t_s: self.t_s, estimate: self.params(), sigma: self.sigma() });
+            let (table_estimate, table_sigma) = self.table_values();
+            self.history.push(HistoryRow {
+                t_s: self.t_s,
+                estimate: self.params(),
+                sigma: self.sigma(),
+                table_estimate,
+                table_sigma,
+            });
             self.next_history_s += 1.0;
         }
+    }
+
+    /// The encoders' measurement of the IMU's attitude on the base (module doc): y =
+    /// log(C̃_s^n · C_s^b(λ̂; p̂)ᵀ · C_refᵀ) ≈ −φ + C_ref·J·(p − p̂) + ψ, the chain evaluated exactly
+    /// at the current estimate p̂ (an extended Kalman filter).
+    fn encoder_update(&mut self) {
+        let m = self.half_window();
+        let Some(table) = &self.table else { return };
+        if self.readings.len() < 2 * m + 1 {
+            return;
+        }
+        // The measurement is made m samples back (φ does not change in 20 ms), the shafts' rates
+        // by the central difference of the readings m samples either side: no lag, and no reading
+        // in both the angle and the rate (its noise would bias the delay: errors in the variables).
+        let (readings, q) = self.readings[m];
+        let (first, last) = (self.readings[0].0, self.readings[2 * m].0);
+        let n_t = table.states.len();
+        let p_hat: Vec<f64> = (0..n_t).map(|j| self.x[TABLE0 + j]).collect();
+        // A shaft at rest is at rest: a rate inside its noise (4σ, and 0.006°/s) is zero, or the
+        // noise alone would make a never-turning shaft's delay look observable.
+        let span = 2.0 * m as f64 * self.cfg.h;
+        let mut rates = [0.0; crate::model::scheme::MAX_AXES];
+        for (k, (r, (a, b))) in rates.iter_mut().zip(last.iter().zip(&first)).enumerate() {
+            let noise = table.encoder_sigma_rad.get(k).copied().unwrap_or(0.0) * std::f64::consts::SQRT_2 / span;
+            let rate = (a - b) / span;
+            *r = if rate.abs() > 4.0 * noise + 1e-4 { rate } else { 0.0 };
+        }
+        let c_bs = table.states.b_from_s(&p_hat, &readings, &rates);
+        let c_nb = q * c_bs.inverse();
+        let c_ref = *self.c_ref.get_or_insert(c_nb);
+        let y = rotvec::log(&(c_nb * c_ref.inverse()));
+        let j = c_ref.to_rotation_matrix().into_inner() * table.states.jacobian(&p_hat, &readings, &rates);
+        let mut h = SMatrix::<f64, 3, N>::zeros();
+        for i in 0..3 {
+            h[(i, i)] = -1.0;
+            h[(i, PSI0 + i)] = 1.0;
+        }
+        h.fixed_view_mut::<3, MAX_TABLE>(0, TABLE0).copy_from(&j);
+        let phi = self.x.fixed_rows::<3>(0).into_owned();
+        let psi = self.x.fixed_rows::<3>(PSI0).into_owned();
+        let innovation = y + phi - psi;
+        let ph = self.p * h.transpose();
+        let r = measurement_variance(&table.encoder_sigma_rad);
+        let s = h * ph + r;
+        if let Some(s_inv) = s.try_inverse() {
+            let gain = ph * s_inv;
+            self.x += gain * innovation;
+            // Joseph's form: the encoders are far more precise than the priors (0.05″ against
+            // 600″), and P − K·H·P then loses the small variances to rounding.
+            let ikh = Mat::identity() - gain * h;
+            self.p = ikh * self.p * ikh.transpose() + gain * r * gain.transpose();
+            self.p = (self.p + self.p.transpose()) * 0.5;
+        }
+    }
+
+    fn table_values(&self) -> (Vec<f64>, Vec<f64>) {
+        let n_t = self.table.as_ref().map_or(0, |t| t.states.len());
+        (
+            (0..n_t).map(|j| self.x[TABLE0 + j]).collect(),
+            (0..n_t).map(|j| self.p[(TABLE0 + j, TABLE0 + j)].max(0.0).sqrt()).collect(),
+        )
     }
 
     fn params(&self) -> [f64; N_PARAMS] {
@@ -421,24 +483,83 @@ impl SelfCal {
     /// The estimates after the last sample.
     #[must_use]
     pub fn finish(self) -> Estimate {
+        let table = self.table.as_ref().map(|t| {
+            let (params, sigma) = self.table_values();
+            let n = N_PARAMS + t.states.len();
+            TableEstimate {
+                states: t.states.clone(),
+                names: t.states.names(),
+                params,
+                sigma,
+                prior: t.states.priors(),
+                covariance: nalgebra::DMatrix::from_fn(n, n, |i, j| self.p[(6 + i, 6 + j)]),
+            }
+        });
         Estimate {
             params: self.params(),
             sigma: self.sigma(),
             covariance: self.p.fixed_view::<N_PARAMS, N_PARAMS>(6, 6).into_owned(),
             prior: self.cfg.prior,
             history: self.history,
+            table,
         }
     }
 }
 
-/// How well a sequence sees each parameter: its 1σ over its prior at the end, and when it first
-/// fell under half the prior.
+/// What parameter k is, in [`Estimate::names`]'s order (the IMU's 21, then the table's).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ParamKind {
+    /// One of the IMU's.
+    Imu(Kind),
+    /// One of the table's.
+    Table(super::selfcal_table::TableKind),
+}
+
+impl ParamKind {
+    /// Parameter `k`'s kind.
+    #[must_use]
+    pub fn of(k: usize) -> Self {
+        if k < N_PARAMS { Self::Imu(param(k).0) } else { Self::Table(TableStates::kind(k - N_PARAMS)) }
+    }
+
+    /// The display unit and how many of it one SI unit is.
+    #[must_use]
+    pub fn unit(self) -> (&'static str, f64) {
+        match self {
+            Self::Imu(k) => k.unit(),
+            Self::Table(k) => k.unit(),
+        }
+    }
+
+    /// The unit as an entity or column name suffix.
+    #[must_use]
+    pub fn unit_key(self) -> &'static str {
+        match self {
+            Self::Imu(k) => k.unit_key(),
+            Self::Table(k) => k.unit_key(),
+        }
+    }
+
+    /// The group a plot gathers.
+    #[must_use]
+    pub fn group(self) -> &'static str {
+        match self {
+            Self::Imu(k) => k.group(),
+            Self::Table(_) => "table",
+        }
+    }
+}
+
+/// How well a sequence sees each parameter (the IMU's 21, then the table's): its 1σ over its prior
+/// at the end, and when it first fell under a tenth of the prior.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Observability {
+    /// The parameters, in the order of the lists below.
+    pub parameters: Vec<String>,
     /// Per parameter: σ_end / σ_0.
-    pub ratio: [f64; N_PARAMS],
+    pub ratio: Vec<f64>,
     /// Per parameter: the time σ first fell under a tenth of σ_0, s (None: never).
-    pub observable_from_s: [Option<f64>; N_PARAMS],
+    pub observable_from_s: Vec<Option<f64>>,
     /// Parameters whose 1σ fell by less than half: not observable from this sequence.
     pub unobservable: Vec<String>,
     /// Parameters whose 1σ fell by half but stayed above a tenth of the prior: weakly observable.
@@ -447,52 +568,88 @@ pub struct Observability {
     pub aliased: Vec<String>,
 }
 
+impl Estimate {
+    /// Every parameter's name: the IMU's 21, then the table's.
+    #[must_use]
+    pub fn names(&self) -> Vec<String> {
+        let mut n = param_names();
+        if let Some(t) = &self.table {
+            n.extend(t.names.iter().cloned());
+        }
+        n
+    }
+
+    /// Every estimate (SI), in [`Self::names`]'s order.
+    #[must_use]
+    pub fn all_params(&self) -> Vec<f64> {
+        let mut v = self.params.to_vec();
+        if let Some(t) = &self.table {
+            v.extend(&t.params);
+        }
+        v
+    }
+
+    /// Every 1σ (SI), in [`Self::names`]'s order.
+    #[must_use]
+    pub fn all_sigma(&self) -> Vec<f64> {
+        let mut v = self.sigma.to_vec();
+        if let Some(t) = &self.table {
+            v.extend(&t.sigma);
+        }
+        v
+    }
+
+    /// Every prior 1σ (SI), in [`Self::names`]'s order.
+    #[must_use]
+    pub fn all_prior(&self) -> Vec<f64> {
+        let mut v = self.prior.to_vec();
+        if let Some(t) = &self.table {
+            v.extend(&t.prior);
+        }
+        v
+    }
+}
+
+impl HistoryRow {
+    /// Parameter `k`'s 1σ in [`Estimate::names`]'s order.
+    #[must_use]
+    pub fn sigma_of(&self, k: usize) -> f64 {
+        if k < N_PARAMS { self.sigma[k] } else { self.table_sigma[k - N_PARAMS] }
+    }
+
+    /// Parameter `k`'s estimate in [`Estimate::names`]'s order.
+    #[must_use]
+    pub fn estimate_of(&self, k: usize) -> f64 {
+        if k < N_PARAMS { self.estimate[k] } else { self.table_estimate[k - N_PARAMS] }
+    }
+}
+
 /// The observability of `e` (a run on data or a plan on the sequence's noise-free motion).
 #[must_use]
 pub fn observability(e: &Estimate) -> Observability {
-    let ratio: [f64; N_PARAMS] = std::array::from_fn(|k| e.sigma[k] / e.prior[k]);
+    let names = e.names();
+    let (sigma, prior) = (e.all_sigma(), e.all_prior());
+    let n = names.len();
+    let ratio: Vec<f64> = (0..n).map(|k| sigma[k] / prior[k]).collect();
     let observable_from_s =
-        std::array::from_fn(|k| e.history.iter().find(|r| r.sigma[k] < 0.1 * e.prior[k]).map(|r| r.t_s));
-    let unobservable = (0..N_PARAMS).filter(|&k| ratio[k] > 0.5).map(|k| param(k).1).collect();
-    let weak = (0..N_PARAMS).filter(|&k| ratio[k] > 0.1 && ratio[k] <= 0.5).map(|k| param(k).1).collect();
+        (0..n).map(|k| e.history.iter().find(|r| r.sigma_of(k) < 0.1 * prior[k]).map(|r| r.t_s)).collect();
+    let unobservable = (0..n).filter(|&k| ratio[k] > 0.5).map(|k| names[k].clone()).collect();
+    let weak = (0..n).filter(|&k| ratio[k] > 0.1 && ratio[k] <= 0.5).map(|k| names[k].clone()).collect();
+    let cov = |i: usize, j: usize| match &e.table {
+        Some(t) => t.covariance[(i, j)],
+        None => e.covariance[(i, j)],
+    };
     let mut aliased = Vec::new();
-    for i in 0..N_PARAMS {
-        for j in i + 1..N_PARAMS {
-            let rho = e.covariance[(i, j)] / (e.covariance[(i, i)] * e.covariance[(j, j)]).sqrt();
+    for i in 0..n {
+        for j in i + 1..n {
+            let rho = cov(i, j) / (cov(i, i) * cov(j, j)).sqrt();
             if rho.abs() >= 0.9 {
                 // The combination with the smaller variance: x_i/σ_i ∓ x_j/σ_j.
                 let sign = if rho > 0.0 { "−" } else { "+" };
-                aliased.push(format!(
-                    "{} and {} (correlation {rho:+.3}): the data see {}/σ {sign} {}/σ",
-                    param(i).1,
-                    param(j).1,
-                    param(i).1,
-                    param(j).1
-                ));
+                let (a, b) = (&names[i], &names[j]);
+                aliased.push(format!("{a} and {b} (correlation {rho:+.3}): the data see {a}/σ {sign} {b}/σ"));
             }
         }
     }
-    Observability { ratio, observable_from_s, unobservable, weak, aliased }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn sequences_stay_within_two_hours_and_end_where_they_started() {
-        for (s, _) in Sequence::ALL {
-            let steps = s.steps().1;
-            let total = s.duration_s();
-            assert!(total <= 2.0 * 3600.0, "{}: {total} s", s.name());
-            for axis in 0..2 {
-                let turned: f64 = steps.iter().filter(|m| m.axis == axis).map(|m| m.angle_rad).sum();
-                assert!(
-                    (turned / std::f64::consts::TAU).fract().abs() < 1e-9,
-                    "{}: axis {axis} ends at {turned} rad",
-                    s.name()
-                );
-            }
-        }
-    }
+    Observability { parameters: names, ratio, observable_from_s, unobservable, weak, aliased }
 }

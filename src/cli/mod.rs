@@ -538,6 +538,10 @@ struct SelfcalArgs {
     /// Only the plan: what the sequence can see, from its noise-free motion (no IMU drawn).
     #[arg(long)]
     plan: bool,
+    /// Leave the encoders out: the IMU's 21 errors from its own navigation alone, the table's not
+    /// estimated (the comparison for what the encoders add; docs/selfcal.md).
+    #[arg(long)]
+    without_encoders: bool,
     /// What it buys: the same IMU navigates this many hours free-inertial, at rest and under the
     /// 16-position modulation, with no, estimated and true compensation (0: skip).
     #[arg(long, default_value_t = 24.0, value_name = "HOURS", allow_negative_numbers = true, value_parser = |t: &str| number(t, &NAVIGATE_HOURS))]

@@ -20,6 +20,7 @@ pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
                 monte_carlo: args.monte_carlo.map(|n| n as usize),
                 navigate_hours: args.navigate_hours,
                 plan_only: args.plan,
+                encoders: !args.without_encoders,
             }
         }
     };

@@ -11,7 +11,7 @@ use rerun::blueprint::components::ContainerKind;
 use super::blueprint::{self, Node};
 use super::palette::{self, rgb};
 use super::{APPLICATION_ID, Stream, TIMELINE, to_rerun_quaternion};
-use crate::calib::selfcal::{HistoryRow, N_PARAMS, param};
+use crate::calib::selfcal::{HistoryRow, ParamKind};
 
 /// What the recording shows.
 pub struct SelfcalView<'a> {
@@ -21,10 +21,12 @@ pub struct SelfcalView<'a> {
     pub document: &'a str,
     /// The filter's history (1 Hz).
     pub history: &'a [HistoryRow],
+    /// Every parameter's name (the IMU's 21, then the table's).
+    pub names: Vec<String>,
     /// The prior 1σ, SI.
-    pub prior: &'a [f64; N_PARAMS],
+    pub prior: Vec<f64>,
     /// The true parameters, SI (None: a log with no truth).
-    pub truth: Option<[f64; N_PARAMS]>,
+    pub truth: Option<Vec<f64>>,
     /// The starts of the moves, s.
     pub move_starts_s: &'a [f64],
     /// The IMU's attitude C_s^n, 1 Hz.
@@ -45,11 +47,12 @@ pub struct NavLine<'a> {
 
 /// The groups of parameters, one plot each: the group's name ([`crate::calib::selfcal::Kind::group`]),
 /// the entity's, and the plot's title (short enough for a third of the plots' width at 1600×1000).
-const GROUPS: [(&str, &str, &str); 4] = [
+const GROUPS: [(&str, &str, &str); 5] = [
     ("gyro bias", "gyro_bias", "gyro bias: log10 σ/σ0"),
     ("gyro scale and misalignment", "gyro_gain", "gyro Kg: log10 σ/σ0"),
     ("accelerometer bias", "accel_bias", "accel bias: log10 σ/σ0"),
     ("accelerometer scale and misalignment", "accel_gain", "accel Ka: log10 σ/σ0"),
+    ("table", "table", "table (encoders): log10 σ/σ0"),
 ];
 
 /// The axes a parameter's name ends in (`bg_y`, `Kg_yx`), in the order of their line colours in
@@ -136,15 +139,18 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
     let mut tabs = Vec::new();
     let mut observability = Vec::new();
     for (group, slug, title) in GROUPS {
-        let members: Vec<usize> = (0..N_PARAMS).filter(|&k| param(k).0.group() == group).collect();
+        let members: Vec<usize> = (0..v.names.len()).filter(|&k| ParamKind::of(k).group() == group).collect();
+        if members.is_empty() {
+            continue;
+        }
         let path = format!("selfcal/observability/{slug}/log10_sigma_ratio");
-        let names: Vec<String> = members.iter().map(|&k| param(k).1).collect();
+        let names: Vec<String> = members.iter().map(|&k| v.names[k].clone()).collect();
         let colors = names.iter().map(|n| rgb(palette::colors::DISTINCT[line_colour(n)].1));
         rec.log_static(path.as_str(), &rerun::SeriesLines::new().with_colors(colors).with_names(names.clone()))?;
         let values: Vec<f64> = v
             .history
             .iter()
-            .flat_map(|r| members.iter().map(|&k| (r.sigma[k] / v.prior[k]).max(1e-12).log10()).collect::<Vec<_>>())
+            .flat_map(|r| members.iter().map(|&k| (r.sigma_of(k) / v.prior[k]).max(1e-12).log10()).collect::<Vec<_>>())
             .collect();
         stream.send_series(&path, &names, &t, values, members.len())?;
         stream.mark_events(&path, "moves", "moves", v.move_starts_s, 0.0)?;
@@ -155,10 +161,10 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
                 .with_property("PlotLegend", &blueprint::no_legend()),
         );
         for &k in &members {
-            let (kind, name) = param(k);
+            let (kind, name) = (ParamKind::of(k), &v.names[k]);
             let (unit, per_si) = kind.unit();
             let path = format!("selfcal/error/{name}_{}", kind.unit_key());
-            let truth = v.truth.map_or(0.0, |t| t[k]);
+            let truth = v.truth.as_ref().map_or(0.0, |t| t[k]);
             let what = if v.truth.is_some() { "estimate − true" } else { "estimate" };
             let series = [what.to_owned(), "+3σ".to_owned(), "−3σ".to_owned()];
             rec.log_static(
@@ -171,13 +177,13 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
                 .history
                 .iter()
                 .flat_map(|r| {
-                    let (e, s) = ((r.estimate[k] - truth) * per_si, 3.0 * r.sigma[k] * per_si);
+                    let (e, s) = ((r.estimate_of(k) - truth) * per_si, 3.0 * r.sigma_of(k) * per_si);
                     [e, s, -s]
                 })
                 .collect();
             stream.send_series(&path, &series, &t, values, 3)?;
             // Framed on the last tenth of the prior: the start (the prior's width) would flatten the rest.
-            let last = v.history.last().map_or(1.0, |r| 3.0 * r.sigma[k] * per_si);
+            let last = v.history.last().map_or(1.0, |r| 3.0 * r.sigma_of(k) * per_si);
             let h = crate::math::units::nice_half_range(last.max(1e-12) * 2.0);
             tabs.push(
                 Node::view("TimeSeries", format!("{name} {what} ({unit}), ±3σ grey"), path)
@@ -191,7 +197,7 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
     // Gyro groups over accelerometer groups, a motion's navigation beside each row.
     let mut navigation = navigation.into_iter();
     let mut observability = observability.into_iter();
-    let rows: Vec<Node> = (0..2)
+    let rows: Vec<Node> = (0..observability.len().div_ceil(2))
         .map(|_| {
             Node::container(
                 ContainerKind::Horizontal,

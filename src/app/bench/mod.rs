@@ -456,7 +456,7 @@ fn live_latency(dir: &std::path::Path, figs: &mut Figures, interrupt: &AtomicBoo
 fn selfcal_speed(figs: &mut Figures, stop: &AtomicBool) -> anyhow::Result<()> {
     use crate::app::selfcal::{SequenceChoice, monte_carlo, run_one, setup};
     let p = presets::load("selfcal-nav-grade")?;
-    let s = setup(&p, SequenceChoice::BuiltIn(crate::calib::selfcal::Sequence::DualAxis29))?;
+    let s = setup(&p, SequenceChoice::BuiltIn(crate::calib::selfcal::Sequence::DualAxis29), true)?;
     let hours = s.samples as f64 * s.config.h / 3600.0;
     let started = Instant::now();
     let one = run_one(&s, p.meta.seed, false, stop)?;

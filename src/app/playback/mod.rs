@@ -194,21 +194,11 @@ impl Playback {
         let f = &log.imu;
         let (imu, start) = ImuSamples::open_checked(log)?;
         let nominal_s = 1.0 / f.rate_hz;
-        let axis_names: Vec<String> = log.table.chain.axes().iter().map(|a| a.name.clone()).collect();
         let mut initial_angles = [0.0; MAX_AXES];
         for (k, a) in log.table.chain.axes().iter().enumerate() {
             initial_angles[k] = a.initial_angle_rad;
         }
-        let encoders = match &log.encoders {
-            None => None,
-            Some(e) => {
-                let mut t =
-                    open_track(&e.path, "encoder", &axis_names, vec![true; axis_names.len()], start, nominal_s)?;
-                t.shift_s = -e.latch_delay_s;
-                t.interpolate_gaps = e.interpolate_gaps;
-                Some(t)
-            }
-        };
+        let encoders = encoder_track(log, start)?;
         let reference = match &log.reference {
             Reference::None => ReferenceTrack::None,
             Reference::Static(a) => ReferenceTrack::Static(*a),
@@ -508,6 +498,35 @@ pub enum ImuItem {
     },
 }
 
+/// The encoder file of `log` as a track on the IMU's clock (first stamp `start`), if it has one.
+fn encoder_track(log: &LogSet, start: StartTime) -> Result<Option<Track>, PlaybackError> {
+    let Some(e) = &log.encoders else { return Ok(None) };
+    let names: Vec<String> = log.table.chain.axes().iter().map(|a| a.name.clone()).collect();
+    let mut t = open_track(&e.path, "encoder", &names, vec![true; names.len()], start, 1.0 / log.imu.rate_hz)?;
+    t.shift_s = -e.latch_delay_s;
+    t.interpolate_gaps = e.interpolate_gaps;
+    Ok(Some(t))
+}
+
+/// A log set's IMU samples, its encoder readings, and the span asked for (s after the first stamp).
+pub type WithEncoders = (ImuSamples, Option<EncoderReadings>, (f64, f64));
+
+/// A log set's encoder readings at the IMU's instants (what `selfcal --log` measures the table's
+/// errors with), raw: no compensation.
+pub struct EncoderReadings(Track);
+
+impl EncoderReadings {
+    /// The readings at `t_s` (an [`ImuItem::Sample`]'s stamp), rad.
+    pub fn at(&mut self, t_s: f64) -> Result<AxisValues, PlaybackError> {
+        self.0.at(t_s)?.ok_or_else(|| {
+            data_err(format!(
+                "{}: no encoder reading at {t_s:.6} s after the IMU's first sample",
+                self.0.path.display()
+            ))
+        })
+    }
+}
+
 /// The IMU samples of a log set without the navigation computer (what `rinscope allan` reads):
 /// increments in the RFU sensor frame (rates held over their interval), gaps reported, not bridged.
 pub struct ImuSamples {
@@ -524,6 +543,16 @@ impl ImuSamples {
     /// Opens `log`'s IMU file as its manifest describes it.
     pub fn open(log: &LogSet) -> Result<Self, PlaybackError> {
         Ok(Self::open_checked(log)?.0)
+    }
+
+    /// [`Self::open`], the log's encoder file on the same clock if it has one, and the span the
+    /// manifest asks for (`log.from_s`, `log.to_s`) on that clock (s after the first stamp).
+    pub fn open_with_encoders(log: &LogSet) -> Result<WithEncoders, PlaybackError> {
+        let (me, start) = Self::open_checked(log)?;
+        let first = clock_s(start);
+        let span =
+            (log.span_s.0.map_or(f64::NEG_INFINITY, |t| t - first), log.span_s.1.map_or(f64::INFINITY, |t| t - first));
+        Ok((me, encoder_track(log, start)?.map(EncoderReadings), span))
     }
 
     /// The reader options of `log`'s IMU file.

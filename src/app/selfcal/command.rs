@@ -29,6 +29,8 @@ pub enum SelfcalInput {
         navigate_hours: f64,
         /// Only the plan (what the sequence can see).
         plan_only: bool,
+        /// The encoders measure the table (false: the IMU alone).
+        encoders: bool,
     },
     /// A log set of a sequence run on a real table.
     Log(Box<LogSet>),
@@ -68,9 +70,9 @@ pub fn execute(req: &SelfcalRequest, stop: &AtomicBool) -> Result<SelfcalReport,
         }
     };
     let (text, document, view_of) = match &req.input {
-        SelfcalInput::Scenario { params, sequence, monte_carlo, navigate_hours, plan_only } => {
+        SelfcalInput::Scenario { params, sequence, monte_carlo, navigate_hours, plan_only, encoders } => {
             check_navigate_hours(*navigate_hours).map_err(|e| Failure::input(format!("--navigate-hours {e}")))?;
-            let setup = setup(params, *sequence).map_err(|e| Failure::input(format!("{e:#}")))?;
+            let setup = setup(params, *sequence, *encoders).map_err(|e| Failure::input(format!("{e:#}")))?;
             let plan = plan(&setup, params.meta.seed, stop).map_err(|e| interrupted("selfcal", e))?;
             if *plan_only || !plan.unobservable.is_empty() || !plan.weak.is_empty() {
                 let list = |v: &Vec<String>| if v.is_empty() { "none".to_owned() } else { v.join(", ") };
@@ -135,22 +137,25 @@ pub fn execute(req: &SelfcalRequest, stop: &AtomicBool) -> Result<SelfcalReport,
                 log.dir.display(),
                 log.imu.rate_hz
             );
-            let text = estimates_table(format!("{head}\n\n"), &estimate, None, &seen, &[], None);
-            let names = crate::calib::selfcal::param_names();
+            let text = estimates_table(format!("{head}\n\n"), &estimate, None, &seen, &[], None, None);
+            let names = estimate.names();
             // A parameter the log's motion does not separate is reported as not observable: no
             // estimate, no 1σ (null), never the prior's number or the noise's.
             let hidden = |k: usize| seen.unobservable.contains(&names[k]);
-            let shown = |v: &[f64; crate::calib::selfcal::N_PARAMS]| -> Vec<Option<f64>> {
-                (0..v.len()).map(|k| (!hidden(k)).then_some(v[k])).collect()
-            };
-            let document = serde_json::json!({ "log": log.dir.display().to_string(), "parameters": names, "units": JSON_UNITS, "estimate": shown(&estimate.params), "sigma": shown(&estimate.sigma), "estimation_s": estimation_s, "observability": seen, "estimated_imu_compensation": super::imu_compensation(&estimate, &seen.unobservable) });
+            let shown =
+                |v: &[f64]| -> Vec<Option<f64>> { (0..v.len()).map(|k| (!hidden(k)).then_some(v[k])).collect() };
+            let mut document = serde_json::json!({ "log": log.dir.display().to_string(), "parameters": names, "units": JSON_UNITS, "estimate": shown(&estimate.all_params()), "sigma": shown(&estimate.all_sigma()), "estimation_s": estimation_s, "observability": seen, "estimated_imu_compensation": super::imu_compensation(&estimate, &seen.unobservable) });
+            if let Some(table) = super::table_compensation(&estimate, &seen.unobservable) {
+                document["estimated_compensation"] = table;
+            }
             let saved = match sinks {
                 Some(s) => {
                     let view = SelfcalView {
                         title: format!("log set {}", log.name),
-                        document: &estimates_document(&head, &estimate, None, &seen, &[], None),
+                        document: &estimates_document(&head, &estimate, None, &seen, &[], None, None),
                         history: &estimate.history,
-                        prior: &estimate.prior,
+                        names: estimate.names(),
+                        prior: estimate.all_prior(),
                         truth: None,
                         move_starts_s: &[],
                         attitude: &[],

@@ -5,8 +5,10 @@
 //! over random IMUs checks the reported 1σ against the spread.
 
 mod command;
+mod log;
 mod tables;
 pub use command::{SelfcalInput, SelfcalReport, SelfcalRequest, execute};
+pub use log::{LOG_ALIGN_S, run_log};
 use tables::head;
 pub use tables::{estimates_document, estimates_table, table, target};
 
@@ -15,10 +17,12 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use anyhow::{Result, anyhow, bail};
 use rayon::prelude::*;
 
-use crate::calib::selfcal::{self, Config, Estimate, ImuErrors, Kind, N_PARAMS, SelfCal, Sequence};
+use crate::calib::selfcal::{self, Config, Estimate, ImuErrors, Kind, SelfCal, Sequence, TableConfig};
+use crate::calib::selfcal_table::TableStates;
 use crate::ins::sensor::ImuErrorSpec;
 use crate::ins::truth::TruthImu;
 use crate::model::earth::Earth;
+use crate::model::scheme::AxisValues;
 use crate::model::scheme::Scheme;
 use crate::scenario::Params;
 use crate::sim::{Model, TableParams};
@@ -116,10 +120,11 @@ pub fn calibrate(
     let mut document = estimates_document(
         &head(&setup, &outcome),
         &outcome.estimate,
-        Some(outcome.truth().to_params()),
+        Some(&outcome.all_truth(&setup)),
         &plan,
         &setup.move_starts_s,
         monte_carlo.as_ref(),
+        setup.table_note.as_deref(),
     );
     if !navigation.is_empty() {
         table.push_str(&navigation_table(&navigation, navigate_hours));
@@ -136,8 +141,9 @@ impl Report {
             title: format!("{name} — {}", self.setup.sequence),
             document: &self.document,
             history: &self.outcome.estimate.history,
-            prior: &self.outcome.estimate.prior,
-            truth: Some(self.outcome.truth().to_params()),
+            names: self.outcome.estimate.names(),
+            prior: self.outcome.estimate.all_prior(),
+            truth: Some(self.outcome.all_truth(&self.setup)),
             move_starts_s: &self.setup.move_starts_s,
             attitude: &self.outcome.attitude,
             navigation: self
@@ -155,20 +161,50 @@ impl Report {
     /// The document `selfcal --json` writes.
     #[must_use]
     pub fn json(&self) -> serde_json::Value {
-        serde_json::json!({
+        let e = &self.outcome.estimate;
+        let mut doc = serde_json::json!({
             "sequence": self.setup.sequence,
-            "parameters": selfcal::param_names(),
+            "parameters": e.names(),
             "units": JSON_UNITS,
-            "truth": self.outcome.truth().to_params(),
-            "estimate": self.outcome.estimate.params,
-            "sigma": self.outcome.estimate.sigma,
+            "truth": self.outcome.all_truth(&self.setup),
+            "estimate": e.all_params(),
+            "sigma": e.all_sigma(),
             "estimation_s": self.outcome.estimation_s,
             "observability": self.plan,
             "monte_carlo": self.monte_carlo,
             "navigation": self.navigation,
-            "estimated_imu_compensation": imu_compensation(&self.outcome.estimate, &self.plan.unobservable),
-        })
+            "estimated_imu_compensation": imu_compensation(e, &self.plan.unobservable),
+        });
+        if let Some(table) = table_compensation(e, &self.plan.unobservable) {
+            doc["estimated_compensation"] = table;
+        }
+        doc
     }
+}
+
+/// The table's states of `e` as the table part of a compensation document (`[compensation]`'s
+/// keys, what `calibrate --json` writes): the folded rotations as swing cones, the encoders' scales
+/// and delays; what they fold in (the other axes' non-orthogonality and encoder offsets, the IMU's
+/// mounting) stated as zero, since the folded values already hold it; the installation and the
+/// first encoder's offset (the base's attitude, which nothing on the table sees) left out, so the
+/// table's own stand. The states in `unobservable` are zero, never a number the data did not give.
+#[must_use]
+pub fn table_compensation(e: &Estimate, unobservable: &[String]) -> Option<serde_json::Value> {
+    let t = e.table.as_ref()?;
+    let seen: Vec<f64> =
+        t.params.iter().zip(&t.names).map(|(v, n)| if unobservable.contains(n) { 0.0 } else { *v }).collect();
+    let chain = t.states.chain();
+    let mut keys = crate::scenario::compensation_keys(chain, &t.states.as_errors(&seen));
+    keys.installation_x_arcsec = None;
+    keys.installation_y_arcsec = None;
+    keys.installation_z_arcsec = None;
+    if let Some(first) = chain.axes().first()
+        && let Some(a) = keys.axis.get_mut(&first.name)
+    {
+        a.encoder_offset_arcsec = None;
+        a.non_orthogonality_arcsec = None;
+    }
+    serde_json::to_value(keys).ok()
 }
 
 /// The estimate `e` as the IMU part of a compensation document (`replay --compensation`): the
@@ -204,6 +240,10 @@ pub struct Setup {
     pub ins: crate::ins::InsParams,
     /// The site.
     pub site: crate::model::earth::Site,
+    /// The table's states the encoders measure (None: the IMU alone, `--without-encoders`).
+    pub table_states: Option<TableConfig>,
+    /// Why the table's errors are not estimated, if they are not.
+    pub table_note: Option<String>,
 }
 
 /// One IMU's calibration.
@@ -225,6 +265,37 @@ impl Outcome {
     pub fn truth(&self) -> ImuErrors {
         self.truth_drawn.in_accelerometer_frame()
     }
+
+    /// Every true value in [`Estimate::names`]'s order: the IMU's (accelerometer frame), then the
+    /// table's folded as the filter sees it ([`TableStates::truth`]).
+    #[must_use]
+    pub fn all_truth(&self, s: &Setup) -> Vec<f64> {
+        let mut v = self.truth().to_params().to_vec();
+        if let Some(t) = &s.table_states {
+            v.extend(t.states.truth(&s.table.truth, &self.truth_drawn.accelerometer_frame_rotation()));
+        }
+        v
+    }
+}
+
+/// The table's states of `table` with its encoders' noise as the datasheet (None, and why, if
+/// its chain has none the encoders can measure).
+#[must_use]
+pub fn table_config(
+    chain: &crate::model::gimbal::Chain,
+    stated: &crate::model::gimbal::TableErrors,
+) -> (Option<TableConfig>, Option<String>) {
+    match TableStates::new(chain) {
+        Ok(states) => (
+            Some(TableConfig {
+                states,
+                encoder_sigma_rad: stated.axes.iter().map(|a| a.encoder_noise_rad).collect(),
+                linearized_at: Vec::new(),
+            }),
+            None,
+        ),
+        Err(e) => (None, Some(e)),
+    }
 }
 
 /// Sets up the self-calibration of `p`'s IMU on `p`'s dual-axis table.
@@ -232,7 +303,7 @@ impl Outcome {
 /// # Errors
 /// No `[imu]`, a table that is not dual-axis, a scenario scheme that is not indexed or does not
 /// start at rest.
-pub fn setup(p: &Params, choice: SequenceChoice) -> Result<Setup> {
+pub fn setup(p: &Params, choice: SequenceChoice, encoders: bool) -> Result<Setup> {
     let ins = p
         .ins
         .as_ref()
@@ -274,7 +345,14 @@ pub fn setup(p: &Params, choice: SequenceChoice) -> Result<Setup> {
         Earth::at(p.site),
         (first_move.min(selfcal::INITIAL_DWELL_S) / h).round() as usize,
     );
+    let (table_states, table_note) = if encoders {
+        table_config(&table.chain, &table.truth)
+    } else {
+        (None, Some("--without-encoders: the IMU alone, from its own navigation".to_owned()))
+    };
     Ok(Setup {
+        table_states,
+        table_note,
         table,
         config,
         samples: (duration_s / h).round() as usize,
@@ -297,33 +375,74 @@ pub fn run_one(s: &Setup, seed: u64, ideal: bool, stop: &AtomicBool) -> Result<O
         cfg.errors = ImuErrorSpec::default();
     }
     cfg.navigation = None;
-    let mut ins = crate::ins::pipeline::InsRun::new(&cfg, s.site, seed, Model::new(&s.table, seed));
-    let per_second = (1.0 / s.config.h).round().max(1.0) as usize;
-    let mut attitude = Vec::with_capacity(s.samples / per_second + 1);
-    let mut sample = |k: usize| {
-        let (t1, g, a) = ins.next_measurement();
-        if (k + 1).is_multiple_of(per_second) {
-            attitude.push((t1, *ins.true_n_from_s(t1).quaternion()));
+    // The plan's motion is noise-free: the encoders' too.
+    let mut table = s.table.clone();
+    if ideal {
+        for a in &mut table.truth.axes {
+            a.encoder_noise_rad = 0.0;
         }
-        (g, a)
+    }
+    let per_second = (1.0 / s.config.h).round().max(1.0) as usize;
+    let encoders = s.table_states.is_some();
+    // The IMU's true attitude once a second (the last pass's: every pass is the same IMU).
+    let attitude = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
+    let truth_drawn = std::cell::Cell::new(None);
+    let open = || {
+        let mut ins = crate::ins::pipeline::InsRun::new(&cfg, s.site, seed, Model::new(&table, seed));
+        truth_drawn.set(Some(ins.drawn_imu_errors()));
+        let seen = std::rc::Rc::clone(&attitude);
+        seen.borrow_mut().clear();
+        let mut sample = move |k: usize| {
+            let (t1, g, a) = ins.next_measurement();
+            if (k + 1).is_multiple_of(per_second) {
+                seen.borrow_mut().push((t1, *ins.true_n_from_s(t1).quaternion()));
+            }
+            ((g, a), encoders.then(|| crate::sim::encoder_readings(ins.model(), t1)))
+        };
+        let align: Vec<_> = (0..s.config.align_samples).map(&mut sample).collect();
+        Ok((align, (s.config.align_samples..s.samples).map(move |k| Ok(sample(k)))))
     };
-    let align: Vec<_> = (0..s.config.align_samples).map(&mut sample).collect();
-    let (estimate, estimation_s) = estimate(s.config, &align, (align.len()..s.samples).map(|k| Ok(sample(k))), stop)?;
-    Ok(Outcome { estimate, truth_drawn: ins.drawn_imu_errors(), estimation_s, attitude })
+    let (estimate, estimation_s) = estimate(s.config, s.table_states.clone(), open, stop)?;
+    let attitude = attitude.take();
+    let truth_drawn = truth_drawn.take().ok_or_else(|| anyhow!("no sample was drawn"))?;
+    Ok(Outcome { estimate, truth_drawn, estimation_s, attitude })
 }
 
-/// The filter on `align` (the first samples, at rest) and then `rest`; the estimation's own wall
-/// time (the samples' production is not counted), s.
+/// One sample: its increments and, with a table, the encoders' readings at its end, rad.
+pub type Reading = (crate::ins::align::Increment, Option<AxisValues>);
+
+/// The filter on the samples `open` gives (the first ones at rest, then the rest); with a table,
+/// twice: the second pass linearizes the table's states about the first's result
+/// ([`TableConfig::linearized_at`]). The estimation's own wall time (the samples' production is
+/// not counted), s.
 ///
 /// # Errors
-/// Interrupted, an alignment that failed, or a sample `rest` could not give.
-pub fn estimate(
+/// Interrupted, an alignment that failed, or a sample `open` could not give.
+pub fn estimate<I: Iterator<Item = Result<Reading>>>(
     config: Config,
-    align: &[crate::ins::align::Increment],
-    rest: impl Iterator<Item = Result<crate::ins::align::Increment>>,
+    table: Option<TableConfig>,
+    mut open: impl FnMut() -> Result<(Vec<Reading>, I)>,
     stop: &AtomicBool,
 ) -> Result<(Estimate, f64)> {
-    let mut filter = SelfCal::new(config, align).ok_or_else(|| {
+    let (align, rest) = open()?;
+    let (first, wall) = one_pass(config, table.clone(), &align, rest, stop)?;
+    let (Some(mut table), Some(found)) = (table, first.table.as_ref()) else { return Ok((first, wall)) };
+    table.linearized_at.clone_from(&found.params);
+    let (align, rest) = open()?;
+    let (second, more) = one_pass(config, Some(table), &align, rest, stop)?;
+    Ok((second, wall + more))
+}
+
+/// One pass of the filter.
+fn one_pass(
+    config: Config,
+    table: Option<TableConfig>,
+    align: &[Reading],
+    rest: impl Iterator<Item = Result<Reading>>,
+    stop: &AtomicBool,
+) -> Result<(Estimate, f64)> {
+    let increments: Vec<_> = align.iter().map(|r| r.0).collect();
+    let mut filter = SelfCal::new(config, table, &increments).ok_or_else(|| {
         anyhow!(
             "the coarse alignment on the first {:.0} s failed (no Earth-rate signature)",
             align.len() as f64 * config.h
@@ -331,8 +450,12 @@ pub fn estimate(
     })?;
     let mut estimation = std::time::Duration::ZERO;
     let started = std::time::Instant::now();
+    let push = |filter: &mut SelfCal, (m, readings): &Reading| match readings {
+        Some(r) => filter.push_with_encoders(m, r),
+        None => filter.push(m),
+    };
     for m in align {
-        filter.push(m);
+        push(&mut filter, m);
     }
     estimation += started.elapsed();
     let mut buffer = Vec::with_capacity(8192);
@@ -347,99 +470,12 @@ pub fn estimate(
         }
         let started = std::time::Instant::now();
         for m in &buffer {
-            filter.push(m);
+            push(&mut filter, m);
         }
         estimation += started.elapsed();
     }
     Ok((filter.finish(), estimation.as_secs_f64()))
 }
-
-/// Self-calibrates the IMU of a logged sequence (a log set: its IMU file, site, rate and the
-/// table description's [imu] as the datasheet). The log must start with at least 60 s at rest
-/// (the coarse alignment) and have no gaps; the vehicle must stand still throughout.
-///
-/// # Errors
-/// An unreadable log, a gap, too short a log, interrupted.
-pub fn run_log(log: &crate::scenario::logset::LogSet, stop: &AtomicBool) -> Result<(Estimate, f64)> {
-    use crate::app::playback::{ImuItem, ImuSamples};
-    let h = 1.0 / log.imu.rate_hz;
-    let mut imu = ImuSamples::open(log).map_err(|e| anyhow!("{e}"))?;
-    let mut next = move || -> Option<Result<crate::ins::align::Increment>> {
-        match imu.next_item() {
-            Ok(None) => None,
-            Ok(Some(ImuItem::Sample { dtheta, dv, .. })) => Some(Ok((dtheta, dv))),
-            Ok(Some(ImuItem::Gap { from_s, to_s })) => Some(Err(anyhow!(
-                "{}: a gap in the IMU samples from {from_s:.3} s to {to_s:.3} s: selfcal needs an unbroken sequence",
-                log.imu.path.display()
-            ))),
-            Err(e) => Some(Err(anyhow!("{e}"))),
-        }
-    };
-    // The rest at the start: whole half-second blocks until the first whose mean rate exceeds
-    // 0.5°/s (a move; the Earth turns at 0.004°/s), at most the built-in sequences' first dwell.
-    let block = ((0.5 / h).round() as usize).max(1);
-    let cap = (selfcal::INITIAL_DWELL_S / h).round() as usize;
-    let mut align: Vec<crate::ins::align::Increment> = Vec::with_capacity(cap);
-    let mut moving: Vec<crate::ins::align::Increment> = Vec::new();
-    while align.len() < cap {
-        let mut piece = Vec::with_capacity(block);
-        for _ in 0..block {
-            match next() {
-                Some(m) => piece.push(m?),
-                None => break,
-            }
-        }
-        if piece.is_empty() {
-            break;
-        }
-        let turned: nalgebra::Vector3<f64> = piece.iter().map(|m| m.0).sum();
-        if turned.norm() / (piece.len() as f64 * h) > MOVE_RATE_RAD_PER_S {
-            moving = piece;
-            break;
-        }
-        align.extend(piece);
-    }
-    if (align.len() as f64) * h < LOG_ALIGN_S {
-        bail!(
-            "{}: {:.1} s at rest before the first move; selfcal needs at least {LOG_ALIGN_S} s at rest first, then the sequence",
-            log.imu.path.display(),
-            align.len() as f64 * h
-        );
-    }
-    let config = Config::for_datasheet(&log.table.ins.errors, h, Earth::at(log.table.site), align.len());
-    // How far the IMU turned after its rest (samples faster than the move threshold): a log with
-    // no calibration sequence — a parked vehicle — separates none of the gains, and its biases only
-    // in combinations; it is refused, not estimated.
-    let turned = std::cell::Cell::new(0.0_f64);
-    let sequence = moving.into_iter().map(Ok).chain(std::iter::from_fn(next)).inspect(|m| {
-        if let Ok((dtheta, _)) = m
-            && dtheta.norm() / h > MOVE_RATE_RAD_PER_S
-        {
-            turned.set(turned.get() + dtheta.norm());
-        }
-    });
-    let result = estimate(config, &align, sequence, stop)?;
-    if turned.get() < MIN_TURN_RAD {
-        bail!(
-            "{}: no calibration sequence: after {:.1} s at rest the IMU turned {:.1}° in all (faster than {:.1}°/s); a self-calibration needs rotations about at least two axes (the built-in sequences turn 90° and 180° about each, docs/selfcal.md): nothing is estimated from a parked vehicle",
-            log.imu.path.display(),
-            align.len() as f64 * h,
-            turned.get().to_degrees(),
-            MOVE_RATE_RAD_PER_S.to_degrees()
-        );
-    }
-    Ok(result)
-}
-
-/// A sample turning faster than this is part of a move (the Earth turns at 0.004°/s), rad/s.
-const MOVE_RATE_RAD_PER_S: f64 = 0.5 * crate::math::units::RAD_PER_DEG;
-
-/// The least total rotation after the rest for a log to hold a calibration sequence: one quarter
-/// turn (every built-in sequence turns many), rad.
-const MIN_TURN_RAD: f64 = 90.0 * crate::math::units::RAD_PER_DEG;
-
-/// The least rest at the start of a logged sequence (the coarse alignment's data), s.
-pub const LOG_ALIGN_S: f64 = 60.0;
 
 /// Per parameter over a Monte Carlo: mean error, the spread of the errors and the mean reported 1σ.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -465,18 +501,17 @@ pub fn monte_carlo(s: &Setup, runs: usize, first_seed: u64, stop: &AtomicBool) -
     let outcomes: Vec<Outcome> =
         (0..runs).into_par_iter().map(|i| run_one(s, first_seed + i as u64, false, stop)).collect::<Result<_>>()?;
     let n = outcomes.len() as f64;
-    let errors: Vec<[f64; N_PARAMS]> = outcomes
+    let errors: Vec<Vec<f64>> = outcomes
         .iter()
-        .map(|o| {
-            let truth = o.truth().to_params();
-            std::array::from_fn(|k| o.estimate.params[k] - truth[k])
-        })
+        .map(|o| o.estimate.all_params().iter().zip(o.all_truth(s)).map(|(e, t)| e - t).collect())
         .collect();
-    let mean_error: Vec<f64> = (0..N_PARAMS).map(|k| errors.iter().map(|e| e[k]).sum::<f64>() / n).collect();
-    let spread = (0..N_PARAMS)
+    let m = errors.first().map_or(0, Vec::len);
+    let mean_error: Vec<f64> = (0..m).map(|k| errors.iter().map(|e| e[k]).sum::<f64>() / n).collect();
+    let spread = (0..m)
         .map(|k| (errors.iter().map(|e| (e[k] - mean_error[k]).powi(2)).sum::<f64>() / (n - 1.0).max(1.0)).sqrt())
         .collect();
-    let reported_sigma = (0..N_PARAMS).map(|k| outcomes.iter().map(|o| o.estimate.sigma[k]).sum::<f64>() / n).collect();
+    let sigmas: Vec<Vec<f64>> = outcomes.iter().map(|o| o.estimate.all_sigma()).collect();
+    let reported_sigma = (0..m).map(|k| sigmas.iter().map(|s| s[k]).sum::<f64>() / n).collect();
     Ok(MonteCarlo { runs, mean_error, spread, reported_sigma, wall_s: started.elapsed().as_secs_f64() })
 }
 
