@@ -52,8 +52,10 @@ fn the_reported_sigma_matches_the_spread_over_random_imus() {
     let s = nav_grade(Sequence::DualAxis29);
     let runs = 30;
     let mc = monte_carlo(&s, runs, 500, &AtomicBool::new(false)).expect("mc");
-    // The spread of 30 errors estimates σ to ±13 % (1σ): a 3σ band of ±40 % per parameter, and
-    // the pooled 29 × 30 to ±2.4 % (±9 % at 3σ, kept from the IMU's 21: the parameters are not
+    // The RMS of 30 normalised errors estimates 1 to ±13 % (1σ, 1/√60). 29 parameters tested at
+    // once: at 3σ each (±40 %) one of them falls outside by chance 8 % of the time (29 × 0.27 %),
+    // at 3.5σ (±45 %) 1.3 % — the band is 3.5σ (this seed's ba_z is 0.59; in 100 runs it is 1.01).
+    // The pooled 29 × 30 to ±2.4 % (±9 % at 3σ, kept from the IMU's 21: the parameters are not
     // independent); the reported 1σ is nearly the same in every run. The IMU's and the table's.
     let n = mc.spread.len();
     assert_eq!(n, N_PARAMS + 8);
@@ -62,7 +64,7 @@ fn the_reported_sigma_matches_the_spread_over_random_imus() {
     for k in 0..n {
         let rms = (mc.spread[k].powi(2) * (runs as f64 - 1.0) / runs as f64 + mc.mean_error[k].powi(2)).sqrt();
         let ratio = rms / mc.reported_sigma[k];
-        assert!((0.6..=1.4).contains(&ratio), "{}: errors' RMS over reported 1σ = {ratio:.2}", names[k]);
+        assert!((0.55..=1.45).contains(&ratio), "{}: errors' RMS over reported 1σ = {ratio:.2}", names[k]);
         pooled += ratio * ratio;
     }
     let pooled = (pooled / n as f64).sqrt();

@@ -24,7 +24,7 @@
 
 use nalgebra::{SMatrix, SVector, UnitQuaternion, Vector3};
 
-use super::selfcal_table::{MAX_TABLE, TableStates, measurement_variance};
+use super::selfcal_table::{MAX_TABLE, TableStates};
 pub use super::sequence::{INITIAL_DWELL_S, Sequence};
 use crate::ins::align::Increment;
 use crate::ins::imu_errors::KA_UPPER;
@@ -451,7 +451,8 @@ impl SelfCal {
         let psi = self.x.fixed_rows::<3>(PSI0).into_owned();
         let innovation = y + phi - psi;
         let ph = self.p * h.transpose();
-        let r = measurement_variance(&table.encoder_sigma_rad);
+        let c = c_ref.to_rotation_matrix().into_inner();
+        let r = c * table.states.measurement_variance(&table.encoder_sigma_rad, &readings) * c.transpose();
         let s = h * ph + r;
         if let Some(s_inv) = s.try_inverse() {
             let gain = ph * s_inv;

@@ -278,13 +278,24 @@ impl TableStates {
     }
 }
 
-/// The encoder noise seen by one attitude measurement, rad²: each axis's reading noise carried
-/// through its shaft (isotropic bound: the sum of the variances).
-#[must_use]
-pub fn measurement_variance(encoder_sigma_rad: &[f64]) -> Matrix3<f64> {
-    let v: f64 = encoder_sigma_rad.iter().map(|s| s * s).sum();
-    // A floor of 0.05″: the exact chain and the navigation are not better than that.
-    Matrix3::identity() * (v + (0.05 / crate::math::units::ARCSEC_PER_RAD).powi(2))
+impl TableStates {
+    /// The encoder noise one attitude measurement carries, rad², body axes: each reading's noise
+    /// turns the IMU about its own shaft's axis (P_k a_k at `readings`), so the covariance is
+    /// Σ σ_k² (P_k a_k)(P_k a_k)ᵀ — nothing about the third direction — with a floor of 0.05″ in
+    /// every direction (the exact chain and the navigation are not better than that).
+    #[must_use]
+    pub fn measurement_variance(&self, encoder_sigma_rad: &[f64], readings: &AxisValues) -> Matrix3<f64> {
+        let shafts = self.chain.shaft_rotations(readings);
+        let mut prefix = UnitQuaternion::identity();
+        let mut r = Matrix3::identity() * (0.05 / crate::math::units::ARCSEC_PER_RAD).powi(2);
+        for (k, g) in self.chain.axes().iter().enumerate() {
+            let a = prefix * g.axis;
+            let s = encoder_sigma_rad.get(k).copied().unwrap_or(0.0);
+            r += a * a.transpose() * (s * s);
+            prefix *= shafts.0[k];
+        }
+        r
+    }
 }
 
 #[cfg(test)]

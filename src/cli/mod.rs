@@ -538,6 +538,14 @@ struct SelfcalArgs {
     /// Only the plan: what the sequence can see, from its noise-free motion (no IMU drawn).
     #[arg(long)]
     plan: bool,
+    /// With --monte-carlo N: run only this slice K/M of the N runs (0 ≤ K < M; a cluster's array
+    /// task) and write them to --json for --merge (docs/cluster.md).
+    #[arg(long, value_name = "K/M", requires_all = ["monte_carlo", "json"], conflicts_with_all = ["log", "plan"])]
+    shard: Option<String>,
+    /// Merge the shard files of one `--monte-carlo N --shard K/M` into the whole Monte Carlo's
+    /// statistics (the same numbers as unsharded).
+    #[arg(long, value_name = "SHARD_FILE", num_args = 1.., conflicts_with_all = ["log", "plan", "monte_carlo", "shard", "scenario", "config"])]
+    merge: Vec<PathBuf>,
     /// Leave the encoders out: the IMU's 21 errors from its own navigation alone, the table's not
     /// estimated (the comparison for what the encoders add; docs/selfcal.md).
     #[arg(long)]

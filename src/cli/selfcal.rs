@@ -10,6 +10,19 @@ use crate::app::terminate::stop_flag;
 pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
     let input = match &args.log {
         Some(dir) => SelfcalInput::Log(Box::new(crate::scenario::logset::load(dir)?)),
+        None if !args.merge.is_empty() => SelfcalInput::Merge(args.merge.clone()),
+        None if args.shard.is_some() => {
+            let shard = crate::calib::montecarlo::Shard::parse(args.shard.as_deref().unwrap_or_default())
+                .map_err(|e| Failure::input(format!("--shard {e}")))?;
+            SelfcalInput::Shard {
+                params: Box::new(args.source.load("selfcal-nav-grade")?),
+                sequence: SequenceChoice::parse(&args.sequence)
+                    .map_err(|e| Failure::input(format!("--sequence {e}")))?,
+                encoders: !args.without_encoders,
+                runs: args.monte_carlo.unwrap_or(2) as usize,
+                shard,
+            }
+        }
         None => {
             let params = args.source.load("selfcal-nav-grade")?;
             let sequence =
@@ -24,7 +37,11 @@ pub(super) fn selfcal(args: &SelfcalArgs) -> Result<(), Failure> {
             }
         }
     };
-    let recording = if args.no_recording || args.plan { None } else { Some(args.sinks.recording()?) };
+    let recording = if args.no_recording || args.plan || args.shard.is_some() || !args.merge.is_empty() {
+        None
+    } else {
+        Some(args.sinks.recording()?)
+    };
     let report = execute(&SelfcalRequest { input, recording, json: args.json.clone() }, &stop_flag())?;
     out!("{}", report.text);
     if let Some(saved) = &report.saved {

@@ -360,4 +360,24 @@ state=$(wait_job_end "$merge")
 grep -qE -- "--runs 0|'0' for '--runs" mc/slurm-"${array}"_0.log || fail "failing shard: the shard's log does not say why it failed"
 say "ok: a failing shard (RUNS=0) cancels the merge (DependencyNeverSatisfied + kill-on-invalid-dep) in $(($(date +%s) - t)) s"
 
+# 4. The self-calibration's Monte Carlo as an array (selfcal-montecarlo.slurm) and its merge as a
+#    dependent job: the unsharded statistics, wall time aside.
+cd "$tmp/work" && mkdir selfcal && cd selfcal
+t=$(date +%s)
+"$bin" selfcal --monte-carlo 2 --no-recording --navigate-hours 0 --json whole.json >whole.log 2>&1 ||
+  { cat whole.log >&2; fail "selfcal: the unsharded run failed"; }
+jid=$(sl sbatch --parsable --array=0-1 --export=ALL,RUNS=2 "$repo/assets/cluster/selfcal-montecarlo.slurm")
+merge=$(sl sbatch --parsable --dependency=afterok:"$jid" --kill-on-invalid-dep=yes --output=merge.log \
+  --wrap "\"$bin\" selfcal --merge sc/shard-0.json sc/shard-1.json --json sc/all.json")
+state=$(wait_job_end "$merge")
+[[ $state == COMPLETED ]] || { cat merge.log rinscope-selfcal-mc-*.log >&2 || true; fail "selfcal: merge job $merge ended $state"; }
+python3 - whole.json sc/all.json <<'PY' || fail "selfcal: merged statistics differ from the unsharded run"
+import json, sys
+a, b = (json.load(open(p))["monte_carlo"] for p in sys.argv[1:3])
+for v in (a, b):
+    v.pop("wall_s", None)
+sys.exit(0 if a == b else 1)
+PY
+say "ok: selfcal-montecarlo.slurm --array=0-1 + a dependent merge (jobs $jid, $merge): the unsharded statistics, in $(($(date +%s) - t)) s"
+
 passed=1

@@ -6,10 +6,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use super::{
     JSON_UNITS, SequenceChoice, calibrate, check_navigate_hours, estimates_document, estimates_table, plan, run_log,
-    setup,
+    run_one, setup,
 };
 use crate::app::failure::Failure;
-use crate::app::outputs::{RecordingName, RecordingRequest, check_output, finish, logged, write_json};
+use crate::app::outputs::{RecordingName, RecordingRequest, check_output, finish, logged, read_small_file, write_json};
 use crate::record::selfcal::SelfcalView;
 use crate::record::sink::Saved;
 use crate::scenario::Params;
@@ -34,6 +34,22 @@ pub enum SelfcalInput {
     },
     /// A log set of a sequence run on a real table.
     Log(Box<LogSet>),
+    /// One shard of a scenario's Monte Carlo (a cluster's array task): its runs only, written to
+    /// `--json` for [`SelfcalInput::Merge`].
+    Shard {
+        /// The scenario.
+        params: Box<Params>,
+        /// The sequence.
+        sequence: SequenceChoice,
+        /// The encoders measure the table.
+        encoders: bool,
+        /// Runs of the whole Monte Carlo.
+        runs: usize,
+        /// This slice of them.
+        shard: crate::calib::montecarlo::Shard,
+    },
+    /// The shards' files of one Monte Carlo, merged.
+    Merge(Vec<PathBuf>),
 }
 
 /// `rinscope selfcal` (and Python's `selfcal`).
@@ -70,6 +86,59 @@ pub fn execute(req: &SelfcalRequest, stop: &AtomicBool) -> Result<SelfcalReport,
         }
     };
     let (text, document, view_of) = match &req.input {
+        SelfcalInput::Shard { params, sequence, encoders, runs, shard } => {
+            if req.json.is_none() {
+                return Err(Failure::input("--shard writes its runs to the file --json names: give --json FILE"));
+            }
+            let setup = setup(params, *sequence, *encoders).map_err(|e| Failure::input(format!("{e:#}")))?;
+            let done = super::monte_carlo_runs(&setup, *runs, params.meta.seed + 1, *shard, stop)
+                .map_err(|e| interrupted("selfcal", e))?;
+            let parameters =
+                run_one(&setup, params.meta.seed, true, stop).map_err(|e| interrupted("selfcal", e))?.estimate.names();
+            let file = super::ShardFile {
+                shard: *shard,
+                scenario: params.meta.name.clone(),
+                seed: params.meta.seed,
+                sequence: setup.sequence.clone(),
+                runs_requested: *runs,
+                parameters,
+                runs: done,
+            };
+            let text = format!(
+                "selfcal Monte Carlo shard {}/{}: {} of {} runs of {} on {}\n",
+                shard.index,
+                shard.count,
+                file.runs.len(),
+                runs,
+                file.scenario,
+                file.sequence
+            );
+            let document = serde_json::to_value(&file).map_err(|e| Failure::run(format!("selfcal: {e}")))?;
+            (text, document, None)
+        }
+        SelfcalInput::Merge(files) => {
+            let mut shards = Vec::new();
+            for f in files {
+                let text = read_small_file(f, "shard file")?;
+                shards.push(serde_json::from_str::<super::ShardFile>(&text).map_err(|e| {
+                    Failure::input(format!(
+                        "{}: not a shard file of `rinscope selfcal --monte-carlo N --shard K/M --json` ({e})",
+                        f.display()
+                    ))
+                })?);
+            }
+            let (mc, first) =
+                super::merge_shards(&shards).map_err(|e| Failure::input(format!("selfcal --merge: {e:#}")))?;
+            let text = format!(
+                "{} on {} (seed {}):\n{}",
+                first.scenario,
+                first.sequence,
+                first.seed,
+                super::monte_carlo_table(&first.parameters, &mc)
+            );
+            let document = serde_json::json!({ "scenario": first.scenario, "seed": first.seed, "sequence": first.sequence, "parameters": first.parameters, "units": JSON_UNITS, "monte_carlo": mc });
+            (text, document, None)
+        }
         SelfcalInput::Scenario { params, sequence, monte_carlo, navigate_hours, plan_only, encoders } => {
             check_navigate_hours(*navigate_hours).map_err(|e| Failure::input(format!("--navigate-hours {e}")))?;
             let setup = setup(params, *sequence, *encoders).map_err(|e| Failure::input(format!("{e:#}")))?;

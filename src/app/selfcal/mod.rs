@@ -6,11 +6,13 @@
 
 mod command;
 mod log;
+mod montecarlo;
 mod tables;
 pub use command::{SelfcalInput, SelfcalReport, SelfcalRequest, execute};
 pub use log::{LOG_ALIGN_S, run_log};
+pub use montecarlo::{McRun, MonteCarlo, ShardFile, merge_shards, monte_carlo, monte_carlo_runs};
 use tables::head;
-pub use tables::{estimates_document, estimates_table, table, target};
+pub use tables::{estimates_document, estimates_table, monte_carlo_table, table, target};
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -475,44 +477,6 @@ fn one_pass(
         estimation += started.elapsed();
     }
     Ok((filter.finish(), estimation.as_secs_f64()))
-}
-
-/// Per parameter over a Monte Carlo: mean error, the spread of the errors and the mean reported 1σ.
-#[derive(Debug, Clone, serde::Serialize)]
-pub struct MonteCarlo {
-    /// Runs.
-    pub runs: usize,
-    /// Mean of estimate − truth, SI.
-    pub mean_error: Vec<f64>,
-    /// Standard deviation of estimate − truth, SI.
-    pub spread: Vec<f64>,
-    /// Mean reported 1σ, SI.
-    pub reported_sigma: Vec<f64>,
-    /// Wall time, s.
-    pub wall_s: f64,
-}
-
-/// `runs` IMUs drawn with seeds `first_seed..`, on every core.
-///
-/// # Errors
-/// Interrupted, or a run that failed.
-pub fn monte_carlo(s: &Setup, runs: usize, first_seed: u64, stop: &AtomicBool) -> Result<MonteCarlo> {
-    let started = std::time::Instant::now();
-    let outcomes: Vec<Outcome> =
-        (0..runs).into_par_iter().map(|i| run_one(s, first_seed + i as u64, false, stop)).collect::<Result<_>>()?;
-    let n = outcomes.len() as f64;
-    let errors: Vec<Vec<f64>> = outcomes
-        .iter()
-        .map(|o| o.estimate.all_params().iter().zip(o.all_truth(s)).map(|(e, t)| e - t).collect())
-        .collect();
-    let m = errors.first().map_or(0, Vec::len);
-    let mean_error: Vec<f64> = (0..m).map(|k| errors.iter().map(|e| e[k]).sum::<f64>() / n).collect();
-    let spread = (0..m)
-        .map(|k| (errors.iter().map(|e| (e[k] - mean_error[k]).powi(2)).sum::<f64>() / (n - 1.0).max(1.0)).sqrt())
-        .collect();
-    let sigmas: Vec<Vec<f64>> = outcomes.iter().map(|o| o.estimate.all_sigma()).collect();
-    let reported_sigma = (0..m).map(|k| sigmas.iter().map(|s| s[k]).sum::<f64>() / n).collect();
-    Ok(MonteCarlo { runs, mean_error, spread, reported_sigma, wall_s: started.elapsed().as_secs_f64() })
 }
 
 /// One free-inertial run of the comparison.

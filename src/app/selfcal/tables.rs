@@ -160,6 +160,26 @@ fn monte_carlo_note(m: &MonteCarlo) -> String {
     )
 }
 
+/// A merged Monte Carlo's table: per parameter the spread of the errors, the mean reported 1σ and
+/// their ratio, in display units.
+#[must_use]
+pub fn monte_carlo_table(names: &[String], m: &MonteCarlo) -> String {
+    let mut out = format!(
+        "Monte Carlo: {} IMUs merged from shards; 1σ/spread is the reported 1σ over the spread of the errors (1 = honest).\n\n  {:<22} {:>5} {:>12} {:>12} {:>10}\n",
+        m.runs, "param", "unit", "MC spread", "mean 1σ", "1σ/spread"
+    );
+    for (k, name) in names.iter().enumerate() {
+        let (unit, per_si) = ParamKind::of(k).unit();
+        out.push_str(&format!(
+            "  {name:<22} {unit:>5} {:>12.4} {:>12.4} {:>10.2}\n",
+            m.spread[k] * per_si,
+            m.reported_sigma[k] * per_si,
+            m.reported_sigma[k] / m.spread[k]
+        ));
+    }
+    out
+}
+
 /// The table of `e` (with the truth when it is known), under `head`.
 #[must_use]
 pub fn estimates_table(
