@@ -69,23 +69,32 @@ def _path(p):
     return None if p is None else str(Path(p))
 
 
-def run(scenario: Any = None, duration_s: float | None = None, save: str | os.PathLike | None = None) -> Result:
+def _compensation_text(compensation: Any) -> str | None:
+    """A compensation document as text: a ``calibrate``/``selfcal`` Result, its summary dict, or a path."""
+    if isinstance(compensation, Result):
+        compensation = compensation.summary
+    if isinstance(compensation, dict):
+        return _json.dumps(compensation)
+    if compensation is not None:
+        return Path(compensation).read_text(encoding="utf-8")
+    return None
+
+
+def run(scenario: Any = None, duration_s: float | None = None, save: str | os.PathLike | None = None,
+        compensation: Any = None) -> Result:
     """Simulates a scenario (a Scenario, a preset's name or a file; default: the default preset)
-    for ``duration_s`` (default: its own), saving the recording to ``save`` if given.
+    for ``duration_s`` (default: its own), saving the recording to ``save`` if given, compensated
+    with ``compensation`` (a ``selfcal``/``calibrate`` Result, its summary dict, or the path of
+    their ``--json``: the table's part and the IMU's, as ``rinscope run --compensation``).
     ``summary`` is ``rinscope run --summary-json``'s; ``series`` every recorded series."""
-    return _result("run", _rinscope.run(_toml(scenario, DEFAULT_SCENARIO), duration_s, _path(save)), "recording_path")
+    toml = _toml(scenario, DEFAULT_SCENARIO)
+    return _result("run", _rinscope.run(toml, duration_s, _path(save), _compensation_text(compensation)), "recording_path")
 
 
 def replay(log_dir: str | os.PathLike, save: str | os.PathLike | None = None, compensation: Any = None) -> Result:
     """Replays a log set (a folder with ``log.toml``), with its table's compensation or
-    ``compensation``: a ``calibrate`` Result, its summary dict, or the path of a ``calibrate --json``."""
-    if isinstance(compensation, Result):
-        compensation = compensation.summary
-    if isinstance(compensation, dict):
-        compensation = _json.dumps(compensation)
-    elif compensation is not None:
-        compensation = Path(compensation).read_text(encoding="utf-8")
-    return _result("replay", _rinscope.replay(str(log_dir), _path(save), compensation), "recording_path")
+    ``compensation``: a ``calibrate`` or ``selfcal`` Result, its summary dict, or the path of their ``--json``."""
+    return _result("replay", _rinscope.replay(str(log_dir), _path(save), _compensation_text(compensation)), "recording_path")
 
 
 def calibrate(scenario: Any = None, log_dir: str | os.PathLike | None = None, save: str | os.PathLike | None = None) -> Result:

@@ -218,11 +218,14 @@ fn set_duration(params: &mut Params, duration_s: Option<f64>) -> Result<(), Fail
 fn run_to_sinks(
     params: Params,
     save: Option<PathBuf>,
+    compensation: Option<(String, String)>,
     stop: &Arc<AtomicBool>,
 ) -> Result<(rinscope::app::run::RunSummary, sink::Saved), Failure> {
     use rinscope::app::run::{RunRequest, execute};
-    let report =
-        execute(&RunRequest { params, recording: recording(save, stop), summary_json: None, progress: false }, stop)?;
+    let report = execute(
+        &RunRequest { params, recording: recording(save, stop), summary_json: None, progress: false, compensation },
+        stop,
+    )?;
     Ok((report.summary, report.saved))
 }
 
@@ -238,7 +241,7 @@ fn _time_run(py: Python<'_>, toml: &str, duration_s: Option<f64>, repeats: usize
                 let started = std::time::Instant::now();
                 let mut params = parse(toml, "the scenario")?;
                 set_duration(&mut params, duration_s)?;
-                let (_, saved) = run_to_sinks(params, None, &stop)?;
+                let (_, saved) = run_to_sinks(params, None, None, &stop)?;
                 std::hint::black_box(saved.tables.len());
                 Ok(started.elapsed().as_secs_f64())
             })
@@ -248,14 +251,22 @@ fn _time_run(py: Python<'_>, toml: &str, duration_s: Option<f64>, repeats: usize
 }
 
 /// Runs a scenario (its TOML text) for `duration_s` (None: its own), saving the recording to
-/// `save` if given: the summary (as `run --summary-json` writes it) and every series as a table.
+/// `save` if given, compensated with `compensation` (a compensation document's text, as
+/// `run --compensation`): the summary (as `run --summary-json` writes it) and every series as a table.
 #[pyfunction]
-#[pyo3(signature = (toml, duration_s=None, save=None))]
-fn run(py: Python<'_>, toml: &str, duration_s: Option<f64>, save: Option<PathBuf>) -> PyResult<PyOutput> {
+#[pyo3(signature = (toml, duration_s=None, save=None, compensation=None))]
+fn run(
+    py: Python<'_>,
+    toml: &str,
+    duration_s: Option<f64>,
+    save: Option<PathBuf>,
+    compensation: Option<&str>,
+) -> PyResult<PyOutput> {
     let mut params = parse(toml, "the scenario")?;
     set_duration(&mut params, duration_s)?;
+    let compensation = compensation.map(|text| (text.to_owned(), "compensation".to_owned()));
     let out = interruptible(py, move |stop| -> Result<Output, Failure> {
-        let (summary, saved) = run_to_sinks(params, save, stop)?;
+        let (summary, saved) = run_to_sinks(params, save, compensation, stop)?;
         output(summary, saved)
     })??;
     Ok(to_python(py, out))

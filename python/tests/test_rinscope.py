@@ -435,6 +435,25 @@ def test_selfcal_gives_the_commands_document(tmp_path):
     assert err.columns[0] == "t_s" and len(err) > 100
 
 
+def test_run_takes_the_selfcal_compensation_as_the_command_does(tmp_path):
+    # The whole compensation document selfcal writes (the table's part and the IMU's), applied in
+    # the loop by Python and by `run --compensation`: the same summary.
+    doc = {"estimated_imu_compensation": {"frame": "accelerometer triad", "gyro_bias_deg_per_h": [0.01, -0.01, 0.005],
+                                          "gyro_gain_ppm": [[10, 0, 0], [0, -5, 0], [0, 0, 3]], "accel_bias_ug": [50, -7, 30],
+                                          "accel_gain_ppm": [[-7, 0, 0], [0, 37, 0], [0, 0, -11]]},
+           "estimated_compensation": {"axis": {"inner": {"encoder_scale_ppm": -20.0}}}}
+    (tmp_path / "c.json").write_text(json.dumps(doc))
+    r = rinscope.run("selfcal-nav-grade", duration_s=30, compensation=doc)
+    command("run", "--scenario", "selfcal-nav-grade", "--duration-s", 30, "--compensation", "c.json", "--save", "r.rrd",
+            "--summary-json", "s.json", cwd=tmp_path)
+    want = json.loads((tmp_path / "s.json").read_text())
+    assert r.summary["ins_attitude_error_arcsec"] == want["ins_attitude_error_arcsec"]
+    plain = rinscope.run("selfcal-nav-grade", duration_s=30)
+    assert plain.summary["ins_attitude_error_arcsec"] != r.summary["ins_attitude_error_arcsec"]
+    doc["estimated_imu_compensation"]["accel_bias_ug"][1] = 1e9
+    raises_naming(rinscope.run, ["accel_bias_ug[1]"], scenario="selfcal-nav-grade", duration_s=30, compensation=doc)
+
+
 @pytest.mark.parametrize("kwargs, says", [(dict(sequence="dual-axis-30"), ["dual-axis-30", "positions-19"]), (dict(navigate_hours=-1), ["navigate_hours", "-1"]), (dict(monte_carlo=0), ["monte_carlo", "0"])])
 def test_selfcal_refuses_bad_input_by_name(kwargs, says):
     raises_naming(rinscope.selfcal, says, **kwargs)

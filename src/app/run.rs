@@ -540,6 +540,9 @@ pub struct RunRequest {
     pub summary_json: Option<std::path::PathBuf>,
     /// A progress bar on a terminal's stderr.
     pub progress: bool,
+    /// `--compensation`: a compensation document (`calibrate --json`, `selfcal --json`) the
+    /// computer applies, the table's part and the IMU's: its text and where it came from.
+    pub compensation: Option<(String, String)>,
 }
 
 /// What `run` reports: the summary (its recording's path and size filled in) and what was kept.
@@ -555,9 +558,17 @@ pub struct RunReport {
 /// # Errors
 /// A sink or output that cannot be opened or written; nothing kept the data.
 pub fn execute(req: &RunRequest, stop: &AtomicBool) -> Result<RunReport, Failure> {
-    let params = &req.params;
     // The summary file is checked before anything runs, so a typo costs nothing.
     check_output("--summary-json", req.summary_json.as_deref())?;
+    let mut compensated = None;
+    if let Some((text, origin)) = &req.compensation {
+        let mut p = req.params.clone();
+        for note in crate::scenario::compensation::apply_to_scenario(&mut p, text, origin)? {
+            errln!("rinscope run: {note}");
+        }
+        compensated = Some(p);
+    }
+    let params = compensated.as_ref().unwrap_or(&req.params);
     let sinks =
         req.recording.open(RecordingName { name: &params.meta.name, kind: None, seed: Some(params.meta.seed) })?;
     let mut summary = run_recorded(params, &sinks, stop, req.progress)?;

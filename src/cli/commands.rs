@@ -7,6 +7,7 @@ use super::{
     CalibrateArgs, Failure, LiveArgs, ModulationArgs, MonteCarloAction, MonteCarloArgs, RunArgs, ScenarioSource,
     TprArgs,
 };
+use crate::app::outputs::read_small_file;
 use crate::app::terminate::stop_flag;
 use crate::app::{live, modulation, reproduce};
 use crate::calib::montecarlo::Shard;
@@ -30,6 +31,10 @@ pub(super) fn run(args: &RunArgs) -> Result<(), Failure> {
         recording: args.sinks.recording()?,
         summary_json: args.summary_json.clone(),
         progress: true,
+        compensation: match &args.compensation {
+            Some(path) => Some((read_small_file(path, "--compensation")?, path.display().to_string())),
+            None => None,
+        },
     };
     let report = execute(&request, &stop_flag())?;
     let summary = &report.summary;

@@ -265,6 +265,11 @@ struct RunArgs {
     /// Override the scenario's simulated duration, s.
     #[arg(long, allow_negative_numbers = true, value_parser = duration_s)]
     duration_s: Option<f64>,
+    /// Compensate with a compensation document (`calibrate --json`, `selfcal --json`): its table
+    /// part replaces the scenario's [compensation] keys it names, its IMU part is removed from
+    /// every sample (docs/selfcal.md).
+    #[arg(long, value_name = "FILE")]
+    compensation: Option<PathBuf>,
 }
 
 #[derive(Args)]

@@ -49,6 +49,9 @@ pub struct InsParams {
     pub navigation: Option<NavOptions>,
     /// Alignment error (east tilt, north tilt, heading), rad.
     pub initial_error_rad: Vector3<f64>,
+    /// The IMU errors the computer removes from every sample (a compensation document's IMU part,
+    /// `run --compensation`), in the accelerometer triad's frame; None: nothing.
+    pub imu_compensation: Option<imu_errors::ImuErrors>,
 }
 
 impl InsParams {
@@ -67,6 +70,7 @@ impl InsParams {
             signal_window_s: 0.25,
             navigation: None,
             initial_error_rad: Vector3::zeros(),
+            imu_compensation: None,
         }
     }
 

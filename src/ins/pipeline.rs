@@ -107,8 +107,20 @@ impl InsRun {
         let start = truth.eval(t0_s - fir_delay_s).n_from_s;
         // FRAME: the alignment error is a small rotation of the navigation frame (C = (I − [φ×]) C_true).
         let start: Rot<N, S> = Rot::<N, N>::from_quaternion(rotvec::exp(&-cfg.initial_error_rad)) * start;
+        // A computer that compensates its IMU with a calibration's estimates reads increments in the
+        // accelerometer triad's frame (docs/selfcal.md): it starts aligned in that frame, as a
+        // perfect alignment of the compensated IMU would find it (ρ turned into n).
+        let start = match cfg.imu_compensation {
+            Some(_) => {
+                let ((bg, ba), (kg, ka)) = (sensors.drawn_bias, sensors.drawn_gain_errors());
+                let rho = super::imu_errors::ImuErrors { bg, kg, ba, ka }.accelerometer_frame_rotation();
+                // FRAME: C_{s'}^n = C_s^n · C_{s'}^s with C_{s'}^s = exp(ρ) (docs/selfcal.md).
+                Rot::<N, S>::from_quaternion(start.quaternion() * rotvec::exp(&rho))
+            }
+            None => start,
+        };
         let samples: Vec<(Vector3<f64>, Vector3<f64>)> = pre_roll.iter().map(|(_, g, a)| (*g, *a)).collect();
-        let core = InsCore::new(cfg, site, start, &samples);
+        let core = InsCore::compensated(cfg, site, start, &samples, cfg.imu_compensation);
         let demod = vec![DemodState::default(); core.algorithms().len()];
         let demod_len = demod.len();
         let last_error = vec![None; demod_len];
@@ -124,6 +136,7 @@ impl InsRun {
             last_error,
             shared: Vec::new(),
             chains: ChainMemo::new(demod_len),
+            // The computer (the core) removes `cfg.imu_compensation` itself: the samples stay raw.
             compensation: None,
             t0_s,
             site,

@@ -171,3 +171,41 @@ pub fn compensation_from_calibration(
     );
     Ok(validate::validate_compensation(&c, &merged, &turntable, &chain, &stated)?.0)
 }
+
+/// A compensation document (`calibrate --json`, `selfcal --json`, or one written by hand) applied
+/// to a simulated scenario, as `replay --compensation` applies it to a log: its table part
+/// replaces the scenario's `[compensation]` keys it names, its IMU part is removed from every
+/// sample the computer reads (`run --compensation`). Returns what was applied, as notes.
+///
+/// # Errors
+/// Not a compensation document, a bad number (named by key), an IMU part for a scenario without
+/// `[imu]`.
+pub fn apply_to_scenario(
+    params: &mut super::Params,
+    json_text: &str,
+    origin: &str,
+) -> Result<Vec<String>, ConfigError> {
+    let imu = from_document(json_text, origin)?;
+    let raw = RawTable {
+        recording: Default::default(),
+        site: Default::default(),
+        turntable: Some(params.resolved.turntable.clone()),
+        compensation: params.resolved.compensation.clone(),
+        imu: None,
+        navigation: None,
+        calibration: None,
+    };
+    params.table.compensation = compensation_from_calibration(&raw, json_text, origin, imu.is_some())?;
+    let mut notes =
+        vec![format!("the table is compensated with {origin}'s estimates (the scenario's own where it names none)")];
+    if let Some(errors) = imu {
+        let ins = params.ins.as_mut().ok_or_else(|| ConfigError::Invalid {
+            origin: origin.to_owned(),
+            key: "estimated_imu_compensation".to_owned(),
+            message: format!("{} has no [imu] section: there is no IMU to compensate", params.meta.name),
+        })?;
+        ins.imu_compensation = Some(errors);
+        notes.push(format!("the IMU is compensated with {origin}'s estimates, in the accelerometer triad's frame"));
+    }
+    Ok(notes)
+}
