@@ -91,7 +91,7 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
             .enumerate()
             .map(|(i, l)| format!("{} {}", nav_colour(i).0, l.compensation));
         format!(
-            "- right column: afterwards, the same IMU free-inertial from t = 0 ({}), the radial position error in log10 metres (1 = 10 m, 4 = 10 km); compensation {}\n",
+            "- right column: afterwards, the same RINS free-inertial from t = 0 ({}), the radial position error in log10 metres (1 = 10 m, 4 = 10 km), and beside the table's plot the body's heading error in log10 arcsec; compensation {} (none: a raw IMU on the nominal table; estimated: this calibration's IMU and table; true: their true errors)\n",
             motions.join(", "),
             compensations.collect::<Vec<_>>().join(", ")
         )
@@ -197,11 +197,15 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
     // Gyro groups over accelerometer groups, a motion's navigation beside each row.
     let mut navigation = navigation.into_iter();
     let mut observability = observability.into_iter();
+    // Three plots a row: two groups and a navigation plot; a row with one group left (the
+    // table's) takes two navigation plots (the headings).
     let rows: Vec<Node> = (0..observability.len().div_ceil(2))
         .map(|_| {
+            let groups: Vec<Node> = observability.by_ref().take(2).collect();
+            let room = 3 - groups.len();
             Node::container(
                 ContainerKind::Horizontal,
-                observability.by_ref().take(2).chain(navigation.next()).collect(),
+                groups.into_iter().chain(navigation.by_ref().take(room)).collect(),
                 &[],
             )
         })
@@ -291,6 +295,36 @@ fn log_navigation(stream: &Stream, lines: &[NavLine<'_>], motions: &[&str]) -> R
             plot = plot.with_property("ScalarAxis", &blueprint::scalar_range(lo.floor() - 1.0, hi.ceil()));
         }
         plots.push(plot);
+    }
+    // The body's heading error of the same runs: what the table's compensation (and the gyros')
+    // leaves in the attitude the RINS reports, arcsec.
+    for motion in motions {
+        let runs: Vec<&NavLine<'_>> = lines.iter().filter(|l| l.motion == *motion).collect();
+        let path = format!("selfcal/navigation/{}/heading_error_log10_arcsec", motion.replace([' ', '-'], "_"));
+        let names: Vec<String> = runs.iter().map(|l| l.compensation.to_owned()).collect();
+        let colors = (0..runs.len()).map(|i| rgb(nav_colour(i).1));
+        stream
+            .rec()
+            .log_static(path.as_str(), &rerun::SeriesLines::new().with_colors(colors).with_names(names.clone()))?;
+        let n = runs.iter().map(|l| l.trace.samples.len()).min().unwrap_or(0);
+        let times: Vec<f64> = runs[0].trace.samples.iter().take(n).map(|s| s.t_s).collect();
+        // log10 of its size, as the position's: the uncompensated table's arcminutes and the
+        // compensated runs' arcseconds on one axis.
+        let values: Vec<f64> = (0..n)
+            .flat_map(|i| runs.iter().map(move |l| l.trace.samples[i].heading_arcsec.abs().max(0.1).log10()))
+            .collect();
+        let (lo, hi) = values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
+        stream.rec().send_columns(
+            path.as_str(),
+            stream.time_columns(&times),
+            rerun::Scalars::new(values).columns(std::iter::repeat_n(names.len(), n))?,
+        )?;
+        plots.push(
+            Node::view("TimeSeries", format!("{motion}: log10 |heading error| (″)"), path)
+                .with_property("TimeAxis", &blueprint::whole_run_time_axis())
+                .with_property("PlotLegend", &blueprint::legend_at(blueprint::LegendCorner::RightBottom))
+                .with_property("ScalarAxis", &blueprint::scalar_range(lo.min(hi).floor() - 1.0, hi.max(lo).ceil())),
+        );
     }
     Ok(plots)
 }

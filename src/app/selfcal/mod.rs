@@ -525,10 +525,29 @@ pub fn navigation_comparison(p: &Params, o: &Outcome, hours: f64, stop: &AtomicB
         let turned = -(c0.quaternion() * rho);
         for (name, comp) in [("none", None), ("estimated", Some(estimated)), ("true", Some(o.truth_drawn))] {
             let mut case = q.clone();
-            if name == "estimated"
-                && let Some(ins) = case.ins.as_mut()
-            {
-                ins.initial_error_rad = turned;
+            match name {
+                // The whole RINS uncompensated: a raw IMU on the nominal table.
+                "none" => {
+                    case.table.compensation = crate::model::gimbal::TableErrors::zero(case.table.chain.axes().len())
+                }
+                // The estimates of both, in the accelerometer triad's frame (the table's folded
+                // with the table's own installation and first encoder's offset, which it cannot see).
+                "estimated" => {
+                    if let Some(t) = &o.estimate.table {
+                        let mut folded = t.states.as_errors(&t.params);
+                        folded.installation_rad = case.table.compensation.installation_rad;
+                        if let (Some(f), Some(own)) = (folded.axes.first_mut(), case.table.compensation.axes.first()) {
+                            f.encoder_offset_rad = own.encoder_offset_rad;
+                        }
+                        case.table.compensation = folded;
+                    }
+                    if let Some(ins) = case.ins.as_mut() {
+                        ins.initial_error_rad = turned;
+                    }
+                }
+                // The truth of both, in the IMU's own frame: the table's true errors (the
+                // scenario's compensation is its truth unless it says otherwise) and the drawn IMU.
+                _ => {}
             }
             cases.push((motion, name, case, comp));
         }
