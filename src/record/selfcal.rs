@@ -12,6 +12,7 @@ use super::blueprint::{self, Node};
 use super::palette::{self, rgb};
 use super::{APPLICATION_ID, Stream, TIMELINE, to_rerun_quaternion};
 use crate::calib::selfcal::{HistoryRow, ParamKind};
+use crate::ins::trace::NavSample;
 
 /// What the recording shows.
 pub struct SelfcalView<'a> {
@@ -256,75 +257,56 @@ fn motions<'a>(lines: &[NavLine<'a>]) -> Vec<&'a str> {
 }
 
 /// What the calibration buys: one plot per motion of its runs' radial position errors (log10 m),
-/// the compensations in the same colours in each, on one value range (so that the plots compare).
-/// On the sequence's timeline from t = 0, for the whole run (hours of navigation, not the sequence).
+/// the compensations in the same colours in each, on one value range (so that the plots compare);
+/// then one per motion of the body's heading error (log10 arcsec: what the table's compensation and
+/// the gyros' leave in the attitude the RINS reports — the nominal table's arcminutes and the
+/// compensated runs' arcseconds on one axis). On the sequence's timeline from t = 0, for the whole
+/// run (hours of navigation, not the sequence).
 fn log_navigation(stream: &Stream, lines: &[NavLine<'_>], motions: &[&str]) -> RecordingStreamResult<Vec<Node>> {
-    let log10_m = |m: f64| m.max(1e-3).log10();
+    let radial = |s: &NavSample| s.position_m[2].max(1e-3).log10();
+    let heading = |s: &NavSample| s.heading_arcsec.abs().max(0.1).log10();
     // From the first hundredth of the run on (the lines' steep start from 0 m would set the range).
     let end_s = lines.iter().filter_map(|l| l.trace.samples.last()).map(|s| s.t_s).fold(0.0, f64::max);
-    let (lo, hi) = lines
-        .iter()
-        .flat_map(|l| &l.trace.samples)
-        .filter(|s| s.t_s >= 0.01 * end_s)
-        .map(|s| log10_m(s.position_m[2]))
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| (lo.min(y), hi.max(y)));
+    let range = |f: &dyn Fn(&NavSample) -> f64| {
+        lines
+            .iter()
+            .flat_map(|l| &l.trace.samples)
+            .filter(|s| s.t_s >= 0.01 * end_s)
+            .map(f)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| (lo.min(y), hi.max(y)))
+    };
     let mut plots = Vec::new();
-    for motion in motions {
-        let runs: Vec<&NavLine<'_>> = lines.iter().filter(|l| l.motion == *motion).collect();
-        let path = format!("selfcal/navigation/{}/radial_position_error_log10_m", motion.replace([' ', '-'], "_"));
-        let names: Vec<String> = runs.iter().map(|l| l.compensation.to_owned()).collect();
-        let colors = (0..runs.len()).map(|i| rgb(nav_colour(i).1));
-        stream
-            .rec()
-            .log_static(path.as_str(), &rerun::SeriesLines::new().with_colors(colors).with_names(names.clone()))?;
-        let n = runs.iter().map(|l| l.trace.samples.len()).min().unwrap_or(0);
-        let times: Vec<f64> = runs[0].trace.samples.iter().take(n).map(|s| s.t_s).collect();
-        let values: Vec<f64> =
-            (0..n).flat_map(|i| runs.iter().map(move |l| log10_m(l.trace.samples[i].position_m[2]))).collect();
-        stream.rec().send_columns(
-            path.as_str(),
-            stream.time_columns(&times),
-            rerun::Scalars::new(values).columns(std::iter::repeat_n(names.len(), n))?,
-        )?;
-        let mut plot = Node::view("TimeSeries", format!("{motion}: log10 error (m)"), path)
-            .with_property("TimeAxis", &blueprint::whole_run_time_axis())
-            // Below the lines once they have left 0 m: the legend covers none of them.
-            .with_property("PlotLegend", &blueprint::legend_at(blueprint::LegendCorner::RightBottom));
-        if lo.is_finite() {
-            // A whole decade of room under the lowest value, for the legend.
-            plot = plot.with_property("ScalarAxis", &blueprint::scalar_range(lo.floor() - 1.0, hi.ceil()));
-        }
-        plots.push(plot);
-    }
-    // The body's heading error of the same runs: what the table's compensation (and the gyros')
-    // leaves in the attitude the RINS reports, arcsec.
-    for motion in motions {
-        let runs: Vec<&NavLine<'_>> = lines.iter().filter(|l| l.motion == *motion).collect();
-        let path = format!("selfcal/navigation/{}/heading_error_log10_arcsec", motion.replace([' ', '-'], "_"));
-        let names: Vec<String> = runs.iter().map(|l| l.compensation.to_owned()).collect();
-        let colors = (0..runs.len()).map(|i| rgb(nav_colour(i).1));
-        stream
-            .rec()
-            .log_static(path.as_str(), &rerun::SeriesLines::new().with_colors(colors).with_names(names.clone()))?;
-        let n = runs.iter().map(|l| l.trace.samples.len()).min().unwrap_or(0);
-        let times: Vec<f64> = runs[0].trace.samples.iter().take(n).map(|s| s.t_s).collect();
-        // log10 of its size, as the position's: the uncompensated table's arcminutes and the
-        // compensated runs' arcseconds on one axis.
-        let values: Vec<f64> = (0..n)
-            .flat_map(|i| runs.iter().map(move |l| l.trace.samples[i].heading_arcsec.abs().max(0.1).log10()))
-            .collect();
-        let (lo, hi) = values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
-        stream.rec().send_columns(
-            path.as_str(),
-            stream.time_columns(&times),
-            rerun::Scalars::new(values).columns(std::iter::repeat_n(names.len(), n))?,
-        )?;
-        plots.push(
-            Node::view("TimeSeries", format!("{motion}: log10 |heading error| (″)"), path)
+    for (slug, title, value) in [
+        ("radial_position_error_log10_m", "log10 error (m)", &radial as &dyn Fn(&NavSample) -> f64),
+        ("heading_error_log10_arcsec", "log10 |heading error| (″)", &heading),
+    ] {
+        let (lo, hi) = range(value);
+        for motion in motions {
+            let runs: Vec<&NavLine<'_>> = lines.iter().filter(|l| l.motion == *motion).collect();
+            let path = format!("selfcal/navigation/{}/{slug}", motion.replace([' ', '-'], "_"));
+            let names: Vec<String> = runs.iter().map(|l| l.compensation.to_owned()).collect();
+            let colors = (0..runs.len()).map(|i| rgb(nav_colour(i).1));
+            stream
+                .rec()
+                .log_static(path.as_str(), &rerun::SeriesLines::new().with_colors(colors).with_names(names.clone()))?;
+            let n = runs.iter().map(|l| l.trace.samples.len()).min().unwrap_or(0);
+            let times: Vec<f64> = runs[0].trace.samples.iter().take(n).map(|s| s.t_s).collect();
+            let values: Vec<f64> = (0..n).flat_map(|i| runs.iter().map(move |l| value(&l.trace.samples[i]))).collect();
+            stream.rec().send_columns(
+                path.as_str(),
+                stream.time_columns(&times),
+                rerun::Scalars::new(values).columns(std::iter::repeat_n(names.len(), n))?,
+            )?;
+            let mut plot = Node::view("TimeSeries", format!("{motion}: {title}"), path)
                 .with_property("TimeAxis", &blueprint::whole_run_time_axis())
-                .with_property("PlotLegend", &blueprint::legend_at(blueprint::LegendCorner::RightBottom))
-                .with_property("ScalarAxis", &blueprint::scalar_range(lo.min(hi).floor() - 1.0, hi.max(lo).ceil())),
-        );
+                // Below the lines once they have left 0: the legend covers none of them.
+                .with_property("PlotLegend", &blueprint::legend_at(blueprint::LegendCorner::RightBottom));
+            if lo.is_finite() {
+                // A whole decade of room under the lowest value, for the legend.
+                plot = plot.with_property("ScalarAxis", &blueprint::scalar_range(lo.floor() - 1.0, hi.ceil()));
+            }
+            plots.push(plot);
+        }
     }
     Ok(plots)
 }
