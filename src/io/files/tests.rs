@@ -168,7 +168,7 @@ fn inputs_that_are_not_regular_files_are_refused_at_once() {
 
 #[test]
 fn a_fifo_at_the_partial_does_not_block() {
-    let d = scratch("fifo");
+    let d = scratch("fifo-partial");
     let fifo = d.join("x.json.partial");
     let status = std::process::Command::new("mkfifo").arg(&fifo).status().expect("mkfifo (coreutils) runs");
     assert!(status.success(), "mkfifo {}", fifo.display());
