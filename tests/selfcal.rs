@@ -59,7 +59,7 @@ fn the_reported_sigma_matches_the_spread_over_random_imus() {
     // independent); the reported 1σ is nearly the same in every run. The IMU's and the table's.
     let n = mc.spread.len();
     assert_eq!(n, N_PARAMS + 8);
-    let names = run_one(&s, 1, true, &AtomicBool::new(false)).expect("plan").estimate.names();
+    let names = rinscope::calib::selfcal::names_with(s.table_states.as_ref().map(|t| &t.states));
     let mut pooled = 0.0;
     for k in 0..n {
         let rms = (mc.spread[k].powi(2) * (runs as f64 - 1.0) / runs as f64 + mc.mean_error[k].powi(2)).sqrt();

@@ -145,16 +145,12 @@ pub struct TableConfig {
 /// The table's part of an estimate.
 #[derive(Debug, Clone)]
 pub struct TableEstimate {
-    /// The states (the chain they belong to).
+    /// The states (the chain they belong to: their names and priors).
     pub states: TableStates,
-    /// The states' names.
-    pub names: Vec<String>,
     /// The estimates, SI.
     pub params: Vec<f64>,
     /// Their 1σ.
     pub sigma: Vec<f64>,
-    /// The priors' 1σ.
-    pub prior: Vec<f64>,
     /// The covariance of the IMU's 21 and the table's states together (correlations: aliasing).
     pub covariance: nalgebra::DMatrix<f64>,
 }
@@ -457,8 +453,9 @@ impl SelfCal {
         if let Some(s_inv) = s.try_inverse() {
             let gain = ph * s_inv;
             self.x += gain * innovation;
-            // Joseph's form: the encoders are far more precise than the priors (0.05″ against
-            // 600″), and P − K·H·P then loses the small variances to rounding.
+            // Joseph's form keeps P symmetric positive semi-definite whatever the gain's rounding
+            // (the encoders are far more precise than the priors: 0.05″ against 600″). Measured, it
+            // gives the same 1σ as P − K·H·P here; it costs two dense 42×42 products a step.
             let ikh = Mat::identity() - gain * h;
             self.p = ikh * self.p * ikh.transpose() + gain * r * gain.transpose();
             self.p = (self.p + self.p.transpose()) * 0.5;
@@ -489,10 +486,8 @@ impl SelfCal {
             let n = N_PARAMS + t.states.len();
             TableEstimate {
                 states: t.states.clone(),
-                names: t.states.names(),
                 params,
                 sigma,
-                prior: t.states.priors(),
                 covariance: nalgebra::DMatrix::from_fn(n, n, |i, j| self.p[(6 + i, 6 + j)]),
             }
         });
@@ -573,11 +568,7 @@ impl Estimate {
     /// Every parameter's name: the IMU's 21, then the table's.
     #[must_use]
     pub fn names(&self) -> Vec<String> {
-        let mut n = param_names();
-        if let Some(t) = &self.table {
-            n.extend(t.names.iter().cloned());
-        }
-        n
+        names_with(self.table.as_ref().map(|t| &t.states))
     }
 
     /// Every estimate (SI), in [`Self::names`]'s order.
@@ -605,10 +596,20 @@ impl Estimate {
     pub fn all_prior(&self) -> Vec<f64> {
         let mut v = self.prior.to_vec();
         if let Some(t) = &self.table {
-            v.extend(&t.prior);
+            v.extend(t.states.priors());
         }
         v
     }
+}
+
+/// Every parameter's name of a filter with the table's states `table`: the IMU's 21, then the table's.
+#[must_use]
+pub fn names_with(table: Option<&TableStates>) -> Vec<String> {
+    let mut n = param_names();
+    if let Some(t) = table {
+        n.extend(t.names());
+    }
+    n
 }
 
 impl HistoryRow {

@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use super::{
     JSON_UNITS, SequenceChoice, calibrate, check_navigate_hours, estimates_document, estimates_table, plan, run_log,
-    run_one, setup,
+    setup,
 };
 use crate::app::failure::Failure;
 use crate::app::outputs::{RecordingName, RecordingRequest, check_output, finish, logged, read_small_file, write_json};
@@ -93,8 +93,7 @@ pub fn execute(req: &SelfcalRequest, stop: &AtomicBool) -> Result<SelfcalReport,
             let setup = setup(params, *sequence, *encoders).map_err(|e| Failure::input(format!("{e:#}")))?;
             let done = super::monte_carlo_runs(&setup, *runs, params.meta.seed + 1, *shard, stop)
                 .map_err(|e| interrupted("selfcal", e))?;
-            let parameters =
-                run_one(&setup, params.meta.seed, true, stop).map_err(|e| interrupted("selfcal", e))?.estimate.names();
+            let parameters = crate::calib::selfcal::names_with(setup.table_states.as_ref().map(|t| &t.states));
             let file = super::ShardFile {
                 shard: *shard,
                 scenario: params.meta.name.clone(),

@@ -194,7 +194,7 @@ impl Report {
 pub fn table_compensation(e: &Estimate, unobservable: &[String]) -> Option<serde_json::Value> {
     let t = e.table.as_ref()?;
     let seen: Vec<f64> =
-        t.params.iter().zip(&t.names).map(|(v, n)| if unobservable.contains(n) { 0.0 } else { *v }).collect();
+        t.params.iter().zip(t.states.names()).map(|(v, n)| if unobservable.contains(&n) { 0.0 } else { *v }).collect();
     let chain = t.states.chain();
     let mut keys = crate::scenario::compensation_keys(chain, &t.states.as_errors(&seen));
     keys.installation_x_arcsec = None;
