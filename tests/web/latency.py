@@ -13,14 +13,20 @@ the viewer, which answers between its frames).
                [--warmup S] [--max-lag S] [--max-lag-peak S] [--max-move S] [--json OUT]
                [--screenshot OUT.png [--dark]]
 
-Prints a line per second and a summary; exits 1 when the steady-state lag (after the viewer first
-shows data plus WARMUP) has a median over MAX_LAG or exceeds MAX_LAG_PEAK in any sample, or a change
-took longer than MAX_MOVE to show. A viewer that falls behind (the defect this guards against: 52 s after
-two minutes) fails both; one that keeps up but paints at 1.6-2.5 fps in software rendering lags by
-its frame period on top of the stream's flush (0.25-0.5 s), which the peak bound allows.
+Prints a line per second (with the machine's load average) and a summary; exits 1 when the
+steady-state lag (after the viewer first shows data plus WARMUP) has a median over MAX_LAG, its last
+ten samples a median over MAX_LAG (it did not recover), or any sample exceeds MAX_LAG_PEAK; or when a
+change was not seen, the median change took longer than MAX_MOVE_MEDIAN or one longer than MAX_MOVE.
+A viewer that falls behind (the defect this guards against: 52 s after two minutes) fails all of them.
+One that keeps up but paints at 1.6-2.5 fps in software rendering lags by its frame period on top of
+the stream's flush (0.25-0.5 s): 0.5-0.9 s here. The tighter TARGET_LAG_PEAK and TARGET_MOVE (what a
+class should see: 1.5 s) are measured and reported, not asserted: these machines are shared, and a
+neighbour's burst stalls the software renderer for seconds (a CI run saw 2.5 s for about 5 s, then
+0.6 s again) — timing targets belong to benchmarks, the test to what a stall cannot explain.
 """
 import argparse
 import json
+import os
 import re
 import statistics
 import sys
@@ -46,6 +52,9 @@ ap.add_argument("--warmup", type=float, default=10.0)
 ap.add_argument("--max-lag", type=float)
 ap.add_argument("--max-move", type=float)
 ap.add_argument("--max-lag-peak", type=float, help="the largest lag allowed in any sample (--max-lag bounds the median)")
+ap.add_argument("--max-move-median", type=float, help="the median time a change may take to show")
+ap.add_argument("--target-lag-peak", type=float, help="reported: the largest lag a class should see")
+ap.add_argument("--target-move", type=float, help="reported: the longest a change should take to show")
 ap.add_argument("--json")
 ap.add_argument("--screenshot")
 ap.add_argument("--dark", action="store_true")
@@ -113,8 +122,8 @@ try:
         if t is not None and first_data is None:
             first_data = now
             next_move = now + a.warmup
-        samples.append({"wall_s": round(now, 2), "session_s": session, "viewer_t_s": t, "viewer_newest_s": newest, "lag_s": lag, "fps": fps, "frames": frames, "viewer_answered_in_s": round(answered_in, 2)})
-        print(f"wall {now:6.1f} s  session {session if session is None else round(session, 2)}  viewer {t if t is None else round(t, 2)}  lag {lag if lag is None else round(lag, 2)}  fps {fps}  (answered in {answered_in:.2f} s)", flush=True)
+        samples.append({"wall_s": round(now, 2), "load1": round(os.getloadavg()[0], 2), "session_s": session, "viewer_t_s": t, "viewer_newest_s": newest, "lag_s": lag, "fps": fps, "frames": frames, "viewer_answered_in_s": round(answered_in, 2)})
+        print(f"wall {now:6.1f} s  session {session if session is None else round(session, 2)}  viewer {t if t is None else round(t, 2)}  lag {lag if lag is None else round(lag, 2)}  fps {fps}  (answered in {answered_in:.2f} s)  load {os.getloadavg()[0]:.2f}", flush=True)
         # A teacher moves a slider on the page (its input and change events, as a mouse release).
         if a.move_every > 0 and a.controls and next_move is not None and now >= next_move:
             next_move = now + a.move_every
@@ -171,6 +180,7 @@ if steady:
 fps = [s["fps"] for s in samples if s["fps"] is not None]
 if fps:
     summary["viewer_fps_median"] = statistics.median(fps)
+seen = []
 if moves:
     seen = [m["seen_after_s"] for m in moves if m["seen_after_s"] is not None]
     summary.update({"moves": len(moves), "moves_seen": len(seen), "move_seen_median_s": round(statistics.median(seen), 2) if seen else None, "move_seen_max_s": max(seen) if seen else None})
@@ -181,10 +191,30 @@ if a.json:
 failed = []
 if a.max_lag is not None and (not steady or summary["lag_median_s"] > a.max_lag):
     failed.append(f"the viewer's median lag was {summary.get('lag_median_s')} s (at most {a.max_lag} s)")
+if a.max_lag is not None and steady and statistics.median(steady[-10:]) > a.max_lag:
+    failed.append(f"the viewer did not recover: its last ten samples' median lag was {statistics.median(steady[-10:]):.2f} s (at most {a.max_lag} s)")
 if a.max_lag_peak is not None and (not steady or max(steady) > a.max_lag_peak):
     failed.append(f"the viewer's lag reached {max(steady) if steady else 'no data'} s (at most {a.max_lag_peak} s)")
-if a.max_move is not None and moves and (len(seen) < len(moves) or max(seen) > a.max_move):
-    failed.append(f"a change showed after {max(seen) if seen else None} s ({len(seen)} of {len(moves)} seen; at most {a.max_move} s)")
+if moves and len(seen) < len(moves):
+    failed.append(f"{len(moves) - len(seen)} of {len(moves)} changes never showed")
+if a.max_move_median is not None and seen and statistics.median(seen) > a.max_move_median:
+    failed.append(f"a change showed after {statistics.median(seen):.2f} s in the median (at most {a.max_move_median} s)")
+if a.max_move is not None and seen and max(seen) > a.max_move:
+    failed.append(f"a change showed after {max(seen)} s (at most {a.max_move} s)")
+missed = []
+if a.target_lag_peak is not None and steady and max(steady) > a.target_lag_peak:
+    missed.append(f"lag peak {max(steady):.2f} s > {a.target_lag_peak} s")
+if a.target_move is not None and seen and max(seen) > a.target_move:
+    missed.append(f"a change shown after {max(seen)} s > {a.target_move} s")
+if missed or failed:
+    # Where it happened: the samples around the worst lag, with the machine's load then.
+    worst = max(range(len(samples)), key=lambda i: samples[i]["lag_s"] if samples[i]["lag_s"] is not None else -1e9)
+    for s in samples[max(0, worst - 4):worst + 5]:
+        print("around the peak:", json.dumps(s), flush=True)
+if missed:
+    print("latency: targets missed on this run (reported, not asserted):", "; ".join(missed), flush=True)
+elif a.target_lag_peak is not None or a.target_move is not None:
+    print("latency: targets met (lag peak, every change shown)", flush=True)
 if failed:
     print("latency: FAILED:", "; ".join(failed), flush=True)
     sys.exit(1)
