@@ -231,6 +231,54 @@ fn the_imu_calibrated_by_selfcal_is_compensated_in_a_replay_as_well_as_by_the_tr
     // the truth 120 m).
     assert!(run_estimated < 0.2 * run_none, "run: estimated {run_estimated:.0} m vs none {run_none:.0} m");
     assert!(run_estimated < 1.3 * run_truth + 50.0, "run: estimated {run_estimated:.0} m vs truth {run_truth:.0} m");
+    // 5. The same documents in a live session (`live --compensation`): the table part written into
+    //    the session's config, the IMU part removed from the INS's samples; 20 simulated minutes
+    //    at 1000× real time, the INS's attitude errors exported.
+    let live = |name: &str, document: Option<&str>| {
+        std::fs::write(dir.join(format!("{name}.toml")), &preset).expect("write");
+        let mut cmd = rinscope();
+        cmd.args(["live", "--config", &format!("{name}.toml"), "--no-viewer", "--no-panel", "--speed", "1000"])
+            .args(["--duration-s", "1200", "--save", &format!("{name}.rrd"), "--export", name])
+            .current_dir(&dir);
+        if let Some(d) = document {
+            cmd.args(["--compensation", d]);
+        }
+        let out = cmd.output().expect("runs");
+        assert!(out.status.success(), "{}", stderr(&out));
+        let rms: Vec<f64> = ["heading", "pitch", "roll"]
+            .iter()
+            .map(|a| {
+                let v = parquet_column(&dir.join(name).join(format!("ins__attitude_error_arcsec__{a}.parquet")), 1);
+                // (Rows before the INS's first attitude update are empty: NaN.)
+                let v: Vec<f64> = v.into_iter().filter(|x| x.is_finite()).collect();
+                assert!(v.len() >= 100, "{name}: {} rows of {a} (1 per 10 s at 1000×)", v.len());
+                (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
+            })
+            .collect();
+        (rms, stderr(&out))
+    };
+    let (live_none, live_estimated, live_truth) =
+        (live("live-none", None), live("live-sc", Some("sc.json")), live("live-truth", Some("truth.json")));
+    eprintln!(
+        "live, INS attitude error RMS (heading, pitch, roll ″): none {:.2?}, estimated {:.2?}, truth {:.2?}",
+        live_none.0, live_estimated.0, live_truth.0
+    );
+    assert!(live_estimated.1.contains("the IMU is compensated with sc.json's estimates"), "{}", live_estimated.1);
+    // The table part is now the config's: every key of sc.json's estimated_compensation, its value.
+    let cfg: toml::Value =
+        toml::from_str(&std::fs::read_to_string(dir.join("live-sc.toml")).expect("cfg")).expect("toml");
+    for (axis, fields) in sc["estimated_compensation"]["axis"].as_object().expect("axes") {
+        for (field, value) in fields.as_object().expect("fields") {
+            let written = cfg["compensation"]["axis"][axis][field].as_float().expect("written");
+            assert!((written - value.as_f64().expect("number")).abs() < 1e-5, "{axis}.{field}: {written} vs {value}");
+        }
+    }
+    // The preset's IMU errors are tens of times the estimates' 1σ (the accuracy table): compensated,
+    // every axis's error falls at least five-fold, and stays within what the truth leaves plus 1″
+    // (the estimates' own error over 20 minutes: 1σ 0.0009 °/h of gyro bias is 0.3″ of heading).
+    let total = |r: &[f64]| r.iter().map(|x| x * x).sum::<f64>().sqrt();
+    assert!(total(&live_estimated.0) < 0.2 * total(&live_none.0), "{live_estimated:?} vs {live_none:?}");
+    assert!(total(&live_estimated.0) < total(&live_truth.0) + 1.0, "{live_estimated:?} vs {live_truth:?}");
     // A document with an impossible number is refused, naming the key, before anything runs.
     let mut doc: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).expect("truth")).expect("json");
@@ -245,6 +293,20 @@ fn the_imu_calibrated_by_selfcal_is_compensated_in_a_replay_as_well_as_by_the_tr
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("estimated_imu_compensation.gyro_gain_ppm[1][2]") && err.contains("1e9"), "{err}");
     assert!(!dir.join("b.rrd").exists(), "a recording of a refused replay");
+}
+
+/// Column `index` of a Parquet table (`--export`), read with the parquet crate's own arrow reader.
+fn parquet_column(path: &std::path::Path, index: usize) -> Vec<f64> {
+    use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+    let file = std::fs::File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let reader = ParquetRecordBatchReaderBuilder::try_new(file).expect("parquet").build().expect("reader");
+    let mut out = Vec::new();
+    for batch in reader {
+        let batch = batch.expect("batch");
+        let col = batch.column(index).as_any().downcast_ref::<arrow_array::Float64Array>().expect("f64 column");
+        out.extend(col.values().iter().copied());
+    }
+    out
 }
 
 /// PSINS `imufile.m`'s writer (the format `io::formats::psins_imu` documents): `%` comments, the

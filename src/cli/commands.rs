@@ -59,6 +59,10 @@ pub(super) fn live(args: &LiveArgs) -> Result<(), Failure> {
         duration_s: args.duration_s,
         no_viewer: args.no_viewer,
         panel: !args.no_panel,
+        compensation: match &args.compensation {
+            Some(path) => Some((read_small_file(path, "--compensation")?, path.display().to_string())),
+            None => None,
+        },
     };
     let report = live::execute(&request, &stop_flag())?;
     let summary = &report.summary;

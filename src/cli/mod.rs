@@ -294,6 +294,12 @@ struct LiveArgs {
     /// No terminal panel (edit the file by hand; Ctrl-C ends the session).
     #[arg(long)]
     no_panel: bool,
+    /// Compensate with a compensation document (`calibrate --json`, `selfcal --json`): its table
+    /// part is written into the config's [compensation] keys (the sliders, the editor and
+    /// "calibrate now" take it from there), its IMU part is removed from every sample the INS
+    /// reads for the whole session (docs/live.md).
+    #[arg(long, value_name = "FILE")]
+    compensation: Option<PathBuf>,
 }
 
 #[derive(Args)]

@@ -121,6 +121,43 @@ pub fn from_document(json_text: &str, origin: &str) -> Result<Option<ImuErrors>,
     doc.estimated_imu_compensation.map(|c| c.validate(origin)).transpose()
 }
 
+/// The document's table part (`estimated_compensation`), if it has one.
+fn table_part(json_text: &str, origin: &str) -> Result<Option<RawCompensation>, ConfigError> {
+    #[derive(Deserialize)]
+    struct WithCompensation {
+        estimated_compensation: Option<RawCompensation>,
+    }
+    let parsed: WithCompensation = serde_json::from_str(json_text).map_err(|e| ConfigError::Parse {
+        origin: origin.to_owned(),
+        message: format!("not a compensation document of `rinscope calibrate --json` or `selfcal --json` ({e})"),
+    })?;
+    Ok(parsed.estimated_compensation)
+}
+
+/// The document's table part as the scenario keys it sets (`compensation.axis.inner.swing_half_angle_arcsec`
+/// = 512.3, ...), in a stable order: what `live --compensation` writes into the session's config.
+/// Empty when the document has no table part.
+///
+/// # Errors
+/// Not a compensation document.
+pub fn table_keys(json_text: &str, origin: &str) -> Result<Vec<(String, toml::Value)>, ConfigError> {
+    fn walk(prefix: &str, v: &toml::Value, out: &mut Vec<(String, toml::Value)>) {
+        match v {
+            toml::Value::Table(t) => t.iter().for_each(|(k, x)| walk(&format!("{prefix}.{k}"), x, out)),
+            leaf => out.push((prefix.to_owned(), leaf.clone())),
+        }
+    }
+    let mut out = Vec::new();
+    if let Some(part) = table_part(json_text, origin)? {
+        let value = toml::Value::try_from(&part).map_err(|e| ConfigError::Parse {
+            origin: origin.to_owned(),
+            message: format!("its estimated_compensation cannot be written as scenario keys ({e})"),
+        })?;
+        walk("compensation", &value, &mut out);
+    }
+    Ok(out)
+}
+
 /// The `estimated_compensation` of a calibration JSON (`rinscope calibrate --json`) as the table errors of
 /// `table`: its keys are `[compensation]`'s, and the table's own values fill what it leaves out.
 ///
@@ -132,19 +169,11 @@ pub fn compensation_from_calibration(
     origin: &str,
     has_imu: bool,
 ) -> Result<TableErrors, ConfigError> {
-    #[derive(Deserialize)]
-    struct WithCompensation {
-        estimated_compensation: Option<RawCompensation>,
-    }
-    let parsed: WithCompensation = serde_json::from_str(json_text).map_err(|e| ConfigError::Parse {
-        origin: origin.to_owned(),
-        message: format!("not a compensation document of `rinscope calibrate --json` or `selfcal --json` ({e})"),
-    })?;
     let c = Checker { origin };
     let turntable = table.turntable.clone().unwrap_or_else(RawTurntable::strapdown);
     let (chain, stated) = validate::turntable(&c, &turntable)?;
     let mut merged = table.compensation.clone();
-    let given = match parsed.estimated_compensation {
+    let given = match table_part(json_text, origin)? {
         Some(g) => g,
         None if has_imu => RawCompensation::default(),
         None => {

@@ -10,7 +10,7 @@ use crate::app::outputs::RecordingName;
 use crate::io::validity::{Range, check_number};
 use crate::record::APPLICATION_ID;
 use crate::record::sink::{self, SinkRequest};
-use crate::scenario::{self, presets};
+use crate::scenario::{self, Params, presets};
 
 /// `--speed`: simulated seconds per wall-clock second, > 0 and at most 10 000 (faster, a step's
 /// drawing no longer keeps up).
@@ -32,6 +32,9 @@ pub struct LiveRequest {
     pub no_viewer: bool,
     /// The slider panel, when stdin and stdout are a terminal.
     pub panel: bool,
+    /// A compensation document (its text and where it came from): its table part written into the
+    /// config's `[compensation]`, its IMU part removed from the INS's samples for the session.
+    pub compensation: Option<(String, String)>,
 }
 
 /// What a live session reports.
@@ -73,7 +76,10 @@ pub fn execute(req: &LiveRequest, stop: &Arc<AtomicBool>) -> Result<LiveReport, 
             path
         }
     };
-    let params = scenario::load_file(&path)?;
+    let params = match &req.compensation {
+        Some((text, origin)) => with_compensation(&path, text, origin)?,
+        None => scenario::load_file(&path)?,
+    };
     if let Some(s) = req.speed {
         check_number(s, &SPEED).map_err(|e| Failure::input(format!("--speed {e}")))?;
     }
@@ -230,4 +236,43 @@ pub fn execute(req: &LiveRequest, stop: &Arc<AtomicBool>) -> Result<LiveReport, 
         None => None,
     };
     Ok(LiveReport { summary: result?, recording: saved, exported, interrupted })
+}
+
+/// The session's parameters with a compensation document in force: its table part written into
+/// the config's `[compensation]` keys (one atomic write; the file stays the one place a session's
+/// table compensation is read from, so the sliders, the editor and "calibrate now" go on from it),
+/// its IMU part held by the INS for the whole session (like `[imu]`, it cannot change while the
+/// INS integrates in its frame). Checked against the scenario before anything is written.
+fn with_compensation(path: &std::path::Path, text: &str, origin: &str) -> Result<Params, Failure> {
+    let mut checked = scenario::load_file(path)?;
+    let notes = scenario::compensation::apply_to_scenario(&mut checked, text, origin)?;
+    let keys = scenario::compensation::table_keys(text, origin)?;
+    if !keys.is_empty() {
+        let writes: Vec<_> = keys
+            .iter()
+            .map(|(k, v)| {
+                let value = match v {
+                    toml::Value::Float(x) => super::edit::float(*x),
+                    toml::Value::Integer(i) => toml_edit::Value::from(*i),
+                    toml::Value::Boolean(b) => toml_edit::Value::from(*b),
+                    other => toml_edit::Value::from(other.to_string()),
+                };
+                (super::edit::KeyPath::parse(k), value)
+            })
+            .collect();
+        super::edit::set_many_in_file(path, &writes).map_err(|e| Failure::input(format!("--compensation: {e}")))?;
+        errln!(
+            "rinscope live: {origin}'s table compensation written into {}'s [compensation] ({} keys)",
+            path.display(),
+            keys.len()
+        );
+    }
+    let mut params = scenario::load_file(path)?;
+    if let (Some(ins), Some(checked)) = (params.ins.as_mut(), checked.ins.as_ref()) {
+        ins.imu_compensation = checked.imu_compensation;
+    }
+    for n in notes {
+        errln!("rinscope live: {n}");
+    }
+    Ok(params)
 }

@@ -106,7 +106,11 @@ pub fn set_in_text(text: &str, key: &KeyPath, value: Value) -> Result<String, St
             i += 2;
         } else {
             if current.get(k).is_none() {
-                current.insert(k, Item::Table(Table::new()));
+                // Implicit: a table that only holds tables gets no header of its own
+                // (`[compensation.axis.inner]`, not an empty `[compensation.axis]` above it).
+                let mut t = Table::new();
+                t.set_implicit(true);
+                current.insert(k, Item::Table(t));
             }
             table =
                 current.get_mut(k).and_then(Item::as_table_like_mut).ok_or_else(|| format!("`{k}` is not a table"))?;

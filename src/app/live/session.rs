@@ -190,6 +190,11 @@ impl LiveSim {
             // Once the INS has finished the updates in progress (at most a few samples).
             self.pending_rate_hz = Some(new.step_hz);
         }
+        // The IMU compensation (`live --compensation`) is the session's, not the file's: it stays.
+        let mut new = new;
+        if let (Some(n), Some(o)) = (new.ins.as_mut(), self.params.ins.as_ref()) {
+            n.imu_compensation = o.imu_compensation;
+        }
         self.params = new;
         self.since_change = ErrorStats::default();
         Ok(changes)

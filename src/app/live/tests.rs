@@ -429,3 +429,27 @@ fn calibrate_now_freezes_the_compensation_and_a_later_change_shows_in_the_compen
     let shown = compensated_after(&calibrated, &wider(&calibrated));
     assert!(shown > 10.0, "after calibrate now, a wider cone leaves only {shown}″ in the compensated curve");
 }
+
+#[test]
+fn a_reload_keeps_the_sessions_imu_compensation() {
+    // `live --compensation`: the IMU part is the session's, not the file's; a reload of the file
+    // (which has no IMU compensation) must not drop it.
+    const SELFCAL: &str = include_str!("../../../assets/scenarios/selfcal-nav-grade.toml");
+    let mut p = scenario::parse(SELFCAL, "test").expect("preset");
+    let errors = crate::ins::imu_errors::ImuErrors {
+        bg: nalgebra::Vector3::new(1e-7, 0.0, 0.0),
+        kg: nalgebra::Matrix3::zeros(),
+        ba: nalgebra::Vector3::zeros(),
+        ka: nalgebra::Matrix3::zeros(),
+    };
+    p.ins.as_mut().expect("an INS").imu_compensation = Some(errors);
+    let mut sim = LiveSim::new(p);
+    for _ in 0..10 {
+        sim.step();
+    }
+    let edited = SELFCAL.replacen("swing_half_angle_arcsec = 300.0", "swing_half_angle_arcsec = 450.0", 1);
+    let reloaded = scenario::parse(&edited, "test").expect("edited");
+    assert_eq!(reloaded.ins.as_ref().expect("an INS").imu_compensation, None);
+    assert_eq!(sim.apply(reloaded).expect("applied").len(), 1);
+    assert_eq!(sim.params.ins.as_ref().expect("an INS").imu_compensation, Some(errors));
+}
