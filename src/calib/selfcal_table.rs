@@ -32,6 +32,17 @@ use crate::model::scheme::{AxisValues, MAX_AXES};
 /// The most table states (four per axis).
 pub const MAX_TABLE: usize = 4 * MAX_AXES;
 
+/// The encoders at one instant: what the recording needs to draw where a table puts the IMU.
+#[derive(Debug, Clone, Copy)]
+pub struct ShaftSample {
+    /// Time from the sequence's first sample, s.
+    pub t_s: f64,
+    /// The readings, rad.
+    pub readings: AxisValues,
+    /// Their rates (the difference with the sample before), rad/s.
+    pub rates: AxisValues,
+}
+
 /// The table's part of the measurement Jacobian: Φ_b per state, body axes.
 pub type TableJacobian = SMatrix<f64, 3, MAX_TABLE>;
 
@@ -191,6 +202,14 @@ impl TableStates {
     pub fn b_from_s(&self, p: &[f64], readings: &AxisValues, rates: &AxisValues) -> UnitQuaternion<f64> {
         let rot = self.chain.error_rotations(&self.as_errors(p));
         *self.chain.b_from_s(&rot, &self.shaft_angles(p, readings, rates)).quaternion()
+    }
+
+    /// Where a table with states `p` puts the IMU, seen from where a table with states `reference`
+    /// does, at the same encoder readings: `log(C_s^b(reference)ᵀ · C_s^b(p))`, sensor axes, rad.
+    #[must_use]
+    pub fn offset(&self, reference: &[f64], p: &[f64], at: &ShaftSample) -> Vector3<f64> {
+        let from = self.b_from_s(reference, &at.readings, &at.rates).inverse();
+        rotvec::log(&(from * self.b_from_s(p, &at.readings, &at.rates)))
     }
 
     /// ∂Φ_b/∂p at `p`, body axes: each column the rotation a small change of one state makes in

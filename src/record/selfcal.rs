@@ -12,7 +12,10 @@ use super::blueprint::{self, Node};
 use super::palette::{self, rgb};
 use super::{APPLICATION_ID, Stream, TIMELINE, to_rerun_quaternion};
 use crate::calib::selfcal::{HistoryRow, ParamKind};
+use crate::calib::selfcal_table::{ShaftSample, TableStates};
 use crate::ins::trace::NavSample;
+use crate::math::rotvec;
+use crate::math::units::ARCSEC_PER_RAD;
 
 /// What the recording shows.
 pub struct SelfcalView<'a> {
@@ -32,9 +35,25 @@ pub struct SelfcalView<'a> {
     pub move_starts_s: &'a [f64],
     /// The IMU's attitude C_s^n, 1 Hz.
     pub attitude: &'a [(f64, UnitQuaternion<f64>)],
+    /// The table's states and its encoders, 1 Hz (None: the IMU alone).
+    pub tables: Option<TableGhosts<'a>>,
     /// What it buys: free-inertial runs (at rest and modulated × none, estimated, true).
     pub navigation: Vec<NavLine<'a>>,
 }
+
+/// Where each table puts the IMU, drawn beside it: the encoders' readings through the exact chain of
+/// the nominal table, of the table as the filter estimates it at each second, and of the true
+/// table (the reference: the IMU's own axes; on a log, with no truth, the final estimate).
+pub struct TableGhosts<'a> {
+    /// The table's states (the last of [`SelfcalView::names`]).
+    pub states: &'a TableStates,
+    /// The encoders, 1 Hz.
+    pub shafts: &'a [ShaftSample],
+}
+
+/// How far the drawing turns the ghosts at most: the nominal table's largest error is magnified to
+/// about this, rad (15°: seen at a glance, the axes still told apart).
+const GHOST_DRAWN_RAD: f64 = 15.0 * std::f64::consts::PI / 180.0;
 
 /// One free-inertial run of what the calibration buys.
 pub struct NavLine<'a> {
@@ -99,10 +118,18 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
     };
     let doc = format!(
         "# Self-calibration: {}\n\n**Plots**\n\n- top left: each parameter's 1σ over its prior σ0 in log10 (−2: a hundredfold), ▼ a move; {}\n{navigation}\
-         - tabs: each estimate{} inside its ±3σ band (grey)\n\ndocs/selfcal.md explains the filter and the sequences.\n\n{}",
+         - tabs: each estimate{} inside its ±3σ band (grey)\n{}\ndocs/selfcal.md explains the filter and the sequences.\n\n{}",
         v.title,
         line_key(),
         if v.truth.is_some() { " minus the truth" } else { "" },
+        if v.tables.is_some() {
+            format!(
+                "- 3D: the IMU's axes where the {} table puts it, and ghosts where the nominal table (orange) and the table as estimated at the time cursor (white) put it from the same encoder readings, their errors magnified (×F in the view's title), each labelled with its true size\n",
+                if v.truth.is_some() { "true" } else { "finally estimated" }
+            )
+        } else {
+            String::new()
+        },
         v.document
     );
     rec.log_static("docs/selfcal", &rerun::TextDocument::from_markdown(doc))?;
@@ -134,6 +161,7 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
                 .columns_of_unit_batches()?,
         )?;
     }
+    let ghosts = log_tables(stream, v)?;
     let t: Vec<f64> = v.history.iter().map(|r| r.t_s).collect();
     // The sequence's plots show the sequence (the free-inertial runs after it share the timeline).
     let seq_axis = blueprint::time_axis_range(0.0, t.last().copied().unwrap_or(1.0));
@@ -224,8 +252,15 @@ pub fn log(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<()> {
     let left = Node::container(
         ContainerKind::Vertical,
         vec![
-            Node::view("3D", "the IMU turning through the sequence (true attitude; the grid is level)", "world")
-                .with_property("EyeControls3D", &blueprint::eye([1.5, -1.7, 1.0], [0.0, 0.0, 0.0])),
+            Node::view(
+                "3D",
+                ghosts.map_or_else(
+                    || "the IMU turning through the sequence (true attitude; the grid is level)".to_owned(),
+                    |f| format!("the IMU; where the nominal (orange), estimated (white) table put it ×{f}"),
+                ),
+                "world",
+            )
+            .with_property("EyeControls3D", &blueprint::eye([1.5, -1.7, 1.0], [0.0, 0.0, 0.0])),
             Node::view("TextDocument", "result", "docs/selfcal"),
         ],
         &[1.0, 1.2],
@@ -309,4 +344,70 @@ fn log_navigation(stream: &Stream, lines: &[NavLine<'_>], motions: &[&str]) -> R
         }
     }
     Ok(plots)
+}
+
+/// The tables in 3D ([`TableGhosts`]): two ghosts of the IMU's axes under `world/imu`, turned by
+/// where the nominal and the estimated table put the IMU relative to the reference table, magnified.
+/// Returns the magnification (None: nothing drawn).
+fn log_tables(stream: &Stream, v: &SelfcalView<'_>) -> RecordingStreamResult<Option<f64>> {
+    let Some(g) = &v.tables else { return Ok(None) };
+    let (n, last) = (g.states.len(), v.history.last());
+    let Some(last) = last.filter(|_| !g.shafts.is_empty() && n > 0 && v.names.len() >= n) else { return Ok(None) };
+    let first = v.names.len() - n;
+    let reference: Vec<f64> = match &v.truth {
+        Some(t) => t[first..].to_vec(),
+        None => (0..n).map(|j| last.estimate_of(first + j)).collect(),
+    };
+    let nominal = vec![0.0; n];
+    // Each second: the reference table's C_s^b and each ghost's rotation from it, sensor axes.
+    let rows: Vec<(f64, [nalgebra::Vector3<f64>; 2])> = g
+        .shafts
+        .iter()
+        .map(|s| {
+            let row = &v.history[v.history.partition_point(|r| r.t_s <= s.t_s).saturating_sub(1)];
+            let estimated: Vec<f64> = (0..n).map(|j| row.estimate_of(first + j)).collect();
+            (s.t_s, [g.states.offset(&reference, &nominal, s), g.states.offset(&reference, &estimated, s)])
+        })
+        .collect();
+    let largest = rows.iter().map(|r| r.1[0].norm()).fold(0.0, f64::max);
+    if largest <= 0.0 {
+        return Ok(None);
+    }
+    let factor = crate::math::units::nice_at_most(GHOST_DRAWN_RAD / largest);
+    let rec = stream.rec();
+    let times: Vec<f64> = rows.iter().map(|r| r.0).collect();
+    for (i, (name, what)) in
+        [("nominal_table", "nominal table"), ("estimated_table", "estimated table")].into_iter().enumerate()
+    {
+        let path = format!("world/imu/{name}");
+        // Orange and white: apart from the IMU's own red, green and blue axes (white as
+        // `calibrate`'s estimated cones).
+        let colour = [palette::colors::DISTINCT[3].1, palette::colors::DISTINCT[8].1][i];
+        rec.log_static(
+            format!("{path}/axes"),
+            &rerun::Arrows3D::from_vectors([[0.5, 0.0, 0.0], [0.0, 0.5, 0.0], [0.0, 0.0, 0.5]])
+                .with_colors([rgb(colour)])
+                .with_radii([0.008]),
+        )?;
+        rec.send_columns(
+            path.as_str(),
+            stream.time_columns(&times),
+            rerun::Transform3D::update_fields()
+                .with_many_quaternion(rows.iter().map(|r| to_rerun_quaternion(&rotvec::exp(&(r.1[i] * factor)))))
+                .columns_of_unit_batches()?,
+        )?;
+        // Its true size, beside the IMU (the two labels one above the other, clear of its axes).
+        let labels = rows.iter().map(|r| format!("{what}: {:.1}″", r.1[i].norm() * ARCSEC_PER_RAD));
+        let tip = [0.25, -0.55, 0.5 - 0.14 * i as f32];
+        rec.log_static(
+            format!("{path}/axes/size"),
+            &rerun::Points3D::new([tip]).with_radii([0.002]).with_colors([palette::label(colour)]),
+        )?;
+        rec.send_columns(
+            format!("{path}/axes/size"),
+            stream.time_columns(&times),
+            rerun::Points3D::update_fields().with_labels(labels).columns_of_unit_batches()?,
+        )?;
+    }
+    Ok(Some(factor))
 }

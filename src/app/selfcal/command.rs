@@ -191,7 +191,7 @@ pub fn execute(req: &SelfcalRequest, stop: &AtomicBool) -> Result<SelfcalReport,
                 .as_ref()
                 .map(|r| r.open(RecordingName { name: &log.name, kind: Some("selfcal"), seed: None }))
                 .transpose()?;
-            let (estimate, estimation_s) = run_log(log, stop).map_err(|e| {
+            let super::Estimation { estimate, estimation_s, shafts } = run_log(log, stop).map_err(|e| {
                 if stop.load(Ordering::SeqCst) {
                     Failure::interrupted("nothing was estimated")
                 } else {
@@ -216,6 +216,11 @@ pub fn execute(req: &SelfcalRequest, stop: &AtomicBool) -> Result<SelfcalReport,
             if let Some(table) = super::table_compensation(&estimate, &seen.unobservable) {
                 document["estimated_compensation"] = table;
             }
+            // The table's states, if its encoders were read (the recording draws the tables).
+            let states = estimate
+                .table
+                .as_ref()
+                .and_then(|_| crate::calib::selfcal_table::TableStates::new(&log.table.chain).ok());
             let saved = match sinks {
                 Some(s) => {
                     let view = SelfcalView {
@@ -227,6 +232,9 @@ pub fn execute(req: &SelfcalRequest, stop: &AtomicBool) -> Result<SelfcalReport,
                         truth: None,
                         move_starts_s: &[],
                         attitude: &[],
+                        tables: states
+                            .as_ref()
+                            .map(|states| crate::record::selfcal::TableGhosts { states, shafts: &shafts }),
                         navigation: Vec::new(),
                     };
                     logged(crate::record::selfcal::log(&s.stream(), &view))?;

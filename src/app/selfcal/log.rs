@@ -4,9 +4,9 @@ use std::sync::atomic::AtomicBool;
 
 use anyhow::{Result, anyhow, bail};
 
-use super::{Reading, estimate, table_config};
+use super::{Estimation, Reading, estimate, table_config};
 use crate::app::playback::{ImuItem, ImuSamples};
-use crate::calib::selfcal::{self, Config, Estimate};
+use crate::calib::selfcal::{self, Config};
 use crate::model::earth::Earth;
 
 /// Self-calibrates the IMU of a logged sequence (a log set: its IMU file, site, rate and the
@@ -16,7 +16,7 @@ use crate::model::earth::Earth;
 ///
 /// # Errors
 /// An unreadable log, a gap, too short a log, interrupted.
-pub fn run_log(log: &crate::scenario::logset::LogSet, stop: &AtomicBool) -> Result<(Estimate, f64)> {
+pub fn run_log(log: &crate::scenario::logset::LogSet, stop: &AtomicBool) -> Result<Estimation> {
     let h = 1.0 / log.imu.rate_hz;
     let table = match &log.encoders {
         Some(_) if !log.table.strapdown => table_config(&log.table.chain, &log.table.stated).0,

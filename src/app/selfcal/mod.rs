@@ -148,6 +148,11 @@ impl Report {
             truth: Some(self.outcome.all_truth(&self.setup)),
             move_starts_s: &self.setup.move_starts_s,
             attitude: &self.outcome.attitude,
+            tables: self
+                .setup
+                .table_states
+                .as_ref()
+                .map(|t| crate::record::selfcal::TableGhosts { states: &t.states, shafts: &self.outcome.shafts }),
             navigation: self
                 .navigation
                 .iter()
@@ -259,6 +264,8 @@ pub struct Outcome {
     pub estimation_s: f64,
     /// The IMU's true attitude C_s^n once a second (the recording's 3D).
     pub attitude: Vec<(f64, nalgebra::UnitQuaternion<f64>)>,
+    /// The encoders once a second (the recording's tables in 3D).
+    pub shafts: Vec<ShaftSample>,
 }
 
 impl Outcome {
@@ -404,19 +411,30 @@ pub fn run_one(s: &Setup, seed: u64, ideal: bool, stop: &AtomicBool) -> Result<O
         let align: Vec<_> = (0..s.config.align_samples).map(&mut sample).collect();
         Ok((align, (s.config.align_samples..s.samples).map(move |k| Ok(sample(k)))))
     };
-    let (estimate, estimation_s) = estimate(s.config, s.table_states.clone(), open, stop)?;
+    let Estimation { estimate, estimation_s, shafts } = estimate(s.config, s.table_states.clone(), open, stop)?;
     let attitude = attitude.take();
     let truth_drawn = truth_drawn.take().ok_or_else(|| anyhow!("no sample was drawn"))?;
-    Ok(Outcome { estimate, truth_drawn, estimation_s, attitude })
+    Ok(Outcome { estimate, truth_drawn, estimation_s, attitude, shafts })
 }
 
 /// One sample: its increments and, with a table, the encoders' readings at its end, rad.
 pub type Reading = (crate::ins::align::Increment, Option<AxisValues>);
 
+pub use crate::calib::selfcal_table::ShaftSample;
+
+/// What [`estimate`] gives: the filter's result, its own wall time and the encoders once a second.
+pub struct Estimation {
+    /// The filter's result.
+    pub estimate: Estimate,
+    /// The estimation's own wall time (the samples' production is not counted), s.
+    pub estimation_s: f64,
+    /// The encoders once a second (empty without a table).
+    pub shafts: Vec<ShaftSample>,
+}
+
 /// The filter on the samples `open` gives (the first ones at rest, then the rest); with a table,
 /// twice: the second pass linearizes the table's states about the first's result
-/// ([`TableConfig::linearized_at`]). The estimation's own wall time (the samples' production is
-/// not counted), s.
+/// ([`TableConfig::linearized_at`]).
 ///
 /// # Errors
 /// Interrupted, an alignment that failed, or a sample `open` could not give.
@@ -425,14 +443,14 @@ pub fn estimate<I: Iterator<Item = Result<Reading>>>(
     table: Option<TableConfig>,
     mut open: impl FnMut() -> Result<(Vec<Reading>, I)>,
     stop: &AtomicBool,
-) -> Result<(Estimate, f64)> {
+) -> Result<Estimation> {
     let (align, rest) = open()?;
-    let (first, wall) = one_pass(config, table.clone(), &align, rest, stop)?;
-    let (Some(mut table), Some(found)) = (table, first.table.as_ref()) else { return Ok((first, wall)) };
+    let first = one_pass(config, table.clone(), &align, rest, stop)?;
+    let (Some(mut table), Some(found)) = (table, first.estimate.table.as_ref()) else { return Ok(first) };
     table.linearized_at.clone_from(&found.params);
     let (align, rest) = open()?;
-    let (second, more) = one_pass(config, Some(table), &align, rest, stop)?;
-    Ok((second, wall + more))
+    let second = one_pass(config, Some(table), &align, rest, stop)?;
+    Ok(Estimation { estimation_s: first.estimation_s + second.estimation_s, ..second })
 }
 
 /// One pass of the filter.
@@ -442,7 +460,7 @@ fn one_pass(
     align: &[Reading],
     rest: impl Iterator<Item = Result<Reading>>,
     stop: &AtomicBool,
-) -> Result<(Estimate, f64)> {
+) -> Result<Estimation> {
     let increments: Vec<_> = align.iter().map(|r| r.0).collect();
     let mut filter = SelfCal::new(config, table, &increments).ok_or_else(|| {
         anyhow!(
@@ -460,6 +478,23 @@ fn one_pass(
         push(&mut filter, m);
     }
     estimation += started.elapsed();
+    // The encoders once a second, for the recording (outside the estimation's time).
+    let per_second = (1.0 / config.h).round().max(1.0) as usize;
+    let mut shafts = Vec::new();
+    let (mut k, mut previous) = (0_usize, None::<AxisValues>);
+    let mut see = |readings: &Option<AxisValues>| {
+        k += 1;
+        if let Some(r) = readings {
+            if k.is_multiple_of(per_second)
+                && let Some(p) = previous
+            {
+                let rates = std::array::from_fn(|i| (r[i] - p[i]) / config.h);
+                shafts.push(ShaftSample { t_s: k as f64 * config.h, readings: *r, rates });
+            }
+            previous = Some(*r);
+        }
+    };
+    align.iter().for_each(|m| see(&m.1));
     let mut buffer = Vec::with_capacity(8192);
     let mut rest = rest.peekable();
     while rest.peek().is_some() {
@@ -475,8 +510,9 @@ fn one_pass(
             push(&mut filter, m);
         }
         estimation += started.elapsed();
+        buffer.iter().for_each(|m| see(&m.1));
     }
-    Ok((filter.finish(), estimation.as_secs_f64()))
+    Ok(Estimation { estimate: filter.finish(), estimation_s: estimation.as_secs_f64(), shafts })
 }
 
 /// One free-inertial run of the comparison.
