@@ -79,6 +79,48 @@ fn a_parked_log_read_with_no_option_navigates_with_its_alignment_estimates() {
     );
     assert!(drift < of_residual, "{drift} m");
     assert!(drift < 0.3 * of_estimate, "{drift} m against the estimate's {of_estimate} m");
+    // The alignment writes the one compensation document too: the summary's
+    // estimated_imu_compensation holds its biases (each with its 1σ, the gains named not
+    // compensated), and a replay given it aligns on the compensated IMU and finds nothing left.
+    let doc = &s["estimated_imu_compensation"];
+    assert_eq!(doc["accel_bias_ug"], al["accel_bias_ug"], "{doc}");
+    assert_eq!(doc["sigma"]["accel_bias_ug"], al["accel_bias_sigma_ug"], "{doc}");
+    assert!(doc["not_compensated"].to_string().contains("gains"), "{doc}");
+    let out = rinscope()
+        .arg("replay")
+        .arg("--imu")
+        .arg(&imu)
+        .args([
+            "--position",
+            "34",
+            "0",
+            "0",
+            "--save",
+            "r2.rrd",
+            "--summary-json",
+            "s2.json",
+            "--compensation",
+            "s.json",
+        ])
+        .current_dir(&dir)
+        .output()
+        .expect("runs");
+    assert!(out.status.success(), "{}", stderr(&out));
+    let s2: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("s2.json")).expect("summary")).expect("json");
+    assert!(s2["notes"].to_string().contains("the IMU is compensated with s.json's estimates"), "{}", s2["notes"]);
+    // What the second alignment finds is within 3σ of zero (the data are the same: the residual of
+    // a bias it already removed), and the document it writes carries the first one's on top.
+    let (again, sigma) = (&s2["alignment"]["accel_bias_ug"], &s2["alignment"]["accel_bias_sigma_ug"]);
+    for i in 0..3 {
+        let (r, sg) = (again[i].as_f64().expect("bias"), sigma[i].as_f64().expect("1σ"));
+        assert!(r.abs() < 3.0 * sg, "residual accelerometer bias {i}: {r} µg (1σ {sg})");
+        let (first, total) = (
+            doc["accel_bias_ug"][i].as_f64().expect("first"),
+            s2["estimated_imu_compensation"]["accel_bias_ug"][i].as_f64().expect("total"),
+        );
+        assert!((total - first - r).abs() < 1e-6 * first.abs().max(1.0), "{total} vs {first} + {r}");
+    }
 }
 
 #[test]

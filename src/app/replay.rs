@@ -41,6 +41,11 @@ pub struct ReplaySummary {
     /// The alignment, when the INS was aligned on the data.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub alignment: Option<AlignmentReport>,
+    /// What the alignment estimated as a compensation document's IMU part (its biases, folded into
+    /// the IMU compensation the replay was given, if any): `--summary-json` is then a compensation
+    /// document `run`, `replay` and `live` read (`--compensation`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub estimated_imu_compensation: Option<crate::scenario::compensation::RawImuCompensation>,
     /// What was said once about the data (a reference that starts late, a trimmed span, ...).
     pub notes: Vec<String>,
     /// IMU samples replayed (after the pre-roll / alignment).
@@ -431,6 +436,10 @@ pub fn replay(
         strapdown,
         t0_file_clock_s: pb.file_time_s(0.0),
         alignment: pb.alignment.clone(),
+        estimated_imu_compensation: pb
+            .alignment
+            .as_ref()
+            .map(|a| alignment_compensation(a, log.imu_compensation.as_ref())),
         notes: pb.notes.clone(),
         compared_updates: compared,
         samples: pb.samples,
@@ -557,4 +566,37 @@ pub fn execute(
         write_json("--summary-json", path, &summary)?;
     }
     Ok(ReplayReport { summary, saved })
+}
+
+/// The alignment's biases as a compensation document's IMU part: on top of `given` (the IMU
+/// compensation the replay applied, whose samples the alignment saw) when there was one. The gains
+/// an alignment at rest does not estimate are the given ones, or zero and named not compensated;
+/// the 1σ are the alignment's for the biases (stated only without a given compensation, whose own
+/// 1σ the replay does not know; a gain's is then 0: not estimated).
+fn alignment_compensation(
+    a: &AlignmentReport,
+    given: Option<&crate::ins::imu_errors::ImuErrors>,
+) -> crate::scenario::compensation::RawImuCompensation {
+    use crate::ins::imu_errors::ImuErrors;
+    use crate::math::units::{MPS2_PER_UG, RAD_PER_S_PER_DEG_PER_H};
+    let v = |x: [f64; 3], unit: f64| nalgebra::Vector3::from(x) * unit;
+    let found = ImuErrors::biases(v(a.gyro_bias_deg_per_h, RAD_PER_S_PER_DEG_PER_H), v(a.accel_bias_ug, MPS2_PER_UG));
+    match given {
+        Some(g) => crate::scenario::compensation::RawImuCompensation::from_errors(
+            &g.with_residual_biases(&found.bg, &found.ba),
+            None,
+            Vec::new(),
+        ),
+        None => {
+            let sigma = ImuErrors::biases(
+                v(a.gyro_bias_sigma_deg_per_h, RAD_PER_S_PER_DEG_PER_H),
+                v(a.accel_bias_sigma_ug, MPS2_PER_UG),
+            );
+            crate::scenario::compensation::RawImuCompensation::from_errors(
+                &found,
+                Some(&sigma),
+                vec!["gyro gains (Kg)".to_owned(), "accelerometer gains (Ka)".to_owned()],
+            )
+        }
+    }
 }

@@ -110,6 +110,14 @@ impl ImuErrors {
         Self { bg, kg: Matrix3::zeros(), ba, ka: Matrix3::zeros() }
     }
 
+    /// These errors with biases `bg`, `ba` found on the samples they compensated (an alignment's on
+    /// a compensated replay) folded in: measured = (I + K)(true + δb) + b, so b' = b + (I + K)·δb.
+    #[must_use]
+    pub fn with_residual_biases(&self, bg: &Vector3<f64>, ba: &Vector3<f64>) -> Self {
+        let one = Matrix3::identity();
+        Self { bg: self.bg + (one + self.kg) * bg, kg: self.kg, ba: self.ba + (one + self.ka) * ba, ka: self.ka }
+    }
+
     /// The same IMU described in the frame its accelerometer triad defines (K_a upper
     /// triangular): both gains change by the same small rotation [ρ×] (the rest is the IMU's
     /// attitude, which no calibration on the IMU's own motion can tell from the errors).
@@ -185,5 +193,20 @@ mod tests {
         assert_eq!((e.kg[(0, 0)], e.ka[(1, 1)]), (kg[(0, 0)], ka[(1, 1)]));
         let p = e.to_params();
         assert_eq!(ImuErrors::from_params(&p), e);
+    }
+
+    #[test]
+    fn residual_biases_fold_into_one_compensation() {
+        // Compensating with e, then removing biases found on what that left, is compensating once
+        // with e.with_residual_biases: checked on a sample, not on the formula.
+        let kg = Matrix3::new(2e-4, 1e-5, 0.0, -3e-5, 1e-4, 2e-5, 0.0, 4e-5, -2e-4);
+        let ka = Matrix3::new(1e-4, 2e-5, 3e-5, 0.0, -1e-4, 6e-5, 0.0, 0.0, 5e-5);
+        let e = ImuErrors { bg: Vector3::new(1e-6, -2e-6, 3e-7), kg, ba: Vector3::new(1e-3, 2e-4, -5e-4), ka };
+        let (dg, da) = (Vector3::new(3e-7, 1e-7, -2e-7), Vector3::new(-2e-4, 1e-4, 3e-5));
+        let (h, m) = (0.01, (Vector3::new(0.01, -0.02, 0.003), Vector3::new(0.05, 0.02, 0.098)));
+        let once = e.compensate(&m, h);
+        let twice = ImuErrors::biases(dg, da).compensate(&once, h);
+        let folded = e.with_residual_biases(&dg, &da).compensate(&m, h);
+        assert!((twice.0 - folded.0).norm() < 1e-17 && (twice.1 - folded.1).norm() < 1e-16, "{twice:?} {folded:?}");
     }
 }
