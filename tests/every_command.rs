@@ -73,6 +73,14 @@ const CASES: &[Case] = &[
         after: Duration::from_millis(2500),
     },
     Case {
+        name: "selfcal-shard-estimating",
+        args: &["selfcal", "--monte-carlo", "10000", "--shard", "1/4", "--no-recording", "--json", "{dir}/sh.json"],
+        document: None,
+        says_interrupted: false,
+        begun: None,
+        after: Duration::from_millis(1500),
+    },
+    Case {
         name: "montecarlo",
         args: &["montecarlo", "--runs", "100000", "--json", "{dir}/mc.json"],
         document: Some("mc.json"),
