@@ -81,6 +81,14 @@ const CASES: &[Case] = &[
         after: Duration::from_millis(1500),
     },
     Case {
+        name: "sweep",
+        args: &["sweep", "--scenario", "rotation-modulation-16-position", "--seeds", "64", "--json", "{dir}/sw.json"],
+        document: Some("sw.json"),
+        says_interrupted: true,
+        begun: None,
+        after: Duration::from_millis(1500),
+    },
+    Case {
         name: "montecarlo",
         args: &["montecarlo", "--runs", "100000", "--json", "{dir}/mc.json"],
         document: Some("mc.json"),

@@ -169,6 +169,39 @@ def montecarlo(scenario: Any = None, runs: int | None = None, eta_measured_sigma
     return Result("montecarlo", summary, Tables([], {"runs": per_run, "rows": rows}), None)
 
 
+def sweep(scenario: Any = None, vary: dict | None = None, seeds: int = 1, duration_s: float | None = None,
+          threads: int | None = None) -> Result:
+    """A scenario over a grid, in parallel on every core (``rinscope sweep``): ``vary`` maps scenario
+    keys to their values (``{"turntable.axis[1].swing_half_angle_arcsec": [0, 300, 600]}``; several
+    keys: every combination), ``seeds`` consecutive seeds from the scenario's at every point, every
+    point a whole run without a recording. ``summary`` is ``sweep --json``'s; ``series["points"]``
+    one row per run: the varied values, the seed, and every RMS and peak of its summary
+    (``uncompensated heading rms_arcsec``, ``ins two-sample heading peak_arcsec``, ``peak_radial_m``)."""
+    import pandas as pd
+
+    pairs = [(str(k), [float(x) for x in v]) for k, v in (vary or {}).items()]
+    summary = _json.loads(_rinscope.sweep(_toml(scenario, DEFAULT_SCENARIO), pairs, seeds, duration_s, threads))
+    rows = []
+    for p in summary["points"]:
+        row = {k: v for k, v in p["values"]}
+        row["seed"] = p["seed"]
+        s = p["summary"]
+        for variant, axes in s.get("attitude_error_arcsec", {}).items():
+            for axis, stat in axes.items():
+                for name, v in stat.items():
+                    row[f"{variant} {axis} {name}"] = v
+        for alg, axes in (s.get("ins_attitude_error_arcsec") or {}).items():
+            for axis, stat in axes.items():
+                for name, v in stat.items():
+                    row[f"ins {alg} {axis} {name}"] = v
+        nav = s.get("navigation") or {}
+        for name in ("peak_radial_m", "final_radial_m"):
+            if name in nav:
+                row[name] = nav[name]
+        rows.append(row)
+    return Result("sweep", summary, Tables([], {"points": pd.DataFrame(rows)}), None)
+
+
 def selfcal(scenario: Any = None, sequence: str = "dual-axis-29", monte_carlo: int | None = None, navigate_hours: float = 24.0,
             save: str | os.PathLike | None = None) -> Result:
     """Self-calibrates a scenario's IMU on its own gimbals (default scenario: selfcal-nav-grade;

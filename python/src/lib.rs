@@ -427,6 +427,55 @@ fn montecarlo(
     Ok(json)
 }
 
+/// A scenario (its TOML text) over a grid: `vary` pairs of a scenario key and its values, `seeds`
+/// consecutive seeds at every point, every point a whole run without a recording, in parallel on
+/// `threads` (None: every core): the document `sweep --json` writes.
+#[pyfunction]
+#[pyo3(signature = (toml, vary, seeds=1, duration_s=None, threads=None))]
+fn sweep(
+    py: Python<'_>,
+    toml: &str,
+    vary: Vec<(String, Vec<f64>)>,
+    seeds: u64,
+    duration_s: Option<f64>,
+    threads: Option<usize>,
+) -> PyResult<String> {
+    use rinscope::app::sweep::{SweepRequest, execute};
+    let params = parse(toml, "the scenario")?;
+    if seeds == 0 || threads == Some(0) {
+        return Err(PyValueError::new_err("sweep: seeds and threads must be at least 1"));
+    }
+    for (key, values) in &vary {
+        if values.is_empty() || values.iter().any(|v| !v.is_finite()) {
+            return Err(PyValueError::new_err(format!("sweep: {key}: give finite values, at least one")));
+        }
+    }
+    let duration_s = duration_s
+        .map(|d| scenario::check_duration(d).map_err(|e| PyValueError::new_err(format!("duration_s {e}"))))
+        .transpose()?;
+    let request = SweepRequest {
+        params,
+        vary,
+        seeds,
+        duration_s,
+        threads,
+        json: None,
+        shard: rinscope::calib::montecarlo::Shard::WHOLE,
+    };
+    let json = interruptible(py, move |stop| -> Result<String, Failure> {
+        let report = execute(&request, stop)?;
+        if report.interrupted {
+            return Err(Failure::Interrupted(format!(
+                "sweep: stopped after {} of {} runs",
+                report.points.len(),
+                report.planned
+            )));
+        }
+        serde_json::to_string(&report).map_err(|e| Failure::Run(e.to_string()))
+    })??;
+    Ok(json)
+}
+
 /// Self-calibrates the IMU of a scenario (its TOML text) on its own gimbals through `sequence`
 /// (`dual-axis-29`, `positions-19`, `azimuth-only`, `scenario`), with `monte_carlo` runs and
 /// `navigate_hours` of free-inertial comparison (0: none): the document `selfcal --json` writes
@@ -506,6 +555,7 @@ fn _rinscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(allan, m)?)?;
     m.add_function(wrap_pyfunction!(montecarlo, m)?)?;
     m.add_function(wrap_pyfunction!(selfcal, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(verify_recording, m)?)?;
     m.add_function(wrap_pyfunction!(write_atomically, m)?)?;
     m.add_function(wrap_pyfunction!(cli, m)?)?;

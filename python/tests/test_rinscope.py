@@ -420,6 +420,27 @@ def test_montecarlo_refuses_zero_runs():
         rinscope.montecarlo(runs=0)
 
 
+# --- sweep -----------------------------------------------------------------------------------------
+
+
+def test_sweep_points_are_the_runs_of_their_scenarios():
+    key = "turntable.axis[1].swing_half_angle_arcsec"
+    r = rinscope.sweep(vary={key: [0, 600]}, duration_s=60, threads=2)
+    points = r["points"]
+    assert list(points[key]) == [0.0, 600.0] and r.summary["threads"] == 2
+    for value, row in zip((0, 600), points.to_dict("records")):
+        s = rinscope.load("jiang2017-dual-axis")
+        s.turntable.axis["inner"].swing_half_angle_arcsec = value
+        alone = rinscope.run(s, duration_s=60)
+        want = alone.summary["attitude_error_arcsec"]["uncompensated"]["heading"]["rms_arcsec"]
+        assert row["uncompensated heading rms_arcsec"] == want
+
+
+def test_sweep_refuses_a_key_the_scenario_cannot_take():
+    with pytest.raises(ValueError, match="swing_half_angle_arcsex"):
+        rinscope.sweep(vary={"turntable.axis[1].swing_half_angle_arcsex": [1]}, duration_s=10)
+
+
 # --- selfcal ---------------------------------------------------------------------------------------
 
 

@@ -18,5 +18,6 @@ pub mod replay;
 pub mod reproduce;
 pub mod run;
 pub mod selfcal;
+pub mod sweep;
 pub mod terminate;
 pub mod tpr;

@@ -75,7 +75,7 @@ impl InsStats {
 }
 
 /// RMS and peak of one component, arcsec.
-#[derive(Debug, Clone, Copy, Serialize)]
+#[derive(Debug, Clone, Copy, Serialize, serde::Deserialize)]
 pub struct RmsPeak {
     /// Root mean square, arcsec.
     pub rms_arcsec: f64,
@@ -84,7 +84,7 @@ pub struct RmsPeak {
 }
 
 /// The result of a run, as printed and as written by `--summary-json`.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, serde::Deserialize)]
 pub struct RunSummary {
     /// Scenario name.
     pub scenario: String,
@@ -125,7 +125,7 @@ pub struct RunSummary {
 }
 
 /// Navigation errors of a run.
-#[derive(Debug, Clone, Copy, Serialize)]
+#[derive(Debug, Clone, Copy, Serialize, serde::Deserialize)]
 pub struct NavSummary {
     /// Largest radial position error, m.
     pub peak_radial_m: f64,

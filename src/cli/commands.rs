@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use super::{
     CalibrateArgs, Failure, LiveArgs, ModulationArgs, MonteCarloAction, MonteCarloArgs, RunArgs, ScenarioSource,
-    TprArgs,
+    SweepArgs, TprArgs,
 };
 use crate::app::outputs::read_small_file;
 use crate::app::terminate::stop_flag;
@@ -235,6 +235,36 @@ pub(super) fn tpr(args: &TprArgs) -> Result<(), Failure> {
     }
     if report.interrupted {
         return Err(Failure::interrupted("the recording holds what was simulated until then"));
+    }
+    Ok(())
+}
+
+/// `rinscope sweep`.
+pub(super) fn sweep(args: &SweepArgs) -> Result<(), Failure> {
+    use crate::app::sweep::{SweepRequest, execute, merge};
+    if !args.merge.is_empty() {
+        out!("{}", merge(&args.merge, args.json.as_deref())?.text());
+        return Ok(());
+    }
+    if args.vary.is_empty() && args.seeds == 1 {
+        return Err(Failure::input("sweep: nothing to sweep: give --vary KEY=V1,V2,... or --seeds N"));
+    }
+    let request = SweepRequest {
+        params: args.source.load(presets::DEFAULT_SCENARIO)?,
+        vary: args.vary.clone(),
+        seeds: args.seeds,
+        duration_s: args.duration_s,
+        threads: args.threads.map(|t| t as usize),
+        json: args.json.clone(),
+        shard: match &args.shard {
+            Some(text) => Shard::parse(text).map_err(|e| Failure::input(format!("--shard {e}")))?,
+            None => Shard::WHOLE,
+        },
+    };
+    let report = execute(&request, &stop_flag())?;
+    out!("{}", report.text());
+    if report.interrupted {
+        return Err(Failure::interrupted("the points run before it are in the table"));
     }
     Ok(())
 }

@@ -73,6 +73,9 @@ enum Command {
     /// Jiang et al. 2017's Monte Carlo (Tables 2-3): many calibrations with drawn parameters, in parallel
     /// (default scenario: jiang2017-calibration).
     Montecarlo(MonteCarloArgs),
+    /// A scenario over a grid of parameter values (and seeds): every point a whole `run` without
+    /// a recording, in parallel on every core; a table of what each gives, and the cost of 1000.
+    Sweep(SweepArgs),
     /// Zheng et al. 2016's Twice Position-fix Reset against the conventional reset, from one IMU stream
     /// (default scenario: zheng2016-tpr; needs [imu], [navigation] and two [position_fix] times).
     Tpr(TprArgs),
@@ -530,6 +533,35 @@ struct TprArgs {
 }
 
 #[derive(Args)]
+struct SweepArgs {
+    // Default jiang2017-dual-axis (the default scenario).
+    #[command(flatten)]
+    source: ScenarioSource,
+    /// KEY=V1,V2,...: a scenario key and its values (e.g. turntable.axis[1].swing_half_angle_arcsec=0,300,600);
+    /// repeated, the grid is every combination.
+    #[arg(long = "vary", value_name = "KEY=V1,V2,...", value_parser = crate::app::sweep::parse_vary)]
+    vary: Vec<(String, Vec<f64>)>,
+    /// Also this many consecutive seeds from the scenario's at every point.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=100_000))]
+    seeds: u64,
+    /// Override every run's simulated duration, s.
+    #[arg(long, allow_negative_numbers = true, value_parser = duration_s)]
+    duration_s: Option<f64>,
+    /// Threads (default: every core).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=4096))]
+    threads: Option<u64>,
+    /// Write every point's values and run summary as JSON.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Only the runs whose index is K modulo M (a cluster's array job; needs --json), for --merge.
+    #[arg(long, value_name = "K/M", requires = "json")]
+    shard: Option<String>,
+    /// Merge the shards' JSON files into the whole sweep (with --json: its document).
+    #[arg(long, value_name = "FILES", num_args = 1.., conflicts_with_all = ["vary", "shard", "scenario", "config"])]
+    merge: Vec<PathBuf>,
+}
+
+#[derive(Args)]
 struct SelfcalArgs {
     // Default selfcal-nav-grade.
     #[command(flatten)]
@@ -600,6 +632,7 @@ where
         Command::Calibrate(args) => commands::calibrate(&args),
         Command::Montecarlo(args) => commands::montecarlo(&args),
         Command::Tpr(args) => commands::tpr(&args),
+        Command::Sweep(args) => commands::sweep(&args),
         Command::Selfcal(args) => selfcal::selfcal(&args),
         Command::Events { file } => commands::events(&file),
         Command::ExportLog(args) => logs::export_log(&args),
