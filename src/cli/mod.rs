@@ -542,13 +542,13 @@ struct SweepArgs {
     #[arg(long = "vary", value_name = "KEY=V1,V2,...", value_parser = crate::app::sweep::parse_vary)]
     vary: Vec<(String, Vec<f64>)>,
     /// Also this many consecutive seeds from the scenario's at every point.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=100_000))]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     seeds: u64,
     /// Override every run's simulated duration, s.
     #[arg(long, allow_negative_numbers = true, value_parser = duration_s)]
     duration_s: Option<f64>,
     /// Threads (default: every core).
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=4096))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(1..=4096))]
     threads: Option<u64>,
     /// Write every point's values and run summary as JSON.
     #[arg(long)]
