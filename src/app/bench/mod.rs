@@ -135,7 +135,7 @@ fn recorded_runs(dir: &std::path::Path, figs: &mut Figures, stop: &AtomicBool) -
         figs.add(format!("recorded run 1 h/{name}/wall"), secs, "s");
         figs.add(format!("recorded run 1 h/{name}/size"), bytes as f64 / 1e6, "MB/h");
         outln!(
-            "recorded 1 h      {name:<32} {:6.2} MB per simulated hour (target <= 30); {} steps at {} Hz in {secs:.2} s (series {} Hz, scene {} Hz)",
+            "recorded 1 h      {name:<32} {:6.2} MB per simulated hour (issue 33: <= 10); {} steps at {} Hz in {secs:.2} s (series {} Hz, scene {} Hz)",
             bytes as f64 / 1e6,
             summary.steps,
             p.step_hz,

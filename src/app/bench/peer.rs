@@ -441,13 +441,13 @@ pub fn text(reports: &[StreamReport]) -> String {
         ));
         let ratio = |x: Spread| format!("{:.1}x [{:.1}, {:.1}]", x.median, x.min, x.max);
         s.push_str(&format!(
-            "  speed: pyins kernel / rinscope replay process {} (target >= 3x); pyins pipeline / rinscope replay process {} (target >= 10x); whole processes {}\n",
+            "  speed: pyins kernel / rinscope replay process {} (issue 33: >= 5x); pyins pipeline / rinscope replay process {} (target >= 10x); whole processes {}\n",
             ratio(r.ratio_kernel),
             ratio(r.ratio_pipeline),
             ratio(r.ratio_pipeline_process)
         ));
         s.push_str(&format!(
-            "  speed: pyins kernel / rinscope INS pipeline with its own exact IMU truth {} (target >= 3x); / rinscope run process (+ error statistics at every update, the table, the recording) {}\n",
+            "  speed: pyins kernel / rinscope INS pipeline with its own exact IMU truth {} (issue 13: >= 3x); / rinscope run process (+ error statistics at every update, the table, the recording) {} (issue 33: >= 3x)\n",
             ratio(r.ratio_pipeline_kernel),
             ratio(r.ratio_run_kernel)
         ));
