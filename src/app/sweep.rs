@@ -303,7 +303,6 @@ pub fn merge(files: &[std::path::PathBuf], json: Option<&std::path::Path>) -> Re
     let Some((_, first)) = reports.first() else { return Err(Failure::input("--merge: no shard files given")) };
     let (scenario, grid, count, planned) =
         (first.scenario.clone(), first.grid.clone(), first.shard.count, first.planned);
-    let mut seen = vec![false; count as usize];
     for (f, r) in &reports {
         let bad = |why: String| Failure::input(format!("--merge {}: {why}", f.display()));
         if r.scenario != scenario || r.grid != grid || r.planned != planned || r.shard.count != count {
@@ -315,14 +314,9 @@ pub fn merge(files: &[std::path::PathBuf], json: Option<&std::path::Path>) -> Re
         if r.interrupted {
             return Err(bad("an interrupted shard: run it again".to_owned()));
         }
-        let k = r.shard.index as usize;
-        if std::mem::replace(&mut seen[k], true) {
-            return Err(bad(format!("shard {k}/{count} given twice")));
-        }
     }
-    if let Some(k) = seen.iter().position(|s| !s) {
-        return Err(Failure::input(format!("--merge: shard {k}/{count} is missing")));
-    }
+    Shard::check_cover(reports.iter().map(|(_, r)| r.shard), count)
+        .map_err(|e| Failure::input(format!("--merge: {e}")))?;
     let threads = reports.iter().map(|(_, r)| r.threads).sum();
     let wall_s = reports.iter().map(|(_, r)| r.wall_s).fold(0.0, f64::max);
     let mut points: Vec<SweepPoint> = reports.into_iter().flat_map(|(_, r)| r.points).collect();

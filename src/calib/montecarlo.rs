@@ -220,6 +220,27 @@ impl Shard {
         Ok(Self { index: k, count: m })
     }
 
+    /// That `shards` (all of one count) are every slice once: the first given twice, else the first
+    /// missing, is the error — what every merge of shards (`montecarlo`, `selfcal`, `sweep`) refuses.
+    ///
+    /// # Errors
+    /// A slice of another count, "shard K/M is given twice", or "shard K/M is missing".
+    pub fn check_cover(shards: impl IntoIterator<Item = Self>, count: u64) -> Result<(), String> {
+        let mut seen = vec![false; count as usize];
+        for s in shards {
+            if s.count != count || s.index >= count {
+                return Err(format!("shard {}/{} is not a slice of {count}", s.index, s.count));
+            }
+            if std::mem::replace(&mut seen[s.index as usize], true) {
+                return Err(format!("shard {}/{count} is given twice", s.index));
+            }
+        }
+        match seen.iter().position(|s| !s) {
+            Some(k) => Err(format!("shard {k}/{count} is missing")),
+            None => Ok(()),
+        }
+    }
+
     /// The run indices of this slice of `runs`.
     #[must_use]
     pub fn indices(&self, runs: u64) -> Vec<u64> {
@@ -390,7 +411,6 @@ pub fn merge(setup: &Setup<'_>, files: &[ShardFile]) -> Result<Summary, MergeErr
     };
     let count = first.shard.count;
     let runs_requested = first.summary.runs_requested;
-    let mut seen = vec![false; count as usize];
     let mut wall_s = 0.0f64;
     let mut done: Vec<RunErrors> = Vec::new();
     for f in files {
@@ -421,11 +441,6 @@ pub fn merge(setup: &Setup<'_>, files: &[ShardFile]) -> Result<Summary, MergeErr
                 s.scenario, s.seed, setup.scenario, setup.seed
             )));
         }
-        let slot = &mut seen[f.shard.index as usize];
-        if *slot {
-            return Err(MergeError::Mismatch(format!("shard {}/{count} is given twice", f.shard.index)));
-        }
-        *slot = true;
         if f.runs.len() != f.shard.indices(runs_requested as u64).len() {
             return Err(MergeError::Mismatch(format!(
                 "shard {}/{count} holds {} of its {} runs (interrupted?)",
@@ -437,9 +452,7 @@ pub fn merge(setup: &Setup<'_>, files: &[ShardFile]) -> Result<Summary, MergeErr
         wall_s = wall_s.max(s.wall_s);
         done.extend(f.runs.iter().cloned());
     }
-    if let Some(missing) = seen.iter().position(|s| !s) {
-        return Err(MergeError::Mismatch(format!("shard {missing}/{count} is missing")));
-    }
+    Shard::check_cover(files.iter().map(|f| f.shard), count).map_err(MergeError::Mismatch)?;
     done.sort_by_key(|r| r.index);
     Ok(summarize(setup, runs_requested, &done, wall_s))
 }

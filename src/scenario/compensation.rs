@@ -105,33 +105,32 @@ impl RawImuCompensation {
     }
 }
 
+/// A compensation document's two parts, as `calibrate --json` (the table's) and `selfcal --json`
+/// (both) write them; anything else in the file is not read.
+#[derive(Deserialize)]
+struct Document {
+    estimated_compensation: Option<RawCompensation>,
+    estimated_imu_compensation: Option<RawImuCompensation>,
+}
+
+fn parse_document(json_text: &str, origin: &str) -> Result<Document, ConfigError> {
+    serde_json::from_str(json_text).map_err(|e| ConfigError::Parse {
+        origin: origin.to_owned(),
+        message: format!("not a compensation document of `rinscope calibrate --json` or `selfcal --json` ({e})"),
+    })
+}
+
 /// The IMU compensation of a compensation document (`selfcal --json`), if it has one.
 ///
 /// # Errors
 /// Not JSON, or an `estimated_imu_compensation` with a bad number.
 pub fn from_document(json_text: &str, origin: &str) -> Result<Option<ImuErrors>, ConfigError> {
-    #[derive(Deserialize)]
-    struct Document {
-        estimated_imu_compensation: Option<RawImuCompensation>,
-    }
-    let doc: Document = serde_json::from_str(json_text).map_err(|e| ConfigError::Parse {
-        origin: origin.to_owned(),
-        message: format!("not a compensation document of `rinscope calibrate --json` or `selfcal --json` ({e})"),
-    })?;
-    doc.estimated_imu_compensation.map(|c| c.validate(origin)).transpose()
+    parse_document(json_text, origin)?.estimated_imu_compensation.map(|c| c.validate(origin)).transpose()
 }
 
 /// The document's table part (`estimated_compensation`), if it has one.
 fn table_part(json_text: &str, origin: &str) -> Result<Option<RawCompensation>, ConfigError> {
-    #[derive(Deserialize)]
-    struct WithCompensation {
-        estimated_compensation: Option<RawCompensation>,
-    }
-    let parsed: WithCompensation = serde_json::from_str(json_text).map_err(|e| ConfigError::Parse {
-        origin: origin.to_owned(),
-        message: format!("not a compensation document of `rinscope calibrate --json` or `selfcal --json` ({e})"),
-    })?;
-    Ok(parsed.estimated_compensation)
+    Ok(parse_document(json_text, origin)?.estimated_compensation)
 }
 
 /// The document's table part as the scenario keys it sets (`compensation.axis.inner.swing_half_angle_arcsec`

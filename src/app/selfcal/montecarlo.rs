@@ -4,7 +4,7 @@
 
 use std::sync::atomic::AtomicBool;
 
-use anyhow::{Result, bail};
+use anyhow::{Result, anyhow, bail};
 use rayon::prelude::*;
 
 use super::{Setup, run_one};
@@ -114,7 +114,6 @@ pub struct ShardFile {
 pub fn merge_shards(files: &[ShardFile]) -> Result<(MonteCarlo, &ShardFile)> {
     let Some(first) = files.first() else { bail!("no shard files given") };
     let count = first.shard.count;
-    let mut seen = vec![false; count as usize];
     for f in files {
         if f.shard.count != count
             || f.scenario != first.scenario
@@ -138,15 +137,8 @@ pub fn merge_shards(files: &[ShardFile]) -> Result<(MonteCarlo, &ShardFile)> {
                 first.runs_requested
             );
         }
-        let slot = &mut seen[f.shard.index as usize];
-        if *slot {
-            bail!("shard {}/{count} is given twice", f.shard.index);
-        }
-        *slot = true;
     }
-    if let Some(k) = seen.iter().position(|s| !s) {
-        bail!("shard {k}/{count} is missing");
-    }
+    Shard::check_cover(files.iter().map(|f| f.shard), count).map_err(|e| anyhow!(e))?;
     let mut runs: Vec<McRun> = files.iter().flat_map(|f| f.runs.iter().cloned()).collect();
     runs.sort_by_key(|r| r.seed);
     Ok((MonteCarlo::of(&runs, 0.0), first))
