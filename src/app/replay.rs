@@ -265,7 +265,8 @@ pub fn replay(
     let (nominal_rot, comp_rot) = (chain.error_rotations(&nominal), chain.error_rotations(compensation));
     let algorithms: Vec<String> = pb.core.algorithms().iter().map(|a| a.name().to_owned()).collect();
     let rate = log.table.ins.rate_hz;
-    let series_every = decimation(rate, log.table.recording.series_hz);
+    // The plots' envelopes and the export take every update at the statistics rate.
+    let series_every = decimation(rate, log.table.recording.bandwidth.statistics_hz().min(rate));
     let scene_every = decimation(rate, log.table.recording.scene_hz);
     let window = log.table.ins.signal_window_s;
     let mut demod = vec![DemodState::default(); algorithms.len()];

@@ -278,7 +278,6 @@ pub fn record_run(
     let model = params.table_model();
     let timeline = params.timeline();
     let steps = timeline.instants();
-    let series_every = decimation(params.step_hz, params.recording.series_hz);
     let scene_every = decimation(params.step_hz, params.recording.scene_hz);
     let stats_every = params.statistics_every();
 
@@ -303,7 +302,6 @@ pub fn record_run(
                     stop,
                     bar: bar.as_ref(),
                     tx: &tx,
-                    series_every,
                     scene_every,
                     stats_every,
                 };
@@ -372,9 +370,9 @@ struct Producer<'a> {
     stop: &'a AtomicBool,
     bar: Option<&'a indicatif::ProgressBar>,
     tx: &'a crossbeam_channel::Sender<Batch>,
-    series_every: u64,
     scene_every: u64,
-    /// Steps between two statistics samples (`Params::statistics_every`).
+    /// Steps between two statistics samples (`Params::statistics_every`): the samples the
+    /// summary's statistics take are the rows the plots' envelopes and the export get.
     stats_every: u64,
 }
 
@@ -431,8 +429,8 @@ impl Producer<'_> {
             done = i + 1;
             // The last steps too: a drift's final value is often its peak.
             let want_stats = i % self.stats_every == 0 || i.saturating_add(self.stats_every) >= timeline.instants();
-            let (want_series, want_scene) = (i % self.series_every == 0, i % self.scene_every == 0);
-            let wanted = want_stats || want_series || want_scene;
+            let want_scene = i % self.scene_every == 0;
+            let wanted = want_stats || want_scene;
             let stepped_last = std::mem::replace(&mut stepped, wanted);
             if !wanted {
                 continue;
@@ -444,7 +442,7 @@ impl Producer<'_> {
             if want_stats {
                 stats.add(&o);
             }
-            if want_series && !out.series(OutputRow { core: o, ins: None }) {
+            if want_stats && !out.series(OutputRow { core: o, ins: None }) {
                 done = i;
                 break;
             }
@@ -474,7 +472,7 @@ impl Producer<'_> {
         let mut out = Outbox { tx: self.tx, series: Vec::new(), scene: Vec::new(), signal: Vec::new() };
         let window = ins.config().signal_window_s;
         let (mut done, mut interrupted) = (1, false);
-        let (mut next_series, mut next_scene, mut next_stats) = (0u64, 0u64, 0u64);
+        let (mut next_scene, mut next_stats) = (0u64, 0u64);
         // The latest attitude update: its instant and whether its step was computed.
         let mut last_update: Option<(f64, bool)> = None;
         for i in 1..=timeline.intervals() {
@@ -494,11 +492,11 @@ impl Producer<'_> {
             // a growing drift, is not missed): the INS's errors at every update (their bandwidth
             // is the algorithms', not the motion's), the table's at the statistics rate
             // (Bandwidth::statistics_hz). The true IMU attitude only for the scene.
-            let (want_series, want_scene) = (i >= next_series, i >= next_scene);
+            let want_scene = i >= next_scene;
             let view = if want_scene { ins.view(s.t_s) } else { ins.errors_view(s.t_s) };
             ins_stats.add(&view);
             let want_stats = i >= next_stats || i.saturating_add(self.stats_every) > timeline.intervals();
-            let wanted = want_stats || want_series || want_scene;
+            let wanted = want_stats || want_scene;
             // The previous update's instant, for the delay correction when it was not computed.
             let previous_update = last_update.replace((s.t_s, wanted));
             if !wanted {
@@ -511,9 +509,6 @@ impl Producer<'_> {
             if want_stats {
                 next_stats = i.saturating_add(self.stats_every);
                 stats.add(&core);
-            }
-            if want_series {
-                next_series = i.saturating_add(self.series_every);
                 if !out.series(OutputRow { core, ins: Some(view.clone()) }) {
                     break;
                 }

@@ -1,8 +1,6 @@
 //! Teaching coning in 3D: beside the table, the body z axis tracing its cone, magnified so that a
-//! 1° cone reads, with a fading trail of its last positions. Only for pure coning (the classical
-//! test, `[vehicle] coning_*`): there the cone is the whole motion.
-
-use std::collections::VecDeque;
+//! 1° cone reads. Only for pure coning (the classical test, `[vehicle] coning_*`): there the cone
+//! is the whole motion.
 
 use nalgebra::{UnitQuaternion, Vector3};
 use rerun::{RecordingStream, RecordingStreamResult};
@@ -16,8 +14,6 @@ use crate::math::units::{RAD_PER_DEG, fmt_angle};
 const OFFSET: [f32; 3] = [1.0, -0.9, 0.5];
 /// The magnified cone's half-angle, rad: wide enough to see, narrow enough to read as a cone.
 const DRAWN_HALF_ANGLE_RAD: f64 = 20.0 * RAD_PER_DEG;
-/// The axis and its trail: the newest position and this many older ones, fading.
-const TRAIL: usize = 3;
 /// Half length of the drawn axis.
 const HALF: f64 = 0.6;
 
@@ -25,13 +21,13 @@ const HALF: f64 = 0.6;
 pub(crate) struct ConeGizmo {
     /// Magnification of the tilt.
     gain: f64,
-    /// The last `TRAIL` directions of the drawn axis (unit vectors), newest last.
-    history: VecDeque<Vector3<f64>>,
-    /// Per buffered scene frame, the trail's `TRAIL` lines, newest first.
-    strips: Vec<Vec<[f32; 3]>>,
+    /// Per buffered scene frame, the drawn axis's attitude (the tilt magnified).
+    frames: Vec<rerun::Quaternion>,
 }
 
-/// The axis and its trail: one entity, a line per trail position (newest first).
+/// The drawn axis: a fixed line along z, turned by a rotation on the timeline (one quaternion a
+/// frame; a trail of earlier positions doubled the scene's size per hour at 25 frames a second,
+/// and the drawn cone shows the path).
 const AXIS_PATH: &str = "world/cone/axis";
 
 impl ConeGizmo {
@@ -46,11 +42,14 @@ impl ConeGizmo {
                 .with_colors([rgb([150, 150, 150])])
                 .with_radii([0.005]),
         )?;
-        // The trail's colours and widths; its lines go on the timeline.
-        let colors = (0..TRAIL).map(|i| rgba([255, 230, 120], (230.0 * (1.0 - i as f64 / TRAIL as f64)) as u8));
-        let radii = (0..TRAIL).map(|i| if i == 0 { 0.012f32 } else { 0.007 });
-        rec.log_static(AXIS_PATH, &rerun::LineStrips3D::update_fields().with_colors(colors).with_radii(radii))?;
-        let me = Self { gain, history: VecDeque::with_capacity(TRAIL), strips: Vec::new() };
+        let end = (HALF * 1.1) as f32;
+        rec.log_static(
+            format!("{AXIS_PATH}/line"),
+            &rerun::LineStrips3D::new([[[0.0, 0.0, -end], [0.0, 0.0, end]]])
+                .with_colors([rgba([255, 230, 120], 230)])
+                .with_radii([0.012f32]),
+        )?;
+        let me = Self { gain, frames: Vec::new() };
         me.log_cone(rec, alpha_rad, at_s)?;
         Ok(me)
     }
@@ -107,31 +106,19 @@ impl ConeGizmo {
         let tilt = z.z.clamp(-1.0, 1.0).acos();
         let about = Vector3::z().cross(&z);
         let drawn = match nalgebra::Unit::try_new(about, 1e-15) {
-            Some(axis) => UnitQuaternion::from_axis_angle(&axis, (tilt * self.gain).min(1.4)) * Vector3::z(),
-            None => Vector3::z(),
+            Some(axis) => UnitQuaternion::from_axis_angle(&axis, (tilt * self.gain).min(1.4)),
+            None => UnitQuaternion::identity(),
         };
-        if self.history.len() == TRAIL {
-            self.history.pop_front();
-        }
-        self.history.push_back(drawn);
-        let end = HALF * 1.1;
-        let frame: Vec<[f32; 3]> = (0..TRAIL)
-            .map(|i| self.history[self.history.len() - 1 - i.min(self.history.len() - 1)])
-            .flat_map(|d| [(-end * d), (end * d)].map(|p| [p.x as f32, p.y as f32, p.z as f32]))
-            .collect();
-        self.strips.push(frame);
+        self.frames.push(super::to_rerun_quaternion(&drawn));
     }
 
     /// Sends the buffered frames at `times`.
     pub(crate) fn flush(&mut self, stream: &super::Stream, times: &[f64]) -> RecordingStreamResult<()> {
-        let frames = std::mem::take(&mut self.strips);
-        let strips = frames.iter().flat_map(|f| f.chunks(2).map(<[[f32; 3]]>::to_vec));
+        let frames = std::mem::take(&mut self.frames);
         stream.rec().send_columns(
             AXIS_PATH,
             stream.time_columns(times),
-            rerun::LineStrips3D::update_fields()
-                .with_strips(strips)
-                .columns(std::iter::repeat_n(TRAIL, frames.len()))?,
+            rerun::Transform3D::update_fields().with_many_quaternion(frames).columns_of_unit_batches()?,
         )?;
         Ok(())
     }

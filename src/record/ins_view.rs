@@ -26,8 +26,17 @@ pub(crate) struct InsScene {
     signal_t: Vec<f64>,
     raw: Vec<f64>,
     filtered: Vec<f64>,
-    /// Per buffered scene frame, the true IMU axes then the computed ones (six arrows).
-    trace_axes: Vec<[f32; 3]>,
+    /// Per buffered scene frame, the true IMU attitude (the trace's moving frame).
+    trace_imu: Vec<rerun::Quaternion>,
+    /// The computed axes relative to the true ones (error ×N, in the IMU frame): the frames where
+    /// the drawing moved by more than [`TRACE_DEAD_BAND_RAD`] since the last sent, and when.
+    trace_error: Vec<rerun::Quaternion>,
+    trace_error_t: Vec<f64>,
+    /// The last relative rotation sent (or buffered) and the newest computed, not yet sent.
+    trace_error_last: Option<UnitQuaternion<f64>>,
+    trace_error_pending: Option<(f64, UnitQuaternion<f64>)>,
+    /// The last true attitude sent (a table that stands still sends nothing).
+    trace_imu_last: Option<rerun::Quaternion>,
     pub(crate) exaggeration: f64,
     pub(crate) fir_taps: Vec<f64>,
     rate_hz: f64,
@@ -68,7 +77,12 @@ impl InsScene {
             signal_t: Vec::new(),
             raw: Vec::new(),
             filtered: Vec::new(),
-            trace_axes: Vec::new(),
+            trace_imu: Vec::new(),
+            trace_error: Vec::new(),
+            trace_error_t: Vec::new(),
+            trace_error_last: None,
+            trace_error_pending: None,
+            trace_imu_last: None,
             // The dial turns by the errors: none without them.
             dial_on: plots.algorithms.len() >= 2 && plots.errors,
             dial: Vec::new(),
@@ -95,13 +109,20 @@ impl InsScene {
                 .and_then(|v| Some((*v.imu_true?.quaternion(), *v.imu_ins.quaternion())))
                 .unwrap_or((UnitQuaternion::identity(), UnitQuaternion::identity()));
             let err = rotvec::log(&(c * t.inverse())) * self.exaggeration;
-            let ins_q = rotvec::exp(&err) * t;
-            // The true axes, then the computed ones, as arrows in the trace's (unturned) frame.
-            for q in [t, ins_q] {
-                for axis in [Vector3::x(), Vector3::y(), Vector3::z()] {
-                    let v = q * (axis * TRACE_AXIS_LENGTH);
-                    self.trace_axes.push([v.x as f32, v.y as f32, v.z as f32]);
-                }
+            // The computed axes are exp(err)·t: the exaggerated error in the navigation frame,
+            // which moves slowly (sent only when the drawing moved by more than the eye sees, and
+            // its newest frame at a flush), turning the true attitude (every frame; the true axes
+            // are the same frame, outside the error's).
+            self.trace_imu.push(super::to_rerun_quaternion(&t));
+            let relative = rotvec::exp(&err);
+            let moved = self.trace_error_last.is_none_or(|last| last.angle_to(&relative) > TRACE_DEAD_BAND_RAD);
+            if moved {
+                self.trace_error_t.push(t_s);
+                self.trace_error.push(super::to_rerun_quaternion(&relative));
+                self.trace_error_last = Some(relative);
+                self.trace_error_pending = None;
+            } else {
+                self.trace_error_pending = Some((t_s, relative));
             }
         }
         // The needles turn clockwise by the size of each algorithm's attitude error (whichever
@@ -121,17 +142,40 @@ impl InsScene {
 
     /// Sends the trace's buffered frames at `times`; returns the chunks sent.
     pub(crate) fn flush_scene(&mut self, stream: &Stream, times: &[f64]) -> RecordingStreamResult<usize> {
-        let trace = std::mem::take(&mut self.trace_axes);
-        if trace.is_empty() {
+        let imu = std::mem::take(&mut self.trace_imu);
+        if imu.is_empty() {
             return Ok(0);
         }
-        debug_assert_eq!(trace.len(), 6 * times.len());
-        stream.rec().send_columns(
-            TRACE_AXES_PATH,
-            stream.time_columns(times),
-            rerun::Arrows3D::update_fields().with_vectors(trace).columns(std::iter::repeat_n(6, times.len()))?,
-        )?;
-        Ok(1)
+        debug_assert_eq!(imu.len(), times.len());
+        let mut sent = 0;
+        if !imu.iter().all(|q| Some(*q) == self.trace_imu_last) {
+            self.trace_imu_last = imu.last().copied();
+            for path in [TRACE_IMU_PATH, TRACE_COMPUTED_IMU_PATH] {
+                stream.rec().send_columns(
+                    path,
+                    stream.time_columns(times),
+                    rerun::Transform3D::update_fields().with_many_quaternion(imu.clone()).columns_of_unit_batches()?,
+                )?;
+                sent += 1;
+            }
+        }
+        // The error as drawn at the newest frame, if it moved less than the dead band since.
+        if let Some((t, q)) = self.trace_error_pending.take() {
+            self.trace_error_t.push(t);
+            self.trace_error.push(super::to_rerun_quaternion(&q));
+        }
+        let error_t = std::mem::take(&mut self.trace_error_t);
+        if !error_t.is_empty() {
+            stream.rec().send_columns(
+                TRACE_ERROR_PATH,
+                stream.time_columns(&error_t),
+                rerun::Transform3D::update_fields()
+                    .with_many_quaternion(std::mem::take(&mut self.trace_error))
+                    .columns_of_unit_batches()?,
+            )?;
+            sent += 1;
+        }
+        Ok(sent)
     }
 
     /// Sends the drift dial's buffered frames (with the plots: the needles turn with the errors);
@@ -172,8 +216,15 @@ pub(crate) fn needle(angle_rad: f64) -> [f32; 3] {
     [(-NEEDLE_LENGTH * s) as f32, (NEEDLE_LENGTH * c) as f32, 0.0]
 }
 
-/// The INS trace's arrows: the true IMU axes, then the computed ones (error ×N).
-pub(crate) const TRACE_AXES_PATH: &str = "world/ins_trace/axes";
+/// The INS trace's true axes: the true IMU attitude (its arrows).
+pub(crate) const TRACE_IMU_PATH: &str = "world/ins_trace/imu";
+/// The computed axes: the INS's attitude error ×N (a rotation in the navigation frame) ...
+pub(crate) const TRACE_ERROR_PATH: &str = "world/ins_trace/error";
+/// ... turning the true IMU attitude (the computed axes are its arrows).
+pub(crate) const TRACE_COMPUTED_IMU_PATH: &str = "world/ins_trace/error/imu";
+/// The drawn computed axes are sent again when they moved by more than this, rad (0.2°: under
+/// what the eye tells apart on an axis 0.6 long; the newest frame goes out at every flush).
+const TRACE_DEAD_BAND_RAD: f64 = 0.2 * crate::math::units::RAD_PER_DEG;
 
 /// Length of a trace arrow.
 pub(crate) const TRACE_AXIS_LENGTH: f64 = 0.6;
@@ -320,13 +371,21 @@ impl InsScene {
         if !layout.trace {
             return Ok(());
         }
-        // The INS trace: true IMU axes (grey) and computed (coloured, error ×N), beside the table,
-        // as six arrows of one entity (their directions on the timeline).
+        // The INS trace: true IMU axes (grey) and computed (coloured, error ×N), beside the table:
+        // fixed arrows in the moving frames (true attitude; error in it, `push_scene`).
         rec.log_static("world/ins_trace", &rerun::Transform3D::from_translation(TRACE_OFFSET))?;
-        let trace_colors = [[170, 170, 170]; 3].into_iter().chain(colors::SENSOR).map(rgb);
+        let unit = |a: Vector3<f64>| {
+            let v = a * TRACE_AXIS_LENGTH;
+            [v.x as f32, v.y as f32, v.z as f32]
+        };
+        let axes = [Vector3::x(), Vector3::y(), Vector3::z()].map(unit);
         rec.log_static(
-            TRACE_AXES_PATH,
-            &rerun::Arrows3D::update_fields().with_colors(trace_colors).with_radii([0.012]),
+            format!("{TRACE_IMU_PATH}/axes"),
+            &rerun::Arrows3D::from_vectors(axes).with_colors([rgb([170, 170, 170])]).with_radii([0.012]),
+        )?;
+        rec.log_static(
+            format!("{TRACE_COMPUTED_IMU_PATH}/axes"),
+            &rerun::Arrows3D::from_vectors(axes).with_colors(colors::SENSOR.map(rgb)).with_radii([0.012]),
         )?;
         let ins_label = format!("INS IMU axes (error ×{})", layout.exaggeration);
         // In a frame that does not turn with the axes (turning, the two labels met).

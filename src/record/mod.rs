@@ -114,12 +114,23 @@ impl Stream {
         values: Vec<f64>,
         width: usize,
     ) -> RecordingStreamResult<()> {
+        self.export_series(path, names, times, &values);
+        self.plot_series(path, times, values, width)
+    }
+
+    /// Writes rows of the series `path` (its lines `names`, values row-major, one row per time) to
+    /// the export tables, in the unit `path` states; nothing without `--export`.
+    pub(crate) fn export_series(&self, path: &str, names: &[String], times: &[f64], values: &[f64]) {
         // A log10 plot is a picture of a series exported in its own unit, not a measurement.
         if let Some(export) = self.export.as_ref().filter(|_| !is_log_plot(path)) {
             let unit = export::unit_of(path).unwrap_or("1");
             let mut e = export.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-            e.write(path, unit, names, times, &values);
+            e.write(path, unit, names, times, values);
         }
+    }
+
+    /// Sends rows of `width` series of `path` (values row-major, one row per time) to Rerun only.
+    pub(crate) fn plot_series(&self, path: &str, times: &[f64], values: Vec<f64>, width: usize) -> RecordingStreamResult<()> {
         self.rec.send_columns(
             path,
             self.time_columns(times),
@@ -326,7 +337,7 @@ impl Recorder {
         replay: Option<ReplayKind>,
         custom: Option<CustomLayout>,
     ) -> RecordingStreamResult<Self> {
-        let plots = Plots::new(params, replay);
+        let plots = Plots::new(params, replay, stream.exports());
         let ins = plots.ins.as_ref().and_then(|series| InsScene::new(params, replay, series));
         // A strapdown IMU: its axes are drawn as the body, nothing of the stand-in table.
         let body = replay.filter(|k| !k.table).map(|k| BodyScene::new(k.reference));
@@ -435,6 +446,7 @@ impl Recorder {
     /// again: noise of 1e-5″ on a compensated line does not fill a plot and look like a drift.
     pub fn fit_plots(&mut self, params: &Params, ranges: PlotRanges) -> RecordingStreamResult<()> {
         // Every row out first: the plots fitted to their data take the whole extent.
+        self.plots.close_buckets();
         self.flush_series()?;
         self.ranges = Some(ranges);
         self.mark_moves(params, &ranges)?;
@@ -642,6 +654,7 @@ impl Recorder {
     /// Sends everything still buffered; a saved live session's layout again, every plot framed on
     /// its data (as a run's).
     pub fn finish(&mut self) -> RecordingStreamResult<()> {
+        self.plots.close_buckets();
         self.flush_now()?;
         match (&self.live, &self.live_params) {
             (Some(LiveOutput::File), Some(p)) => self.send_blueprint(&p.clone(), self.custom.clone()),

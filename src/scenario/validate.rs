@@ -512,12 +512,16 @@ pub struct Bandwidth {
 }
 
 impl Bandwidth {
-    /// The default series rate, Hz: one point per degree of the fastest shaft (a 10″ swing error
-    /// at 10°/s is a sinusoid of period 36 s: 360 points per period), 40 per period of the fastest
-    /// vehicle motion, and at least 500 points over the run; at most 50 Hz.
+    /// The default series rate, Hz: buckets per second of the plots' envelopes (each bucket keeps
+    /// every line's first, smallest, largest and last sample, `record/plots/envelope.rs`). 3000
+    /// buckets over the run — one per pixel of the widest plot, two or more per pixel of a laptop's,
+    /// so a plot zoomed in twice still draws each pixel column from every sample in it —, at most
+    /// 50 Hz (a short run: nearly every sample). The motion does not enter: a bucket spanning
+    /// several periods draws their band, its extremes exact. Four rows per bucket at most: about
+    /// 12 000 rows per plot over any run, a few MB per hour of the noisiest (docs/benchmarks.md).
     #[must_use]
     pub fn series_hz(&self) -> f64 {
-        self.shaft_deg_per_s.max(40.0 * self.motion_hz).max(500.0 / self.duration_s).clamp(1e-3, 50.0)
+        (3000.0 / self.duration_s).clamp(1e-3, 50.0)
     }
 
     /// The default scene rate, Hz: what the eye needs when the run plays in a minute (1500 frames,

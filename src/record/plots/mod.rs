@@ -3,6 +3,7 @@
 //! It owns those entities and their styles; nothing else logs to them.
 
 pub(crate) mod coning;
+mod envelope;
 mod extents;
 pub mod series;
 mod styles;
@@ -38,6 +39,8 @@ pub(crate) struct Plots {
     pub(crate) ins: Option<InsSeries>,
     /// Each series' extent (the plots fitted to their data).
     extents: Extents,
+    /// Whether every sample's row is kept for the export tables (`--export`).
+    exporting: bool,
 }
 
 /// What a row without a navigation view shows.
@@ -50,12 +53,19 @@ const NO_NAV: NavError = NavError {
 
 impl Plots {
     /// The plots of a run of `params` (`replay`: of a replayed log of that kind).
-    pub(crate) fn new(params: &Params, replay: Option<ReplayKind>) -> Self {
+    /// Each plot draws the envelope of its samples over buckets of `1 / recording.series_hz`
+    /// (`envelope.rs`); `exporting`: every sample's row also goes to the export tables.
+    pub(crate) fn new(params: &Params, replay: Option<ReplayKind>, exporting: bool) -> Self {
         let chain = params.table.chain.clone();
         let unit = params.recording.error_unit;
         let mut series = series::table_series(&chain, replay, unit);
         let ins = series::ins_series(params, replay, &mut series);
-        Self { series, t: Vec::new(), chain, truth: params.table.truth.clone(), unit, ins, extents: Extents::default() }
+        let bucket_s = 1.0 / params.recording.series_hz;
+        for s in &mut series {
+            s.envelope = envelope::Envelope::new(s.width(), bucket_s);
+        }
+        let truth = params.table.truth.clone();
+        Self { series, t: Vec::new(), chain, truth, unit, ins, extents: Extents::default(), exporting }
     }
 
     /// The unit of the table's error plots.
@@ -96,7 +106,7 @@ impl Plots {
     /// Buffers one row of every series from the table's step `out`, the INS's view `ins` (errors,
     /// navigation) and, in a replay, its own `solution`.
     pub(crate) fn push(&mut self, out: &StepOutput, ins: Option<&InsView>, solution: Option<&Solution>) {
-        let Self { series, chain, truth, unit, ins: layout, t, .. } = self;
+        let Self { series, chain, truth, unit, ins: layout, t, exporting, .. } = self;
         t.push(out.t_s);
         let per_rad = unit.per_rad();
         let lines = layout.as_ref().and_then(|l| l.coning.as_ref());
@@ -104,6 +114,7 @@ impl Plots {
         let state = solution.and_then(|s| s.nav);
         for s in series.iter_mut() {
             let width = s.width();
+            let start = s.values.len();
             let v = &mut s.values;
             match s.what {
                 Quantity::TableError(a) => v.extend(out.errors[..width].iter().map(|e| e.as_array()[a] * per_rad)),
@@ -150,24 +161,40 @@ impl Plots {
                 ),
                 Quantity::Height => v.push(state.map_or(f64::NAN, |n| n.height_m)),
             }
+            s.envelope.push(out.t_s, &s.values[start..]);
+            if !*exporting {
+                s.values.truncate(start);
+            }
         }
     }
 
-    /// Sends the buffered rows; returns the chunks sent. With `hold` (viewers watching live, a
-    /// stream that exports nothing): a series whose rows all repeat the last row it sent (a table
-    /// error that is zero, a vehicle at rest) sends nothing for up to `hold`, then its newest row
-    /// only — the same line, drawn flat to the same end, with a chunk every `hold` instead of every
-    /// flush (a web viewer ingests a few dozen chunks a second).
-    pub(crate) fn flush(&mut self, stream: &Stream, hold: Option<Duration>) -> RecordingStreamResult<usize> {
-        if self.t.is_empty() {
-            return Ok(0);
+    /// Closes every plot's open bucket (the end of the data): the next flush sends it.
+    pub(crate) fn close_buckets(&mut self) {
+        for s in &mut self.series {
+            s.envelope.close();
         }
+    }
+
+    /// Sends every finished bucket's rows to the plots, and every sample's rows to the export
+    /// tables; returns the chunks sent. With `hold` (viewers watching live, a stream that exports
+    /// nothing): a series whose rows all repeat the last row it sent (a table error that is zero,
+    /// a vehicle at rest) sends nothing for up to `hold`, then its newest row only — the same line,
+    /// drawn flat to the same end, with a chunk every `hold` instead of every flush (a web viewer
+    /// ingests a few dozen chunks a second).
+    pub(crate) fn flush(&mut self, stream: &Stream, hold: Option<Duration>) -> RecordingStreamResult<usize> {
+        let samples = std::mem::take(&mut self.t);
         let hold = hold.filter(|_| !stream.exports());
-        let times = std::mem::take(&mut self.t);
         let now = Instant::now();
         let mut sent = 0;
         for s in &mut self.series {
-            let values = std::mem::take(&mut s.values);
+            let raw = std::mem::take(&mut s.values);
+            if self.exporting && !samples.is_empty() {
+                stream.export_series(&s.path, &s.names, &samples, &raw);
+            }
+            let (times, values) = s.envelope.take();
+            if times.is_empty() {
+                continue;
+            }
             let width = s.width();
             debug_assert_eq!(values.len(), width * times.len());
             self.extents.observe(&s.path, &values);
@@ -189,10 +216,10 @@ impl Plots {
                         row.iter().copied().chain(values).collect(),
                     )
                 }
-                _ => (times.clone(), values),
+                _ => (times, values),
             };
             s.held_until_s = None;
-            stream.send_series(&s.path, &s.names, &t, v, width)?;
+            stream.plot_series(&s.path, &t, v, width)?;
             s.last_sent = Some((last_row, now));
             sent += 1;
         }

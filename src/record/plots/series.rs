@@ -5,6 +5,7 @@
 use nalgebra::Vector3;
 
 use super::coning::{self, ConingLines};
+use super::envelope::Envelope;
 use crate::ins::nav::{NavState, Vertical};
 use crate::math::attitude::Attitude;
 use crate::math::units::AngleUnit;
@@ -62,7 +63,10 @@ pub(crate) struct Series {
     pub(crate) path: String,
     /// The names of its lines (the legend, and the export's columns).
     pub(crate) names: Vec<String>,
+    /// Every sample's row since the last flush (exported at full rate, then dropped).
     pub(crate) values: Vec<f64>,
+    /// What the plot draws of them: the per-bucket envelope.
+    pub(crate) envelope: Envelope,
     pub(crate) what: Quantity,
     /// The last row sent and when (a live viewer's stream holds rows that repeat it).
     pub(crate) last_sent: Option<(Vec<f64>, std::time::Instant)>,
@@ -81,7 +85,8 @@ pub(crate) fn same_row(a: &[f64], b: &[f64]) -> bool {
 
 impl Series {
     pub(crate) fn new(path: impl Into<String>, names: Vec<String>, what: Quantity) -> Self {
-        Self { path: path.into(), names, values: Vec::new(), what, last_sent: None, held_until_s: None }
+        let envelope = Envelope::new(names.len(), 0.0);
+        Self { path: path.into(), names, values: Vec::new(), envelope, what, last_sent: None, held_until_s: None }
     }
 
     pub(crate) fn width(&self) -> usize {

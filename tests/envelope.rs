@@ -1,0 +1,151 @@
+//! The recording keeps what a viewer can show (issue 33): a long high-rate series is recorded as
+//! per-bucket envelopes (first, smallest, largest, last sample of every line), the full-rate
+//! numbers go to `--export`, and the summary's RMS and peak are taken on every sample. A spike of
+//! one sample — an encoder reading off by 0.06° for one 5-ms sample of a log set — must survive
+//! into the saved recording, at its value, where a decimated recording (every n-th sample) drops it.
+
+mod common;
+use common::{rinscope, scratch, stderr};
+use std::path::{Path, PathBuf};
+
+fn ok(o: &std::process::Output) {
+    assert!(o.status.success(), "exit {:?}: {}", o.status.code(), stderr(o));
+}
+
+/// A CSV export table: header and rows of numbers.
+fn csv_table(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header = lines.next().expect("header").split(',').map(str::to_owned).collect();
+    let rows = lines.map(|l| l.split(',').map(|x| x.parse().unwrap_or(f64::NAN)).collect()).collect();
+    (header, rows)
+}
+
+/// The export table of the table's attitude error about `axis` (its unit in its name).
+fn error_table(dir: &Path, axis: &str) -> (PathBuf, String) {
+    let file = std::fs::read_dir(dir)
+        .expect("export dir")
+        .map(|e| e.expect("entry").path())
+        .find(|p| {
+            let n = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+            n.starts_with("attitude_error_") && n.ends_with(&format!("__{axis}.csv"))
+        })
+        .expect("the table's error export");
+    let entity = file.file_stem().and_then(|s| s.to_str()).expect("name").replace("__", "/");
+    (file, entity)
+}
+
+#[test]
+fn a_one_sample_glitch_survives_in_the_recording_and_the_summary_counts_every_sample() {
+    let dir = scratch("glitch");
+    let log = dir.join("log");
+    ok(&rinscope()
+        .args(["export-log", "--scenario", "dual-axis-8-position", "--format", "csv", "--out"])
+        .arg(&log)
+        .output()
+        .expect("export-log"));
+    // One encoder sample at t = 10.000 s (the table dwells at its start: the readings are zero,
+    // exact) reads 1e-3 rad (206″) too much on the inner axis.
+    let path = log.join("encoders.csv");
+    let text = std::fs::read_to_string(&path).expect("encoders");
+    let mut glitched = 0;
+    let edited: Vec<String> = text
+        .lines()
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            if f[0].parse::<f64>().is_ok_and(|t| (t - 10.0).abs() < 1e-9) {
+                glitched += 1;
+                let inner: f64 = f[2].parse().expect("inner");
+                format!("{},{},{}", f[0], f[1], inner + 1e-3)
+            } else {
+                l.to_owned()
+            }
+        })
+        .collect();
+    assert_eq!(glitched, 1, "one row at t = 10 s");
+    std::fs::write(&path, edited.join("\n") + "\n").expect("write");
+
+    let (rrd, json, tables) = (dir.join("r.rrd"), dir.join("r.json"), dir.join("tables"));
+    ok(&rinscope()
+        .arg("replay")
+        .arg(&log)
+        .arg("--save")
+        .arg(&rrd)
+        .arg("--summary-json")
+        .arg(&json)
+        .args(["--export-format", "csv", "--export"])
+        .arg(&tables)
+        .output()
+        .expect("replay"));
+    let summary: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).expect("json")).expect("json");
+    let set = rinscope::scenario::logset::load(&log).expect("log set");
+    let bucket_s = 1.0 / set.table.recording.series_hz;
+    let plots = rinscope::record::read::plots(&rrd).expect("recording");
+
+    let mut spikes = 0;
+    for axis in ["pitch", "roll", "heading"] {
+        let (file, entity) = error_table(&tables, axis);
+        let (header, rows) = csv_table(&file);
+        let unit_per_arcsec = match entity.split('/').next().unwrap_or("") {
+            "attitude_error_arcsec" => 1.0,
+            "attitude_error_arcmin" => 1.0 / 60.0,
+            "attitude_error_deg" => 1.0 / 3600.0,
+            other => panic!("unit of {other}"),
+        };
+        let first = header.iter().position(|c| c != "t_s" && c != "t_file_s").expect("a line");
+        let recorded: Vec<&rinscope::record::read::PlotSeries> =
+            plots.iter().flat_map(|p| p.series.iter()).filter(|s| s.entity == entity).collect();
+        assert_eq!(recorded.len(), header.len() - first, "{entity}: one recorded line per exported column");
+        for (k, line) in recorded.iter().enumerate() {
+            let column: Vec<(f64, f64)> = rows.iter().map(|r| (r[0], r[first + k])).collect();
+            // The export is every attitude update: 100 Hz (two 200-Hz samples an update) over the log.
+            let span = column.last().expect("rows").0 - column[0].0;
+            assert!(column.len() as f64 > 0.99 * 100.0 * span && span > 600.0, "{} rows over {span} s", column.len());
+            let finite = |v: &[f64]| v.iter().copied().filter(|x| x.is_finite()).collect::<Vec<f64>>();
+            let all = finite(&column.iter().map(|c| c.1).collect::<Vec<_>>());
+            let drawn = finite(&line.y);
+            // Far fewer rows than samples; every drawn value is a sample's; the extremes are the same.
+            assert!(line.t.len() * 10 < column.len(), "{entity}: {} rows for {} samples", line.t.len(), column.len());
+            for v in &drawn {
+                assert!(all.iter().any(|x| x.to_bits() == v.to_bits()), "{entity}: {v} is no sample's value");
+            }
+            let extremes = |v: &[f64]| v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
+            // To 1e-9 of the plot's unit: rows closer than that are one row (a zero error's rounding
+            // flicker, `same_row`; far under the smallest range a plot is framed at).
+            let ((a, b), (c, d)) = (extremes(&drawn), extremes(&all));
+            assert!(
+                (a - c).abs() <= 1e-9 * c.abs().max(1.0) && (b - d).abs() <= 1e-9 * d.abs().max(1.0),
+                "{entity} line {k} ({}): the envelope spans every sample: drawn [{a}, {b}], sampled [{c}, {d}]",
+                line.name
+            );
+            // The glitch: one sample far off its neighbours, drawn at its value within one bucket
+            // of its time (a single sample: every 20th would miss it 19 times in 20).
+            let (i, peak) = column
+                .iter()
+                .enumerate()
+                .max_by(|a, b| (a.1.1 - column[0].1).abs().total_cmp(&(b.1.1 - column[0].1).abs()))
+                .map(|(i, c)| (i, c.1))
+                .expect("samples");
+            let near = (column[i - 1].1 - column[0].1).abs().max((column[i + 1].1 - column[0].1).abs());
+            if (peak - column[0].1).abs() > 20.0 * near.max(1e-12) && (column[i].0 - 10.0).abs() < 0.05 {
+                spikes += 1;
+                let at = line.y.iter().position(|y| y.to_bits() == peak.to_bits()).expect("the spike is drawn");
+                assert!((line.t[at] - column[i].0).abs() <= bucket_s, "drawn at {} s, sampled at {} s", line.t[at], column[i].0);
+            }
+            // The summary's statistics are every sample's (its variants named as the lines are).
+            let variant = if line.name.contains("nominal") { "nominal" } else { "compensated" };
+            let stats = summary["attitude_error_arcsec"]
+                .as_object()
+                .and_then(|m| m.iter().find(|(name, _)| name.starts_with(variant)))
+                .map(|(_, v)| &v[axis])
+                .unwrap_or_else(|| panic!("summary of {variant}: {}", summary["attitude_error_arcsec"]));
+            let rms = (all.iter().map(|x| x * x).sum::<f64>() / all.len() as f64).sqrt() / unit_per_arcsec;
+            let peak_abs = all.iter().fold(0.0_f64, |m, x| m.max(x.abs())) / unit_per_arcsec;
+            let (s_rms, s_peak) = (stats["rms_arcsec"].as_f64().expect("rms"), stats["peak_arcsec"].as_f64().expect("peak"));
+            assert!((s_rms - rms).abs() <= 1e-9 * rms.max(1e-12), "{entity} {variant}: summary RMS {s_rms}, samples {rms}");
+            assert!((s_peak - peak_abs).abs() <= 1e-9 * peak_abs.max(1e-12), "{entity} {variant}: peak {s_peak} vs {peak_abs}");
+        }
+    }
+    assert!(spikes >= 1, "the glitch shows as a one-sample spike on some line");
+    std::fs::remove_dir_all(&dir).ok();
+}
