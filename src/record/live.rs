@@ -88,8 +88,11 @@ impl Recorder {
     /// repeat the last row it sent (a table error that is zero, a vehicle at rest) sends nothing
     /// for up to `hold`, then its newest row only — the same line, drawn flat to the same end, with
     /// a chunk every `hold` instead of every flush (a web viewer ingests a few dozen chunks a
-    /// second). Every row is sent when the stream also exports its tables.
+    /// second). Every row is sent when the stream also exports its tables. The plots' open
+    /// buckets go out too (a live session's rows are about a bucket each: waiting for the next
+    /// would delay every row by one).
     pub fn flush_series_held(&mut self, hold: std::time::Duration) -> RecordingStreamResult<()> {
+        self.plots.close_buckets();
         self.flush_series_with(Some(hold))
     }
 }

@@ -495,8 +495,11 @@ impl Recorder {
         self.plots.error_unit()
     }
 
-    /// Sends every buffered row now (live mode: low latency over large chunks).
+    /// Sends every buffered row now (live mode: low latency over large chunks; the plots' open
+    /// buckets too: a live session's rows are a bucket each, and waiting for the next would delay
+    /// every row by one).
     pub fn flush_now(&mut self) -> RecordingStreamResult<()> {
+        self.plots.close_buckets();
         self.flush_signal()?;
         self.flush_series()?;
         self.flush_scene()
@@ -654,7 +657,6 @@ impl Recorder {
     /// Sends everything still buffered; a saved live session's layout again, every plot framed on
     /// its data (as a run's).
     pub fn finish(&mut self) -> RecordingStreamResult<()> {
-        self.plots.close_buckets();
         self.flush_now()?;
         match (&self.live, &self.live_params) {
             (Some(LiveOutput::File), Some(p)) => self.send_blueprint(&p.clone(), self.custom.clone()),

@@ -201,8 +201,14 @@ fn simulation_speed(steps: u64, figs: &mut Figures, stop: &AtomicBool) -> anyhow
 
 /// Runs `f` in a scratch folder `rinscope-NAME-PID` under the temporary directory, removed however
 /// it ends: returned, failed, or the process ended early (a second signal, a closed stdout: it is
-/// registered with [`crate::io::files::remove_unfinished`]).
+/// registered with [`crate::io::files::remove_unfinished`]). With `RINSCOPE_BENCH_KEEP=DIR` in the
+/// environment, the folder is `DIR/NAME` and kept (the inputs, to profile one process of a bench).
 pub(crate) fn in_scratch<T>(name: &str, f: impl FnOnce(&std::path::Path) -> anyhow::Result<T>) -> anyhow::Result<T> {
+    if let Some(keep) = std::env::var_os("RINSCOPE_BENCH_KEEP") {
+        let dir = std::path::PathBuf::from(keep).join(name);
+        std::fs::create_dir_all(&dir)?;
+        return f(&dir);
+    }
     let dir = std::env::temp_dir().join(format!("rinscope-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
     crate::io::files::unfinished_dir(&dir);
