@@ -607,10 +607,6 @@ impl Recorder {
     }
 
     fn flush_series_with(&mut self, hold: Option<std::time::Duration>) -> RecordingStreamResult<()> {
-        if let Some(ins) = self.ins.as_mut() {
-            let sent = ins.flush_dial(&self.stream)?;
-            self.throttle(sent);
-        }
         let newest = self.plots.newest();
         let sent = self.plots.flush(&self.stream, hold)?;
         self.throttle(sent);
@@ -638,7 +634,8 @@ impl Recorder {
             sent += table.flush(&self.stream, &times)?;
         }
         if let Some(ins) = self.ins.as_mut() {
-            sent += ins.flush_scene(&self.stream, &times)?;
+            // The dial's frames (at most 4 Hz) are buffered with the scene's: they go with them.
+            sent += ins.flush_scene(&self.stream, &times)? + ins.flush_dial(&self.stream)?;
         }
         self.throttle(sent);
         Ok(())

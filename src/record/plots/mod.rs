@@ -29,8 +29,10 @@ use series::{Series, same_row};
 /// Every plotted series of a recording and the rows buffered for them.
 pub(crate) struct Plots {
     series: Vec<Series>,
-    /// The buffered rows' times, s.
+    /// With `--export`: the buffered samples' times, s.
     t: Vec<f64>,
+    /// The newest sample's time since the last flush, s.
+    newest: Option<f64>,
     /// The table (its swing plots), its true errors and the unit of its error plots.
     chain: Chain,
     truth: TableErrors,
@@ -65,7 +67,7 @@ impl Plots {
             s.envelope = envelope::Envelope::new(s.width(), bucket_s);
         }
         let truth = params.table.truth.clone();
-        Self { series, t: Vec::new(), chain, truth, unit, ins, extents: Extents::default(), exporting }
+        Self { series, t: Vec::new(), newest: None, chain, truth, unit, ins, extents: Extents::default(), exporting }
     }
 
     /// The unit of the table's error plots.
@@ -88,14 +90,16 @@ impl Plots {
         self.series.iter().find(|s| s.path == path).map(|s| s.names.clone()).unwrap_or_default()
     }
 
-    /// Rows buffered.
+    /// Rows buffered: the samples kept for the export, else the envelope's rows ready to send
+    /// (a chunk is sent per 8192 of them: a chunk per few thousand samples made tens of thousands
+    /// of tiny chunks over a long run, and the file sink's index of them grew with the run).
     pub(crate) fn buffered(&self) -> usize {
-        self.t.len()
+        if self.exporting { self.t.len() } else { self.series.iter().map(|s| s.envelope.t.len()).max().unwrap_or(0) }
     }
 
-    /// The newest buffered row's time, s.
+    /// The newest sample's time since the last flush, s.
     pub(crate) fn newest(&self) -> Option<f64> {
-        self.t.last().copied()
+        self.newest
     }
 
     /// New true errors (a live reload): the swing plots follow them.
@@ -107,7 +111,10 @@ impl Plots {
     /// navigation) and, in a replay, its own `solution`.
     pub(crate) fn push(&mut self, out: &StepOutput, ins: Option<&InsView>, solution: Option<&Solution>) {
         let Self { series, chain, truth, unit, ins: layout, t, exporting, .. } = self;
-        t.push(out.t_s);
+        if *exporting {
+            t.push(out.t_s);
+        }
+        self.newest = Some(out.t_s);
         let per_rad = unit.per_rad();
         let lines = layout.as_ref().and_then(|l| l.coning.as_ref());
         let nav = ins.and_then(|v| v.nav).unwrap_or(NO_NAV);
@@ -183,6 +190,7 @@ impl Plots {
     /// ingests a few dozen chunks a second).
     pub(crate) fn flush(&mut self, stream: &Stream, hold: Option<Duration>) -> RecordingStreamResult<usize> {
         let samples = std::mem::take(&mut self.t);
+        self.newest = None;
         let hold = hold.filter(|_| !stream.exports());
         let now = Instant::now();
         let mut sent = 0;
