@@ -109,7 +109,8 @@ fn a_one_sample_glitch_survives_in_the_recording_and_the_summary_counts_every_sa
             for v in &drawn {
                 assert!(all.iter().any(|x| x.to_bits() == v.to_bits()), "{entity}: {v} is no sample's value");
             }
-            let extremes = |v: &[f64]| v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
+            let extremes =
+                |v: &[f64]| v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
             // To 1e-9 of the plot's unit: rows closer than that are one row (a zero error's rounding
             // flicker, `same_row`; far under the smallest range a plot is framed at).
             let ((a, b), (c, d)) = (extremes(&drawn), extremes(&all));
@@ -130,7 +131,12 @@ fn a_one_sample_glitch_survives_in_the_recording_and_the_summary_counts_every_sa
             if (peak - column[0].1).abs() > 20.0 * near.max(1e-12) && (column[i].0 - 10.0).abs() < 0.05 {
                 spikes += 1;
                 let at = line.y.iter().position(|y| y.to_bits() == peak.to_bits()).expect("the spike is drawn");
-                assert!((line.t[at] - column[i].0).abs() <= bucket_s, "drawn at {} s, sampled at {} s", line.t[at], column[i].0);
+                assert!(
+                    (line.t[at] - column[i].0).abs() <= bucket_s,
+                    "drawn at {} s, sampled at {} s",
+                    line.t[at],
+                    column[i].0
+                );
             }
             // The summary's statistics are every sample's (its variants named as the lines are).
             let variant = if line.name.contains("nominal") { "nominal" } else { "compensated" };
@@ -141,9 +147,16 @@ fn a_one_sample_glitch_survives_in_the_recording_and_the_summary_counts_every_sa
                 .unwrap_or_else(|| panic!("summary of {variant}: {}", summary["attitude_error_arcsec"]));
             let rms = (all.iter().map(|x| x * x).sum::<f64>() / all.len() as f64).sqrt() / unit_per_arcsec;
             let peak_abs = all.iter().fold(0.0_f64, |m, x| m.max(x.abs())) / unit_per_arcsec;
-            let (s_rms, s_peak) = (stats["rms_arcsec"].as_f64().expect("rms"), stats["peak_arcsec"].as_f64().expect("peak"));
-            assert!((s_rms - rms).abs() <= 1e-9 * rms.max(1e-12), "{entity} {variant}: summary RMS {s_rms}, samples {rms}");
-            assert!((s_peak - peak_abs).abs() <= 1e-9 * peak_abs.max(1e-12), "{entity} {variant}: peak {s_peak} vs {peak_abs}");
+            let (s_rms, s_peak) =
+                (stats["rms_arcsec"].as_f64().expect("rms"), stats["peak_arcsec"].as_f64().expect("peak"));
+            assert!(
+                (s_rms - rms).abs() <= 1e-9 * rms.max(1e-12),
+                "{entity} {variant}: summary RMS {s_rms}, samples {rms}"
+            );
+            assert!(
+                (s_peak - peak_abs).abs() <= 1e-9 * peak_abs.max(1e-12),
+                "{entity} {variant}: peak {s_peak} vs {peak_abs}"
+            );
         }
     }
     assert!(spikes >= 1, "the glitch shows as a one-sample spike on some line");

@@ -296,15 +296,8 @@ pub fn record_run(
     let (stats, ins_stats, done, interrupted) =
         std::thread::scope(|scope| -> anyhow::Result<(ErrorStats, InsStats, u64, bool)> {
             let sim = scope.spawn(|| {
-                let ctx = Producer {
-                    model: &model,
-                    params,
-                    stop,
-                    bar: bar.as_ref(),
-                    tx: &tx,
-                    scene_every,
-                    stats_every,
-                };
+                let ctx =
+                    Producer { model: &model, params, stop, bar: bar.as_ref(), tx: &tx, scene_every, stats_every };
                 let r = if params.ins.is_some() { ctx.run_ins(&timeline) } else { ctx.run_ideal(&timeline) };
                 drop(tx);
                 r

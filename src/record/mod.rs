@@ -130,7 +130,13 @@ impl Stream {
     }
 
     /// Sends rows of `width` series of `path` (values row-major, one row per time) to Rerun only.
-    pub(crate) fn plot_series(&self, path: &str, times: &[f64], values: Vec<f64>, width: usize) -> RecordingStreamResult<()> {
+    pub(crate) fn plot_series(
+        &self,
+        path: &str,
+        times: &[f64],
+        values: Vec<f64>,
+        width: usize,
+    ) -> RecordingStreamResult<()> {
         self.rec.send_columns(
             path,
             self.time_columns(times),

@@ -194,14 +194,16 @@ mod tests {
         for b in 0..60usize {
             let samples = &all[b * 100..(b + 1) * 100];
             for j in 0..2 {
-                let (lo, hi) = samples.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, z), r| (a.min(r[j]), z.max(r[j])));
+                let (lo, hi) =
+                    samples.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, z), r| (a.min(r[j]), z.max(r[j])));
                 let rows: Vec<f64> = t
                     .iter()
                     .zip(v.chunks(2))
                     .filter(|(tt, _)| (**tt / 1.0 + 1e-9).floor() as usize == b)
                     .map(|(_, r)| r[j])
                     .collect();
-                let (rlo, rhi) = rows.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, z), x| (a.min(*x), z.max(*x)));
+                let (rlo, rhi) =
+                    rows.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, z), x| (a.min(*x), z.max(*x)));
                 assert_eq!((rlo, rhi), (lo, hi), "bucket {b} line {j}");
                 assert_eq!(rows.first().copied(), Some(samples[0][j]), "bucket {b} line {j} starts where it starts");
                 assert_eq!(rows.last().copied(), Some(samples[99][j]), "bucket {b} line {j} ends where it ends");
