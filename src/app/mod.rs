@@ -8,6 +8,7 @@ pub mod bench;
 pub mod calibrate;
 pub mod export_log;
 pub mod failure;
+pub(crate) mod feed;
 pub mod inspect;
 pub mod live;
 pub mod modulation;

@@ -11,6 +11,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::failure::Failure;
+use super::feed::{self, Outbox, OutputRow};
 use super::outputs::{RecordingName, RecordingRequest, check_output, finish, write_json};
 use super::playback::{AlignmentReport, Gap, Playback, PlaybackError};
 use super::run::{NavSummary, RmsPeak};
@@ -287,130 +288,149 @@ pub fn replay(
     let mut errors: Vec<AttitudeError> = Vec::with_capacity(algorithms.len());
     let has_reference = !matches!(log.reference, Reference::None);
     let mut compared = 0u64;
-    while let Some(s) = pb.step()? {
-        i += 1;
-        t_end = s.t_s;
-        if i.is_multiple_of(65_536) {
-            if stop.load(Ordering::Relaxed) {
-                interrupted = true;
-                break;
-            }
-            if let Some(bar) = bar {
-                bar.set_message(format!(
-                    "{:.0} s of the log replayed ({:.1} M samples/s)",
-                    s.t_s,
-                    i as f64 / started.elapsed().as_secs_f64().max(1e-9) / 1e6
-                ));
-            }
-        }
-        if s.t_s <= window
-            && let Some(r) = recorder.as_deref_mut()
-        {
-            r.push_signal(&s).map_err(rerun)?;
-        }
-        if !s.updated {
-            continue;
-        }
-        // Every update is demodulated and counted in the statistics (as a run does); rows are
-        // recorded at the series and scene rates.
-        let (want_series, want_scene) = (i >= next_series, i >= next_scene);
-        // Each algorithm at the instant its own output stands for, as the simulation compares them.
-        errors.clear();
-        let mut primary = None;
-        for (k, state) in demod.iter_mut().enumerate() {
-            let (t_repr, _) = pb.core.output_attitude(k);
-            let t_ref = pb.core.reference_instant(t_repr);
-            let encoder = pb.encoders_at(t_repr)?;
-            let corrected = state.correct(compensation, t_repr, &encoder);
-            let comp_b_from_s = comp_cache.get(chain, &comp_rot, &corrected);
-            let body = pb.body_attitude_through(k, comp_b_from_s);
-            let reference = pb.reference_at(t_ref)?;
-            errors.push(body.error_from(&reference.unwrap_or(body)));
-            if k == 0 {
-                let raw = demod_nominal.correct(&nominal, t_repr, &encoder);
-                let nominal_b_from_s = nominal_cache.get(chain, &nominal_rot, &raw);
-                // Nothing compensated (no table errors known): the same chain, the same attitude.
-                let body_nominal = if nominal_b_from_s.quaternion() == comp_b_from_s.quaternion() {
-                    body
+    let recording = recorder.is_some();
+    // The recorder on its own thread (`feed`): the loop never waits for the encoding.
+    std::thread::scope(|scope| -> Result<(), PlaybackError> {
+        let (tx, rx) = feed::channel();
+        let consumer = recorder.as_deref_mut().map(|r| scope.spawn(move || feed::consume(r, rx)));
+        let mut outbox = Outbox::new(&tx);
+        let looped = (|| -> Result<(), PlaybackError> {
+            while let Some(s) = pb.step()? {
+                i += 1;
+                t_end = s.t_s;
+                if i.is_multiple_of(65_536) {
+                    if stop.load(Ordering::Relaxed) {
+                        interrupted = true;
+                        break;
+                    }
+                    if let Some(bar) = bar {
+                        bar.set_message(format!(
+                            "{:.0} s of the log replayed ({:.1} M samples/s)",
+                            s.t_s,
+                            i as f64 / started.elapsed().as_secs_f64().max(1e-9) / 1e6
+                        ));
+                    }
+                }
+                if s.t_s <= window && recording && !outbox.signal(s) {
+                    break;
+                }
+                if !s.updated {
+                    continue;
+                }
+                // Every update is demodulated and counted in the statistics (as a run does); rows are
+                // recorded at the series and scene rates.
+                let (want_series, want_scene) = (i >= next_series, i >= next_scene);
+                // Each algorithm at the instant its own output stands for, as the simulation compares them.
+                errors.clear();
+                let mut primary = None;
+                for (k, state) in demod.iter_mut().enumerate() {
+                    let (t_repr, _) = pb.core.output_attitude(k);
+                    let t_ref = pb.core.reference_instant(t_repr);
+                    let encoder = pb.encoders_at(t_repr)?;
+                    let corrected = state.correct(compensation, t_repr, &encoder);
+                    let comp_b_from_s = comp_cache.get(chain, &comp_rot, &corrected);
+                    let body = pb.body_attitude_through(k, comp_b_from_s);
+                    let reference = pb.reference_at(t_ref)?;
+                    errors.push(body.error_from(&reference.unwrap_or(body)));
+                    if k == 0 {
+                        let raw = demod_nominal.correct(&nominal, t_repr, &encoder);
+                        let nominal_b_from_s = nominal_cache.get(chain, &nominal_rot, &raw);
+                        // Nothing compensated (no table errors known): the same chain, the same attitude.
+                        let body_nominal = if nominal_b_from_s.quaternion() == comp_b_from_s.quaternion() {
+                            body
+                        } else {
+                            pb.body_attitude_through(0, nominal_b_from_s)
+                        };
+                        primary = Some((t_repr, encoder, corrected, body, body_nominal, reference));
+                    }
+                }
+                let Some((t_repr, encoder, corrected, body, body_nominal, reference)) = primary else { continue };
+                // Outside the reference's span (it starts late or ends early) nothing is compared (the
+                // errors recorded there are NaN); the INS's own solution is recorded all along.
+                let compare = !(has_reference && reference.is_none());
+                let truth = reference.unwrap_or(body);
+                let table_errors =
+                    if compare { [body_nominal.error_from(&truth), body.error_from(&truth)] } else { [nan; 2] };
+                let nav_error = pb.core.nav_error();
+                if compare {
+                    compared += 1;
+                    for (v, e) in table_errors.iter().enumerate() {
+                        for (a, x) in e.as_array().into_iter().enumerate() {
+                            stats[v][a].add(x);
+                        }
+                    }
+                    for (k, e) in errors.iter().enumerate() {
+                        for (a, x) in e.as_array().into_iter().enumerate() {
+                            ins_stats[k][a].add(x);
+                        }
+                    }
+                    if let Some(e) = nav_error {
+                        let peak = nav.map_or(0.0, |n| n.peak_radial_m).max(e.radial_m);
+                        nav = Some(NavSummary {
+                            peak_radial_m: peak,
+                            final_radial_m: e.radial_m,
+                            final_east_m: e.east_m,
+                            final_north_m: e.north_m,
+                        });
+                    }
                 } else {
-                    pb.body_attitude_through(0, nominal_b_from_s)
+                    errors.iter_mut().for_each(|e| *e = nan);
+                }
+                if !(want_series || want_scene) || !recording {
+                    next_series = if want_series { i.saturating_add(series_every) } else { next_series };
+                    next_scene = if want_scene { i.saturating_add(scene_every) } else { next_scene };
+                    continue;
+                }
+                // A recorded row: the rest of what the scene and plots show.
+                let out = StepOutput {
+                    t_s: s.t_s,
+                    attitude: truth,
+                    n_from_b: truth.n_from_b(),
+                    gimbal_rad: corrected,
+                    encoder_rad: encoder,
+                    errors: [table_errors[0], table_errors[1], nan],
                 };
-                primary = Some((t_repr, encoder, corrected, body, body_nominal, reference));
-            }
-        }
-        let Some((t_repr, encoder, corrected, body, body_nominal, reference)) = primary else { continue };
-        // Outside the reference's span (it starts late or ends early) nothing is compared (the
-        // errors recorded there are NaN); the INS's own solution is recorded all along.
-        let compare = !(has_reference && reference.is_none());
-        let truth = reference.unwrap_or(body);
-        let table_errors = if compare { [body_nominal.error_from(&truth), body.error_from(&truth)] } else { [nan; 2] };
-        let nav_error = pb.core.nav_error();
-        if compare {
-            compared += 1;
-            for (v, e) in table_errors.iter().enumerate() {
-                for (a, x) in e.as_array().into_iter().enumerate() {
-                    stats[v][a].add(x);
-                }
-            }
-            for (k, e) in errors.iter().enumerate() {
-                for (a, x) in e.as_array().into_iter().enumerate() {
-                    ins_stats[k][a].add(x);
-                }
-            }
-            if let Some(e) = nav_error {
-                let peak = nav.map_or(0.0, |n| n.peak_radial_m).max(e.radial_m);
-                nav = Some(NavSummary {
-                    peak_radial_m: peak,
-                    final_radial_m: e.radial_m,
-                    final_east_m: e.east_m,
-                    final_north_m: e.north_m,
+                let (_, imu_ins) = pb.core.output_attitude(0);
+                // The best estimate of the true IMU attitude: the reference through the compensated table.
+                let imu_true = Some(match reference {
+                    Some(r) => r.n_from_b() * chain.b_from_s(&comp_rot, &corrected),
+                    None => imu_ins,
                 });
+                let view = InsView {
+                    t_s: s.t_s,
+                    t_ref_s: pb.core.reference_instant(t_repr),
+                    errors: errors.clone(),
+                    imu_true,
+                    imu_ins,
+                    nav: nav_error,
+                };
+                if want_series {
+                    next_series = i.saturating_add(series_every);
+                    let solution = Some(Solution { body, nav: pb.core.nav_state().copied() });
+                    if !outbox.series(OutputRow { core: out, ins: Some(view.clone()), solution }) {
+                        break;
+                    }
+                }
+                if want_scene {
+                    next_scene = i.saturating_add(scene_every);
+                    if !outbox.scene(OutputRow { core: out, ins: Some(view), solution: None }) {
+                        break;
+                    }
+                }
             }
-        } else {
-            errors.iter_mut().for_each(|e| *e = nan);
+            Ok(())
+        })();
+        outbox.close();
+        drop(tx);
+        // A data error first (the recording then holds what came before it); else the recorder's.
+        let recorded = consumer.map(|h| h.join());
+        looped?;
+        match recorded {
+            Some(Ok(Err(e))) => Err(rerun(e)),
+            Some(Err(_)) => Err(PlaybackError::Record("the recorder's thread panicked".into())),
+            _ => Ok(()),
         }
-        if !(want_series || want_scene) || recorder.is_none() {
-            next_series = if want_series { i.saturating_add(series_every) } else { next_series };
-            next_scene = if want_scene { i.saturating_add(scene_every) } else { next_scene };
-            continue;
-        }
-        // A recorded row: the rest of what the scene and plots show.
-        let out = StepOutput {
-            t_s: s.t_s,
-            attitude: truth,
-            n_from_b: truth.n_from_b(),
-            gimbal_rad: corrected,
-            encoder_rad: encoder,
-            errors: [table_errors[0], table_errors[1], nan],
-        };
-        let (_, imu_ins) = pb.core.output_attitude(0);
-        // The best estimate of the true IMU attitude: the reference through the compensated table.
-        let imu_true = Some(match reference {
-            Some(r) => r.n_from_b() * chain.b_from_s(&comp_rot, &corrected),
-            None => imu_ins,
-        });
-        let view = InsView {
-            t_s: s.t_s,
-            t_ref_s: pb.core.reference_instant(t_repr),
-            errors: errors.clone(),
-            imu_true,
-            imu_ins,
-            nav: nav_error,
-        };
-        if want_series {
-            next_series = i.saturating_add(series_every);
-            if let Some(r) = recorder.as_deref_mut() {
-                let solution = Solution { body, nav: pb.core.nav_state().copied() };
-                r.push_replay_row(&out, &view, &solution).map_err(rerun)?;
-            }
-        }
-        if want_scene {
-            next_scene = i.saturating_add(scene_every);
-            if let Some(r) = recorder.as_deref_mut() {
-                r.push_scene_row(&out, Some(&view)).map_err(rerun)?;
-            }
-        }
-    }
+    })?;
     if !interrupted {
         pb.finish()?;
     }

@@ -8,8 +8,8 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::app::failure::Failure;
+use crate::app::feed::{self, Outbox, OutputRow};
 use crate::app::outputs::{RecordingName, RecordingRequest, check_output, finish, write_json};
-use crate::ins::core::SampleOut;
 use crate::ins::pipeline::{InsRun, InsView};
 use crate::math::stats::RunningStat;
 use crate::math::timeline::{Timeline, decimation};
@@ -17,29 +17,10 @@ use crate::math::units::ARCSEC_PER_RAD;
 use crate::record::Recorder;
 use crate::record::sink::OpenSinks;
 use crate::scenario::Params;
-use crate::sim::{DEMODULATIONS, DemodState, ERROR_AXES, ErrorStats, Model, StepOutput, step};
+use crate::sim::{DEMODULATIONS, DemodState, ERROR_AXES, ErrorStats, Model, step};
 
 /// Summary row of the closed form minus the exact (uncompensated) error.
 pub const CLOSED_FORM_DEVIATION: &str = "closed_form_minus_exact";
-
-/// Rows per message from the simulation thread to the recorder.
-const BATCH_ROWS: usize = 2048;
-
-/// One output instant: the turntable-only demodulations and, with an IMU in the loop, the INS's view.
-#[derive(Debug, Clone)]
-pub struct OutputRow {
-    /// Ideal-INS step (truth, encoders, the three demodulations).
-    pub core: StepOutput,
-    /// The INS in the loop, if any.
-    pub ins: Option<InsView>,
-}
-
-/// What the simulation thread sends.
-enum Batch {
-    Series(Vec<OutputRow>),
-    Scene(Vec<OutputRow>),
-    Signal(Vec<SampleOut>),
-}
 
 /// Statistics of the INS in the loop.
 #[derive(Debug, Clone, Default)]
@@ -292,7 +273,7 @@ pub fn record_run(
         None
     };
 
-    let (tx, rx) = crossbeam_channel::bounded::<Batch>(8);
+    let (tx, rx) = feed::channel();
     let (stats, ins_stats, done, interrupted) =
         std::thread::scope(|scope| -> anyhow::Result<(ErrorStats, InsStats, u64, bool)> {
             let sim = scope.spawn(|| {
@@ -302,21 +283,7 @@ pub fn record_run(
                 drop(tx);
                 r
             });
-            let mut result = Ok(());
-            for batch in &rx {
-                let r = match batch {
-                    Batch::Series(rows) => rows.iter().try_for_each(|o| recorder.push_row(&o.core, o.ins.as_ref())),
-                    Batch::Scene(rows) => {
-                        rows.iter().try_for_each(|o| recorder.push_scene_row(&o.core, o.ins.as_ref()))
-                    }
-                    Batch::Signal(samples) => samples.iter().try_for_each(|o| recorder.push_signal(o)),
-                };
-                if let Err(e) = r {
-                    result = Err(e);
-                    break;
-                }
-            }
-            drop(rx);
+            let result = feed::consume(&mut recorder, rx);
             let r = sim.join().map_err(|_| anyhow::anyhow!("simulation thread panicked"))?;
             result?;
             Ok(r)
@@ -362,40 +329,11 @@ struct Producer<'a> {
     params: &'a Params,
     stop: &'a AtomicBool,
     bar: Option<&'a indicatif::ProgressBar>,
-    tx: &'a crossbeam_channel::Sender<Batch>,
+    tx: &'a crossbeam_channel::Sender<feed::Batch>,
     scene_every: u64,
     /// Steps between two statistics samples (`Params::statistics_every`): the samples the
     /// summary's statistics take are the rows the plots' envelopes and the export get.
     stats_every: u64,
-}
-
-/// Buffers rows and sends them in batches; `false` when the recorder has gone away.
-struct Outbox<'a> {
-    tx: &'a crossbeam_channel::Sender<Batch>,
-    series: Vec<OutputRow>,
-    scene: Vec<OutputRow>,
-    signal: Vec<SampleOut>,
-}
-
-impl Outbox<'_> {
-    fn series(&mut self, r: OutputRow) -> bool {
-        self.series.push(r);
-        self.series.len() < BATCH_ROWS || self.tx.send(Batch::Series(std::mem::take(&mut self.series))).is_ok()
-    }
-    fn scene(&mut self, r: OutputRow) -> bool {
-        self.scene.push(r);
-        self.scene.len() < BATCH_ROWS || self.tx.send(Batch::Scene(std::mem::take(&mut self.scene))).is_ok()
-    }
-    fn signal(&mut self, s: SampleOut) -> bool {
-        self.signal.push(s);
-        self.signal.len() < BATCH_ROWS || self.tx.send(Batch::Signal(std::mem::take(&mut self.signal))).is_ok()
-    }
-    fn close(self) {
-        // A closed receiver means the recorder failed; it reports the error itself.
-        let _ = self.tx.send(Batch::Signal(self.signal));
-        let _ = self.tx.send(Batch::Series(self.series));
-        let _ = self.tx.send(Batch::Scene(self.scene));
-    }
 }
 
 impl Producer<'_> {
@@ -410,7 +348,7 @@ impl Producer<'_> {
     fn run_ideal(&self, timeline: &Timeline) -> (ErrorStats, InsStats, u64, bool) {
         let mut state = DemodState::default();
         let mut stats = ErrorStats::default();
-        let mut out = Outbox { tx: self.tx, series: Vec::new(), scene: Vec::new(), signal: Vec::new() };
+        let mut out = Outbox::new(self.tx);
         let (mut done, mut interrupted) = (0, false);
         // Whether the previous instant was computed (else the delay correction is fed its reading).
         let mut stepped = false;
@@ -435,11 +373,11 @@ impl Producer<'_> {
             if want_stats {
                 stats.add(&o);
             }
-            if want_stats && !out.series(OutputRow { core: o, ins: None }) {
+            if want_stats && !out.series(OutputRow { core: o, ins: None, solution: None }) {
                 done = i;
                 break;
             }
-            if want_scene && !out.scene(OutputRow { core: o, ins: None }) {
+            if want_scene && !out.scene(OutputRow { core: o, ins: None, solution: None }) {
                 done = i;
                 break;
             }
@@ -462,7 +400,7 @@ impl Producer<'_> {
             algorithms: ins.algorithms().iter().map(|a| a.name().to_owned()).collect(),
             ..InsStats::default()
         };
-        let mut out = Outbox { tx: self.tx, series: Vec::new(), scene: Vec::new(), signal: Vec::new() };
+        let mut out = Outbox::new(self.tx);
         let window = ins.config().signal_window_s;
         let (mut done, mut interrupted) = (1, false);
         let (mut next_scene, mut next_stats) = (0u64, 0u64);
@@ -502,13 +440,13 @@ impl Producer<'_> {
             if want_stats {
                 next_stats = i.saturating_add(self.stats_every);
                 stats.add(&core);
-                if !out.series(OutputRow { core, ins: Some(view.clone()) }) {
+                if !out.series(OutputRow { core, ins: Some(view.clone()), solution: None }) {
                     break;
                 }
             }
             if want_scene {
                 next_scene = i.saturating_add(self.scene_every);
-                if !out.scene(OutputRow { core, ins: Some(view) }) {
+                if !out.scene(OutputRow { core, ins: Some(view), solution: None }) {
                     break;
                 }
             }
