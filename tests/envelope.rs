@@ -162,3 +162,47 @@ fn a_one_sample_glitch_survives_in_the_recording_and_the_summary_counts_every_sa
     assert!(spikes >= 1, "the glitch shows as a one-sample spike on some line");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_run_exports_every_sample_its_summary_counts_and_records_their_extremes() {
+    // jiang2017-calibration for 600 s (3000 buckets: 20 updates each): an INS with white sensor noise at 100 attitude updates a
+    // second (two 200-Hz samples an update), the table's errors with white encoder noise. The
+    // summary's INS statistics are every update's; the export must be every one of them, the
+    // recording their envelope.
+    let dir = scratch("run");
+    let (rrd, json, tables) = (dir.join("r.rrd"), dir.join("r.json"), dir.join("tables"));
+    ok(&rinscope()
+        .args(["run", "--scenario", "jiang2017-calibration", "--duration-s", "600", "--save"])
+        .arg(&rrd)
+        .arg("--summary-json")
+        .arg(&json)
+        .args(["--export-format", "csv", "--export"])
+        .arg(&tables)
+        .output()
+        .expect("run"));
+    let summary: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).expect("json")).expect("json");
+    let plots = rinscope::record::read::plots(&rrd).expect("recording");
+    for axis in ["pitch", "roll", "heading"] {
+        let entity = format!("ins/attitude_error_arcsec/{axis}");
+        let (header, rows) = csv_table(&tables.join(format!("ins__attitude_error_arcsec__{axis}.csv")));
+        assert!(rows.len() >= 100 * 600 - 2, "{entity}: {} exported rows, every update of 600 s at 100 Hz", rows.len());
+        let k = header.iter().position(|c| c.starts_with("two_sample_p1")).expect("the algorithm's column");
+        let all: Vec<f64> = rows.iter().map(|r| r[k]).filter(|x| x.is_finite()).collect();
+        let stats = &summary["ins_attitude_error_arcsec"]["two-sample-p1"][axis];
+        let rms = (all.iter().map(|x| x * x).sum::<f64>() / all.len() as f64).sqrt();
+        let peak = all.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let (s_rms, s_peak) =
+            (stats["rms_arcsec"].as_f64().expect("rms"), stats["peak_arcsec"].as_f64().expect("peak"));
+        assert!((s_rms - rms).abs() <= 1e-9 * rms, "{entity}: summary RMS {s_rms}, every exported sample {rms}");
+        assert!((s_peak - peak).abs() <= 1e-9 * peak, "{entity}: summary peak {s_peak}, every exported sample {peak}");
+        let line = plots
+            .iter()
+            .flat_map(|p| p.series.iter())
+            .find(|s| s.entity == entity && s.name.contains("p1"))
+            .expect("the recorded line");
+        let drawn = line.y.iter().fold(0.0_f64, |m, x| if x.is_finite() { m.max(x.abs()) } else { m });
+        assert_eq!(drawn.to_bits(), peak.to_bits(), "{entity}: the recording draws the largest sample");
+        assert!(line.t.len() * 4 < all.len(), "{entity}: {} rows drawn for {} samples", line.t.len(), all.len());
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

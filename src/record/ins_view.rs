@@ -178,7 +178,13 @@ impl InsScene {
         Ok(sent)
     }
 
-    /// Sends the drift dial's buffered frames (with the scene's); returns the chunks sent.
+    /// The drift dial's frames buffered.
+    pub(crate) fn dial_buffered(&self) -> usize {
+        self.dial_t.len()
+    }
+
+    /// Sends the drift dial's buffered frames (with the plots: the needles turn with the errors);
+    /// returns the chunks sent.
     pub(crate) fn flush_dial(&mut self, stream: &Stream) -> RecordingStreamResult<usize> {
         let dial_t = std::mem::take(&mut self.dial_t);
         let needles = std::mem::take(&mut self.dial);

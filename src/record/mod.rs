@@ -587,6 +587,10 @@ impl Recorder {
         }
         if let Some(view) = self.ins.as_mut().filter(|v| v.in_scene()) {
             view.push_scene(out.t_s, ins);
+            if view.dial_buffered() >= SERIES_CHUNK_ROWS {
+                let sent = view.flush_dial(&self.stream)?;
+                self.throttle(sent);
+            }
         }
         if self.scene_t.len() >= SERIES_CHUNK_ROWS {
             self.flush_scene()?;
@@ -613,6 +617,12 @@ impl Recorder {
     }
 
     fn flush_series_with(&mut self, hold: Option<std::time::Duration>) -> RecordingStreamResult<()> {
+        // The dial's needles turn with the errors: they go out with the plots (and when their own
+        // buffer is full, `push_scene_row`: a long run's series chunks are far apart).
+        if let Some(ins) = self.ins.as_mut() {
+            let sent = ins.flush_dial(&self.stream)?;
+            self.throttle(sent);
+        }
         let newest = self.plots.newest();
         let sent = self.plots.flush(&self.stream, hold)?;
         self.throttle(sent);
@@ -640,8 +650,7 @@ impl Recorder {
             sent += table.flush(&self.stream, &times)?;
         }
         if let Some(ins) = self.ins.as_mut() {
-            // The dial's frames (at most 4 Hz) are buffered with the scene's: they go with them.
-            sent += ins.flush_scene(&self.stream, &times)? + ins.flush_dial(&self.stream)?;
+            sent += ins.flush_scene(&self.stream, &times)?;
         }
         self.throttle(sent);
         Ok(())

@@ -31,6 +31,11 @@ use watch::WatchEvent;
 pub const SCENE_WALL_HZ: f64 = 30.0;
 /// Series rows per wall-clock second streamed in live mode (at most).
 pub const SERIES_WALL_HZ: f64 = 100.0;
+/// Series rows per simulated second streamed in live mode (at most): a live session has no length
+/// for the recording's default (3000 envelope buckets over the run: 25 Hz for the 120-s pure-coning
+/// preset, where a software-rendered web viewer fell seconds behind within 100 s); at 10 Hz, the
+/// rate issue 30's class measurements were made at, it keeps up (tests/web).
+pub const SERIES_SIM_HZ: f64 = 10.0;
 /// At most this many steps between two looks at the reload channel (~10 ms of work).
 const MAX_STEPS_PER_SLICE: u64 = 20_000;
 
@@ -110,7 +115,7 @@ pub fn sim_loop(
     let mut anchor = (Instant::now(), 0.0f64);
     let decimation = |speed: f64, p: &Params| {
         let scene = decimation(p.step_hz, (SCENE_WALL_HZ / speed).min(p.step_hz));
-        let series = decimation(p.step_hz, p.recording.series_hz)
+        let series = decimation(p.step_hz, p.recording.series_hz.min(SERIES_SIM_HZ))
             .max(decimation(p.step_hz, (SERIES_WALL_HZ / speed).min(p.step_hz)));
         (scene, series)
     };
