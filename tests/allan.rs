@@ -4,7 +4,7 @@
 //! and the new scenario keys refused clearly when misused.
 
 mod common;
-use common::{rinscope, scratch, stderr};
+use common::{csv_table, rinscope, scratch, stderr};
 use std::path::Path;
 
 use serde_json::Value;
@@ -171,15 +171,6 @@ fn bad_requests_and_misused_keys_are_refused_by_name() {
         None,
         &["--decimate", "0: must be a whole number of samples, 1 ..= 1000000"],
     );
-}
-
-/// The columns of a csv table and its rows.
-fn csv_table(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut lines = text.lines();
-    let header = lines.next().expect("header").split(',').map(String::from).collect();
-    let rows = lines.map(|l| l.split(',').map(|v| v.parse::<f64>().expect("number")).collect()).collect();
-    (header, rows)
 }
 
 #[test]

@@ -5,20 +5,34 @@
 //! into the saved recording, at its value, where a decimated recording (every n-th sample) drops it.
 
 mod common;
-use common::{rinscope, scratch, stderr};
+use common::{csv_table, rinscope, scratch, stderr};
 use std::path::{Path, PathBuf};
 
 fn ok(o: &std::process::Output) {
     assert!(o.status.success(), "exit {:?}: {}", o.status.code(), stderr(o));
 }
 
-/// A CSV export table: header and rows of numbers.
-fn csv_table(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut lines = text.lines();
-    let header = lines.next().expect("header").split(',').map(str::to_owned).collect();
-    let rows = lines.map(|l| l.split(',').map(|x| x.parse().unwrap_or(f64::NAN)).collect()).collect();
-    (header, rows)
+/// `rinscope ARGS... --save r.rrd --summary-json r.json --export-format csv --export tables` in
+/// `dir`: its summary, the recording's plots and the export folder.
+fn recorded(dir: &Path, args: &[&std::ffi::OsStr]) -> (serde_json::Value, Vec<rinscope::record::read::Plot>, PathBuf) {
+    let (rrd, json, tables) = (dir.join("r.rrd"), dir.join("r.json"), dir.join("tables"));
+    ok(&rinscope()
+        .args(args)
+        .arg("--save")
+        .arg(&rrd)
+        .arg("--summary-json")
+        .arg(&json)
+        .args(["--export-format", "csv", "--export"])
+        .arg(&tables)
+        .output()
+        .expect("rinscope"));
+    let summary = serde_json::from_slice(&std::fs::read(&json).expect("json")).expect("json");
+    (summary, rinscope::record::read::plots(&rrd).expect("recording"), tables)
+}
+
+/// The RMS and the largest magnitude of `v`.
+fn rms_peak(v: &[f64]) -> (f64, f64) {
+    ((v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt(), v.iter().fold(0.0_f64, |m, x| m.max(x.abs())))
 }
 
 /// The export table of the table's attitude error about `axis` (its unit in its name).
@@ -65,22 +79,9 @@ fn a_one_sample_glitch_survives_in_the_recording_and_the_summary_counts_every_sa
     assert_eq!(glitched, 1, "one row at t = 10 s");
     std::fs::write(&path, edited.join("\n") + "\n").expect("write");
 
-    let (rrd, json, tables) = (dir.join("r.rrd"), dir.join("r.json"), dir.join("tables"));
-    ok(&rinscope()
-        .arg("replay")
-        .arg(&log)
-        .arg("--save")
-        .arg(&rrd)
-        .arg("--summary-json")
-        .arg(&json)
-        .args(["--export-format", "csv", "--export"])
-        .arg(&tables)
-        .output()
-        .expect("replay"));
-    let summary: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).expect("json")).expect("json");
+    let (summary, plots, tables) = recorded(&dir, &["replay".as_ref(), log.as_os_str()]);
     let set = rinscope::scenario::logset::load(&log).expect("log set");
     let bucket_s = 1.0 / set.table.recording.series_hz;
-    let plots = rinscope::record::read::plots(&rrd).expect("recording");
 
     let mut spikes = 0;
     for axis in ["pitch", "roll", "heading"] {
@@ -145,8 +146,8 @@ fn a_one_sample_glitch_survives_in_the_recording_and_the_summary_counts_every_sa
                 .and_then(|m| m.iter().find(|(name, _)| name.starts_with(variant)))
                 .map(|(_, v)| &v[axis])
                 .unwrap_or_else(|| panic!("summary of {variant}: {}", summary["attitude_error_arcsec"]));
-            let rms = (all.iter().map(|x| x * x).sum::<f64>() / all.len() as f64).sqrt() / unit_per_arcsec;
-            let peak_abs = all.iter().fold(0.0_f64, |m, x| m.max(x.abs())) / unit_per_arcsec;
+            let (rms, peak_abs) = rms_peak(&all);
+            let (rms, peak_abs) = (rms / unit_per_arcsec, peak_abs / unit_per_arcsec);
             let (s_rms, s_peak) =
                 (stats["rms_arcsec"].as_f64().expect("rms"), stats["peak_arcsec"].as_f64().expect("peak"));
             assert!(
@@ -170,18 +171,8 @@ fn a_run_exports_every_sample_its_summary_counts_and_records_their_extremes() {
     // summary's INS statistics are every update's; the export must be every one of them, the
     // recording their envelope.
     let dir = scratch("run");
-    let (rrd, json, tables) = (dir.join("r.rrd"), dir.join("r.json"), dir.join("tables"));
-    ok(&rinscope()
-        .args(["run", "--scenario", "jiang2017-calibration", "--duration-s", "600", "--save"])
-        .arg(&rrd)
-        .arg("--summary-json")
-        .arg(&json)
-        .args(["--export-format", "csv", "--export"])
-        .arg(&tables)
-        .output()
-        .expect("run"));
-    let summary: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).expect("json")).expect("json");
-    let plots = rinscope::record::read::plots(&rrd).expect("recording");
+    let args = ["run", "--scenario", "jiang2017-calibration", "--duration-s", "600"].map(std::ffi::OsStr::new);
+    let (summary, plots, tables) = recorded(&dir, &args);
     for axis in ["pitch", "roll", "heading"] {
         let entity = format!("ins/attitude_error_arcsec/{axis}");
         let (header, rows) = csv_table(&tables.join(format!("ins__attitude_error_arcsec__{axis}.csv")));
@@ -189,8 +180,7 @@ fn a_run_exports_every_sample_its_summary_counts_and_records_their_extremes() {
         let k = header.iter().position(|c| c.starts_with("two_sample_p1")).expect("the algorithm's column");
         let all: Vec<f64> = rows.iter().map(|r| r[k]).filter(|x| x.is_finite()).collect();
         let stats = &summary["ins_attitude_error_arcsec"]["two-sample-p1"][axis];
-        let rms = (all.iter().map(|x| x * x).sum::<f64>() / all.len() as f64).sqrt();
-        let peak = all.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let (rms, peak) = rms_peak(&all);
         let (s_rms, s_peak) =
             (stats["rms_arcsec"].as_f64().expect("rms"), stats["peak_arcsec"].as_f64().expect("peak"));
         assert!((s_rms - rms).abs() <= 1e-9 * rms, "{entity}: summary RMS {s_rms}, every exported sample {rms}");

@@ -4,7 +4,7 @@
 //! bad input is one clear message, exit code 2, nothing written.
 
 mod common;
-use common::{rinscope, scratch, stderr};
+use common::{csv_table, rinscope, scratch, stderr};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
@@ -366,15 +366,6 @@ fn export_tables_read_back_and_say_their_units() {
     let c = rinscope::record::read::contents(&dir.join("x.rrd")).expect("recording");
     assert!(c.empty_views().is_empty(), "views of entities the recording lacks: {:?}", c.empty_views());
     std::fs::remove_dir_all(&dir).ok();
-}
-
-/// The columns of a csv table and its rows.
-fn csv_table(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut lines = text.lines();
-    let header = lines.next().expect("header").split(',').map(String::from).collect();
-    let rows = lines.map(|l| l.split(',').map(|v| v.parse::<f64>().expect("number")).collect()).collect();
-    (header, rows)
 }
 
 /// Every column of every table in `dir` has at least two distinct finite values (the issue: no

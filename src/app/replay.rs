@@ -317,8 +317,8 @@ pub fn replay(
                 if !s.updated {
                     continue;
                 }
-                // Every update is demodulated and counted in the statistics (as a run does); rows are
-                // recorded at the series and scene rates.
+                // Every update is demodulated and counted in the statistics (as a run does); the plots
+                // take the updates at the statistics rate (their envelopes), the scene its own rate.
                 let (want_series, want_scene) = (i >= next_series, i >= next_scene);
                 // Each algorithm at the instant its own output stands for, as the simulation compares them.
                 errors.clear();

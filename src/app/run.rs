@@ -1,6 +1,6 @@
-//! A recorded run: the simulation thread steps the model and sends decimated outputs through a
-//! bounded channel to the recorder (this thread), which turns them into Rerun chunks. Memory stays
-//! flat: nothing holds more than one chunk of rows.
+//! A recorded run: the simulation thread steps the model and sends its outputs (the statistics'
+//! samples for the plots, the scene's frames) through `feed` to the recorder (this thread), which
+//! turns them into Rerun chunks. Memory stays flat: nothing holds more than one chunk of rows.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;

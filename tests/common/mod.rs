@@ -1,7 +1,7 @@
 //! What the tests that run the built binary share: the command, a scratch folder, its output.
 #![allow(dead_code)] // each test crate uses its own part
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// The binary under test; `RINSCOPE_TEST_BIN=PATH` runs another build instead (e.g. a copy from
@@ -28,4 +28,13 @@ pub fn stderr(o: &Output) -> String {
 
 pub fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// A CSV table (`--export-format csv`): its header and rows of numbers.
+pub fn csv_table(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header = lines.next().expect("header").split(',').map(String::from).collect();
+    let rows = lines.map(|l| l.split(',').map(|v| v.parse::<f64>().expect("number")).collect()).collect();
+    (header, rows)
 }
