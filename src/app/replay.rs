@@ -25,7 +25,7 @@ use crate::model::gimbal::ChainMemo;
 use crate::model::gimbal::TableErrors;
 use crate::record::{Recorder, Solution};
 use crate::scenario::logset::{LogSet, Reference};
-use crate::sim::{DemodState, ERROR_AXES, StepOutput};
+use crate::sim::{DemodState, ERROR_AXES, StepOutput, demodulate};
 
 /// The result of a replay, as printed and as written by `--summary-json`.
 #[derive(Debug, Clone, Serialize)]
@@ -320,37 +320,49 @@ pub fn replay(
                 // Every update is demodulated and counted in the statistics (as a run does); the plots
                 // take the updates at the statistics rate (their envelopes), the scene its own rate.
                 let (want_series, want_scene) = (i >= next_series, i >= next_scene);
+                let row = recording && (want_series || want_scene);
                 // Each algorithm at the instant its own output stands for, as the simulation compares them.
+                // The Euler angles are taken only where they are compared or drawn: without a reference
+                // the compensated demodulation is its own reference, an error of zero by definition.
                 errors.clear();
                 let mut primary = None;
                 for (k, state) in demod.iter_mut().enumerate() {
-                    let (t_repr, _) = pb.core.output_attitude(k);
+                    let (t_repr, n_from_s) = pb.core.output_attitude(k);
                     let t_ref = pb.core.reference_instant(t_repr);
                     let encoder = pb.encoders_at(t_repr)?;
                     let corrected = state.correct(compensation, t_repr, &encoder);
                     let comp_b_from_s = comp_cache.get(chain, &comp_rot, &corrected);
-                    let body = pb.body_attitude_through(k, comp_b_from_s);
                     let reference = pb.reference_at(t_ref)?;
-                    errors.push(body.error_from(&reference.unwrap_or(body)));
+                    let body = (reference.is_some() || (k == 0 && row)).then(|| demodulate(n_from_s, comp_b_from_s));
+                    errors.push(match (body, reference) {
+                        (Some(b), Some(r)) => b.error_from(&r),
+                        _ => AttitudeError::default(),
+                    });
                     if k == 0 {
                         let raw = demod_nominal.correct(&nominal, t_repr, &encoder);
                         let nominal_b_from_s = nominal_cache.get(chain, &nominal_rot, &raw);
                         // Nothing compensated (no table errors known): the same chain, the same attitude.
-                        let body_nominal = if nominal_b_from_s.quaternion() == comp_b_from_s.quaternion() {
-                            body
-                        } else {
-                            pb.body_attitude_through(0, nominal_b_from_s)
-                        };
-                        primary = Some((t_repr, encoder, corrected, body, body_nominal, reference));
+                        let nominal = (nominal_b_from_s.quaternion() != comp_b_from_s.quaternion())
+                            .then(|| demodulate(n_from_s, nominal_b_from_s));
+                        let body = body.or_else(|| nominal.map(|_| demodulate(n_from_s, comp_b_from_s)));
+                        primary = Some((t_repr, encoder, corrected, (n_from_s, comp_b_from_s), body, nominal, reference));
                     }
                 }
-                let Some((t_repr, encoder, corrected, body, body_nominal, reference)) = primary else { continue };
+                let Some((t_repr, encoder, corrected, compensated_chain, body, nominal, reference)) = primary else { continue };
                 // Outside the reference's span (it starts late or ends early) nothing is compared (the
                 // errors recorded there are NaN); the INS's own solution is recorded all along.
                 let compare = !(has_reference && reference.is_none());
-                let truth = reference.unwrap_or(body);
-                let table_errors =
-                    if compare { [body_nominal.error_from(&truth), body.error_from(&truth)] } else { [nan; 2] };
+                let truth = reference.or(body);
+                let table_errors = if compare {
+                    // The compensated body against the reference (or itself); the nominal one against it.
+                    let compensated = errors[0];
+                    match (nominal, truth) {
+                        (Some(n), Some(truth)) => [n.error_from(&truth), compensated],
+                        _ => [compensated; 2],
+                    }
+                } else {
+                    [nan; 2]
+                };
                 let nav_error = pb.core.nav_error();
                 if compare {
                     compared += 1;
@@ -381,7 +393,9 @@ pub fn replay(
                     next_scene = if want_scene { i.saturating_add(scene_every) } else { next_scene };
                     continue;
                 }
-                // A recorded row: the rest of what the scene and plots show.
+                // A recorded row: the rest of what the scene and plots show (the body was demodulated).
+                let body = body.unwrap_or_else(|| demodulate(compensated_chain.0, compensated_chain.1));
+                let truth = truth.unwrap_or(body);
                 let out = StepOutput {
                     t_s: s.t_s,
                     attitude: truth,

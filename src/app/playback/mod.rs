@@ -57,16 +57,16 @@ pub struct Gap {
     pub to_s: f64,
 }
 
-/// The IMU file read on a thread of its own, in blocks: parsing the file overlaps the navigation.
+/// The IMU file read on a thread of its own, in blocks: parsing the file and turning its samples into
+/// compensated increments overlap the navigation.
 struct ImuStream {
     rx: crossbeam_channel::Receiver<Block>,
-    samples: std::vec::IntoIter<ImuSample>,
+    items: std::vec::IntoIter<ImuItem>,
 }
 
 /// What the reading thread sends.
 enum Block {
-    Samples(Vec<ImuSample>),
-    Gap(ImuEvent),
+    Items(Vec<ImuItem>),
     Error(LogError),
 }
 
@@ -74,44 +74,97 @@ enum Block {
 const IMU_BLOCK: usize = 4096;
 
 impl ImuStream {
-    fn spawn(mut reader: ImuReader) -> Result<Self, PlaybackError> {
+    fn spawn(mut reader: ImuReader, mut increments: Increments) -> Result<Self, PlaybackError> {
         let (tx, rx) = crossbeam_channel::bounded(4);
         std::thread::Builder::new()
             .name("imu-reader".into())
             .spawn(move || {
+                let mut samples = Vec::with_capacity(IMU_BLOCK);
                 loop {
-                    let mut samples = Vec::with_capacity(IMU_BLOCK);
+                    samples.clear();
                     let end = reader.next_samples(&mut samples, IMU_BLOCK);
-                    if !samples.is_empty() && tx.send(Block::Samples(samples)).is_err() {
+                    let mut items: Vec<ImuItem> = samples.iter().map(|s| increments.sample(s)).collect();
+                    let (done, error) = match end {
+                        Ok(BlockEnd::Full) => (false, None),
+                        Ok(BlockEnd::Gap(g)) => {
+                            items.extend(increments.gap(g));
+                            (false, None)
+                        }
+                        Ok(BlockEnd::End) => (true, None),
+                        Err(e) => (true, Some(e)),
+                    };
+                    if !items.is_empty() && tx.send(Block::Items(items)).is_err() {
                         return;
                     }
-                    let next = match end {
-                        Ok(BlockEnd::Full) => continue,
-                        Ok(BlockEnd::Gap(g)) => Block::Gap(g),
-                        Ok(BlockEnd::End) => return,
-                        Err(e) => Block::Error(e),
-                    };
-                    let last = matches!(next, Block::Error(_));
-                    if tx.send(next).is_err() || last {
+                    if let Some(e) = error {
+                        let _ = tx.send(Block::Error(e));
+                    }
+                    if done {
                         return;
                     }
                 }
             })
             .map_err(|e| data_err(format!("cannot start the IMU reader: {e}")))?;
-        Ok(Self { rx, samples: Vec::new().into_iter() })
+        Ok(Self { rx, items: Vec::new().into_iter() })
     }
 
-    fn next(&mut self) -> Option<Result<ImuEvent, LogError>> {
+    fn next(&mut self) -> Option<Result<ImuItem, LogError>> {
         loop {
-            if let Some(s) = self.samples.next() {
-                return Some(Ok(ImuEvent::Sample(s)));
+            if let Some(item) = self.items.next() {
+                return Some(Ok(item));
             }
             match self.rx.recv().ok()? {
-                Block::Samples(v) => self.samples = v.into_iter(),
-                Block::Gap(g) => return Some(Ok(g)),
+                Block::Items(v) => self.items = v.into_iter(),
                 Block::Error(e) => return Some(Err(e)),
             }
         }
+    }
+}
+
+/// The file's samples as increments in the RFU sensor frame (rates held over their interval), the
+/// IMU compensation removed.
+struct Increments {
+    kind: SampleKind,
+    nominal_s: f64,
+    last_t: Option<f64>,
+    pending_gap: bool,
+    /// The IMU errors removed from every sample ([`LogSet::imu_compensation`]).
+    compensation: Option<crate::ins::imu_errors::ImuErrors>,
+}
+
+impl Increments {
+    fn gap(&mut self, event: ImuEvent) -> Option<ImuItem> {
+        match event {
+            ImuEvent::Gap { t_before_s, t_after_s, .. } => {
+                self.pending_gap = true;
+                Some(ImuItem::Gap { from_s: t_before_s, to_s: t_after_s })
+            }
+            ImuEvent::Sample(_) => None,
+        }
+    }
+
+    #[inline]
+    fn sample(&mut self, s: &ImuSample) -> ImuItem {
+        let (dtheta, dv) = match self.kind {
+            SampleKind::Increments => (s.gyro, s.accel),
+            SampleKind::Rates => {
+                // A rate held over its interval; across a gap, over one nominal interval
+                // (the gap itself is not integrated).
+                let dt = match self.last_t {
+                    Some(t) if !self.pending_gap => s.t_s - t,
+                    _ => self.nominal_s,
+                };
+                (s.gyro * dt, s.accel * dt)
+            }
+        };
+        self.pending_gap = false;
+        self.last_t = Some(s.t_s);
+        // The compensated IMU: (I + K)⁻¹(measured − b·h) over the nominal interval.
+        let (dtheta, dv) = match &self.compensation {
+            Some(c) => c.compensate(&(dtheta, dv), self.nominal_s),
+            None => (dtheta, dv),
+        };
+        ImuItem::Sample { t_s: s.t_s, dtheta, dv }
     }
 }
 
@@ -531,12 +584,6 @@ impl EncoderReadings {
 /// increments in the RFU sensor frame (rates held over their interval), gaps reported, not bridged.
 pub struct ImuSamples {
     imu: ImuStream,
-    kind: SampleKind,
-    nominal_s: f64,
-    last_t: Option<f64>,
-    pending_gap: bool,
-    /// The IMU errors removed from every sample ([`LogSet::imu_compensation`]).
-    compensation: Option<crate::ins::imu_errors::ImuErrors>,
 }
 
 impl ImuSamples {
@@ -582,44 +629,20 @@ impl ImuSamples {
                 kind_name(declared)
             )));
         }
-        let kind = imu.kind();
         let start = imu.start_time().ok_or_else(|| data_err(format!("{}: no IMU samples", f.path.display())))?;
-        let imu = ImuStream::spawn(imu)?;
-        let compensation = log.imu_compensation;
-        Ok((Self { imu, kind, nominal_s: 1.0 / f.rate_hz, last_t: None, pending_gap: false, compensation }, start))
+        let increments = Increments {
+            kind: imu.kind(),
+            nominal_s: 1.0 / f.rate_hz,
+            last_t: None,
+            pending_gap: false,
+            compensation: log.imu_compensation,
+        };
+        Ok((Self { imu: ImuStream::spawn(imu, increments)? }, start))
     }
 
     /// The next sample or gap; None at the end of the file.
     pub fn next_item(&mut self) -> Result<Option<ImuItem>, PlaybackError> {
-        let Some(event) = self.imu.next() else { return Ok(None) };
-        match event? {
-            ImuEvent::Gap { t_before_s, t_after_s, .. } => {
-                self.pending_gap = true;
-                Ok(Some(ImuItem::Gap { from_s: t_before_s, to_s: t_after_s }))
-            }
-            ImuEvent::Sample(s) => {
-                let (dtheta, dv) = match self.kind {
-                    SampleKind::Increments => (s.gyro, s.accel),
-                    SampleKind::Rates => {
-                        // A rate held over its interval; across a gap, over one nominal interval
-                        // (the gap itself is not integrated).
-                        let dt = match self.last_t {
-                            Some(t) if !self.pending_gap => s.t_s - t,
-                            _ => self.nominal_s,
-                        };
-                        (s.gyro * dt, s.accel * dt)
-                    }
-                };
-                self.pending_gap = false;
-                self.last_t = Some(s.t_s);
-                // The compensated IMU: (I + K)⁻¹(measured − b·h) over the nominal interval.
-                let (dtheta, dv) = match &self.compensation {
-                    Some(c) => c.compensate(&(dtheta, dv), self.nominal_s),
-                    None => (dtheta, dv),
-                };
-                Ok(Some(ImuItem::Sample { t_s: s.t_s, dtheta, dv }))
-            }
-        }
+        Ok(self.imu.next().transpose()?)
     }
 }
 
