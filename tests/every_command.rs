@@ -65,6 +65,22 @@ const CASES: &[Case] = &[
         after: Duration::from_millis(1500),
     },
     Case {
+        name: "budget",
+        args: &["budget", "--hours", "720", "--save", "{dir}/b.rrd", "--json", "{dir}/b.json"],
+        document: Some("b.json"),
+        says_interrupted: true,
+        begun: None,
+        after: Duration::from_millis(1500),
+    },
+    Case {
+        name: "schemes",
+        args: &["schemes", "--hours", "720", "--seeds", "2", "--save", "{dir}/x.rrd", "--json", "{dir}/x.json"],
+        document: Some("x.json"),
+        says_interrupted: true,
+        begun: None,
+        after: Duration::from_millis(1500),
+    },
+    Case {
         name: "selfcal-navigating",
         args: &["selfcal", "--navigate-hours", "720", "--save", "{dir}/s.rrd", "--json", "{dir}/s.json"],
         document: Some("s.json"),

@@ -202,6 +202,17 @@ def sweep(scenario: Any = None, vary: dict | None = None, seeds: int = 1, durati
     return Result("sweep", summary, Tables([], {"points": pd.DataFrame(rows)}), None)
 
 
+def budget(scenario: Any = None, hours: float | None = None, sample_s: float | None = None,
+           threads: int | None = None, save: str | os.PathLike | None = None) -> Result:
+    """The error budget (``rinscope budget``, docs/budget.md): the scenario (default
+    ``budget-dual-axis-16``) with each error source alone, with none and with all, in parallel.
+    ``summary`` is ``budget --json``'s (per source: every channel's value at the end, peak and RMS;
+    the remainder's share); ``series["budget/position_east_m"]`` and the other channels: one column
+    per source's part, the full run, the baseline and their sum."""
+    out = _rinscope.budget(_toml(scenario, "budget-dual-axis-16"), hours, sample_s, threads, _path(save))
+    return _result("budget", out, None, save)
+
+
 def selfcal(scenario: Any = None, sequence: str = "dual-axis-29", monte_carlo: int | None = None, navigate_hours: float = 24.0,
             save: str | os.PathLike | None = None) -> Result:
     """Self-calibrates a scenario's IMU on its own gimbals (default scenario: selfcal-nav-grade;

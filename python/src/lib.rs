@@ -476,6 +476,39 @@ fn sweep(
     Ok(json)
 }
 
+/// The error budget of a scenario (its TOML text) over `hours` (default: its own duration): the
+/// document `budget --json` writes and every channel's table (each source's part, the full run, the
+/// baseline and their sum), the recording saved to `save` if given.
+#[pyfunction]
+#[pyo3(signature = (toml, hours=None, sample_s=None, threads=None, save=None))]
+fn budget(
+    py: Python<'_>,
+    toml: &str,
+    hours: Option<f64>,
+    sample_s: Option<f64>,
+    threads: Option<usize>,
+    save: Option<PathBuf>,
+) -> PyResult<PyOutput> {
+    use rinscope::app::budget::{BudgetRequest, execute};
+    let mut params = parse(toml, "the scenario")?;
+    if let Some(h) = hours {
+        set_duration(&mut params, Some(h * 3600.0))?;
+    }
+    if threads == Some(0) || sample_s.is_some_and(|s| !(s.is_finite() && s > 0.0)) {
+        return Err(PyValueError::new_err("budget: threads at least 1, sample_s a positive number of seconds"));
+    }
+    let out = interruptible(py, move |stop| -> Result<Output, Failure> {
+        let request = BudgetRequest { params, sample_s, threads, json: None, recording: recording(save, stop) };
+        let mut report = execute(&request, stop)?;
+        if report.interrupted {
+            return Err(Failure::Interrupted("budget: stopped before every run was done".into()));
+        }
+        let saved = report.saved.take().unwrap_or_default();
+        output(report, saved)
+    })??;
+    Ok(to_python(py, out))
+}
+
 /// Self-calibrates the IMU of a scenario (its TOML text) on its own gimbals through `sequence`
 /// (`dual-axis-29`, `positions-19`, `azimuth-only`, `scenario`), with `monte_carlo` runs and
 /// `navigate_hours` of free-inertial comparison (0: none): the document `selfcal --json` writes
@@ -556,6 +589,7 @@ fn _rinscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(montecarlo, m)?)?;
     m.add_function(wrap_pyfunction!(selfcal, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(budget, m)?)?;
     m.add_function(wrap_pyfunction!(verify_recording, m)?)?;
     m.add_function(wrap_pyfunction!(write_atomically, m)?)?;
     m.add_function(wrap_pyfunction!(cli, m)?)?;

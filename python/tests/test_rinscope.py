@@ -441,6 +441,27 @@ def test_sweep_refuses_a_key_the_scenario_cannot_take():
         rinscope.sweep(vary={"turntable.axis[1].swing_half_angle_arcsex": [1]}, duration_s=10)
 
 
+# --- budget ----------------------------------------------------------------------------------------
+
+
+def test_budget_gives_the_commands_document_and_every_part(tmp_path):
+    # Python and the command line: one owner, the same numbers; the series add up as the summary says.
+    r = rinscope.budget(hours=0.25, save=tmp_path / "b.rrd")
+    rinscope.verify_recording(tmp_path / "b.rrd")
+    command("budget", "--hours", 0.25, "--json", "b.json", "--save", "c.rrd", cwd=tmp_path)
+    want = json.loads((tmp_path / "b.json").read_text())
+    for got, row in zip(r.summary["rows"], want["rows"]):
+        assert got["source"] == row["source"] and got["channels"] == row["channels"], row["source"]
+    east = r["budget/position_east_m"]
+    parts = [c for c in east.columns if c not in ("t_s", "full_run_m", "baseline_plus_parts_m", "baseline_m")]
+    assert len(parts) == len(r.summary["rows"]) - 4
+    total = east[parts].sum(axis=1) + east["baseline_m"]
+    assert (total - east["baseline_plus_parts_m"]).abs().max() < 1e-9
+    remainder = (east["full_run_m"] - east["baseline_plus_parts_m"]).abs().max()
+    row = next(x for x in r.summary["rows"] if x["kind"] == "remainder")
+    assert abs(remainder - row["channels"]["position_east_m"]["peak"]) < 1e-12
+
+
 # --- selfcal ---------------------------------------------------------------------------------------
 
 

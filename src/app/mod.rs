@@ -5,6 +5,7 @@
 
 pub mod allan;
 pub mod bench;
+pub mod budget;
 pub mod calibrate;
 pub mod export_log;
 pub mod failure;
@@ -18,6 +19,7 @@ pub mod playback;
 pub mod replay;
 pub mod reproduce;
 pub mod run;
+pub mod schemes;
 pub mod selfcal;
 pub mod sweep;
 pub mod terminate;

@@ -345,10 +345,13 @@ pub fn replay(
                         let nominal = (nominal_b_from_s.quaternion() != comp_b_from_s.quaternion())
                             .then(|| demodulate(n_from_s, nominal_b_from_s));
                         let body = body.or_else(|| nominal.map(|_| demodulate(n_from_s, comp_b_from_s)));
-                        primary = Some((t_repr, encoder, corrected, (n_from_s, comp_b_from_s), body, nominal, reference));
+                        primary =
+                            Some((t_repr, encoder, corrected, (n_from_s, comp_b_from_s), body, nominal, reference));
                     }
                 }
-                let Some((t_repr, encoder, corrected, compensated_chain, body, nominal, reference)) = primary else { continue };
+                let Some((t_repr, encoder, corrected, compensated_chain, body, nominal, reference)) = primary else {
+                    continue;
+                };
                 // Outside the reference's span (it starts late or ends early) nothing is compared (the
                 // errors recorded there are NaN); the INS's own solution is recorded all along.
                 let compare = !(has_reference && reference.is_none());

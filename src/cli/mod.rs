@@ -25,6 +25,7 @@
 
 mod allan;
 mod commands;
+mod design;
 mod logs;
 mod numbers;
 mod selfcal;
@@ -41,6 +42,7 @@ use crate::io::validity;
 use crate::record::export::ExportFormat;
 use crate::record::sink::{self, SinkRequest};
 use crate::scenario::{self, ConfigError, Params, presets};
+use design::{BudgetArgs, SchemesArgs};
 use numbers::{
     ALIGN_S, ANGLE_DEG, CI_SIGMA, ETA_SIGMA_ARCSEC, HOURS, NAVIGATE_HOURS, POSITION_PART, SPEED, count, duration_s,
     number, port,
@@ -63,6 +65,16 @@ enum Command {
     Run(RunArgs),
     /// Run in real time, streaming to a viewer, with the config file watched and a slider panel.
     Live(LiveArgs),
+    /// The error budget: which error source causes how much of the INS's attitude, velocity and
+    /// position errors and of the table's — the scenario with each source alone, with none and with
+    /// all, in parallel; the parts, their sum against the full run, the remainder (default scenario
+    /// budget-dual-axis-16, 72 h; docs/budget.md).
+    Budget(BudgetArgs),
+    /// Rotation schemes side by side on one IMU and table: built-in (none, single-axis-4, continuous,
+    /// dual-axis-8/16/32/64) and your own `[scheme]`s, each on the same seeds (a Monte Carlo over the
+    /// error draws): position error at 24 h and at the end, peak heading error, degrees turned and
+    /// cable wrap (default scenario budget-dual-axis-16; docs/schemes.md).
+    Schemes(SchemesArgs),
     /// Rotation modulation: static INS with constant biases, no rotation vs continuous vs 16-position,
     /// simulated together and recorded side by side.
     Modulation(ModulationArgs),
@@ -638,6 +650,8 @@ where
         Command::ExportLog(args) => logs::export_log(&args),
         Command::Replay(args) => logs::replay(&args),
         Command::Allan(args) => allan::allan(&args),
+        Command::Budget(args) => design::budget(&args),
+        Command::Schemes(args) => design::schemes(&args),
         Command::Modulation(args) => commands::modulation(&args),
         Command::Scenarios => {
             commands::list_scenarios();

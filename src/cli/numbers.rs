@@ -22,6 +22,8 @@ pub(super) use crate::app::modulation::HOURS;
 pub(super) use crate::app::selfcal::NAVIGATE_HOURS;
 /// `replay --align-s`: > 0 and at most a day (a manifest's `initial.alignment_s`).
 pub(super) const ALIGN_S: Range = Range::positive(86_400.0, "s", "an alignment time");
+/// `budget --sample-s`: > 0, at most a day.
+pub(super) const SAMPLE_S: Range = Range::positive(86_400.0, "s", "a sampling interval");
 /// One of `--attitude-deg` / `--reference-attitude-deg`: within ±360° (each angle's own bound,
 /// pitch ±90°, roll ±180°, is the manifest's check, which these options feed).
 pub(super) const ANGLE_DEG: Range = Range::symmetric(360.0, "deg", "an attitude angle");

@@ -4,6 +4,7 @@
 
 pub mod align;
 pub mod allan;
+pub mod budget;
 pub mod coning;
 pub mod core;
 pub mod fir;
@@ -52,6 +53,8 @@ pub struct InsParams {
     /// The IMU errors the computer removes from every sample (a compensation document's IMU part,
     /// `run --compensation`), in the accelerometer triad's frame; None: nothing.
     pub imu_compensation: Option<imu_errors::ImuErrors>,
+    /// Which of `errors`' terms act (all in a run; one at a time in an error budget's runs).
+    pub sources: sensor::ImuSources,
 }
 
 impl InsParams {
@@ -70,6 +73,7 @@ impl InsParams {
             signal_window_s: 0.25,
             navigation: None,
             initial_error_rad: Vector3::zeros(),
+            sources: sensor::ImuSources::ALL,
             imu_compensation: None,
         }
     }

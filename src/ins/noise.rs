@@ -228,6 +228,9 @@ pub struct TriadNoise {
     white_sigma: f64,
     pulse: f64,
     axes: [AxisState; 3],
+    /// 1 or 0 per term (R, B, K): whether it reaches the output; every draw is made either way
+    /// ([`Self::select`]).
+    gains: [f64; 3],
 }
 
 impl TriadNoise {
@@ -250,7 +253,15 @@ impl TriadNoise {
             white_sigma: terms.random_walk_si * tau0_s.sqrt(),
             pulse: terms.pulse_weight_si(),
             axes,
+            gains: [1.0; 3],
         }
+    }
+
+    /// Which terms reach the output: the rate ramp R, the bias instability B, the rate random walk
+    /// K (an error budget's one term alone). The same numbers are drawn whichever do, so a term
+    /// alone is that term of the full run.
+    pub fn select(&mut self, ramp: bool, instability: bool, random_walk: bool) {
+        self.gains = [ramp, instability, random_walk].map(|on| if on { 1.0 } else { 0.0 });
     }
 
     /// The additive error increments (rad | m/s) of the next sample: N, B, K, R (no quantization,
@@ -258,7 +269,9 @@ impl TriadNoise {
     pub fn next_error(&mut self) -> Vector3<f64> {
         let (tau0, k) = (self.tau0_s, self.k);
         self.k += 1;
-        let ramp = self.terms.rate_ramp_si * tau0 * tau0 * (k as f64 + 0.5);
+        // Each term times its gain (1 or 0: x · 1 is x to the bit, a full run is unchanged).
+        let [g_ramp, g_flicker, g_rrw] = self.gains;
+        let ramp = self.terms.rate_ramp_si * tau0 * tau0 * (k as f64 + 0.5) * g_ramp;
         let kk = self.terms.rate_random_walk_si;
         let mut out = Vector3::zeros();
         for (o, ax) in out.iter_mut().zip(self.axes.iter_mut()) {
@@ -268,12 +281,12 @@ impl TriadNoise {
             }
             for gm in &mut ax.flicker {
                 let (z1, z2) = (ax.rng.sample(StandardNormal), ax.rng.sample(StandardNormal));
-                inc += gm.step(z1, z2);
+                inc += gm.step(z1, z2) * g_flicker;
             }
             if kk > 0.0 {
                 let (z1, z2): (f64, f64) = (ax.rng.sample(StandardNormal), ax.rng.sample(StandardNormal));
                 let v = kk * tau0 * tau0.sqrt() * (0.5 * z1 + z2 / (2.0 * 3f64.sqrt()));
-                inc += ax.rrw_rate * tau0 + v;
+                inc += (ax.rrw_rate * tau0 + v) * g_rrw;
                 ax.rrw_rate += kk * tau0.sqrt() * z1;
             }
             *o = inc;

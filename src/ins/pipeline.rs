@@ -92,7 +92,7 @@ impl InsRun {
         let pre = InsCore::pre_roll_samples(cfg);
         let t_start = t0_s - (pre as f64) * h;
         let mut truth = TruthImu::new(model, Earth::at(site), t_start);
-        let mut sensors = Sensors::new(&cfg.errors, h, seed, t_start);
+        let mut sensors = Sensors::selected(&cfg.errors, h, seed, t_start, &cfg.sources);
         let pre_roll: Vec<(f64, Vector3<f64>, Vector3<f64>)> = (0..pre)
             .map(|i| {
                 let t1 = t_start + (i + 1) as f64 * h;

@@ -46,6 +46,84 @@ impl Spec {
     }
 }
 
+/// Which of one triad's error terms act (1 or 0 as factors: every draw is made whichever act, so a
+/// term alone is exactly that term of the full run; an error budget runs them one at a time).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TriadSources {
+    /// The constant bias, per axis.
+    pub bias: [bool; 3],
+    /// The scale-factor error, per axis.
+    pub scale: [bool; 3],
+    /// The six misalignment angles.
+    pub misalignment: bool,
+    /// The white noise N (angle / velocity random walk).
+    pub white: bool,
+    /// The Gauss-Markov bias.
+    pub markov: bool,
+    /// IEEE's bias instability B.
+    pub instability: bool,
+    /// IEEE's rate (acceleration) random walk K.
+    pub random_walk: bool,
+    /// IEEE's ramp R.
+    pub ramp: bool,
+    /// The readout: quantization Q and saturation (applied to the total, not additive).
+    pub readout: bool,
+}
+
+impl TriadSources {
+    /// Every term.
+    pub const ALL: Self = Self::every(true);
+    /// None.
+    pub const NONE: Self = Self::every(false);
+
+    const fn every(on: bool) -> Self {
+        Self {
+            bias: [on; 3],
+            scale: [on; 3],
+            misalignment: on,
+            white: on,
+            markov: on,
+            instability: on,
+            random_walk: on,
+            ramp: on,
+            readout: on,
+        }
+    }
+}
+
+/// Which of the IMU's error terms act ([`TriadSources`] per triad, and the gyros' g-sensitivity and
+/// dither).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImuSources {
+    /// The gyros'.
+    pub gyro: TriadSources,
+    /// The accelerometers'.
+    pub accel: TriadSources,
+    /// The g-dependent gyro bias.
+    pub g_sensitivity: bool,
+    /// The ring-laser-gyro dither.
+    pub dither: bool,
+}
+
+impl ImuSources {
+    /// Every term (what a run simulates).
+    pub const ALL: Self = Self { gyro: TriadSources::ALL, accel: TriadSources::ALL, g_sensitivity: true, dither: true };
+    /// None: an ideal IMU drawn from the same seed.
+    pub const NONE: Self =
+        Self { gyro: TriadSources::NONE, accel: TriadSources::NONE, g_sensitivity: false, dither: false };
+}
+
+impl Default for ImuSources {
+    fn default() -> Self {
+        Self::ALL
+    }
+}
+
+/// 1 for a term that acts, 0 for one that does not (x · 1 is x to the bit: a full run is unchanged).
+fn gain(on: bool) -> f64 {
+    if on { 1.0 } else { 0.0 }
+}
+
 /// Errors of the gyro triad, SI.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct GyroSpec {
@@ -156,21 +234,25 @@ struct Triad {
     bias: Vector3<f64>,
     gain: Matrix3<f64>,
     white_per_sample: f64,
+    /// The white noise's factor (its draws are made whenever `white_per_sample` > 0).
+    white_gain: f64,
     gm: Vector3<f64>,
     gm_decay: f64,
     gm_drive: f64,
+    /// The Gauss-Markov bias's factor (it runs whatever it is).
+    gm_gain: f64,
 }
 
 impl Triad {
-    fn new(spec: &TriadErrors, h: f64, rng: &mut ChaCha8Rng) -> Self {
-        let bias = spec.bias.draw(rng);
-        let scale = spec.scale.draw(rng);
-        let mut gain = Matrix3::identity() + Matrix3::from_diagonal(&scale);
+    fn new(spec: &TriadErrors, h: f64, rng: &mut ChaCha8Rng, on: &TriadSources) -> Self {
+        let bias = spec.bias.draw(rng).component_mul(&Vector3::from(on.bias.map(gain)));
+        let scale = spec.scale.draw(rng).component_mul(&Vector3::from(on.scale.map(gain)));
+        let mut gain_matrix = Matrix3::identity() + Matrix3::from_diagonal(&scale);
         for i in 0..3 {
             for j in 0..3 {
                 if i != j {
                     let a: f64 = StandardNormal.sample(rng);
-                    gain[(i, j)] += a * spec.misalignment_rad;
+                    gain_matrix[(i, j)] += a * spec.misalignment_rad * gain(on.misalignment);
                 }
             }
         }
@@ -185,15 +267,24 @@ impl Triad {
             // Start in the stationary distribution.
             gm = Spec::Sigma(spec.instability).draw(rng);
         }
-        Self { bias, gain, white_per_sample: spec.white_per_sqrt_s * h.sqrt(), gm, gm_decay, gm_drive }
+        Self {
+            bias,
+            gain: gain_matrix,
+            white_per_sample: spec.white_per_sqrt_s * h.sqrt(),
+            white_gain: gain(on.white),
+            gm,
+            gm_decay,
+            gm_drive,
+            gm_gain: gain(on.markov),
+        }
     }
 
     #[inline]
     fn apply(&mut self, x: &Vector3<f64>, extra_bias: Vector3<f64>, h: f64, rng: &mut ChaCha8Rng) -> Vector3<f64> {
-        let mut y = self.gain * x + (self.bias + self.gm + extra_bias) * h;
+        let mut y = self.gain * x + (self.bias + self.gm * self.gm_gain + extra_bias) * h;
         if self.white_per_sample > 0.0 {
             let n: [f64; 3] = [StandardNormal.sample(rng), StandardNormal.sample(rng), StandardNormal.sample(rng)];
-            y += Vector3::from(n) * self.white_per_sample;
+            y += Vector3::from(n) * (self.white_per_sample * self.white_gain);
         }
         if self.gm_drive > 0.0 {
             let n: [f64; 3] = [StandardNormal.sample(rng), StandardNormal.sample(rng), StandardNormal.sample(rng)];
@@ -216,6 +307,8 @@ pub struct Sensors {
     dither_last: [f64; 3],
     h: f64,
     rng: ChaCha8Rng,
+    /// Whether the readouts (quantization, saturation) act: (gyros, accelerometers).
+    readout: (bool, bool),
     /// The constant biases drawn (gyro rad/s, accel m/s²), for reports.
     pub drawn_bias: (Vector3<f64>, Vector3<f64>),
 }
@@ -224,28 +317,45 @@ impl Sensors {
     /// Draws the constant errors with `seed` for samples every `h` seconds starting at `t0`.
     #[must_use]
     pub fn new(spec: &ImuErrorSpec, h: f64, seed: u64, t0: f64) -> Self {
+        Self::selected(spec, h, seed, t0, &ImuSources::ALL)
+    }
+
+    /// [`Self::new`] with only the error terms `on` acting: the same draws, so each term is the one
+    /// of the full IMU (an error budget's runs).
+    #[must_use]
+    pub fn selected(spec: &ImuErrorSpec, h: f64, seed: u64, t0: f64, on: &ImuSources) -> Self {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let gyro = Triad::new(&TriadErrors::from(&spec.gyro), h, &mut rng);
-        let accel = Triad::new(&TriadErrors::from(&spec.accel), h, &mut rng);
+        let gyro = Triad::new(&TriadErrors::from(&spec.gyro), h, &mut rng, &on.gyro);
+        let accel = Triad::new(&TriadErrors::from(&spec.accel), h, &mut rng, &on.accel);
         let mut dither_phase = [0.0; 3];
         for p in &mut dither_phase {
             *p = rand::Rng::random::<f64>(&mut rng) * std::f64::consts::TAU;
         }
         let drawn_bias = (gyro.bias, accel.bias);
         // Streams 1-3 (gyros) and 4-6 (accelerometers) of the seed: stream 0 is `rng`'s.
-        let gyro_ieee = ieee_generator(&spec.gyro.noise, h, seed, 1);
-        let accel_ieee = ieee_generator(&spec.accel.noise, h, seed, 4);
+        let mut gyro_ieee = ieee_generator(&spec.gyro.noise, h, seed, 1);
+        let mut accel_ieee = ieee_generator(&spec.accel.noise, h, seed, 4);
+        for (n, t) in [(&mut gyro_ieee, &on.gyro), (&mut accel_ieee, &on.accel)] {
+            if let Some(n) = n {
+                n.select(t.ramp, t.instability, t.random_walk);
+            }
+        }
+        let mut dither = spec.dither;
+        if !on.dither {
+            dither.amplitudes_rad = [0.0; 3];
+        }
         let mut me = Self {
             gyro,
             accel,
             gyro_ieee,
             accel_ieee,
-            g_sensitivity: spec.g_sensitivity,
-            dither: spec.dither,
+            g_sensitivity: spec.g_sensitivity * gain(on.g_sensitivity),
+            dither,
             dither_phase,
             dither_last: [0.0; 3],
             h,
             rng,
+            readout: (on.gyro.readout, on.accel.readout),
             drawn_bias,
         };
         me.dither_last = me.dither_angles(t0);
@@ -283,10 +393,10 @@ impl Sensors {
             self.dither_last = now;
         }
         // What the readout does last: saturation and pulse counting, of the dithered total.
-        if let Some(n) = &mut self.gyro_ieee {
+        if let Some(n) = self.gyro_ieee.as_mut().filter(|_| self.readout.0) {
             g = n.output(g);
         }
-        if let Some(n) = &mut self.accel_ieee {
+        if let Some(n) = self.accel_ieee.as_mut().filter(|_| self.readout.1) {
             a = n.output(a);
         }
         (g, a)

@@ -20,6 +20,8 @@ pub enum Node {
         children: Vec<Node>,
         /// Relative sizes along the container's axis (empty: equal).
         shares: Vec<f32>,
+        /// Its title (a tab's), if any.
+        name: Option<String>,
     },
     /// A view.
     View {
@@ -38,7 +40,13 @@ impl Node {
     /// A container.
     #[must_use]
     pub fn container(kind: ContainerKind, children: Vec<Node>, shares: &[f32]) -> Self {
-        Self::Container { kind, children, shares: shares.to_vec() }
+        Self::Container { kind, children, shares: shares.to_vec(), name: None }
+    }
+
+    /// A container with a title (what its tab shows inside a tab container).
+    #[must_use]
+    pub fn named_container(kind: ContainerKind, name: &str, children: Vec<Node>, shares: &[f32]) -> Self {
+        Self::Container { kind, children, shares: shares.to_vec(), name: Some(name.to_owned()) }
     }
 
     /// A view with no properties.
@@ -177,7 +185,7 @@ fn log_node(node: &Node, stream: &RecordingStream, ids: &mut Ids) -> RecordingSt
             }
             Ok(path)
         }
-        Node::Container { kind, children, shares } => {
+        Node::Container { kind, children, shares, name } => {
             let mut child_paths = Vec::new();
             for c in children {
                 child_paths.push(log_node(c, stream, ids)?);
@@ -185,6 +193,9 @@ fn log_node(node: &Node, stream: &RecordingStream, ids: &mut Ids) -> RecordingSt
             let path = format!("container/{}", ids.next());
             let mut arch = bp::ContainerBlueprint::new(*kind)
                 .with_contents(child_paths.iter().map(|p| bpc::IncludedContent(p.as_str().into())));
+            if let Some(name) = name {
+                arch = arch.with_display_name(name.as_str());
+            }
             if !shares.is_empty() {
                 let s = shares.iter().map(|&x| bpc::ColumnShare(datatypes::Float32(x)));
                 let r = shares.iter().map(|&x| bpc::RowShare(datatypes::Float32(x)));

@@ -15,6 +15,7 @@ pub const PRESETS: &[(&str, &str)] = &[
     ("rotary-table-2016-angular", include_str!("../../assets/scenarios/rotary-table-2016-angular.toml")),
     ("dual-axis-8-position", include_str!("../../assets/scenarios/dual-axis-8-position.toml")),
     ("dual-axis-16-position", include_str!("../../assets/scenarios/dual-axis-16-position.toml")),
+    ("budget-dual-axis-16", include_str!("../../assets/scenarios/budget-dual-axis-16.toml")),
     ("li2014-phase-lag", include_str!("../../assets/scenarios/li2014-phase-lag.toml")),
     ("li2014-coning", include_str!("../../assets/scenarios/li2014-coning.toml")),
     ("li2014-wobble-1", include_str!("../../assets/scenarios/li2014-wobble-1.toml")),
