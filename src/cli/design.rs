@@ -77,14 +77,7 @@ pub(super) fn budget(args: &BudgetArgs) -> Result<(), Failure> {
         recording: args.sinks.recording()?,
     };
     let report = execute(&request, &stop_flag())?;
-    out!("{}", report.text());
-    if let Some(saved) = &report.saved {
-        print_saved(saved);
-    }
-    if report.interrupted {
-        return Err(Failure::interrupted("the budget covers the simulated part only"));
-    }
-    Ok(())
+    print_report(&report.text(), report.saved.as_ref(), report.interrupted, "the budget")
 }
 
 /// `rinscope schemes`.
@@ -124,12 +117,23 @@ pub(super) fn schemes(args: &SchemesArgs) -> Result<(), Failure> {
         recording: args.sinks.recording()?,
     };
     let report = execute(&request, &stop_flag())?;
-    out!("{}", report.text());
-    if let Some(saved) = &report.saved {
+    print_report(&report.text(), report.saved.as_ref(), report.interrupted, "the comparison")
+}
+
+/// Prints a report's table and where its recording went; stopped early, the interrupted exit (what
+/// was printed covers the simulated part only).
+fn print_report(
+    text: &str,
+    saved: Option<&crate::record::sink::Saved>,
+    interrupted: bool,
+    what: &str,
+) -> Result<(), Failure> {
+    out!("{text}");
+    if let Some(saved) = saved {
         print_saved(saved);
     }
-    if report.interrupted {
-        return Err(Failure::interrupted("the comparison covers the simulated part only"));
+    if interrupted {
+        return Err(Failure::interrupted(format!("{what} covers the simulated part only")));
     }
     Ok(())
 }
