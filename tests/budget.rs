@@ -143,6 +143,7 @@ vertical = "held"
         threads: None,
         json: None,
         budget: false,
+        modulable_only: false,
         recording: RecordingRequest { sinks: Default::default(), save_by_default: false },
     };
     let report = execute(&request, &AtomicBool::new(false)).expect("schemes");

@@ -81,6 +81,14 @@ const CASES: &[Case] = &[
         after: Duration::from_millis(1500),
     },
     Case {
+        name: "design",
+        args: &["design", "--hours", "720", "--candidates", "50", "--seeds", "1", "--save", "{dir}/d.rrd", "--json", "{dir}/d.json"],
+        document: Some("d.json"),
+        says_interrupted: true,
+        begun: None,
+        after: Duration::from_millis(1500),
+    },
+    Case {
         name: "selfcal-navigating",
         args: &["selfcal", "--navigate-hours", "720", "--save", "{dir}/s.rrd", "--json", "{dir}/s.json"],
         document: Some("s.json"),

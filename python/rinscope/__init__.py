@@ -26,7 +26,7 @@ from . import _rinscope
 from ._result import Result, Tables, result as _result
 from ._scenario import Scenario, Section
 
-__all__ = ["scenarios", "load", "check", "run", "replay", "calibrate", "allan", "montecarlo", "selfcal", "verify_recording", "Scenario", "Section", "Result", "Tables", "DEFAULT_SCENARIO", "__version__"]
+__all__ = ["scenarios", "load", "check", "run", "replay", "calibrate", "allan", "montecarlo", "sweep", "budget", "schemes", "selfcal", "verify_recording", "Scenario", "Section", "Result", "Tables", "DEFAULT_SCENARIO", "__version__"]
 
 __version__ = _rinscope.VERSION
 DEFAULT_SCENARIO = _rinscope.DEFAULT_SCENARIO
@@ -211,6 +211,22 @@ def budget(scenario: Any = None, hours: float | None = None, sample_s: float | N
     per source's part, the full run, the baseline and their sum."""
     out = _rinscope.budget(_toml(scenario, "budget-dual-axis-16"), hours, sample_s, threads, _path(save))
     return _result("budget", out, None, save)
+
+
+def schemes(scenario: Any = None, schemes: list | tuple = (), hours: float | None = None, seeds: int = 4,
+            budget: bool = False, modulable_only: bool = False, threads: int | None = None,
+            save: str | os.PathLike | None = None) -> Result:
+    """Rotation schemes side by side (``rinscope schemes``, docs/schemes.md): each scheme (a built-in's
+    name, ``none``, ``single-axis-4``, ``continuous``, ``dual-axis-8/16/32/64``, or a file with a
+    ``[scheme]``; none given: every built-in) replaces the scenario's (default ``budget-dual-axis-16``)
+    and runs on the same ``seeds``. ``summary`` is ``schemes --json``'s (per scheme: position at 24 h and
+    at the end, peak heading, median and range over the seeds; degrees turned; cable wrap; with
+    ``budget=True`` the sources it leaves largest; ``modulable_only=True``: no noise, no alignment
+    error, as ``--modulable-only``); the series are the recording's."""
+    names = [str(s) for s in ([schemes] if isinstance(schemes, (str, os.PathLike)) else schemes)]
+    out = _rinscope.schemes(_toml(scenario, "budget-dual-axis-16"), names, hours, seeds, budget, modulable_only, threads,
+                            _path(save))
+    return _result("schemes", out, None, save)
 
 
 def selfcal(scenario: Any = None, sequence: str = "dual-axis-29", monte_carlo: int | None = None, navigate_hours: float = 24.0,

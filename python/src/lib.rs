@@ -509,6 +509,54 @@ fn budget(
     Ok(to_python(py, out))
 }
 
+/// Rotation schemes side by side on a scenario (its TOML text) over `hours` (default: its own
+/// duration): `schemes` names built-ins or files with a `[scheme]` (none: every built-in), run on
+/// `seeds` seeds each; the document `schemes --json` writes and the recording's series.
+#[pyfunction]
+#[pyo3(signature = (toml, schemes=Vec::new(), hours=None, seeds=4, budget=false, modulable_only=false, threads=None, save=None))]
+#[allow(clippy::too_many_arguments)]
+fn schemes(
+    py: Python<'_>,
+    toml: &str,
+    schemes: Vec<String>,
+    hours: Option<f64>,
+    seeds: u64,
+    budget: bool,
+    modulable_only: bool,
+    threads: Option<usize>,
+    save: Option<PathBuf>,
+) -> PyResult<PyOutput> {
+    use rinscope::app::schemes::{SchemesRequest, execute, resolve};
+    let mut params = parse(toml, "the scenario")?;
+    if let Some(h) = hours {
+        set_duration(&mut params, Some(h * 3600.0))?;
+    }
+    if threads == Some(0) || seeds == 0 {
+        return Err(PyValueError::new_err("schemes: seeds and threads at least 1"));
+    }
+    let schemes = resolve(&schemes)?;
+    let out = interruptible(py, move |stop| -> Result<Output, Failure> {
+        let request =
+            SchemesRequest {
+            params,
+            schemes,
+            seeds,
+            threads,
+            json: None,
+            budget,
+            modulable_only,
+            recording: recording(save, stop),
+        };
+        let mut report = execute(&request, stop)?;
+        if report.interrupted {
+            return Err(Failure::Interrupted("schemes: stopped before every run was done".into()));
+        }
+        let saved = report.saved.take().unwrap_or_default();
+        output(report, saved)
+    })??;
+    Ok(to_python(py, out))
+}
+
 /// Self-calibrates the IMU of a scenario (its TOML text) on its own gimbals through `sequence`
 /// (`dual-axis-29`, `positions-19`, `azimuth-only`, `scenario`), with `monte_carlo` runs and
 /// `navigate_hours` of free-inertial comparison (0: none): the document `selfcal --json` writes
@@ -590,6 +638,7 @@ fn _rinscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(selfcal, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(budget, m)?)?;
+    m.add_function(wrap_pyfunction!(schemes, m)?)?;
     m.add_function(wrap_pyfunction!(verify_recording, m)?)?;
     m.add_function(wrap_pyfunction!(write_atomically, m)?)?;
     m.add_function(wrap_pyfunction!(cli, m)?)?;

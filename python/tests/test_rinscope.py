@@ -462,6 +462,28 @@ def test_budget_gives_the_commands_document_and_every_part(tmp_path):
     assert abs(remainder - row["channels"]["position_east_m"]["peak"]) < 1e-12
 
 
+def test_schemes_give_the_commands_document(tmp_path):
+    # Python and the command line: one owner (app::schemes), the same rows on the same seeds; a user's
+    # scheme file (written here, in the documented [scheme] format) runs beside a built-in; a name that
+    # is neither is refused with the built-ins named.
+    (tmp_path / "two.toml").write_text(
+        "[scheme]\nkind = \"indexed\"\nrepeat = true\n"
+        "[[scheme.step]]\naxis = \"inner\"\nangle_deg = 180.0\nrate_deg_per_s = 10.0\ndwell_s = 300.0\n"
+        "[[scheme.step]]\naxis = \"inner\"\nangle_deg = -180.0\nrate_deg_per_s = 10.0\ndwell_s = 300.0\n")
+    names = ["none", "dual-axis-16", str(tmp_path / "two.toml")]
+    r = rinscope.schemes(schemes=names, hours=0.5, seeds=2, save=tmp_path / "s.rrd")
+    rinscope.verify_recording(tmp_path / "s.rrd")
+    command("schemes", "--schemes", ",".join(names), "--hours", 0.5, "--seeds", 2, "--json", "s.json",
+            "--save", "c.rrd", cwd=tmp_path)
+    want = json.loads((tmp_path / "s.json").read_text())
+    assert [row["scheme"] for row in r.summary["rows"]] == names
+    assert r.summary["rows"] == want["rows"] and r.summary["seeds"] == want["seeds"]
+    two = r.summary["rows"][2]
+    assert dict(two["turned_deg"])["inner"] > 0 and dict(two["wrap_deg"])["inner"] == pytest.approx(180, abs=1e-6)
+    with pytest.raises(ValueError, match="neither a built-in scheme .*dual-axis-64"):
+        rinscope.schemes(schemes=["dual-axis-17"], hours=0.1)
+
+
 # --- selfcal ---------------------------------------------------------------------------------------
 
 

@@ -7,6 +7,7 @@ pub mod allan;
 pub mod bench;
 pub mod budget;
 pub mod calibrate;
+pub mod design;
 pub mod export_log;
 pub mod failure;
 pub(crate) mod feed;

@@ -4,13 +4,16 @@
 //! position error at 24 h and at the end and the peak heading error (median and range over the
 //! seeds), what the scheme turns (degrees per axis) and how far it winds the cable.
 
+use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use serde::Serialize;
 
 use super::failure::Failure;
-use super::outputs::{RecordingName, RecordingRequest, check_output, finish, logged, write_json};
+use super::outputs::{
+    RecordingName, RecordingRequest, check_output, finish, logged, read_small_file, write_json,
+};
 use crate::ins::budget::{self, INS_HEADING, POSITION, Selection, Trace};
 use crate::record::sink::Saved;
 use crate::scenario::{self, Params};
@@ -32,6 +35,34 @@ pub fn built_in(name: &str) -> Option<&'static str> {
     BUILT_IN.iter().find(|(n, _)| *n == name).map(|(_, t)| *t)
 }
 
+/// The schemes named (each a built-in's name or a file with a `[scheme]` table; none: every
+/// built-in) as (label, TOML text).
+///
+/// # Errors
+/// A name that is neither a built-in nor a readable file (the built-ins listed).
+pub fn resolve(names: &[String]) -> Result<Vec<(String, String)>, Failure> {
+    if names.is_empty() {
+        return Ok(BUILT_IN.iter().map(|(n, t)| ((*n).to_owned(), (*t).to_owned())).collect());
+    }
+    names
+        .iter()
+        .map(|name| {
+            let text = match built_in(name) {
+                Some(t) => t.to_owned(),
+                None if Path::new(name).exists() => read_small_file(Path::new(name), "--schemes")?,
+                None => {
+                    let known: Vec<&str> = BUILT_IN.iter().map(|(n, _)| *n).collect();
+                    return Err(Failure::input(format!(
+                        "--schemes {name}: neither a built-in scheme ({}) nor a file",
+                        known.join(", ")
+                    )));
+                }
+            };
+            Ok((name.clone(), text))
+        })
+        .collect()
+}
+
 /// `rinscope schemes` (and Python's `schemes`).
 pub struct SchemesRequest {
     /// The scenario whose IMU, table, site and duration every scheme shares.
@@ -46,6 +77,9 @@ pub struct SchemesRequest {
     pub json: Option<std::path::PathBuf>,
     /// Also each scheme's error budget (the first seed): the sources it leaves unmodulated.
     pub budget: bool,
+    /// Only the sources a scheme can modulate act (`ins::budget::modulable_only`: no noise, no
+    /// alignment error), so that seeds differ by the constant errors' draws alone.
+    pub modulable_only: bool,
     /// Where the recording goes.
     pub recording: RecordingRequest,
 }
@@ -62,7 +96,9 @@ pub struct Spread {
 }
 
 impl Spread {
-    fn of(mut v: Vec<f64>) -> Self {
+    /// The median and range of the finite values of `v` (NaN when none is).
+    #[must_use]
+    pub fn of(mut v: Vec<f64>) -> Self {
         v.retain(|x| x.is_finite());
         if v.is_empty() {
             return Self { median: f64::NAN, min: f64::NAN, max: f64::NAN };
@@ -84,6 +120,8 @@ pub struct SchemeRow {
     pub position_24h_m: Option<Spread>,
     /// Horizontal position error at the end, m.
     pub position_end_m: Spread,
+    /// The same per seed, in the seeds' order, m.
+    pub position_end_per_seed_m: Vec<f64>,
     /// Peak horizontal position error, m.
     pub position_peak_m: Spread,
     /// Peak |heading error|, arcsec.
@@ -193,8 +231,13 @@ pub fn execute(req: &SchemesRequest, stop: &AtomicBool) -> Result<SchemesReport,
     if req.schemes.is_empty() || req.seeds == 0 {
         return Err(Failure::input("schemes: give at least one scheme and one seed"));
     }
-    let params: Vec<Params> =
+    let mut params: Vec<Params> =
         req.schemes.iter().map(|(label, text)| with_scheme(base, label, text)).collect::<Result<_, _>>()?;
+    if req.modulable_only {
+        for p in &mut params {
+            p.ins = p.ins.as_ref().map(budget::modulable_only);
+        }
+    }
     let sinks = req.recording.open(RecordingName {
         name: &base.meta.name,
         kind: Some("schemes"),
@@ -263,6 +306,7 @@ pub fn execute(req: &SchemesRequest, stop: &AtomicBool) -> Result<SchemesReport,
             scheme: req.schemes[s].0.clone(),
             position_24h_m: day.map(|i| per(&|t| radial(t, i))),
             position_end_m: per(&|t| if n > 0 { radial(t, n - 1) } else { f64::NAN }),
+            position_end_per_seed_m: mine.iter().map(|t| if n > 0 { radial(t, n - 1) } else { f64::NAN }).collect(),
             position_peak_m: per(&|t| (0..n).map(|i| radial(t, i)).fold(0.0, f64::max)),
             heading_peak_arcsec: per(&|t| (0..n).map(|i| t.values[i][INS_HEADING].abs()).fold(0.0, f64::max)),
             turned_deg,
@@ -294,6 +338,12 @@ pub fn execute(req: &SchemesRequest, stop: &AtomicBool) -> Result<SchemesReport,
 }
 
 impl SchemesReport {
+    /// A scheme's position error at the end per seed, m (empty: no such scheme).
+    #[must_use]
+    pub fn per_seed_end_m(&self, label: &str) -> Vec<f64> {
+        self.rows.iter().find(|r| r.scheme == label).map_or_else(Vec::new, |r| r.position_end_per_seed_m.clone())
+    }
+
     /// The table the recording's side panel shows: per scheme the medians over the seeds.
     #[must_use]
     pub fn short_text(&self) -> String {

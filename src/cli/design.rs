@@ -1,15 +1,15 @@
-//! `rinscope budget` and `rinscope schemes`: which error source causes which drift, and which rotation
-//! scheme cancels it (the owners are `app::budget::execute` and `app::schemes::execute`, the
-//! mechanism `ins::budget`).
+//! `rinscope budget`, `rinscope schemes` and `rinscope design`: which error source causes which
+//! drift, which rotation scheme cancels it, and a search for a better one (the owners are
+//! `app::budget::execute`, `app::schemes::execute` and `app::design::execute`; the mechanisms
+//! `ins::budget`, `ins::averaged`, `model::sequences`).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use clap::Args;
 
 use super::commands::print_saved;
-use super::numbers::{HOURS, SAMPLE_S, count, number};
+use super::numbers::{DWELL_S, HOURS, MOVE_DEG, RATE_DEG_PER_S, SAMPLE_S, WRAP_DEG, count, number};
 use super::{Failure, ScenarioSource, SinkArgs};
-use crate::app::outputs::read_small_file;
 use crate::app::terminate::stop_flag;
 
 #[derive(Args)]
@@ -60,6 +60,58 @@ pub(super) struct SchemesArgs {
     /// sources each leaves unmodulated.
     #[arg(long)]
     budget: bool,
+    /// Only the errors a scheme can modulate (biases, scale factors, misalignments, g-sensitivity,
+    /// the table's): no noise, no alignment error — the seeds then differ by those draws alone,
+    /// and the schemes' differences are not hidden by the random walks' luck.
+    #[arg(long)]
+    modulable_only: bool,
+}
+
+#[derive(Args)]
+pub(super) struct DesignArgs {
+    #[command(flatten)]
+    source: ScenarioSource,
+    #[command(flatten)]
+    sinks: SinkArgs,
+    /// Override the scenario's simulated duration, h.
+    #[arg(long, allow_negative_numbers = true, value_parser = |t: &str| number(t, &HOURS))]
+    hours: Option<f64>,
+    /// The axes that may move, comma-separated names (default: every axis).
+    #[arg(long, value_delimiter = ',')]
+    axes: Vec<String>,
+    /// Moves per period, comma-separated even numbers.
+    #[arg(long, value_delimiter = ',', default_values_t = [8, 16, 32], value_parser = |t: &str| count(t, 2, 256, "moves").map(|n| n as usize))]
+    moves: Vec<usize>,
+    /// Move sizes, deg, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = [180.0], allow_negative_numbers = true, value_parser = |t: &str| number(t, &MOVE_DEG))]
+    angles_deg: Vec<f64>,
+    /// Cruise rates, deg/s, comma-separated (default: the scenario's).
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true, value_parser = |t: &str| number(t, &RATE_DEG_PER_S))]
+    rates_deg_per_s: Vec<f64>,
+    /// Dwells after each move, s, comma-separated (default: the scenario's).
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true, value_parser = |t: &str| number(t, &DWELL_S))]
+    dwells_s: Vec<f64>,
+    /// The largest excursion of an axis from its start (the cable's wrap), deg.
+    #[arg(long, default_value_t = 360.0, allow_negative_numbers = true, value_parser = |t: &str| number(t, &WRAP_DEG))]
+    max_wrap_deg: f64,
+    /// Sequences drawn (duplicates dropped) and ranked by the averaged model.
+    #[arg(long, default_value_t = 1000, allow_negative_numbers = true, value_parser = |t: &str| count(t, 1, 1_000_000, "candidates").map(|n| n as usize))]
+    candidates: usize,
+    /// The model's best this many are confirmed by the exact simulation, beside every built-in.
+    #[arg(long, default_value_t = 4, allow_negative_numbers = true, value_parser = |t: &str| count(t, 1, 100, "schemes").map(|n| n as usize))]
+    confirm: usize,
+    /// Seeds per confirmed scheme.
+    #[arg(long, default_value_t = 4, allow_negative_numbers = true, value_parser = |t: &str| count(t, 1, 10_000, "seeds"))]
+    seeds: u64,
+    /// Threads (default: every core).
+    #[arg(long, allow_negative_numbers = true, value_parser = |t: &str| count(t, 1, 1024, "threads").map(|n| n as usize))]
+    threads: Option<usize>,
+    /// Write the design (every ranked scheme, its model terms and exact row) as JSON.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Write the best scheme's `[scheme]` to this file (run it with `schemes --schemes FILE`).
+    #[arg(long)]
+    save_scheme: Option<PathBuf>,
 }
 
 /// `rinscope budget`.
@@ -82,31 +134,12 @@ pub(super) fn budget(args: &BudgetArgs) -> Result<(), Failure> {
 
 /// `rinscope schemes`.
 pub(super) fn schemes(args: &SchemesArgs) -> Result<(), Failure> {
-    use crate::app::schemes::{BUILT_IN, SchemesRequest, built_in, execute};
+    use crate::app::schemes::{SchemesRequest, execute, resolve};
     let mut params = args.source.load("budget-dual-axis-16")?;
     if let Some(h) = args.hours {
         params.set_duration(h * 3600.0);
     }
-    let names: Vec<String> = if args.schemes.is_empty() {
-        BUILT_IN.iter().map(|(n, _)| (*n).to_owned()).collect()
-    } else {
-        args.schemes.clone()
-    };
-    let mut schemes = Vec::new();
-    for name in names {
-        let text = match built_in(&name) {
-            Some(t) => t.to_owned(),
-            None if Path::new(&name).exists() => read_small_file(Path::new(&name), "--schemes")?,
-            None => {
-                let known: Vec<&str> = BUILT_IN.iter().map(|(n, _)| *n).collect();
-                return Err(Failure::input(format!(
-                    "--schemes {name}: neither a built-in scheme ({}) nor a file",
-                    known.join(", ")
-                )));
-            }
-        };
-        schemes.push((name, text));
-    }
+    let schemes = resolve(&args.schemes)?;
     let request = SchemesRequest {
         params,
         schemes,
@@ -114,10 +147,40 @@ pub(super) fn schemes(args: &SchemesArgs) -> Result<(), Failure> {
         threads: args.threads,
         json: args.json.clone(),
         budget: args.budget,
+        modulable_only: args.modulable_only,
         recording: args.sinks.recording()?,
     };
     let report = execute(&request, &stop_flag())?;
     print_report(&report.text(), report.saved.as_ref(), report.interrupted, "the comparison")
+}
+
+/// `rinscope design`.
+pub(super) fn design(args: &DesignArgs) -> Result<(), Failure> {
+    use crate::app::design::{DesignRequest, DesignSpace, execute};
+    let mut params = args.source.load("budget-dual-axis-16")?;
+    if let Some(h) = args.hours {
+        params.set_duration(h * 3600.0);
+    }
+    let request = DesignRequest {
+        params,
+        space: DesignSpace {
+            axes: args.axes.clone(),
+            steps: args.moves.clone(),
+            angles_deg: args.angles_deg.clone(),
+            rates_deg_per_s: args.rates_deg_per_s.clone(),
+            dwells_s: args.dwells_s.clone(),
+            max_wrap_deg: args.max_wrap_deg,
+        },
+        candidates: args.candidates,
+        confirm: args.confirm,
+        seeds: args.seeds,
+        threads: args.threads,
+        json: args.json.clone(),
+        save_scheme: args.save_scheme.clone(),
+        recording: args.sinks.recording()?,
+    };
+    let report = execute(&request, &stop_flag())?;
+    print_report(&report.text(), report.saved.as_ref(), report.interrupted, "the design")
 }
 
 /// Prints a report's table and where its recording went; stopped early, the interrupted exit (what

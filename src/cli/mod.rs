@@ -42,7 +42,7 @@ use crate::io::validity;
 use crate::record::export::ExportFormat;
 use crate::record::sink::{self, SinkRequest};
 use crate::scenario::{self, ConfigError, Params, presets};
-use design::{BudgetArgs, SchemesArgs};
+use design::{BudgetArgs, DesignArgs, SchemesArgs};
 use numbers::{
     ALIGN_S, ANGLE_DEG, CI_SIGMA, ETA_SIGMA_ARCSEC, HOURS, NAVIGATE_HOURS, POSITION_PART, SPEED, count, duration_s,
     number, port,
@@ -75,6 +75,11 @@ enum Command {
     /// error draws): position error at 24 h and at the end, peak heading error, degrees turned and
     /// cable wrap (default scenario budget-dual-axis-16; docs/schemes.md).
     Schemes(SchemesArgs),
+    /// A rotation-scheme designer: draws indexing sequences under your constraints (axes, moves per
+    /// period, angles, rates, dwells, cable wrap), ranks them and the built-ins with an averaged
+    /// error model, confirms the best by simulation and prints the winner as a `[scheme]`
+    /// (docs/schemes.md).
+    Design(DesignArgs),
     /// Rotation modulation: static INS with constant biases, no rotation vs continuous vs 16-position,
     /// simulated together and recorded side by side.
     Modulation(ModulationArgs),
@@ -652,6 +657,7 @@ where
         Command::Allan(args) => allan::allan(&args),
         Command::Budget(args) => design::budget(&args),
         Command::Schemes(args) => design::schemes(&args),
+        Command::Design(args) => design::design(&args),
         Command::Modulation(args) => commands::modulation(&args),
         Command::Scenarios => {
             commands::list_scenarios();

@@ -24,6 +24,14 @@ pub(super) use crate::app::selfcal::NAVIGATE_HOURS;
 pub(super) const ALIGN_S: Range = Range::positive(86_400.0, "s", "an alignment time");
 /// `budget --sample-s`: > 0, at most a day.
 pub(super) const SAMPLE_S: Range = Range::positive(86_400.0, "s", "a sampling interval");
+/// `design --angles-deg`: a move of at most two turns.
+pub(super) const MOVE_DEG: Range = Range::positive(720.0, "deg", "a move");
+/// `design --rates-deg-per-s`: a table's rate, at most 1000°/s.
+pub(super) const RATE_DEG_PER_S: Range = Range::positive(1000.0, "deg/s", "a rate");
+/// `design --dwells-s`: 0 (no dwell) to a day.
+pub(super) const DWELL_S: Range = Range::closed(0.0, 86_400.0, "s", "a dwell");
+/// `design --max-wrap-deg`: up to ten turns.
+pub(super) const WRAP_DEG: Range = Range::positive(3600.0, "deg", "a cable wrap");
 /// One of `--attitude-deg` / `--reference-attitude-deg`: within ±360° (each angle's own bound,
 /// pitch ±90°, roll ±180°, is the manifest's check, which these options feed).
 pub(super) const ANGLE_DEG: Range = Range::symmetric(360.0, "deg", "an attitude angle");

@@ -4,6 +4,7 @@
 
 pub mod align;
 pub mod allan;
+pub mod averaged;
 pub mod budget;
 pub mod coning;
 pub mod core;

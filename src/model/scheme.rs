@@ -211,6 +211,18 @@ impl Scheme {
         }
     }
 
+    /// One period of a repeated indexed sequence as (start, length), s: it starts when the initial
+    /// dwell ends. None for a continuous scheme or a sequence that runs once.
+    #[must_use]
+    pub fn period_window(&self) -> Option<(f64, f64)> {
+        match &self.kind {
+            Kind::Indexed { initial_dwell_s, period_s, repeat: true, .. } if *period_s > 0.0 => {
+                Some((*initial_dwell_s, *period_s))
+            }
+            _ => None,
+        }
+    }
+
     /// The indexed moves as configured (empty for continuous schemes).
     #[must_use]
     pub fn steps(&self) -> &[IndexedStep] {

@@ -9,7 +9,7 @@ use rerun::blueprint::components::ContainerKind;
 use super::blueprint::{self, LegendCorner, Node};
 use super::palette::{colors, rgb};
 use super::{APPLICATION_ID, Stream, TIMELINE};
-use crate::ins::budget::{Budget, CHANNELS, INS_HEADING, POSITION, TABLE_HEADING};
+use crate::ins::budget::{Budget, CHANNELS, POSITION};
 
 /// Parts drawn per plot; the others are summed into one line.
 const SHOWN: usize = 6;
@@ -95,7 +95,7 @@ pub fn log(
     }
     // The headline stacked: the parts' sizes added up, the largest at the bottom.
     let navigating = channels.contains(&POSITION[0]);
-    if let Some(h) = [POSITION[0], INS_HEADING, TABLE_HEADING].into_iter().find(|c| channels.contains(c)) {
+    if let Some(h) = Budget::headline(channels) {
         let size = |k: usize, i: usize| {
             let v = &b.parts[k].1.values[i];
             if navigating { v[POSITION[0]].hypot(v[POSITION[1]]) } else { v[h].abs() }

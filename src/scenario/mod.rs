@@ -411,6 +411,35 @@ pub fn compensation_keys(
     }
 }
 
+/// An indexed sequence as a `[scheme]` table of TOML (what `rinscope design` prints and `schemes`
+/// reads): `steps` on the chain's `axes`, repeated, after `initial_dwell_s`.
+#[must_use]
+pub fn indexed_scheme_toml(axes: &[String], initial_dwell_s: f64, steps: &[crate::model::scheme::IndexedStep]) -> String {
+    #[derive(serde::Serialize)]
+    struct File {
+        scheme: raw::RawScheme,
+    }
+    // Degrees back from radians to the digits they were given in.
+    let deg = |rad: f64| (rad.to_degrees() * 1e9).round() / 1e9;
+    let scheme = raw::RawScheme {
+        kind: "indexed".into(),
+        rate: Vec::new(),
+        initial_dwell_s: Some(initial_dwell_s),
+        repeat: Some(true),
+        step: steps
+            .iter()
+            .map(|s| raw::RawStep {
+                axis: axes.get(s.axis).cloned().unwrap_or_default(),
+                angle_deg: deg(s.angle_rad),
+                rate_deg_per_s: deg(s.rate_rad_per_s),
+                dwell_s: s.dwell_s,
+                accel_deg_per_s2: deg(s.accel_rad_per_s2),
+            })
+            .collect(),
+    };
+    toml::to_string(&File { scheme }).unwrap_or_default()
+}
+
 #[cfg(test)]
 mod tests {
     #[test]

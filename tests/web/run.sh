@@ -52,11 +52,14 @@ passed=0 failed=0
 if "$venv/bin/python" "$here/drive.py" "$url" "$work/rinscope-live/jiang2017-dual-axis.toml" "$cport"; then
   sleep 1
   kill -INT "$pid"; wait "$pid" || true; pid=
-  if "$bin" events "$work/session.rrd" | grep -q "reloaded at .*inner swing half-angle 300″ → 450″"; then
-    echo "web: the recording holds the reload: $("$bin" events "$work/session.rrd" | grep -m1 reloaded)"
+  # The events read whole first: `events | grep -q` under pipefail fails at random when grep quits
+  # at its first match and `events` then writes into a closed pipe.
+  events=$("$bin" events "$work/session.rrd" 2>&1) || events+=$'\n(rinscope events failed)'
+  if grep -q "reloaded at .*inner swing half-angle 300″ → 450″" <<<"$events"; then
+    echo "web: the recording holds the reload: $(grep -m1 reloaded <<<"$events")"
     passed=$((passed + 1))
   else
-    "$bin" events "$work/session.rrd" || true
+    echo "$events"
     echo "web: the reload is not in the recording"; failed=$((failed + 1))
   fi
 else
