@@ -6,7 +6,7 @@
 //! (−+−+), (+−−+), (−++−). The dwells at 0° and 180° cancel a horizontal bias in all six; the moves
 //! do not: a move sweeps a half plane, ∫(cos θ, sin θ) dθ/ω = (0, ±2/ω), and (+−) sweeps the upper
 //! one twice (the averaged bias 4ε/(ωT), `ins::averaged`'s test), as does (+−+−); only (+−−+) and
-//! its mirror sweep both halves and leave nothing. The designer must find exactly those two, and
+//! its mirror sweep both halves and leave no drift. The designer must find exactly those two, and
 //! the exact simulation must confirm them far ahead of the two-move sequence that is the textbook
 //! "two-position" scheme.
 
@@ -87,10 +87,12 @@ fn the_designer_finds_the_sequence_that_sweeps_both_half_planes() {
     let mut first_two = order[..2].to_vec();
     first_two.sort();
     assert_eq!(first_two, ["+--+", "-++-"], "the model's ranking: {order:?}\n{}", report.text());
-    // The model: the two leave nothing of the biases (rounding of the midpoint sums), the rest a
-    // drift of 4ε/(ωT) or, for (+−+−), the same over a period twice as long.
+    // The model: the two leave no drift of the biases, only the tilt the dwells hold between the
+    // moves (bounded: about R·ε·D/4 ≈ 20 m for the 60 s dwells D); the rest a drift of 4ε/(ωT) =
+    // 0.15 ε or, for (+−+−), the same over a period twice as long, whose position error grows as
+    // R·0.15·ε·t, a few km in 12 h: two orders of magnitude apart.
     let two = found.iter().find(|r| signs(&r.scheme) == "+-").expect("(+−) drawn");
-    assert!(found[0].model_m < 1e-3 * two.model_m, "{} vs {}", found[0].model_m, two.model_m);
+    assert!(found[0].model_m < 0.05 * two.model_m, "{} vs {}", found[0].model_m, two.model_m);
     // The exact simulation agrees: the best confirmed is one of the two, and its position error is a
     // small fraction of the two-position sequence's (which drifts by 0.15 of the bias).
     let end = |label: &str| {

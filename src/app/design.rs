@@ -213,7 +213,7 @@ fn responses(p: &Params, n_from_s: &Matrix3<f64>, sample_s: f64, stop: &AtomicBo
             t.values.iter().map(|v| [v[POSITION[0]], v[POSITION[1]]]).collect()
         })
         .collect();
-    Responses::from_runs([&traces[0], &traces[1], &traces[2]], GYRO, [&traces[3], &traces[4], &traces[5]], ACCEL)
+    Responses::from_runs([&traces[0], &traces[1], &traces[2]], GYRO, [&traces[3], &traces[4], &traces[5]], ACCEL, sample_s)
 }
 
 /// A scheme's model score and its terms named, largest first.
