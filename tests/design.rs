@@ -96,7 +96,14 @@ fn the_designer_finds_the_sequence_that_sweeps_both_half_planes() {
     // The exact simulation agrees: the best confirmed is one of the two, and its position error is a
     // small fraction of the two-position sequence's (which drifts by 0.15 of the bias).
     let end = |label: &str| {
-        report.ranked.iter().find(|r| r.label == label).and_then(|r| r.exact.as_ref()).expect("confirmed").position_end_m.median
+        report
+            .ranked
+            .iter()
+            .find(|r| r.label == label)
+            .and_then(|r| r.exact.as_ref())
+            .expect("confirmed")
+            .position_end_m
+            .median
     };
     let best = report.ranked.iter().find(|r| r.label == report.best).expect("the best");
     assert!(["+--+", "-++-"].contains(&signs(&best.scheme).as_str()), "{}", report.text());

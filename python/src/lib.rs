@@ -534,10 +534,9 @@ fn schemes(
     if threads == Some(0) || seeds == 0 {
         return Err(PyValueError::new_err("schemes: seeds and threads at least 1"));
     }
-    let schemes = resolve(&schemes)?;
+    let schemes = resolve(&schemes).map_err(Failure::from)?;
     let out = interruptible(py, move |stop| -> Result<Output, Failure> {
-        let request =
-            SchemesRequest {
+        let request = SchemesRequest {
             params,
             schemes,
             seeds,
@@ -550,6 +549,60 @@ fn schemes(
         let mut report = execute(&request, stop)?;
         if report.interrupted {
             return Err(Failure::Interrupted("schemes: stopped before every run was done".into()));
+        }
+        let saved = report.saved.take().unwrap_or_default();
+        output(report, saved)
+    })??;
+    Ok(to_python(py, out))
+}
+
+/// The rotation-scheme designer on a scenario (its TOML text): `candidates` sequences drawn under
+/// the constraints (`axes`, `moves`, `angles_deg`, `rates_deg_per_s`, `dwells_s`, `max_wrap_deg`),
+/// ranked by the averaged model with the built-ins, the best `confirm` simulated on `seeds` seeds;
+/// the document `design --json` writes (the designed `[scheme]` under each ranked row's "scheme").
+#[pyfunction]
+#[pyo3(signature = (toml, hours=None, axes=Vec::new(), moves=vec![8, 16, 32], angles_deg=vec![180.0], rates_deg_per_s=Vec::new(), dwells_s=Vec::new(), max_wrap_deg=360.0, candidates=1000, confirm=4, seeds=4, threads=None, save=None))]
+#[allow(clippy::too_many_arguments)]
+fn design(
+    py: Python<'_>,
+    toml: &str,
+    hours: Option<f64>,
+    axes: Vec<String>,
+    moves: Vec<usize>,
+    angles_deg: Vec<f64>,
+    rates_deg_per_s: Vec<f64>,
+    dwells_s: Vec<f64>,
+    max_wrap_deg: f64,
+    candidates: usize,
+    confirm: usize,
+    seeds: u64,
+    threads: Option<usize>,
+    save: Option<PathBuf>,
+) -> PyResult<PyOutput> {
+    use rinscope::app::design::{DesignRequest, DesignSpace, execute};
+    let mut params = parse(toml, "the scenario")?;
+    if let Some(h) = hours {
+        set_duration(&mut params, Some(h * 3600.0))?;
+    }
+    if threads == Some(0) || seeds == 0 || candidates == 0 || confirm == 0 {
+        return Err(PyValueError::new_err("design: candidates, confirm, seeds and threads at least 1"));
+    }
+    let space = DesignSpace { axes, steps: moves, angles_deg, rates_deg_per_s, dwells_s, max_wrap_deg };
+    let out = interruptible(py, move |stop| -> Result<Output, Failure> {
+        let request = DesignRequest {
+            params,
+            space,
+            candidates,
+            confirm,
+            seeds,
+            threads,
+            json: None,
+            save_scheme: None,
+            recording: recording(save, stop),
+        };
+        let mut report = execute(&request, stop)?;
+        if report.interrupted {
+            return Err(Failure::Interrupted("design: stopped before every run was done".into()));
         }
         let saved = report.saved.take().unwrap_or_default();
         output(report, saved)
@@ -639,6 +692,7 @@ fn _rinscope(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(budget, m)?)?;
     m.add_function(wrap_pyfunction!(schemes, m)?)?;
+    m.add_function(wrap_pyfunction!(design, m)?)?;
     m.add_function(wrap_pyfunction!(verify_recording, m)?)?;
     m.add_function(wrap_pyfunction!(write_atomically, m)?)?;
     m.add_function(wrap_pyfunction!(cli, m)?)?;

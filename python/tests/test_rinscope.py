@@ -484,6 +484,23 @@ def test_schemes_give_the_commands_document(tmp_path):
         rinscope.schemes(schemes=["dual-axis-17"], hours=0.1)
 
 
+def test_design_gives_the_commands_document_and_a_scheme_that_runs(tmp_path):
+    # Python and the command line: one owner (app::design), the same ranking and numbers on the same
+    # seed; the designed [scheme] (TOML text) runs in `schemes` and gives the exact row it was ranked by.
+    kw = dict(hours=2, moves=[4, 8], candidates=40, confirm=2, seeds=1)
+    r = rinscope.design(**kw)
+    command("design", "--hours", 2, "--moves", "4,8", "--candidates", 40, "--confirm", 2, "--seeds", 1,
+            "--json", "d.json", "--save", "d.rrd", "--save-scheme", "best.toml", cwd=tmp_path)
+    want = json.loads((tmp_path / "d.json").read_text())
+    for key in ("best", "best_built_in", "ratio", "drawn", "distinct"):
+        assert r.summary[key] == want[key], key
+    assert [x["label"] for x in r.summary["ranked"]] == [x["label"] for x in want["ranked"]]
+    best = next(x for x in want["ranked"] if x["label"] == want["best"])
+    assert (tmp_path / "best.toml").read_text().endswith(best["scheme"])
+    again = rinscope.schemes(schemes=[str(tmp_path / "best.toml")], hours=2, seeds=1, modulable_only=True)
+    assert again.summary["rows"][0]["position_end_m"] == best["exact"]["position_end_m"]
+
+
 # --- selfcal ---------------------------------------------------------------------------------------
 
 

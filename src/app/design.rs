@@ -98,7 +98,8 @@ pub struct Ranked {
     /// One period, s (None: not a repeated sequence).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub period_s: Option<f64>,
-    /// The exact simulation's row, if confirmed.
+    /// The exact simulation's row, if confirmed (the drawn best and the built-ins the model puts
+    /// within 5× of the best built-in).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub exact: Option<SchemeRow>,
     /// Its `[scheme]` (TOML).
@@ -170,7 +171,11 @@ fn constraints(p: &Params, space: &DesignSpace) -> Result<Constraints, Failure> 
         } else {
             rad(&space.rates_deg_per_s)
         },
-        dwells_s: if space.dwells_s.is_empty() { vec![own.map_or(60.0, |s| s.dwell_s)] } else { space.dwells_s.clone() },
+        dwells_s: if space.dwells_s.is_empty() {
+            vec![own.map_or(60.0, |s| s.dwell_s)]
+        } else {
+            space.dwells_s.clone()
+        },
         accel_rad_per_s2: own.map_or(10f64.to_radians(), |s| s.accel_rad_per_s2),
         max_wrap_rad: space.max_wrap_deg.to_radians(),
     };
@@ -213,7 +218,13 @@ fn responses(p: &Params, n_from_s: &Matrix3<f64>, sample_s: f64, stop: &AtomicBo
             t.values.iter().map(|v| [v[POSITION[0]], v[POSITION[1]]]).collect()
         })
         .collect();
-    Responses::from_runs([&traces[0], &traces[1], &traces[2]], GYRO, [&traces[3], &traces[4], &traces[5]], ACCEL, sample_s)
+    Responses::from_runs(
+        [&traces[0], &traces[1], &traces[2]],
+        GYRO,
+        [&traces[3], &traces[4], &traces[5]],
+        ACCEL,
+        sample_s,
+    )
 }
 
 /// A scheme's model score and its terms named, largest first.
@@ -326,9 +337,14 @@ pub fn execute(req: &DesignRequest, stop: &AtomicBool) -> Result<DesignReport, F
             scheme: text.clone(),
         });
     }
-    // The exact simulation: every ranked scheme on the same seeds.
+    // The exact simulation on the same seeds: the drawn best and the built-ins the model puts within
+    // HOPELESS of the best built-in (one further behind cannot be the best built-in: the model and the
+    // simulation agree to well within that; its model row is still reported).
+    const HOPELESS: f64 = 5.0;
     let t_exact = Instant::now();
-    let schemes = ranked.iter().map(|r| (r.label.clone(), r.scheme.clone())).collect();
+    let floor = ranked.iter().filter(|r| r.built_in).map(|r| r.model_m).fold(f64::INFINITY, f64::min);
+    let confirmed = |r: &Ranked| !r.built_in || r.model_m <= HOPELESS * floor || !floor.is_finite();
+    let schemes = ranked.iter().filter(|r| confirmed(r)).map(|r| (r.label.clone(), r.scheme.clone())).collect();
     let request = SchemesRequest {
         params: p.clone(),
         schemes,
@@ -341,8 +357,8 @@ pub fn execute(req: &DesignRequest, stop: &AtomicBool) -> Result<DesignReport, F
     };
     let mut exact: SchemesReport = super::schemes::execute(&request, stop)?;
     let t_exact = t_exact.elapsed().as_secs_f64();
-    for (r, row) in ranked.iter_mut().zip(&exact.rows) {
-        r.exact = Some(row.clone());
+    for r in &mut ranked {
+        r.exact = exact.rows.iter().find(|x| x.scheme == r.label).cloned();
     }
     let end = |r: &Ranked| r.exact.as_ref().map_or(f64::NAN, |x| x.position_end_m.median);
     let best_of = |built_in: bool| {
@@ -353,7 +369,12 @@ pub fn execute(req: &DesignRequest, stop: &AtomicBool) -> Result<DesignReport, F
     };
     let best = &best_found;
     let per_seed = super::schemes::Spread::of(
-        exact.per_seed_end_m(&best_built_in.label).iter().zip(exact.per_seed_end_m(&best.label)).map(|(b, f)| b / f).collect(),
+        exact
+            .per_seed_end_m(&best_built_in.label)
+            .iter()
+            .zip(exact.per_seed_end_m(&best.label))
+            .map(|(b, f)| b / f)
+            .collect(),
     );
     let term = |r: &Ranked, name: &str| r.model_terms.iter().find(|(n, _)| n == name).map_or(0.0, |x| x.1);
     let mut cancels: Vec<(String, f64, f64)> = best_built_in
@@ -365,8 +386,11 @@ pub fn execute(req: &DesignRequest, stop: &AtomicBool) -> Result<DesignReport, F
     cancels.sort_by(|a, b| (b.1 - b.2).total_cmp(&(a.1 - a.2)));
     cancels.truncate(4);
     if let Some(path) = &req.save_scheme {
-        write_atomically(path, format!("# rinscope design: {} on {}\n{}", best.label, p.meta.name, best.scheme).as_bytes())
-            .map_err(|e| Failure::output("--save-scheme", &e))?;
+        write_atomically(
+            path,
+            format!("# rinscope design: {} on {}\n{}", best.label, p.meta.name, best.scheme).as_bytes(),
+        )
+        .map_err(|e| Failure::output("--save-scheme", &e))?;
     }
     let mut report = DesignReport {
         scenario: p.meta.name.clone(),
@@ -432,7 +456,14 @@ impl DesignReport {
         for r in &self.ranked {
             let exact = r.exact.as_ref().map_or_else(
                 || "—".into(),
-                |x| format!("{} [{}, {}]", num(x.position_end_m.median), num(x.position_end_m.min), num(x.position_end_m.max)),
+                |x| {
+                    format!(
+                        "{} [{}, {}]",
+                        num(x.position_end_m.median),
+                        num(x.position_end_m.min),
+                        num(x.position_end_m.max)
+                    )
+                },
             );
             let top = r.model_terms.first().map_or_else(String::new, |(n, m)| format!("{n} {}", num(*m)));
             s.push_str(&format!(

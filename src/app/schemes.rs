@@ -11,9 +11,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::failure::Failure;
-use super::outputs::{
-    RecordingName, RecordingRequest, check_output, finish, logged, read_small_file, write_json,
-};
+use super::outputs::{RecordingName, RecordingRequest, check_output, finish, logged, read_small_file, write_json};
 use crate::ins::budget::{self, INS_HEADING, POSITION, Selection, Trace};
 use crate::record::sink::Saved;
 use crate::scenario::{self, Params};

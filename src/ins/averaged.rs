@@ -91,7 +91,8 @@ pub fn averages(
     let steps = ((window_s.1 / step_s).ceil() as usize).max(1);
     let h = window_s.1 / steps as f64;
     let f_n = -earth.gravity_n;
-    let mut out = Averages { c: Default::default(), gyro: Default::default(), accel: Default::default(), f_n, window_s };
+    let mut out =
+        Averages { c: Default::default(), gyro: Default::default(), accel: Default::default(), f_n, window_s };
     for k in 0..steps {
         let tau = (k as f64 + 0.5) * h;
         let lever = 0.5 * window_s.1 - tau;
@@ -136,7 +137,13 @@ impl Responses {
     /// acceleration step's derivative (an offset is an impulse of acceleration; the INS at rest is
     /// time-invariant).
     #[must_use]
-    pub fn from_runs(gyro: [&[[f64; 2]]; 3], unit_gyro: f64, accel: [&[[f64; 2]]; 3], unit_accel: f64, dt_s: f64) -> Self {
+    pub fn from_runs(
+        gyro: [&[[f64; 2]]; 3],
+        unit_gyro: f64,
+        accel: [&[[f64; 2]]; 3],
+        unit_accel: f64,
+        dt_s: f64,
+    ) -> Self {
         let n = gyro.iter().chain(&accel).map(|r| r.len()).min().unwrap_or(0);
         let mut q = SMatrix::<f64, 9, 9>::zeros();
         for i in 0..n {
@@ -147,8 +154,7 @@ impl Responses {
                     r[(e, 3 + k)] = accel[k][i][e] / unit_accel;
                     // The derivative: central differences, one-sided at the ends.
                     let (lo, hi) = (i.saturating_sub(1), (i + 1).min(n - 1));
-                    r[(e, 6 + k)] =
-                        (accel[k][hi][e] - accel[k][lo][e]) / (unit_accel * dt_s * (hi - lo).max(1) as f64);
+                    r[(e, 6 + k)] = (accel[k][hi][e] - accel[k][lo][e]) / (unit_accel * dt_s * (hi - lo).max(1) as f64);
                 }
             }
             q += r.transpose() * r;
@@ -249,7 +255,13 @@ mod tests {
     fn back_and_forth(signs: &[f64], rate: f64, dwell: f64) -> Scheme {
         let steps = signs
             .iter()
-            .map(|s| IndexedStep { axis: 0, angle_rad: s * std::f64::consts::PI, rate_rad_per_s: rate, dwell_s: dwell, accel_rad_per_s2: 0.0 })
+            .map(|s| IndexedStep {
+                axis: 0,
+                angle_rad: s * std::f64::consts::PI,
+                rate_rad_per_s: rate,
+                dwell_s: dwell,
+                accel_rad_per_s2: 0.0,
+            })
             .collect();
         Scheme::indexed(vec![0.0], 0.0, steps, true)
     }
@@ -262,12 +274,26 @@ mod tests {
         // never turns: ⟨C e_z⟩ = e_z.
         let (rate, dwell) = (10f64.to_radians(), 60.0);
         let t = 2.0 * (std::f64::consts::PI / rate + dwell);
-        let two = averages(&azimuth_table(), &back_and_forth(&[1.0, -1.0], rate, dwell), &Matrix3::identity(), &earth(), 0.0, 0.01);
+        let two = averages(
+            &azimuth_table(),
+            &back_and_forth(&[1.0, -1.0], rate, dwell),
+            &Matrix3::identity(),
+            &earth(),
+            0.0,
+            0.01,
+        );
         assert!((two.window_s.1 - t).abs() < 1e-9);
         let want = 4.0 / rate / t;
         assert!((two.c[0].mean.y - want).abs() < 1e-5 * want, "{} vs {want}", two.c[0].mean.y);
         assert!(two.c[0].mean.x.abs() < 1e-6 && (two.c[2].mean.z - 1.0).abs() < 1e-12);
-        let four = averages(&azimuth_table(), &back_and_forth(&[1.0, -1.0, -1.0, 1.0], rate, dwell), &Matrix3::identity(), &earth(), 0.0, 0.01);
+        let four = averages(
+            &azimuth_table(),
+            &back_and_forth(&[1.0, -1.0, -1.0, 1.0], rate, dwell),
+            &Matrix3::identity(),
+            &earth(),
+            0.0,
+            0.01,
+        );
         assert!(four.c[0].mean.xy().norm() < 1e-6 && four.c[1].mean.xy().norm() < 1e-6, "{:?}", four.c);
         // A misalignment K_xz (x gyro sensing the table's z rate) averages out on the return path in
         // both: ⟨C e_x θ̇⟩ = ∫ C e_x dθ over the path and back = 0; what is left is the Earth's
@@ -286,7 +312,14 @@ mod tests {
         let mut q = SMatrix::<f64, 9, 9>::zeros();
         q.fixed_view_mut::<3, 3>(0, 0).fill_with_identity();
         let r = Responses { q };
-        let avg = averages(&azimuth_table(), &Scheme::continuous(vec![0.0], vec![0.0]), &Matrix3::identity(), &earth(), 10.0, 1.0);
+        let avg = averages(
+            &azimuth_table(),
+            &Scheme::continuous(vec![0.0], vec![0.0]),
+            &Matrix3::identity(),
+            &earth(),
+            10.0,
+            1.0,
+        );
         let mut e = ImuErrorSpec::default();
         e.gyro.bias_rad_per_s = Spec::Sigma(3.0);
         let s = score(&avg, &e, &r);

@@ -51,7 +51,7 @@ impl Constraints {
             return Some("the acceleration must be ≥ 0".into());
         }
         let smallest = self.angles_rad.iter().copied().fold(f64::INFINITY, f64::min);
-        if !(self.max_wrap_rad >= smallest * (1.0 - 1e-12)) {
+        if self.max_wrap_rad.is_nan() || self.max_wrap_rad < smallest * (1.0 - 1e-12) {
             return Some(format!(
                 "a wrap of {:.1}° is less than the smallest move, {:.1}°",
                 self.max_wrap_rad.to_degrees(),
@@ -72,13 +72,7 @@ fn pick<T: Copy>(v: &[T], rng: &mut impl Rng) -> T {
 fn direction(pos: i64, wrap: i64, left: Option<i64>, rng: &mut impl Rng) -> i64 {
     let ok = |d: i64| (pos + d).abs() <= wrap && left.is_none_or(|r| (pos + d).abs() <= r);
     match (ok(1), ok(-1)) {
-        (true, true) => {
-            if rng.random_bool(0.5) {
-                1
-            } else {
-                -1
-            }
-        }
+        (true, true) if rng.random_bool(0.5) => 1,
         (true, false) => 1,
         // One always fits: |pos| ≤ min(wrap, left + 1) by construction.
         _ => -1,
@@ -112,7 +106,8 @@ pub fn candidate(c: &Constraints, rng: &mut impl Rng) -> Vec<IndexedStep> {
                 step(axis, d)
             })
             .collect();
-        let mirror: Vec<IndexedStep> = half.iter().rev().map(|s| IndexedStep { angle_rad: -s.angle_rad, ..*s }).collect();
+        let mirror: Vec<IndexedStep> =
+            half.iter().rev().map(|s| IndexedStep { angle_rad: -s.angle_rad, ..*s }).collect();
         half.extend(mirror);
         return half;
     }
@@ -175,7 +170,9 @@ mod tests {
                 }
                 assert!(at.iter().all(|a| a.abs() < 1e-9), "{s:?}");
                 let n = s.len();
-                mirrored += usize::from((0..n / 2).all(|i| s[i].axis == s[n - 1 - i].axis && s[i].angle_rad == -s[n - 1 - i].angle_rad));
+                mirrored += usize::from(
+                    (0..n / 2).all(|i| s[i].axis == s[n - 1 - i].axis && s[i].angle_rad == -s[n - 1 - i].angle_rad),
+                );
             }
             assert!((600..=1400).contains(&mirrored), "{mirrored} of 2000 mirrored");
         }

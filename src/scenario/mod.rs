@@ -414,7 +414,11 @@ pub fn compensation_keys(
 /// An indexed sequence as a `[scheme]` table of TOML (what `rinscope design` prints and `schemes`
 /// reads): `steps` on the chain's `axes`, repeated, after `initial_dwell_s`.
 #[must_use]
-pub fn indexed_scheme_toml(axes: &[String], initial_dwell_s: f64, steps: &[crate::model::scheme::IndexedStep]) -> String {
+pub fn indexed_scheme_toml(
+    axes: &[String],
+    initial_dwell_s: f64,
+    steps: &[crate::model::scheme::IndexedStep],
+) -> String {
     #[derive(serde::Serialize)]
     struct File {
         scheme: raw::RawScheme,

@@ -2,7 +2,7 @@
 # Speed against the fastest peer, printed and never asserted (these machines are shared and noisy: a
 # speed target is a benchmark, not a test; docs/benchmarks.md): `rinscope bench --peer pyins`, whole
 # processes alternated with python-ins 1.0.1 on the same 2 M-sample streams, 3 rounds (median and range), and the recording
-# size per simulated hour of every preset (`bench --only recorded`).
+# size per simulated hour of every preset (`bench --only recorded`), and the designer's search time.
 #
 #   tests/bench/run.sh [RINSCOPE]
 #
@@ -29,3 +29,7 @@ if "$venv/bin/python" -c "import pyins" 2>/dev/null; then
   "$bin" bench --peer pyins --python "$venv/bin/python" --rounds 3 2>&1 | grep -v "round [0-9] of 3" | sed 's/^/bench: /'
 fi
 "$bin" bench --only recorded 2>&1 | grep "recorded 1 h" | sed 's/^/bench: /'
+# Issue 34's search target (1000 candidate schemes under 10 minutes on two cores): the default design
+# (budget-dual-axis-16, 72 h, 1000 sequences ranked by the averaged model), the exact confirmation cut
+# to the best sequence and one seed; its own time line (responses, model, exact, all).
+"$bin" design --confirm 1 --seeds 1 --save "$work/design.rrd" 2>/dev/null | grep "^time:\|^designed:" | sed 's/^/bench: design: /'
