@@ -161,6 +161,20 @@ fn output<S: Serialize>(summary: S, saved: sink::Saved) -> Result<Output, Failur
     Ok((json, tables))
 }
 
+/// A report of runs in parallel as the document and recording Python returns; one stopped before
+/// every run was done is a KeyboardInterrupt (its numbers cover the simulated part only).
+fn complete<S: Serialize>(
+    report: S,
+    interrupted: bool,
+    saved: Option<sink::Saved>,
+    command: &str,
+) -> Result<Output, Failure> {
+    if interrupted {
+        return Err(Failure::Interrupted(format!("{command}: stopped before every run was done")));
+    }
+    output(report, saved.unwrap_or_default())
+}
+
 /// The presets: (name, title) pairs, in the order `rinscope scenarios` lists them.
 #[pyfunction]
 fn scenarios() -> Vec<(String, String)> {
@@ -500,11 +514,8 @@ fn budget(
     let out = interruptible(py, move |stop| -> Result<Output, Failure> {
         let request = BudgetRequest { params, sample_s, threads, json: None, recording: recording(save, stop) };
         let mut report = execute(&request, stop)?;
-        if report.interrupted {
-            return Err(Failure::Interrupted("budget: stopped before every run was done".into()));
-        }
-        let saved = report.saved.take().unwrap_or_default();
-        output(report, saved)
+        let (interrupted, saved) = (report.interrupted, report.saved.take());
+        complete(report, interrupted, saved, "budget")
     })??;
     Ok(to_python(py, out))
 }
@@ -547,11 +558,8 @@ fn schemes(
             recording: recording(save, stop),
         };
         let mut report = execute(&request, stop)?;
-        if report.interrupted {
-            return Err(Failure::Interrupted("schemes: stopped before every run was done".into()));
-        }
-        let saved = report.saved.take().unwrap_or_default();
-        output(report, saved)
+        let (interrupted, saved) = (report.interrupted, report.saved.take());
+        complete(report, interrupted, saved, "schemes")
     })??;
     Ok(to_python(py, out))
 }
@@ -601,11 +609,8 @@ fn design(
             recording: recording(save, stop),
         };
         let mut report = execute(&request, stop)?;
-        if report.interrupted {
-            return Err(Failure::Interrupted("design: stopped before every run was done".into()));
-        }
-        let saved = report.saved.take().unwrap_or_default();
-        output(report, saved)
+        let (interrupted, saved) = (report.interrupted, report.saved.take());
+        complete(report, interrupted, saved, "design")
     })??;
     Ok(to_python(py, out))
 }

@@ -381,7 +381,7 @@ pub fn execute(req: &DesignRequest, stop: &AtomicBool) -> Result<DesignReport, F
         .model_terms
         .iter()
         .map(|(n, m)| (n.clone(), *m, term(best, n)))
-        .filter(|(_, b, f)| b > f)
+        .filter(|(_, b, f)| *b > 1.05 * f)
         .collect();
     cancels.sort_by(|a, b| (b.1 - b.2).total_cmp(&(a.1 - a.2)));
     cancels.truncate(4);

@@ -75,7 +75,7 @@ pub struct SchemesRequest {
     pub json: Option<std::path::PathBuf>,
     /// Also each scheme's error budget (the first seed): the sources it leaves unmodulated.
     pub budget: bool,
-    /// Only the sources a scheme can modulate act (`ins::budget::modulable_only`: no noise, no
+    /// Only the sources a scheme can modulate act (`ins::averaged::modulable_only`: no noise, no
     /// alignment error), so that seeds differ by the constant errors' draws alone.
     pub modulable_only: bool,
     /// Where the recording goes.
@@ -233,7 +233,7 @@ pub fn execute(req: &SchemesRequest, stop: &AtomicBool) -> Result<SchemesReport,
         req.schemes.iter().map(|(label, text)| with_scheme(base, label, text)).collect::<Result<_, _>>()?;
     if req.modulable_only {
         for p in &mut params {
-            p.ins = p.ins.as_ref().map(budget::modulable_only);
+            p.ins = p.ins.as_ref().map(crate::ins::averaged::modulable_only);
         }
     }
     let sinks = req.recording.open(RecordingName {
@@ -275,8 +275,6 @@ pub fn execute(req: &SchemesRequest, stop: &AtomicBool) -> Result<SchemesReport,
             })
             .collect()
     });
-    let wall_s = started.elapsed().as_secs_f64();
-    let interrupted = stop.load(Ordering::SeqCst);
     let n = traces.iter().map(|t| t.t_s.len()).min().unwrap_or(0);
     let day = (n > 0 && traces[0].t_s[n - 1] >= 86_400.0 - 1.0)
         .then(|| traces[0].t_s[..n].iter().position(|t| *t >= 86_400.0 - 1e-6).unwrap_or(n - 1));
@@ -313,6 +311,9 @@ pub fn execute(req: &SchemesRequest, stop: &AtomicBool) -> Result<SchemesReport,
             leaves,
         });
     }
+    // Wall time to here: the runs and, with --budget, each scheme's budget.
+    let wall_s = started.elapsed().as_secs_f64();
+    let interrupted = stop.load(Ordering::SeqCst);
     let mut report = SchemesReport {
         scenario: base.meta.name.clone(),
         duration_s: if n > 0 { traces[0].t_s[n - 1] } else { 0.0 },

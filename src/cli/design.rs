@@ -80,7 +80,7 @@ pub(super) struct DesignArgs {
     #[arg(long, value_delimiter = ',')]
     axes: Vec<String>,
     /// Moves per period, comma-separated even numbers.
-    #[arg(long, value_delimiter = ',', default_values_t = [8, 16, 32], value_parser = |t: &str| count(t, 2, 256, "moves").map(|n| n as usize))]
+    #[arg(long, value_delimiter = ',', default_values_t = [8, 16, 32], allow_negative_numbers = true, value_parser = |t: &str| count(t, 2, 256, "moves").map(|n| n as usize))]
     moves: Vec<usize>,
     /// Move sizes, deg, comma-separated.
     #[arg(long, value_delimiter = ',', default_values_t = [180.0], allow_negative_numbers = true, value_parser = |t: &str| number(t, &MOVE_DEG))]

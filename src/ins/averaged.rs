@@ -30,6 +30,7 @@
 
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
+use super::InsParams;
 use super::budget::{ImuTerm, Source, Triad};
 use super::sensor::{ImuErrorSpec, Spec};
 use crate::model::earth::Earth;
@@ -235,6 +236,26 @@ pub fn score(avg: &Averages, errors: &ImuErrorSpec, r: &Responses) -> Score {
     }
     terms.retain(|(_, m)| *m > 0.0);
     Score { rms_m: (random + quad(&fixed)).sqrt(), terms }
+}
+
+/// `ins` with only the sources a rotation scheme can modulate acting — the constant errors (biases,
+/// scale factors, misalignments, g-sensitivity) — on the same draws: the noise (a random walk turned
+/// is still one), the readout, the dither and the alignment off. The table's errors are the
+/// compensation's, not the scheme's, and stay.
+#[must_use]
+pub fn modulable_only(ins: &InsParams) -> InsParams {
+    let mut i = ins.clone();
+    for t in [&mut i.sources.gyro, &mut i.sources.accel] {
+        t.white = false;
+        t.markov = false;
+        t.instability = false;
+        t.random_walk = false;
+        t.ramp = false;
+        t.readout = false;
+    }
+    i.sources.dither = false;
+    i.initial_error_rad = Vector3::zeros();
+    i
 }
 
 #[cfg(test)]

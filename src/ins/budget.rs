@@ -338,26 +338,6 @@ pub fn select(table: &TableParams, ins: Option<&InsParams>, selection: Selection
     (t, ins)
 }
 
-/// `ins` with only the sources a rotation scheme can modulate acting — the constant errors (biases,
-/// scale factors, misalignments, g-sensitivity) — on the same draws: the noise (a random walk turned
-/// is still one), the readout, the dither and the alignment off. The table's errors are the
-/// compensation's, not the scheme's, and stay.
-#[must_use]
-pub fn modulable_only(ins: &InsParams) -> InsParams {
-    let mut i = ins.clone();
-    for t in [&mut i.sources.gyro, &mut i.sources.accel] {
-        t.white = false;
-        t.markov = false;
-        t.instability = false;
-        t.random_walk = false;
-        t.ramp = false;
-        t.readout = false;
-    }
-    i.sources.dither = false;
-    i.initial_error_rad = Vector3::zeros();
-    i
-}
-
 /// One quantity the budget attributes: its group, component and unit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Channel {

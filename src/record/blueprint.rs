@@ -137,6 +137,15 @@ pub fn legend_at(corner: LegendCorner) -> bp::PlotLegend {
     bp::PlotLegend::new().with_corner(corner)
 }
 
+/// A time-series view over the whole run with its legend in `legend` (None: hidden, the view's
+/// title names the lines).
+#[must_use]
+pub fn whole_run_plot(name: &str, origin: &str, legend: Option<LegendCorner>) -> Node {
+    Node::view("TimeSeries", name, origin)
+        .with_property("TimeAxis", &whole_run_time_axis())
+        .with_property("PlotLegend", &legend.map_or_else(no_legend, legend_at))
+}
+
 /// A 3D eye looking at `target` from `position` with +z up.
 #[must_use]
 pub fn eye(position: [f32; 3], target: [f32; 3]) -> bp::EyeControls3D {

@@ -156,7 +156,5 @@ pub fn log(
 }
 
 fn plot(name: &str, origin: &str) -> Node {
-    Node::view("TimeSeries", name, origin)
-        .with_property("TimeAxis", &blueprint::whole_run_time_axis())
-        .with_property("PlotLegend", &blueprint::legend_at(LegendCorner::LeftTop))
+    blueprint::whole_run_plot(name, origin, Some(LegendCorner::LeftTop))
 }

@@ -62,11 +62,7 @@ pub fn log(stream: &Stream, traces: &[NavTrace], table: &str) -> RecordingStream
     }
     // Legends would sit over the data: the first title gives the colours.
     let key = names.iter().zip(COLOR_NAMES).map(|(n, c)| format!("{c} {n}")).collect::<Vec<_>>().join(" · ");
-    let plot = |name: &str, origin: &str| {
-        Node::view("TimeSeries", name, origin)
-            .with_property("TimeAxis", &blueprint::whole_run_time_axis())
-            .with_property("PlotLegend", &blueprint::no_legend())
-    };
+    let plot = |name: &str, origin: &str| blueprint::whole_run_plot(name, origin, None);
     let root = Node::container(
         ContainerKind::Horizontal,
         vec![

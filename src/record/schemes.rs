@@ -42,11 +42,7 @@ pub fn log(stream: &Stream, labels: &[String], traces: &[&Trace], n: usize, tabl
         rec.log_static(path, &rerun::SeriesLines::new().with_colors(line_colors.clone()).with_names(labels.to_vec()))?;
         stream.send_series(path, labels, &times, values, labels.len())?;
     }
-    let plot = |name: &str, origin: &str| {
-        Node::view("TimeSeries", name, origin)
-            .with_property("TimeAxis", &blueprint::whole_run_time_axis())
-            .with_property("PlotLegend", &blueprint::legend_at(LegendCorner::LeftTop))
-    };
+    let plot = |name: &str, origin: &str| blueprint::whole_run_plot(name, origin, Some(LegendCorner::LeftTop));
     let root = Node::container(
         ContainerKind::Horizontal,
         vec![

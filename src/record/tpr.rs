@@ -72,11 +72,7 @@ pub fn log(stream: &Stream, params: &Params, r: &TprResult, table: &str) -> Reco
         rec.log("events", &rerun::TextLog::new(what).with_level("INFO"))?;
     }
     // Legends would sit over the data: the first title gives the colours.
-    let plot = |name: &str, origin: &str| {
-        Node::view("TimeSeries", name, origin)
-            .with_property("TimeAxis", &blueprint::whole_run_time_axis())
-            .with_property("PlotLegend", &blueprint::no_legend())
-    };
+    let plot = |name: &str, origin: &str| blueprint::whole_run_plot(name, origin, None);
     let key = format!("red {} · green {} · blue {} · ▼ fixes", BRANCH_NAMES[0], BRANCH_NAMES[1], BRANCH_NAMES[2]);
     let root = Node::container(
         ContainerKind::Horizontal,
