@@ -56,6 +56,7 @@ fn request(space: DesignSpace) -> DesignRequest {
         params: scenario::parse(TABLE, "the test's table").expect("the test's scenario"),
         space,
         candidates: 200,
+        refine: 50,
         confirm: 6,
         seeds: 1,
         threads: None,

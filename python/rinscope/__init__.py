@@ -231,18 +231,19 @@ def schemes(scenario: Any = None, schemes: list | tuple = (), hours: float | Non
 
 def design(scenario: Any = None, hours: float | None = None, axes: list | tuple = (), moves: list | tuple = (8, 16, 32),
            angles_deg: list | tuple = (180.0,), rates_deg_per_s: list | tuple = (), dwells_s: list | tuple = (),
-           max_wrap_deg: float = 360.0, candidates: int = 1000, confirm: int = 4, seeds: int = 4,
+           max_wrap_deg: float = 360.0, candidates: int = 1000, refine: int = 300, confirm: int = 4, seeds: int = 4,
            threads: int | None = None, save: str | os.PathLike | None = None) -> Result:
     """The rotation-scheme designer (``rinscope design``, docs/schemes.md): ``candidates`` indexing
     sequences drawn under the constraints (the axes that may move, moves per period, move angles,
-    rates and dwells — empty: the scenario's —, the cable's wrap), ranked with the built-ins by the
-    averaged error model, the best ``confirm`` simulated beside the built-ins on ``seeds`` seeds.
+    rates and dwells — empty: the scenario's —, the cable's wrap), ``refine`` local moves from each of
+    the model's 8 best, ranked with the built-ins by the averaged error model, the best ``confirm`` simulated beside the built-ins on ``seeds`` seeds.
     ``summary`` is ``design --json``'s: ``best`` (the designed scheme's label), ``ratio`` (the best
     built-in's position error ÷ the design's), ``ranked`` (each with its model terms, exact row and
     ``scheme``, a ``[scheme]`` TOML text to run with ``schemes``)."""
     out = _rinscope.design(_toml(scenario, "budget-dual-axis-16"), hours, list(axes), [int(m) for m in moves],
                            [float(a) for a in angles_deg], [float(r) for r in rates_deg_per_s],
-                           [float(d) for d in dwells_s], max_wrap_deg, candidates, confirm, seeds, threads, _path(save))
+                           [float(d) for d in dwells_s], max_wrap_deg, candidates, refine, confirm, seeds, threads,
+                           _path(save))
     return _result("design", out, None, save)
 
 

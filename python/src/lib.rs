@@ -569,7 +569,7 @@ fn schemes(
 /// ranked by the averaged model with the built-ins, the best `confirm` simulated on `seeds` seeds;
 /// the document `design --json` writes (the designed `[scheme]` under each ranked row's "scheme").
 #[pyfunction]
-#[pyo3(signature = (toml, hours=None, axes=Vec::new(), moves=vec![8, 16, 32], angles_deg=vec![180.0], rates_deg_per_s=Vec::new(), dwells_s=Vec::new(), max_wrap_deg=360.0, candidates=1000, confirm=4, seeds=4, threads=None, save=None))]
+#[pyo3(signature = (toml, hours=None, axes=Vec::new(), moves=vec![8, 16, 32], angles_deg=vec![180.0], rates_deg_per_s=Vec::new(), dwells_s=Vec::new(), max_wrap_deg=360.0, candidates=1000, refine=300, confirm=4, seeds=4, threads=None, save=None))]
 #[allow(clippy::too_many_arguments)]
 fn design(
     py: Python<'_>,
@@ -582,6 +582,7 @@ fn design(
     dwells_s: Vec<f64>,
     max_wrap_deg: f64,
     candidates: usize,
+    refine: usize,
     confirm: usize,
     seeds: u64,
     threads: Option<usize>,
@@ -601,6 +602,7 @@ fn design(
             params,
             space,
             candidates,
+            refine,
             confirm,
             seeds,
             threads,

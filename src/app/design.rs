@@ -24,7 +24,7 @@ use crate::ins::sensor::{ImuErrorSpec, Spec};
 use crate::io::files::write_atomically;
 use crate::model::earth::Earth;
 use crate::model::gimbal::TableErrors;
-use crate::model::scheme::Scheme;
+use crate::model::scheme::{IndexedStep, Scheme};
 use crate::model::sequences::{self, Constraints};
 use crate::record::sink::Saved;
 use crate::scenario::{Params, indexed_scheme_toml};
@@ -67,6 +67,8 @@ pub struct DesignRequest {
     pub space: DesignSpace,
     /// Sequences drawn (duplicates dropped).
     pub candidates: usize,
+    /// Local moves tried from each of the model's best drawn sequences (0: none).
+    pub refine: usize,
     /// How many of the model's best are confirmed by the exact simulation (beside every built-in).
     pub confirm: usize,
     /// Seeds per confirmed scheme.
@@ -115,8 +117,11 @@ pub struct DesignReport {
     pub duration_s: f64,
     /// Sequences drawn and, of them, distinct.
     pub drawn: usize,
-    /// Distinct sequences the model ranked.
+    /// Distinct sequences the model ranked (drawn and refined).
     pub distinct: usize,
+    /// Local moves tried from each of the best drawn sequences, and how many of those searches
+    /// ended on a sequence not drawn.
+    pub refine: (usize, usize),
     /// The confirmed and the built-in schemes, the model's order.
     pub ranked: Vec<Ranked>,
     /// The best drawn sequence by the exact median position error at the end (its `[scheme]` is
@@ -227,12 +232,18 @@ fn responses(p: &Params, n_from_s: &Matrix3<f64>, sample_s: f64, stop: &AtomicBo
     )
 }
 
+/// The model's RMS position error, m, and its share per source (named, largest first).
+type Scored = (f64, Vec<(String, f64)>);
+
 /// A scheme's model score and its terms named, largest first.
-fn scored(avg: &Averages, errors: &ImuErrorSpec, r: &Responses, axes: &[String]) -> (f64, Vec<(String, f64)>) {
+fn scored(avg: &Averages, errors: &ImuErrorSpec, r: &Responses, axes: &[String]) -> Scored {
     let Score { rms_m, mut terms } = averaged::score(avg, errors, r);
     terms.sort_by(|a, b| b.1.total_cmp(&a.1));
     (rms_m, terms.into_iter().map(|(s, m)| (s.name(axes), m)).collect())
 }
+
+/// How many of the model's best drawn sequences a local search starts from.
+const REFINED: usize = 8;
 
 /// `design`'s one owner.
 ///
@@ -301,18 +312,50 @@ pub fn execute(req: &DesignRequest, stop: &AtomicBool) -> Result<DesignReport, F
     errln!("rinscope: design: the averaged model over {} schemes...", pool_of.len());
     let earth = Earth::at(p.site);
     let fallback_s = p.duration_s.min(86_400.0);
-    let scores: Vec<(f64, Vec<(String, f64)>)> = pool.install(|| {
-        pool_of
+    let model = |scheme: &Scheme| {
+        if stop.load(Ordering::Relaxed) {
+            return (f64::NAN, Vec::new());
+        }
+        let avg = averaged::averages(chain, scheme, &n_from_b, &earth, fallback_s, 0.05);
+        scored(&avg, &ins.errors, &resp, &axes)
+    };
+    let mut scores: Vec<Scored> = pool.install(|| pool_of.par_iter().map(|(_, _, scheme, _)| model(scheme)).collect());
+    // A local search from the model's best drawn sequences: a neighbour (`sequences::neighbour`)
+    // replaces the sequence when the model scores it lower.
+    let sequence = |steps: Vec<IndexedStep>| Scheme::indexed(initial[..axes.len()].to_vec(), 0.0, steps, true);
+    let mut starts: Vec<usize> = (0..pool_of.len()).filter(|k| !pool_of[*k].1).collect();
+    starts.sort_by(|a, b| scores[*a].0.total_cmp(&scores[*b].0));
+    starts.truncate(if req.refine > 0 { REFINED } else { 0 });
+    if !starts.is_empty() {
+        errln!("rinscope: design: {} local moves from each of the best {}...", req.refine, starts.len());
+    }
+    let refined: Vec<(Scheme, Scored)> = pool.install(|| {
+        starts
             .par_iter()
-            .map(|(_, _, scheme, _)| {
-                if stop.load(Ordering::Relaxed) {
-                    return (f64::NAN, Vec::new());
+            .enumerate()
+            .map(|(r, &k)| {
+                let mut rng = ChaCha8Rng::seed_from_u64(p.meta.seed.wrapping_add(1 + r as u64));
+                let (mut best, mut score) = (pool_of[k].2.clone(), scores[k].clone());
+                for _ in 0..req.refine {
+                    let next = sequence(sequences::neighbour(best.steps(), &c, &mut rng));
+                    let s = model(&next);
+                    if s.0 < score.0 {
+                        (best, score) = (next, s);
+                    }
                 }
-                let avg = averaged::averages(chain, scheme, &n_from_b, &earth, fallback_s, 0.05);
-                scored(&avg, &ins.errors, &resp, &axes)
+                (best, score)
             })
             .collect()
     });
+    let mut improved = 0;
+    for (scheme, score) in refined {
+        let text = indexed_scheme_toml(&axes, 0.0, scheme.steps());
+        if seen.insert(text.clone()) {
+            improved += 1;
+            pool_of.push((String::new(), false, scheme, text));
+            scores.push(score);
+        }
+    }
     let t_model = started.elapsed().as_secs_f64() - t_responses;
     let mut order: Vec<usize> = (0..pool_of.len()).collect();
     order.sort_by(|a, b| scores[*a].0.total_cmp(&scores[*b].0));
@@ -397,6 +440,7 @@ pub fn execute(req: &DesignRequest, stop: &AtomicBool) -> Result<DesignReport, F
         duration_s: exact.duration_s,
         drawn,
         distinct: pool_of.len() - ranked.iter().filter(|r| r.built_in).count(),
+        refine: (req.refine, improved),
         ratio: end(&best_built_in) / end(best),
         ratio_per_seed: per_seed,
         best: best.label.clone(),
@@ -439,12 +483,15 @@ impl DesignReport {
     #[must_use]
     pub fn text(&self) -> String {
         let mut s = format!(
-            "{}: {} sequences drawn, {} distinct, ranked by the averaged model with the built-ins; the best {} confirmed by \
+            "{}: {} sequences drawn; {} local moves from each of the best {REFINED}, {} of which ended on a new sequence; \
+             {} distinct, ranked by the averaged model with the built-ins; the best {} confirmed by \
              the exact simulation ({:.1} h, median [min, max] over the seeds) of the errors a scheme can modulate (biases, \
              scale factors, misalignments, the table's; the noise and the alignment, alike under every scheme, are \
              `budget`'s)\n\n",
             self.scenario,
             self.drawn,
+            self.refine.0,
+            self.refine.1,
             self.distinct,
             self.ranked.iter().filter(|r| !r.built_in).count(),
             self.duration_s / 3600.0
@@ -500,6 +547,16 @@ impl DesignReport {
             for (n, b, f) in &self.cancels {
                 s.push_str(&format!("  {n:<22} {} → {}\n", num(*b), num(*f)));
             }
+        }
+        // The averaged model takes a period well inside the Schuler loop's 84 min: a longer one
+        // resonates with it and is ranked on the simulation alone.
+        let reach = 2.0 * std::f64::consts::PI / crate::model::earth::schuler_rate() / 3.0;
+        if self.ranked.iter().any(|r| !r.built_in && r.period_s.is_some_and(|t| t > reach)) {
+            s.push_str(&format!(
+                "note: periods over {:.0} min (a third of the Schuler period) are beyond the averaged model's reach: \
+                 its numbers for them rank loosely, the simulation decides (shorter dwells or fewer moves keep it in reach)\n",
+                reach / 60.0
+            ));
         }
         s.push_str(&format!(
             "time: responses {:.1} s, model {:.1} s, exact {:.1} s, all {:.1} s on {} threads\n\n{}",

@@ -97,6 +97,10 @@ pub(super) struct DesignArgs {
     /// Sequences drawn (duplicates dropped) and ranked by the averaged model.
     #[arg(long, default_value_t = 1000, allow_negative_numbers = true, value_parser = |t: &str| count(t, 1, 1_000_000, "candidates").map(|n| n as usize))]
     candidates: usize,
+    /// Local moves (two moves exchanged, an axis reversed) tried from each of the model's 8 best
+    /// drawn sequences, each kept when the model scores it lower (0: no local search).
+    #[arg(long, default_value_t = 300, allow_negative_numbers = true, value_parser = |t: &str| count(t, 0, 1_000_000, "moves").map(|n| n as usize))]
+    refine: usize,
     /// The model's best this many are confirmed by the exact simulation, beside every built-in.
     #[arg(long, default_value_t = 4, allow_negative_numbers = true, value_parser = |t: &str| count(t, 1, 100, "schemes").map(|n| n as usize))]
     confirm: usize,
@@ -172,6 +176,7 @@ pub(super) fn design(args: &DesignArgs) -> Result<(), Failure> {
             max_wrap_deg: args.max_wrap_deg,
         },
         candidates: args.candidates,
+        refine: args.refine,
         confirm: args.confirm,
         seeds: args.seeds,
         threads: args.threads,

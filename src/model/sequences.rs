@@ -132,6 +132,52 @@ pub fn candidate(c: &Constraints, rng: &mut impl Rng) -> Vec<IndexedStep> {
         .collect()
 }
 
+/// True when no axis of `steps` goes further than `c.max_wrap_rad` from its start.
+fn within_wrap(steps: &[IndexedStep], c: &Constraints) -> bool {
+    let mut at = [0.0f64; super::scheme::MAX_AXES];
+    steps.iter().all(|m| {
+        at[m.axis] += m.angle_rad;
+        at[m.axis].abs() <= c.max_wrap_rad * (1.0 + 1e-12)
+    })
+}
+
+/// A neighbour of `steps` for a local search: two neighbouring moves of different axes exchanged
+/// (each axis keeps its own walk), one axis's moves all reversed (its walk mirrored; the wrap is
+/// symmetric), or two moves of one axis exchanged where its walk stays within the wrap. Whatever
+/// `steps` satisfies of [`candidate`]'s rules, the neighbour does too.
+#[must_use]
+pub fn neighbour(steps: &[IndexedStep], c: &Constraints, rng: &mut impl Rng) -> Vec<IndexedStep> {
+    let mut s = steps.to_vec();
+    let n = s.len();
+    if n < 2 {
+        return s;
+    }
+    match rng.random_range(0..3) {
+        0 => {
+            let i = rng.random_range(0..n - 1);
+            if s[i].axis != s[i + 1].axis {
+                s.swap(i, i + 1);
+            }
+        }
+        1 => {
+            let axis = s[rng.random_range(0..n)].axis;
+            for m in s.iter_mut().filter(|m| m.axis == axis) {
+                m.angle_rad = -m.angle_rad;
+            }
+        }
+        _ => {
+            let (i, j) = (rng.random_range(0..n), rng.random_range(0..n));
+            if s[i].axis == s[j].axis {
+                s.swap(i, j);
+                if !within_wrap(&s, c) {
+                    s.swap(i, j);
+                }
+            }
+        }
+    }
+    s
+}
+
 #[cfg(test)]
 mod tests {
     use rand::SeedableRng;
@@ -176,6 +222,29 @@ mod tests {
             }
             assert!((600..=1400).contains(&mirrored), "{mirrored} of 2000 mirrored");
         }
+    }
+
+    #[test]
+    fn a_neighbour_keeps_every_rule() {
+        // 20 000 steps of a random walk through neighbours from drawn candidates: every axis still
+        // returns and stays within its wrap; the walk moves (most neighbours differ).
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let c = constraints(vec![0, 1], vec![8, 16, 32], 360.0);
+        let mut changed = 0;
+        for _ in 0..200 {
+            let mut s = candidate(&c, &mut rng);
+            for _ in 0..100 {
+                let next = neighbour(&s, &c, &mut rng);
+                changed += usize::from(next != s);
+                s = next;
+                assert!(within_wrap(&s, &c), "{s:?}");
+                for axis in 0..2 {
+                    let net: f64 = s.iter().filter(|m| m.axis == axis).map(|m| m.angle_rad).sum();
+                    assert!(net.abs() < 1e-9, "{s:?}");
+                }
+            }
+        }
+        assert!(changed > 10_000, "{changed} of 20000 neighbours differ");
     }
 
     #[test]
