@@ -147,7 +147,7 @@ pub struct DesignReport {
     pub saved: Option<Saved>,
 }
 
-/// The base's IMU-to-navigation frame at the start, and the model's constraints in SI.
+/// The search's constraints in SI: the axes by index, the scenario's own move where none is given.
 fn constraints(p: &Params, space: &DesignSpace) -> Result<Constraints, Failure> {
     let chain = &p.table.chain;
     let axes = if space.axes.is_empty() {
@@ -294,8 +294,9 @@ pub fn execute(req: &DesignRequest, stop: &AtomicBool) -> Result<DesignReport, F
     while drawn_steps.len() < req.candidates && drawn < 20 * req.candidates {
         drawn += 1;
         let steps = sequences::candidate(&c, &mut rng);
-        if seen.insert(indexed_scheme_toml(&axes, 0.0, &steps)) {
-            drawn_steps.push(steps);
+        let text = indexed_scheme_toml(&axes, 0.0, &steps);
+        if seen.insert(text.clone()) {
+            drawn_steps.push((steps, text));
         }
     }
     let mut pool_of: Vec<(String, bool, Scheme, String)> = BUILT_IN
@@ -305,8 +306,7 @@ pub fn execute(req: &DesignRequest, stop: &AtomicBool) -> Result<DesignReport, F
             Some(((*name).to_owned(), true, q.table.scheme.clone(), (*text).to_owned()))
         })
         .collect();
-    for steps in drawn_steps {
-        let text = indexed_scheme_toml(&axes, 0.0, &steps);
+    for (steps, text) in drawn_steps {
         pool_of.push((String::new(), false, Scheme::indexed(initial[..axes.len()].to_vec(), 0.0, steps, true), text));
     }
     errln!("rinscope: design: the averaged model over {} schemes...", pool_of.len());
