@@ -202,7 +202,7 @@ pub fn execute(req: &BudgetRequest, stop: &AtomicBool) -> Result<BudgetReport, F
     let names: Vec<String> = b.parts.iter().map(|(s, _)| s.name(&axis_names(p))).collect();
     let drawn = b.moving_channels();
     let rank = Budget::headline(&drawn).map_or_else(|| (0..b.parts.len()).collect(), |h| b.ranked(h));
-    logged(crate::record::budget::log(&sinks.stream(), &b, &names, &rank, &drawn, &report.short_text()))?;
+    logged(crate::record::budget::log(&sinks.stream(), p, &b, &names, &rank, &drawn, &report.short_text()))?;
     if let Some(path) = &req.json {
         write_json("--json", path, &report)?;
     }

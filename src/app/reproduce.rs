@@ -3,6 +3,8 @@
 //! Each row states the quantity, the paper's value as printed, rinscope's value and the tolerance
 //! band it must fall in. Later issues add rows; docs/reproduce.md keeps the latest table.
 
+mod modulation;
+
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::app::failure::Failure;
@@ -461,6 +463,8 @@ pub fn run_all(stop: &AtomicBool) -> anyhow::Result<Table> {
         );
     }
     calibration_rows(&mut rows, stop)?;
+    modulation::rate_rows(&mut rows, stop)?;
+    modulation::positions_rows(&mut rows, stop)?;
     Ok(Table { rows })
 }
 

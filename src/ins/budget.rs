@@ -658,14 +658,18 @@ impl Budget {
         order
     }
 
-    /// The source whose part of channel `c` is largest in size at instant `i`.
+    /// The size of part `k` on headline `h` at instant `i` (the horizontal position's size for the position).
     #[must_use]
-    pub fn dominant(&self, c: usize, i: usize) -> Option<Source> {
-        self.parts
-            .iter()
-            .filter(|(_, p)| p.values[i][c].is_finite())
-            .max_by(|a, b| a.1.values[i][c].abs().total_cmp(&b.1.values[i][c].abs()))
-            .map(|(s, _)| *s)
+    pub fn size(&self, k: usize, h: usize, i: usize) -> f64 {
+        let v = &self.parts[k].1.values[i];
+        if h == POSITION[0] { v[POSITION[0]].hypot(v[POSITION[1]]) } else { v[h].abs() }
+    }
+
+    /// The part largest in size on headline `h` at instant `i` (None: no finite part).
+    #[must_use]
+    pub fn dominant(&self, h: usize, i: usize) -> Option<usize> {
+        let finite = (0..self.parts.len()).filter(|&k| self.size(k, h, i).is_finite());
+        finite.max_by(|&a, &b| self.size(a, h, i).total_cmp(&self.size(b, h, i)))
     }
 }
 

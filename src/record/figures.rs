@@ -90,6 +90,9 @@ struct Axes {
     hours: bool,
     x_label: String,
     y_label: String,
+    /// Each series the sum of those before it and one more (the budget's stacked headline): the
+    /// bands between them are filled, each in its series' colour.
+    stacked: bool,
 }
 
 impl Axes {
@@ -133,7 +136,8 @@ fn axes(plot: &Plot) -> Axes {
             .or_else(|| super::export::unit_of(&plot.origin))
             .unwrap_or(""),
     );
-    Axes { log_x, log_y, hours, x_label, y_label: unit }
+    let stacked = !log_y && plot.origin.starts_with(super::budget::STACKED);
+    Axes { log_x, log_y, hours, x_label, y_label: unit, stacked }
 }
 
 /// A unit suffix as a reader writes it: `deg_per_sqrt_h` → `°/√h`, `mps2` → `m/s²`.
@@ -421,6 +425,22 @@ where
         .bold_line_style(RGBColor(210, 210, 210))
         .draw()
         .map_err(draw_error)?;
+    if a.stacked {
+        // Each band from the series below (the axis for the first) up to its own line.
+        let mut below: Vec<(f64, f64)> = Vec::new();
+        for (s, segs) in drawn {
+            let upper: Vec<(f64, f64)> = segs.iter().flatten().copied().collect();
+            let (Some(first), Some(last)) = (upper.first(), upper.last()) else { continue };
+            let mut band = upper.clone();
+            if below.is_empty() {
+                band.extend([(last.0, 0.0), (first.0, 0.0)]);
+            } else {
+                band.extend(below.iter().rev().copied());
+            }
+            c.draw_series(std::iter::once(Polygon::new(band, color(s).mix(0.45).filled()))).map_err(draw_error)?;
+            below = upper;
+        }
+    }
     for (s, segs) in drawn {
         let color = color(s);
         let width = (s.width * K as f32).round().clamp(1.0, 12.0) as u32;
@@ -505,7 +525,14 @@ mod tests {
 
     #[test]
     fn lines_are_cut_at_the_box_not_drawn_along_it() {
-        let a = Axes { log_x: false, log_y: false, hours: false, x_label: String::new(), y_label: String::new() };
+        let a = Axes {
+            log_x: false,
+            log_y: false,
+            hours: false,
+            x_label: String::new(),
+            y_label: String::new(),
+            stacked: false,
+        };
         // Up from inside through the top edge, back down: two pieces ending and starting on y = 1.
         let pieces = clip(&[(0.0, 0.0), (1.0, 2.0), (2.0, 0.0)], (0.0, 2.0), (-1.0, 1.0), &a);
         assert_eq!(pieces, vec![vec![(0.0, 0.0), (0.5, 1.0)], vec![(1.5, 1.0), (2.0, 0.0)]]);

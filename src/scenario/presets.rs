@@ -27,6 +27,7 @@ pub const PRESETS: &[(&str, &str)] = &[
     ("rotation-modulation-continuous", include_str!("../../assets/scenarios/rotation-modulation-continuous.toml")),
     ("rotation-modulation-16-position", include_str!("../../assets/scenarios/rotation-modulation-16-position.toml")),
     ("selfcal-nav-grade", include_str!("../../assets/scenarios/selfcal-nav-grade.toml")),
+    ("sensors2014-rate", include_str!("../../assets/scenarios/sensors2014-rate.toml")),
 ];
 
 /// The TOML text of a preset.
