@@ -144,6 +144,7 @@ vertical = "held"
         json: None,
         budget: false,
         modulable_only: false,
+        preface: None,
         recording: RecordingRequest { sinks: Default::default(), save_by_default: false },
     };
     let report = execute(&request, &AtomicBool::new(false)).expect("schemes");

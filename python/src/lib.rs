@@ -555,6 +555,7 @@ fn schemes(
             json: None,
             budget,
             modulable_only,
+            preface: None,
             recording: recording(save, stop),
         };
         let mut report = execute(&request, stop)?;

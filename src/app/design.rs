@@ -108,6 +108,29 @@ pub struct Ranked {
     pub scheme: String,
 }
 
+/// The model's ranking as the recording's document shows it (before the exact simulation, whose
+/// table follows it): each scheme's model score and largest term, which were confirmed.
+fn model_ranking(ranked: &[Ranked], simulated: &dyn Fn(&Ranked) -> bool) -> String {
+    let mut s = String::from(
+        "# The designer's ranking\n\nThe averaged model's expected RMS horizontal position error of each scheme drawn \
+         and built in (docs/schemes.md, \"A designer\"); those marked ✓ were simulated exactly, and their plots and \
+         table follow. The chosen one and the `[scheme]` to run are in the terminal and `--json`.\n\n\
+         | scheme | moves | period s | model m | largest model term | simulated |\n|---|---|---|---|---|---|\n",
+    );
+    for r in ranked {
+        let top = r.model_terms.first().map_or_else(String::new, |(n, m)| format!("{n} {}", num(*m)));
+        s.push_str(&format!(
+            "| {} | {} | {} | {} | {top} | {} |\n",
+            r.label,
+            r.moves,
+            r.period_s.map_or_else(|| "—".into(), |x| format!("{x:.0}")),
+            num(r.model_m),
+            if simulated(r) { "✓" } else { "" }
+        ));
+    }
+    s
+}
+
 /// What `design` reports (and `--json` writes).
 #[derive(Debug, Clone, Serialize)]
 pub struct DesignReport {
@@ -396,6 +419,7 @@ pub fn execute(req: &DesignRequest, stop: &AtomicBool) -> Result<DesignReport, F
         json: None,
         budget: false,
         modulable_only: true,
+        preface: Some(model_ranking(&ranked, &confirmed)),
         recording: req.recording.clone(),
     };
     let mut exact: SchemesReport = super::schemes::execute(&request, stop)?;

@@ -78,6 +78,9 @@ pub struct SchemesRequest {
     /// Only the sources a scheme can modulate act (`ins::averaged::modulable_only`: no noise, no
     /// alignment error), so that seeds differ by the constant errors' draws alone.
     pub modulable_only: bool,
+    /// Markdown put before the comparison's table in the recording's document (the designer's
+    /// model ranking); None: the table alone.
+    pub preface: Option<String>,
     /// Where the recording goes.
     pub recording: RecordingRequest,
 }
@@ -328,7 +331,14 @@ pub fn execute(req: &SchemesRequest, stop: &AtomicBool) -> Result<SchemesReport,
     // The recording: each scheme's first seed, its radial position and heading errors over time.
     let labels: Vec<String> = req.schemes.iter().map(|(l, _)| l.clone()).collect();
     let first: Vec<&Trace> = (0..params.len()).map(|s| &traces[s * report.seeds.len()]).collect();
-    logged(crate::record::schemes::log(&sinks.stream(), &labels, &first, n, &report.short_text()))?;
+    logged(crate::record::schemes::log(
+        &sinks.stream(),
+        &labels,
+        &first,
+        n,
+        &report.short_text(),
+        req.preface.as_deref(),
+    ))?;
     if let Some(path) = &req.json {
         write_json("--json", path, &report)?;
     }

@@ -152,6 +152,7 @@ pub(super) fn schemes(args: &SchemesArgs) -> Result<(), Failure> {
         json: args.json.clone(),
         budget: args.budget,
         modulable_only: args.modulable_only,
+        preface: None,
         recording: args.sinks.recording()?,
     };
     let report = execute(&request, &stop_flag())?;

@@ -13,14 +13,23 @@ const RADIAL: &str = "schemes/radial_position_error_m";
 const RADIAL_LOG: &str = "schemes/radial_position_error_log10_m";
 const HEADING: &str = "schemes/heading_error_arcsec";
 
-/// Logs the first `n` rows of each scheme's `traces` (sampled at the same instants) under `labels`.
-pub fn log(stream: &Stream, labels: &[String], traces: &[&Trace], n: usize, table: &str) -> RecordingStreamResult<()> {
+/// Logs the first `n` rows of each scheme's `traces` (sampled at the same instants) under `labels`,
+/// with `table` (and `preface` before it) as the document.
+pub fn log(
+    stream: &Stream,
+    labels: &[String],
+    traces: &[&Trace],
+    n: usize,
+    table: &str,
+    preface: Option<&str>,
+) -> RecordingStreamResult<()> {
     let rec = stream.rec();
     rec.send_recording_name("rinscope: rotation schemes side by side")?;
     let doc = format!(
-        "# Rotation schemes side by side\n\nThe same IMU and table with each scheme in turn (assets/schemes/, or a user's \
+        "{}# Rotation schemes side by side\n\nThe same IMU and table with each scheme in turn (assets/schemes/, or a user's \
          `[scheme]`), every scheme on the same seeds: the table is over every seed, the plots are the first seed's. \
-         docs/schemes.md explains the built-in sequences.\n\n```\n{table}```\n"
+         docs/schemes.md explains the built-in sequences.\n\n```\n{table}```\n",
+        preface.map_or_else(String::new, |p| format!("{p}\n\n"))
     );
     rec.log_static("docs/schemes", &rerun::TextDocument::from_markdown(doc))?;
     let line_colors: Vec<rerun::Color> =

@@ -114,6 +114,7 @@ pub(super) fn positions_rows(rows: &mut Vec<Row>, stop: &AtomicBool) -> anyhow::
         json: None,
         budget: false,
         modulable_only: true,
+        preface: None,
         recording: RecordingRequest { sinks: Default::default(), save_by_default: false },
     };
     let report = crate::app::schemes::execute(&request, stop).map_err(|e| anyhow::anyhow!("{e}"))?;
