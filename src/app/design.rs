@@ -118,17 +118,26 @@ fn model_ranking(ranked: &[Ranked], simulated: &dyn Fn(&Ranked) -> bool) -> Stri
          | scheme | moves | period s | model m | largest model term | simulated |\n|---|---|---|---|---|---|\n",
     );
     for r in ranked {
-        let top = r.model_terms.first().map_or_else(String::new, |(n, m)| format!("{n} {}", num(*m)));
+        let [label, moves, period, model, top] = r.model_cells();
         s.push_str(&format!(
-            "| {} | {} | {} | {} | {top} | {} |\n",
-            r.label,
-            r.moves,
-            r.period_s.map_or_else(|| "—".into(), |x| format!("{x:.0}")),
-            num(r.model_m),
+            "| {label} | {moves} | {period} | {model} | {top} | {} |\n",
             if simulated(r) { "✓" } else { "" }
         ));
     }
     s
+}
+
+impl Ranked {
+    /// Its label, moves, period (s), model score (m) and largest model term, as the tables print them.
+    fn model_cells(&self) -> [String; 5] {
+        [
+            self.label.clone(),
+            self.moves.to_string(),
+            self.period_s.map_or_else(|| "—".into(), |x| format!("{x:.0}")),
+            num(self.model_m),
+            self.model_terms.first().map_or_else(String::new, |(n, m)| format!("{n} {}", num(*m))),
+        ]
+    }
 }
 
 /// What `design` reports (and `--json` writes).
@@ -536,16 +545,8 @@ impl DesignReport {
                     )
                 },
             );
-            let top = r.model_terms.first().map_or_else(String::new, |(n, m)| format!("{n} {}", num(*m)));
-            s.push_str(&format!(
-                "{:<14} {:>6} {:>9} {:>11}  {:<32} {}\n",
-                r.label,
-                r.moves,
-                r.period_s.map_or_else(|| "—".into(), |x| format!("{x:.0}")),
-                num(r.model_m),
-                exact,
-                top
-            ));
+            let [label, moves, period, model, top] = r.model_cells();
+            s.push_str(&format!("{label:<14} {moves:>6} {period:>9} {model:>11}  {exact:<32} {top}\n"));
         }
         let per_seed = format!(
             "per seed {:.2}× [{:.2}, {:.2}]",
