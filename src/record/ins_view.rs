@@ -140,8 +140,10 @@ impl InsScene {
         }
     }
 
-    /// Sends the trace's buffered frames at `times`; returns the chunks sent.
-    pub(crate) fn flush_scene(&mut self, stream: &Stream, times: &[f64]) -> RecordingStreamResult<usize> {
+    /// Sends the trace's buffered frames at `times` (`newest`: and the computed axes' newest frame
+    /// if it moved less than the dead band since the last sent: a live viewer's periodic flush
+    /// leaves it out, a chunk it could not show); returns the chunks sent.
+    pub(crate) fn flush_scene(&mut self, stream: &Stream, times: &[f64], newest: bool) -> RecordingStreamResult<usize> {
         let imu = std::mem::take(&mut self.trace_imu);
         if imu.is_empty() {
             return Ok(0);
@@ -160,7 +162,7 @@ impl InsScene {
             }
         }
         // The error as drawn at the newest frame, if it moved less than the dead band since.
-        if let Some((t, q)) = self.trace_error_pending.take() {
+        if let Some((t, q)) = self.trace_error_pending.take_if(|_| newest) {
             self.trace_error_t.push(t);
             self.trace_error.push(super::to_rerun_quaternion(&q));
         }

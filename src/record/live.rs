@@ -95,4 +95,17 @@ impl Recorder {
         self.plots.close_buckets();
         self.flush_series_with(Some(hold))
     }
+
+    /// Sends the buffered scene frames to viewers watching live: the INS trace's computed axes
+    /// only where they moved by more than the eye sees (their exact newest pose goes out with the
+    /// next full flush, [`Recorder::flush_now`]).
+    pub fn flush_scene_held(&mut self) -> RecordingStreamResult<()> {
+        self.flush_scene_with(false)
+    }
+
+    /// The chunks this recorder has sent so far (the live viewers' cadence keeps their rate).
+    #[must_use]
+    pub fn chunks_sent(&self) -> u64 {
+        self.chunks_sent
+    }
 }

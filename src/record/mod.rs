@@ -274,8 +274,9 @@ pub struct Recorder {
     plots: Plots,
     /// The buffered scene frames' times, s.
     scene_t: Vec<f64>,
-    /// Chunks sent since the sinks last caught up.
+    /// Chunks sent since the sinks last caught up, and in all.
     chunks_in_flight: usize,
+    chunks_sent: u64,
     /// Live mode (geometry on the timeline instead of static), and what this recorder feeds.
     live: Option<LiveOutput>,
     /// A live session's parameters in force (its final layout is framed on them).
@@ -357,6 +358,7 @@ impl Recorder {
             plots,
             scene_t: Vec::new(),
             chunks_in_flight: 0,
+            chunks_sent: 0,
             live,
             live_params: live.map(|_| Box::new(params.clone())),
             replay,
@@ -605,6 +607,7 @@ impl Recorder {
     /// length. Every few dozen chunks we wait for the sinks to catch up: memory stays flat.
     fn throttle(&mut self, chunks: usize) {
         self.chunks_in_flight += chunks;
+        self.chunks_sent += chunks as u64;
         if self.chunks_in_flight >= MAX_CHUNKS_IN_FLIGHT {
             // A sink that cannot flush (a viewer gone away) must not stop the run; data keeps flowing
             // to the other sinks.
@@ -636,6 +639,11 @@ impl Recorder {
 
     /// Sends the buffered scene frames.
     pub fn flush_scene(&mut self) -> RecordingStreamResult<()> {
+        self.flush_scene_with(true)
+    }
+
+    /// `newest`: also the INS trace's newest computed axes where they moved less than the eye sees.
+    fn flush_scene_with(&mut self, newest: bool) -> RecordingStreamResult<()> {
         if self.scene_t.is_empty() {
             return Ok(());
         }
@@ -652,7 +660,7 @@ impl Recorder {
             sent += table.flush(&self.stream, &times)?;
         }
         if let Some(ins) = self.ins.as_mut() {
-            sent += ins.flush_scene(&self.stream, &times)?;
+            sent += ins.flush_scene(&self.stream, &times, newest)?;
         }
         self.throttle(sent);
         Ok(())

@@ -242,14 +242,24 @@ pub fn sim_loop(
     sim
 }
 
-/// How often the recorder hands the 3D scene's buffered frames to viewers. A web viewer drawing
-/// without a GPU paints about 2-3 frames a second and ingests a few dozen chunks a second (Rerun
-/// 0.36, headless Chromium on 2 cores: `tests/web/latency.py`), and every flush is a chunk per
-/// moving entity: 30 chunks a second left it minutes behind, so the scene goes out 4 times a
-/// second, the plots twice.
+/// How often, at most, the recorder hands the 3D scene's buffered frames to viewers: 4 times a
+/// second; the plots, which a user reads rather than watches move, twice.
 pub const SCENE_FLUSH: Duration = Duration::from_millis(250);
-/// Same for the plots, which a user reads rather than watches move.
+/// Same for the plots.
 pub const SERIES_FLUSH: Duration = Duration::from_millis(500);
+/// The chunks a second the viewers' stream carries for the scene and for the plots, at most:
+/// every flush is a chunk per moving entity, and a web viewer drawing without a GPU (2 frames a
+/// second, Rerun 0.36 in headless Chromium on 2 cores: `tests/web/latency.py`) ingests a few
+/// dozen a second. Pure coning at the fixed rates above sent 37 a second (five moving entities
+/// at 4 Hz, six plots at 2 Hz): after the viewer's first-load stall it was 20 s behind, catching
+/// up at 1.8× the session's pace; at about 20 a second it had no backlog. A scene of many moving
+/// parts (or many plots) is flushed less often instead ([`Cadence`]).
+pub const SCENE_CHUNKS_PER_S: f64 = 12.0;
+/// Same for the plots.
+pub const SERIES_CHUNKS_PER_S: f64 = 8.0;
+/// The longest the scene and the plots wait between two flushes.
+const SCENE_FLUSH_MAX: Duration = Duration::from_secs(1);
+const SERIES_FLUSH_MAX: Duration = Duration::from_secs(2);
 /// How long after a reload the viewers get what the new parameters did (a few steps of it).
 const RELOAD_FLUSH: Duration = Duration::from_millis(60);
 /// A plot whose rows repeat its last one (a zero error, a vehicle at rest) sends its newest row
@@ -292,7 +302,8 @@ pub fn recorder_loop(
     mut history: Option<(Recorder, History)>,
     msgs: &Receiver<RecorderMsg>,
 ) -> anyhow::Result<()> {
-    let (mut last_scene, mut last_series) = (Instant::now(), Instant::now());
+    let mut scene = Cadence::new(SCENE_FLUSH, SCENE_FLUSH_MAX, SCENE_CHUNKS_PER_S);
+    let mut series = Cadence::new(SERIES_FLUSH, SERIES_FLUSH_MAX, SERIES_CHUNKS_PER_S);
     // After a reload, the first moments of the new parameters go out at once (a teacher waits for
     // them), not at the next tick.
     let mut soon: Option<Instant> = None;
@@ -326,14 +337,16 @@ pub fn recorder_loop(
             if reloaded {
                 soon = None;
             }
-            if reloaded || last_scene.elapsed() >= SCENE_FLUSH {
-                v.flush_scene()?;
-                last_scene = Instant::now();
+            if reloaded || scene.due() {
+                let before = v.chunks_sent();
+                v.flush_scene_held()?;
+                scene.flushed(v.chunks_sent() - before);
             }
-            if reloaded || last_series.elapsed() >= SERIES_FLUSH {
+            if reloaded || series.due() {
+                let before = v.chunks_sent();
                 v.flush_signal()?;
                 v.flush_series_held(SERIES_HOLD)?;
-                last_series = Instant::now();
+                series.flushed(v.chunks_sent() - before);
             }
         }
         if let Some((recorder, h)) = history.as_mut() {
@@ -348,6 +361,32 @@ pub fn recorder_loop(
         recorder.finish()?;
     }
     Ok(())
+}
+
+/// When the viewers' next flush of the scene or of the plots is due: at least `every` after the
+/// last, later when the last sent more chunks than `per_s` allows (never later than `longest`).
+struct Cadence {
+    every: Duration,
+    longest: Duration,
+    per_s: f64,
+    wait: Duration,
+    last: Instant,
+}
+
+impl Cadence {
+    fn new(every: Duration, longest: Duration, per_s: f64) -> Self {
+        Self { every, longest, per_s, wait: every, last: Instant::now() }
+    }
+
+    fn due(&self) -> bool {
+        self.last.elapsed() >= self.wait
+    }
+
+    /// A flush sent `chunks`: the next waits long enough to keep their rate.
+    fn flushed(&mut self, chunks: u64) {
+        self.wait = Duration::from_secs_f64(chunks as f64 / self.per_s).clamp(self.every, self.longest);
+        self.last = Instant::now();
+    }
 }
 
 /// Where a preset's editable copy lives: `rinscope-live/<name>.toml` in the working directory.

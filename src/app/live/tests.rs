@@ -453,3 +453,19 @@ fn a_reload_keeps_the_sessions_imu_compensation() {
     assert_eq!(sim.apply(reloaded).expect("applied").len(), 1);
     assert_eq!(sim.params.ins.as_ref().expect("an INS").imu_compensation, Some(errors));
 }
+
+#[test]
+fn the_viewers_cadence_keeps_each_flush_within_its_chunk_rate() {
+    // Pure coning's scene: five moving entities a flush at 12 chunks a second are 5/12 s apart.
+    let mut c = Cadence::new(SCENE_FLUSH, SCENE_FLUSH_MAX, SCENE_CHUNKS_PER_S);
+    c.flushed(5);
+    assert!((c.wait.as_secs_f64() - 5.0 / 12.0).abs() < 1e-9, "{:?}", c.wait);
+    assert!(!c.due());
+    // One entity: no sooner than the fastest cadence; fifty: no later than the slowest.
+    c.flushed(1);
+    assert_eq!(c.wait, SCENE_FLUSH);
+    c.flushed(50);
+    assert_eq!(c.wait, SCENE_FLUSH_MAX);
+    c.last = Instant::now() - SCENE_FLUSH_MAX;
+    assert!(c.due());
+}
