@@ -256,7 +256,7 @@ pub const SERIES_FLUSH: Duration = Duration::from_millis(500);
 /// parts (or many plots) is flushed less often instead ([`Cadence`]).
 pub const SCENE_CHUNKS_PER_S: f64 = 12.0;
 /// Same for the plots.
-pub const SERIES_CHUNKS_PER_S: f64 = 8.0;
+pub const SERIES_CHUNKS_PER_S: f64 = 6.0;
 /// The longest the scene and the plots wait between two flushes.
 const SCENE_FLUSH_MAX: Duration = Duration::from_secs(1);
 const SERIES_FLUSH_MAX: Duration = Duration::from_secs(2);
@@ -264,7 +264,7 @@ const SERIES_FLUSH_MAX: Duration = Duration::from_secs(2);
 const RELOAD_FLUSH: Duration = Duration::from_millis(60);
 /// A plot whose rows repeat its last one (a zero error, a vehicle at rest) sends its newest row
 /// to viewers this often, not at every flush ([`Recorder::flush_series_held`]).
-pub const SERIES_HOLD: Duration = Duration::from_secs(2);
+pub const SERIES_HOLD: Duration = Duration::from_secs(4);
 
 /// A request for the session so far as one recording (the class page's `/history.rrd`), answered
 /// by the recorder thread with the `.rrd` bytes or why not.
