@@ -564,6 +564,12 @@ pub struct Part {
 }
 
 impl Part {
+    /// `minuend − subtrahend`, instant by instant (a source's part: its run alone − the baseline).
+    #[must_use]
+    pub fn difference(minuend: &[[f64; CHANNELS.len()]], subtrahend: &[[f64; CHANNELS.len()]]) -> Self {
+        Self { values: minuend.iter().zip(subtrahend).map(|(a, b)| std::array::from_fn(|c| a[c] - b[c])).collect() }
+    }
+
     /// The metrics of channel `c`.
     #[must_use]
     pub fn metrics(&self, c: usize) -> Metrics {
@@ -601,24 +607,19 @@ pub fn assemble(full: Trace, baseline: Trace, alone: Vec<(Source, Trace)>) -> Bu
     let n =
         alone.iter().map(|(_, t)| t.values.len()).chain([full.values.len(), baseline.values.len()]).min().unwrap_or(0);
     let base = &baseline.values[..n];
-    let parts: Vec<(Source, Part)> = alone
-        .into_iter()
-        .map(|(s, t)| {
-            let values = t.values[..n].iter().zip(base).map(|(a, b)| std::array::from_fn(|c| a[c] - b[c])).collect();
-            (s, Part { values })
-        })
-        .collect();
+    let parts: Vec<(Source, Part)> =
+        alone.into_iter().map(|(s, t)| (s, Part::difference(&t.values[..n], base))).collect();
     let sum: Vec<[f64; CHANNELS.len()]> = (0..n)
         .map(|i| std::array::from_fn(|c| base[i][c] + parts.iter().map(|(_, p)| p.values[i][c]).sum::<f64>()))
         .collect();
-    let remainder = full.values[..n].iter().zip(&sum).map(|(f, s)| std::array::from_fn(|c| f[c] - s[c])).collect();
+    let remainder = Part::difference(&full.values[..n], &sum);
     Budget {
         t_s: full.t_s[..n].to_vec(),
         parts,
         baseline: Part { values: base.to_vec() },
         full: Part { values: full.values[..n].to_vec() },
         sum: Part { values: sum },
-        remainder: Part { values: remainder },
+        remainder,
     }
 }
 
@@ -668,8 +669,8 @@ impl Budget {
     /// The part largest in size on headline `h` at instant `i` (None: no finite part).
     #[must_use]
     pub fn dominant(&self, h: usize, i: usize) -> Option<usize> {
-        let finite = (0..self.parts.len()).filter(|&k| self.size(k, h, i).is_finite());
-        finite.max_by(|&a, &b| self.size(a, h, i).total_cmp(&self.size(b, h, i)))
+        let sizes = (0..self.parts.len()).map(|k| (k, self.size(k, h, i))).filter(|(_, s)| s.is_finite());
+        sizes.max_by(|a, b| a.1.total_cmp(&b.1)).map(|(k, _)| k)
     }
 }
 

@@ -103,7 +103,8 @@ impl Recorder {
         self.flush_scene_with(false)
     }
 
-    /// The chunks this recorder has sent so far (the live viewers' cadence keeps their rate).
+    /// The chunks of scene frames and plot rows this recorder has sent so far (the live viewers'
+    /// cadence keeps their rate; a plot's occasional frame points are not counted).
     #[must_use]
     pub fn chunks_sent(&self) -> u64 {
         self.chunks_sent

@@ -6,7 +6,7 @@ use std::sync::atomic::AtomicBool;
 use super::{Row, go_on};
 use crate::app::outputs::RecordingRequest;
 use crate::app::schemes::{SchemesRequest, built_in};
-use crate::ins::budget::{self, INS_HEADING, ImuTerm, Selection, Source, Triad};
+use crate::ins::budget::{self, INS_HEADING, ImuTerm, Part, Selection, Source, Triad};
 use crate::math::units::RAD_PER_DEG;
 use crate::model::earth::{EARTH_RATE, schuler_rate};
 use crate::model::scheme::Scheme;
@@ -21,13 +21,12 @@ fn rate_parts(p: &crate::scenario::Params, omega: f64, sample_s: f64) -> (f64, f
     let go = || true;
     let baseline = budget::simulate(&setup, Selection::Nothing, &go);
     let part = |t: ImuTerm| {
-        let alone = budget::simulate(&setup, Selection::Only(Source::Imu(t)), &go);
-        alone.values.iter().zip(&baseline.values).map(|(a, b)| std::array::from_fn(|c| a[c] - b[c])).collect()
+        Part::difference(&budget::simulate(&setup, Selection::Only(Source::Imu(t)), &go).values, &baseline.values)
     };
-    let bias: Vec<[f64; budget::CHANNELS.len()]> = part(ImuTerm::Bias(Triad::Gyro, 0));
-    let scale: Vec<[f64; budget::CHANNELS.len()]> = part(ImuTerm::Scale(Triad::Gyro, 2));
-    let tilt = bias.iter().map(|v| v[0].hypot(v[1])).fold(0.0, f64::max);
-    (tilt, scale.last().map_or(f64::NAN, |v| v[INS_HEADING].abs()))
+    let (bias, scale) = (part(ImuTerm::Bias(Triad::Gyro, 0)), part(ImuTerm::Scale(Triad::Gyro, 2)));
+    // The tilt: the INS's pitch and roll errors (channels 0 and 1).
+    let tilt = bias.values.iter().map(|v| v[0].hypot(v[1])).fold(0.0, f64::max);
+    (tilt, scale.values.last().map_or(f64::NAN, |v| v[INS_HEADING].abs()))
 }
 
 /// Sensors 2014 (rate dependence): at 2°/s and 10°/s about the vertical, the turned x gyro bias's
