@@ -15,7 +15,7 @@ use super::feed::{self, Outbox, OutputRow};
 use super::outputs::{RecordingName, RecordingRequest, check_output, finish, write_json};
 use super::playback::{AlignmentReport, Gap, Playback, PlaybackError};
 use super::run::{NavSummary, RmsPeak};
-use crate::ins::pipeline::InsView;
+use crate::ins::pipeline::{AlgorithmErrors, InsView};
 use crate::math::attitude::{Attitude, AttitudeError};
 use crate::math::frames::Rot;
 use crate::math::stats::RunningStat;
@@ -285,7 +285,7 @@ pub fn replay(
     let nan = AttitudeError { pitch_rad: f64::NAN, roll_rad: f64::NAN, heading_rad: f64::NAN };
     // Each update's errors, one per algorithm (the buffer kept: an allocation per update was a
     // tenth of a replay's time); a recorded row takes a copy.
-    let mut errors: Vec<AttitudeError> = Vec::with_capacity(algorithms.len());
+    let mut errors = AlgorithmErrors::default();
     let has_reference = !matches!(log.reference, Reference::None);
     let mut compared = 0u64;
     let recording = recorder.is_some();
@@ -416,7 +416,7 @@ pub fn replay(
                 let view = InsView {
                     t_s: s.t_s,
                     t_ref_s: pb.core.reference_instant(t_repr),
-                    errors: errors.clone(),
+                    errors,
                     imu_true,
                     imu_ins,
                     nav: nav_error,

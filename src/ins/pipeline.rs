@@ -10,13 +10,66 @@ use super::core::{InsCore, NavError, SampleOut};
 use super::nav::NavState;
 use super::sensor::Sensors;
 use super::truth::TruthImu;
-use crate::math::attitude::{Attitude, AttitudeError};
+use crate::math::attitude::{Attitude, AttitudeError, EulerParts};
 use crate::math::frames::{B, N, Rot, S};
 use crate::math::rotvec;
 use crate::model::earth::{Earth, Site};
 use crate::model::gimbal::ChainMemo;
 use crate::model::scheme::AxisValues;
-use crate::sim::{DemodState, Model, demodulate, encoder_readings};
+use crate::sim::{DemodState, Model, demodulated, encoder_readings};
+
+/// One attitude error per algorithm run, in integrator order: a fixed array (at most the five
+/// algorithms), so a view at every update allocates nothing and copies as a value.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct AlgorithmErrors {
+    len: usize,
+    values: [AttitudeError; Algorithm::ALL.len()],
+}
+
+impl AlgorithmErrors {
+    /// Appends the next algorithm's error.
+    ///
+    /// # Panics
+    /// Past the five algorithms (an INS runs each at most once).
+    pub fn push(&mut self, e: AttitudeError) {
+        self.values[self.len] = e;
+        self.len += 1;
+    }
+
+    /// Empties it (for the next update).
+    pub fn clear(&mut self) {
+        self.len = 0;
+    }
+}
+
+impl std::ops::Deref for AlgorithmErrors {
+    type Target = [AttitudeError];
+    fn deref(&self) -> &[AttitudeError] {
+        &self.values[..self.len]
+    }
+}
+
+impl std::ops::DerefMut for AlgorithmErrors {
+    fn deref_mut(&mut self) -> &mut [AttitudeError] {
+        &mut self.values[..self.len]
+    }
+}
+
+impl<'a> IntoIterator for &'a AlgorithmErrors {
+    type Item = &'a AttitudeError;
+    type IntoIter = std::slice::Iter<'a, AttitudeError>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.iter()
+    }
+}
+
+impl FromIterator<AttitudeError> for AlgorithmErrors {
+    fn from_iter<I: IntoIterator<Item = AttitudeError>>(iter: I) -> Self {
+        let mut out = Self::default();
+        iter.into_iter().for_each(|e| out.push(e));
+        out
+    }
+}
 
 /// The INS's view of the body at one output instant.
 #[derive(Debug, Clone)]
@@ -26,7 +79,7 @@ pub struct InsView {
     /// Truth reference time (output time minus the compensation Δt), s.
     pub t_ref_s: f64,
     /// Body attitude error of each algorithm (computed minus true), in integrator order.
-    pub errors: Vec<AttitudeError>,
+    pub errors: AlgorithmErrors,
     /// True C_s^n at the instant the INS output represents (None from [`InsRun::errors_view`]:
     /// what only the scene draws is not computed at every update).
     pub imu_true: Option<Rot<N, S>>,
@@ -44,7 +97,7 @@ type LastError = (f64, Rot<N, S>, AttitudeError);
 struct Shared {
     t_repr_s: f64,
     encoder_rad: AxisValues,
-    truth: Attitude,
+    truth: EulerParts,
 }
 
 /// The INS in the loop (cloned to fork one IMU stream into two navigation strategies).
@@ -305,7 +358,7 @@ impl InsRun {
 
     fn view_with(&mut self, t_s: f64, with_truth: bool) -> InsView {
         let model = self.truth.model();
-        let mut errors = Vec::with_capacity(self.demod.len());
+        let mut errors = AlgorithmErrors::default();
         // Algorithms that stand for the same instant share its encoder readings (a pure function of
         // the instant) and its true attitude; the same corrected angles, the compensated chain.
         let mut shared = std::mem::take(&mut self.shared);
@@ -326,8 +379,8 @@ impl InsRun {
                 None => {
                     let t_ref = self.core.reference_instant(t_repr);
                     // The encoders are read for the instant the IMU data represent (matched synchronisation).
-                    let truth_att = model.fixed_state().map_or_else(|| model.vehicle.state(t_ref).0, |(a, _)| a);
-                    (encoder_readings(model, t_repr), truth_att)
+                    let truth = model.fixed_state().map_or_else(|| model.vehicle.n_from_b(t_ref), |(_, r)| r);
+                    (encoder_readings(model, t_repr), EulerParts::of(&truth))
                 }
             };
             self.demod[k].observe_if_first(model, t_repr - self.h);
@@ -336,7 +389,7 @@ impl InsRun {
             if known.is_none() {
                 shared.push(Shared { t_repr_s: t_repr, encoder_rad: encoder, truth: truth_att });
             }
-            let error = demodulate(n_from_s, b_from_s_comp).error_from(&truth_att);
+            let error = AttitudeError::between(&demodulated(n_from_s, b_from_s_comp), &truth_att);
             self.last_error[k] = Some((t_repr, n_from_s, error));
             errors.push(error);
         }

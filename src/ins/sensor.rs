@@ -241,6 +241,9 @@ struct Triad {
     gm_drive: f64,
     /// The Gauss-Markov bias's factor (it runs whatever it is).
     gm_gain: f64,
+    /// `gain` is the identity (no scale factor or misalignment): the product is skipped (it would
+    /// give the same numbers).
+    unit_gain: bool,
 }
 
 impl Triad {
@@ -276,12 +279,14 @@ impl Triad {
             gm_decay,
             gm_drive,
             gm_gain: gain(on.markov),
+            unit_gain: gain_matrix == Matrix3::identity(),
         }
     }
 
     #[inline]
     fn apply(&mut self, x: &Vector3<f64>, extra_bias: Vector3<f64>, h: f64, rng: &mut ChaCha8Rng) -> Vector3<f64> {
-        let mut y = self.gain * x + (self.bias + self.gm * self.gm_gain + extra_bias) * h;
+        let mut y = if self.unit_gain { *x } else { self.gain * x };
+        y += (self.bias + self.gm * self.gm_gain + extra_bias) * h;
         if self.white_per_sample > 0.0 {
             let n: [f64; 3] = [StandardNormal.sample(rng), StandardNormal.sample(rng), StandardNormal.sample(rng)];
             y += Vector3::from(n) * (self.white_per_sample * self.white_gain);

@@ -58,6 +58,62 @@ impl Attitude {
     }
 }
 
+/// The direction cosines of one C_b^n that its Euler angles are read from, as a (sine, cosine) pair
+/// per angle up to a positive factor: pitch (C21, √(C20² + C22²)), roll (−C20, C22) and heading
+/// (C01, C11), each of the latter two scaled by cos θ. An attitude error read from two of these
+/// needs no trigonometry of either attitude ([`AttitudeError::between`]): what the INS's error
+/// statistics take at every update.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EulerParts {
+    pitch: (f64, f64),
+    roll: (f64, f64),
+    heading: (f64, f64),
+}
+
+impl EulerParts {
+    /// The parts of `n_from_b` (five DCM elements, straight from the quaternion).
+    #[must_use]
+    pub fn of(n_from_b: &Rot<N, B>) -> Self {
+        let q = n_from_b.quaternion();
+        let (w, x, y, z) = (q.w, q.i, q.j, q.k);
+        let c01 = 2.0 * (x * y - w * z);
+        let c11 = 1.0 - 2.0 * (x * x + z * z);
+        let c20 = 2.0 * (x * z - w * y);
+        let c21 = 2.0 * (y * z + w * x);
+        let c22 = 1.0 - 2.0 * (x * x + y * y);
+        // sin θ = C21 and cos θ = √(C20² + C22²) ≥ 0 (the third column is a unit vector): pitch
+        // stays in [−π/2, π/2], as asin(C21) reads it.
+        Self { pitch: (c21, (c20 * c20 + c22 * c22).sqrt()), roll: (-c20, c22), heading: (c01, c11) }
+    }
+
+    /// The Euler angles.
+    #[must_use]
+    pub fn attitude(&self) -> Attitude {
+        Attitude {
+            pitch_rad: self.pitch.0.atan2(self.pitch.1),
+            roll_rad: self.roll.0.atan2(self.roll.1),
+            heading_rad: self.heading.0.atan2(self.heading.1),
+        }
+    }
+}
+
+/// The angle from the direction (c₂, s₂) to (c₁, s₁), in [−π, π]: atan2 of the sine and cosine of
+/// the difference (s₁c₂ − c₁s₂, c₁c₂ + s₁s₂). Near zero — where an attitude error lives — the
+/// arctangent is its series u − u³/3 + u⁵/5 − u⁷/7 (|u| ≤ 2⁻⁷: the next term, u⁹/9, is below 1.6·10⁻¹⁸
+/// of u, under the rounding of a double); elsewhere libm's atan2.
+#[inline]
+fn angle_between((s1, c1): (f64, f64), (s2, c2): (f64, f64)) -> f64 {
+    let s = s1 * c2 - c1 * s2;
+    let c = c1 * c2 + s1 * s2;
+    if c > 0.0 && s.abs() <= c * (1.0 / 128.0) {
+        let u = s / c;
+        let u2 = u * u;
+        u * (1.0 - u2 * (1.0 / 3.0 - u2 * (1.0 / 5.0 - u2 * (1.0 / 7.0))))
+    } else {
+        s.atan2(c)
+    }
+}
+
 /// An attitude error as differences of Euler angles (computed minus true), in radians.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct AttitudeError {
@@ -70,6 +126,18 @@ pub struct AttitudeError {
 }
 
 impl AttitudeError {
+    /// `computed − truth` as [`Attitude::error_from`] gives it (roll and heading wrapped into
+    /// [−π, π]), read from the two attitudes' [`EulerParts`]: the difference's sine and cosine per
+    /// angle, no arctangent of either attitude.
+    #[must_use]
+    pub fn between(computed: &EulerParts, truth: &EulerParts) -> Self {
+        Self {
+            pitch_rad: angle_between(computed.pitch, truth.pitch),
+            roll_rad: angle_between(computed.roll, truth.roll),
+            heading_rad: angle_between(computed.heading, truth.heading),
+        }
+    }
+
     /// The three components as an array ordered pitch, roll, heading.
     #[must_use]
     pub fn as_array(&self) -> [f64; 3] {
@@ -133,6 +201,47 @@ mod tests {
         assert!((e.pitch_rad - c[(2, 1)].asin()).abs() < 1e-14);
         assert!((e.roll_rad - (-c[(2, 0)]).atan2(c[(2, 2)])).abs() < 1e-14);
         assert!((e.heading_rad - c[(0, 1)].atan2(c[(1, 1)])).abs() < 1e-14);
+    }
+
+    #[test]
+    fn the_error_read_from_the_parts_is_the_difference_of_the_euler_angles() {
+        // Independent computation: each attitude's Euler angles by libm's asin/atan2 (eq. 19), then
+        // their difference wrapped (`error_from`). Errors from 1e-9 rad (the series branch) to
+        // whole turns (atan2's), attitudes away from the pitch singularity.
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut uniform = |lo: f64, hi: f64| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            lo + (hi - lo) * (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut series_branch = 0;
+        for i in 0..4000 {
+            let truth = att(uniform(-80.0, 80.0), uniform(-180.0, 180.0), uniform(-180.0, 180.0));
+            let size = 10f64.powf(uniform(-9.0, 0.5));
+            let phi = Vector3::new(uniform(-1.0, 1.0), uniform(-1.0, 1.0), uniform(-1.0, 1.0)) * size;
+            // FRAME: a small rotation of the navigation frame applied to the true C_b^n.
+            let computed = Rot::<N, B>::from_quaternion(rotvec::exp(&phi) * *truth.n_from_b().quaternion());
+            let truth_rot = truth.n_from_b();
+            let want = Attitude::from_n_from_b(&computed).error_from(&Attitude::from_n_from_b(&truth_rot));
+            let got = AttitudeError::between(&EulerParts::of(&computed), &EulerParts::of(&truth_rot));
+            // asin(C21) and the atan2 of roll and heading round to 4e-16 / cos θ (their
+            // conditioning near the pitch singularity); a difference carries both attitudes'.
+            let cos_pitch = [&computed, &truth_rot]
+                .map(|r| Attitude::from_n_from_b(r).pitch_rad.cos())
+                .into_iter()
+                .fold(1.0, f64::min);
+            let tol = 2e-15 / cos_pitch;
+            for (g, w) in got.as_array().into_iter().zip(want.as_array()) {
+                // A wrapped difference may land on the other side of ±π.
+                assert!(
+                    (g - w).abs() < tol || ((g - w).abs() - std::f64::consts::TAU).abs() < tol,
+                    "{i}: {got:?} vs {want:?}"
+                );
+            }
+            series_branch += usize::from(size < 1e-3);
+        }
+        assert!(series_branch > 1000, "{series_branch} small errors");
     }
 
     #[test]

@@ -4,7 +4,7 @@
 //! Pure: `step(&Model, &mut DemodState, t)` knows nothing of Rerun, files or threads.
 //! The IMU attitude is exact here (an ideal INS), so every error is the turntable's.
 
-use crate::math::attitude::{Attitude, AttitudeError};
+use crate::math::attitude::{Attitude, AttitudeError, EulerParts};
 use crate::math::frames::{B, N, Rot, S};
 use crate::math::stats::RunningStat;
 use crate::math::timeline::Timeline;
@@ -195,10 +195,18 @@ pub fn demodulate(n_from_s: Rot<N, S>, b_from_s: Rot<B, S>) -> Attitude {
     Attitude::from_n_from_b(&(n_from_s * b_from_s.inverse()))
 }
 
+/// [`demodulate`]'s attitude as the parts an error is read from ([`AttitudeError::between`]): no
+/// trigonometry, what the errors at every update take.
+#[must_use]
+pub fn demodulated(n_from_s: Rot<N, S>, b_from_s: Rot<B, S>) -> EulerParts {
+    EulerParts::of(&(n_from_s * b_from_s.inverse()))
+}
+
 /// Advances the simulation to `t_s` (steps must come in increasing time).
 #[must_use]
 pub fn step(model: &Model, state: &mut DemodState, t_s: f64) -> StepOutput {
     let (attitude, n_from_b) = model.fixed_attitude.unwrap_or_else(|| model.vehicle.state(t_s));
+    let truth = EulerParts::of(&n_from_b);
     let (gimbal_rad, rate_rad_per_s) = model.scheme.state(t_s - model.scheme_t0_s);
 
     // Truth: the IMU attitude through the exact chain (an ideal INS reports it without error).
@@ -211,11 +219,11 @@ pub fn step(model: &Model, state: &mut DemodState, t_s: f64) -> StepOutput {
         |angles: &AxisValues| if *angles == gimbal_rad { true_shafts } else { model.chain.shaft_rotations(angles) };
 
     // 1. Uncompensated: the nominal table with the raw encoder angles.
-    let uncompensated = demodulate(n_from_s, model.chain.b_from_s_nominal_with(&shafts_of(&encoder_rad)));
+    let uncompensated = demodulated(n_from_s, model.chain.b_from_s_nominal_with(&shafts_of(&encoder_rad)));
 
     // 2. Compensated: the exact chain with the assumed errors and corrected encoder angles.
     let corrected = state.correct(&model.compensation, t_s, &encoder_rad);
-    let compensated = demodulate(n_from_s, model.chain.b_from_s_with(&model.compensation_rot, &shafts_of(&corrected)));
+    let compensated = demodulated(n_from_s, model.chain.b_from_s_with(&model.compensation_rot, &shafts_of(&corrected)));
 
     // 3. Closed form: first-order error model (docs/closed-form.md).
     let phi_b =
@@ -228,7 +236,11 @@ pub fn step(model: &Model, state: &mut DemodState, t_s: f64) -> StepOutput {
         n_from_b,
         gimbal_rad,
         encoder_rad,
-        errors: [uncompensated.error_from(&attitude), compensated.error_from(&attitude), closed_form],
+        errors: [
+            AttitudeError::between(&uncompensated, &truth),
+            AttitudeError::between(&compensated, &truth),
+            closed_form,
+        ],
     }
 }
 

@@ -142,12 +142,15 @@ impl Plots {
                     Some(view) => v.extend(view.errors.iter().map(|e| e.as_array()[a] * ARCSEC_PER_RAD)),
                     None => v.extend(std::iter::repeat_n(f64::NAN, width)),
                 },
+                // The values whose log10 the plot shows: the logarithm is monotonic, so the
+                // envelope of the values is the envelope of their logarithms, taken at the flush
+                // for the rows sent only (`log10_of_positive`).
                 Quantity::ConingLog => {
-                    let log10 = |x: f64| if x > 0.0 && x.is_finite() { x.log10() } else { f64::NAN };
+                    let positive = |x: f64| if x > 0.0 && x.is_finite() { x } else { f64::NAN };
                     for j in 0..lines.map_or(0, |l| l.rates.len()) {
                         let measured =
-                            ins.map_or(f64::NAN, |view| log10(view.errors[j].heading_rad.abs() * ARCSEC_PER_RAD));
-                        v.extend([measured, log10(lines.map_or(f64::NAN, |l| l.at(j, out.t_s)))]);
+                            ins.map_or(f64::NAN, |view| positive(view.errors[j].heading_rad.abs() * ARCSEC_PER_RAD));
+                        v.extend([measured, positive(lines.map_or(f64::NAN, |l| l.at(j, out.t_s)))]);
                     }
                 }
                 Quantity::PositionError => v.extend([nav.east_m, nav.north_m, nav.radial_m]),
@@ -195,11 +198,18 @@ impl Plots {
         let now = Instant::now();
         let mut sent = 0;
         for s in &mut self.series {
-            let raw = std::mem::take(&mut s.values);
+            let logarithmic = s.what == Quantity::ConingLog;
+            let mut raw = std::mem::take(&mut s.values);
             if self.exporting && !samples.is_empty() {
+                if logarithmic {
+                    log10_of_positive(&mut raw);
+                }
                 stream.export_series(&s.path, &s.names, &samples, &raw);
             }
-            let (times, values) = s.envelope.take();
+            let (times, mut values) = s.envelope.take();
+            if logarithmic {
+                log10_of_positive(&mut values);
+            }
             if times.is_empty() {
                 continue;
             }
@@ -284,4 +294,9 @@ impl Plots {
         }
         what.map(|w| plot_range(w, lo, hi))
     }
+}
+
+/// The coning plot's values as it shows them: log10 of each (positive or NaN, [`Plots::push`]).
+fn log10_of_positive(values: &mut [f64]) {
+    values.iter_mut().for_each(|x| *x = x.log10());
 }
