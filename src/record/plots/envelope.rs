@@ -64,10 +64,13 @@ impl Envelope {
     /// Takes one sample `row` (`width` values) at `t_s` (not before the previous sample's).
     pub(crate) fn push(&mut self, t_s: f64, row: &[f64]) {
         debug_assert_eq!(row.len(), self.width);
-        let b = self.bucket_of(t_s);
-        if self.bucket != Some(b) || self.bucket_s <= 0.0 {
+        // Still in the open bucket: `bucket_of`'s floor without calling it (a libm call per line
+        // and sample was a tenth of the recorder's time).
+        let x = t_s / self.bucket_s + 1e-9;
+        let open = self.bucket_s > 0.0 && self.bucket.is_some_and(|b| x >= b as f64 && x < (b + 1) as f64);
+        if !open {
             self.close();
-            self.bucket = Some(b);
+            self.bucket = Some(self.bucket_of(t_s));
         }
         if self.n == 0 {
             self.t_first = t_s;
