@@ -283,8 +283,8 @@ pub fn replay(
     let mut t_end = 0.0;
     let mut i = 0u64;
     let nan = AttitudeError { pitch_rad: f64::NAN, roll_rad: f64::NAN, heading_rad: f64::NAN };
-    // Each update's errors, one per algorithm (the buffer kept: an allocation per update was a
-    // tenth of a replay's time); a recorded row takes a copy.
+    // Each update's errors, one per algorithm (a fixed array: an allocation per update was a tenth
+    // of a replay's time); a recorded row takes a copy.
     let mut errors = AlgorithmErrors::default();
     let has_reference = !matches!(log.reference, Reference::None);
     let mut compared = 0u64;

@@ -36,14 +36,7 @@ impl Attitude {
     /// Extracts the Euler angles from C_b^n (Jiang et al. 2017 eq. 19 with the slip T31/T32 read as T31/T33).
     #[must_use]
     pub fn from_n_from_b(n_from_b: &Rot<N, B>) -> Self {
-        // Only five DCM elements are needed; computed straight from the quaternion (hot path).
-        let q = n_from_b.quaternion();
-        let (w, x, y, z) = (q.w, q.i, q.j, q.k);
-        let c01 = 2.0 * (x * y - w * z);
-        let c11 = 1.0 - 2.0 * (x * x + z * z);
-        let c20 = 2.0 * (x * z - w * y);
-        let c21 = 2.0 * (y * z + w * x);
-        let c22 = 1.0 - 2.0 * (x * x + y * y);
+        let Cosines { c01, c11, c20, c21, c22 } = Cosines::of(n_from_b);
         Self { pitch_rad: c21.clamp(-1.0, 1.0).asin(), roll_rad: (-c20).atan2(c22), heading_rad: c01.atan2(c11) }
     }
 
@@ -54,6 +47,31 @@ impl Attitude {
             pitch_rad: self.pitch_rad - truth.pitch_rad,
             roll_rad: wrap_pi(self.roll_rad - truth.roll_rad),
             heading_rad: wrap_pi(self.heading_rad - truth.heading_rad),
+        }
+    }
+}
+
+/// The five elements of C_b^n the Euler angles are read from (Jiang et al. 2017 eq. 19), straight
+/// from the quaternion: the hot path needs no whole matrix.
+struct Cosines {
+    c01: f64,
+    c11: f64,
+    c20: f64,
+    c21: f64,
+    c22: f64,
+}
+
+impl Cosines {
+    #[inline]
+    fn of(n_from_b: &Rot<N, B>) -> Self {
+        let q = n_from_b.quaternion();
+        let (w, x, y, z) = (q.w, q.i, q.j, q.k);
+        Self {
+            c01: 2.0 * (x * y - w * z),
+            c11: 1.0 - 2.0 * (x * x + z * z),
+            c20: 2.0 * (x * z - w * y),
+            c21: 2.0 * (y * z + w * x),
+            c22: 1.0 - 2.0 * (x * x + y * y),
         }
     }
 }
@@ -74,13 +92,7 @@ impl EulerParts {
     /// The parts of `n_from_b` (five DCM elements, straight from the quaternion).
     #[must_use]
     pub fn of(n_from_b: &Rot<N, B>) -> Self {
-        let q = n_from_b.quaternion();
-        let (w, x, y, z) = (q.w, q.i, q.j, q.k);
-        let c01 = 2.0 * (x * y - w * z);
-        let c11 = 1.0 - 2.0 * (x * x + z * z);
-        let c20 = 2.0 * (x * z - w * y);
-        let c21 = 2.0 * (y * z + w * x);
-        let c22 = 1.0 - 2.0 * (x * x + y * y);
+        let Cosines { c01, c11, c20, c21, c22 } = Cosines::of(n_from_b);
         // sin θ = C21 and cos θ = √(C20² + C22²) ≥ 0 (the third column is a unit vector): pitch
         // stays in [−π/2, π/2], as asin(C21) reads it.
         Self { pitch: (c21, (c20 * c20 + c22 * c22).sqrt()), roll: (-c20, c22), heading: (c01, c11) }
@@ -153,11 +165,7 @@ impl AttitudeError {
     /// C21 = sin θ), so the hot path needs no trigonometry.
     #[must_use]
     pub fn first_order(n_from_b: &Rot<N, B>, phi_n: V3<N>) -> Self {
-        let q = n_from_b.quaternion();
-        let (w, x, y, z) = (q.w, q.i, q.j, q.k);
-        let c01 = 2.0 * (x * y - w * z);
-        let c11 = 1.0 - 2.0 * (x * x + z * z);
-        let c21 = 2.0 * (y * z + w * x);
+        let Cosines { c01, c11, c21, .. } = Cosines::of(n_from_b);
         let cos_pitch = c01.hypot(c11);
         let (sh, ch) = (c01 / cos_pitch, c11 / cos_pitch);
         let phi_hx = ch * phi_n.v.x - sh * phi_n.v.y;
