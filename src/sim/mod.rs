@@ -33,6 +33,9 @@ pub struct TableParams {
     pub compensation: TableErrors,
 }
 
+/// The next [`Model::id`].
+static NEXT_MODEL_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
 /// Everything a step needs, precomputed from [`TableParams`].
 #[derive(Debug, Clone)]
 pub struct Model {
@@ -54,6 +57,9 @@ pub struct Model {
     compensation_rot: ErrorRotations,
     /// The attitude of a vehicle at rest, computed once.
     fixed_attitude: Option<(Attitude, Rot<N, B>)>,
+    /// Which [`Model::new`] made it (its clones share it): what a step's memo of the table's part
+    /// is kept for (a live reload makes a new model).
+    id: u64,
 }
 
 impl Model {
@@ -75,6 +81,7 @@ impl Model {
             truth_rot,
             compensation_rot,
             fixed_attitude,
+            id: NEXT_MODEL_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
         }
     }
 
@@ -108,6 +115,22 @@ impl Model {
 #[derive(Debug, Clone, Default)]
 pub struct DemodState {
     previous: Option<(f64, AxisValues)>,
+    /// The table's part of the latest step, kept while the angles and rates repeat ([`step`]).
+    table: Option<TableStep>,
+}
+
+/// What [`step`] computes from the gimbal angles, rates and encoder readings alone: the same at
+/// every step of a dwell (a table at rest, an indexing scheme between its moves).
+#[derive(Debug, Clone, Copy)]
+struct TableStep {
+    /// The model and the (true angles, rates, raw readings, corrected readings) it was computed for.
+    key: (u64, [AxisValues; 4]),
+    /// C_b^s through the true chain, the nominal chain at the raw readings and the compensated one.
+    true_b_from_s: Rot<B, S>,
+    nominal_b_from_s: Rot<B, S>,
+    compensated_b_from_s: Rot<B, S>,
+    /// The closed form's small rotation, in b.
+    phi_b: crate::math::frames::V3<B>,
 }
 
 /// Encoder readings handed to the navigation computer with the IMU sample at `t_s`: latched
@@ -115,9 +138,13 @@ pub struct DemodState {
 /// The noise is a pure function of (seed, axis, `t_s`): asking twice gives the same reading.
 #[must_use]
 pub fn encoder_readings(model: &Model, t_s: f64) -> AxisValues {
+    encoder_readings_of(model, t_s, &model.scheme.state(t_s - model.scheme_t0_s).0)
+}
+
+/// [`encoder_readings`] when the true angles at `t_s`, `now`, are known.
+fn encoder_readings_of(model: &Model, t_s: f64, now: &AxisValues) -> AxisValues {
     let t_scheme = t_s - model.scheme_t0_s;
     let mut encoder_rad = [0.0; MAX_AXES];
-    let now = model.scheme.state(t_scheme).0;
     for (k, e) in model.truth.axes.iter().enumerate() {
         let latched =
             if e.encoder_delay_s == 0.0 { now[k] } else { model.scheme.state(t_scheme - e.encoder_delay_s).0[k] };
@@ -202,33 +229,45 @@ pub fn demodulated(n_from_s: Rot<N, S>, b_from_s: Rot<B, S>) -> EulerParts {
     EulerParts::of(&(n_from_s * b_from_s.inverse()))
 }
 
+/// The table's part of a step at `key` = (true angles, rates, raw readings, corrected readings).
+fn table_step(model: &Model, key: (u64, [AxisValues; 4])) -> TableStep {
+    let [gimbal_rad, rate_rad_per_s, encoder_rad, corrected] = key.1;
+    let chain = &model.chain;
+    let true_shafts = chain.shaft_rotations(&gimbal_rad);
+    // Shaft rotations of other angles; reuses the true ones when the angles are identical.
+    let shafts_of =
+        |angles: &AxisValues| if *angles == gimbal_rad { true_shafts } else { chain.shaft_rotations(angles) };
+    TableStep {
+        key,
+        true_b_from_s: chain.b_from_s_with(&model.truth_rot, &true_shafts),
+        nominal_b_from_s: chain.b_from_s_nominal_with(&shafts_of(&encoder_rad)),
+        compensated_b_from_s: chain.b_from_s_with(&model.compensation_rot, &shafts_of(&corrected)),
+        phi_b: chain.first_order_phi_b_with(&model.truth, &model.truth_rot, &gimbal_rad, &rate_rad_per_s, &true_shafts),
+    }
+}
+
 /// Advances the simulation to `t_s` (steps must come in increasing time).
 #[must_use]
 pub fn step(model: &Model, state: &mut DemodState, t_s: f64) -> StepOutput {
     let (attitude, n_from_b) = model.fixed_attitude.unwrap_or_else(|| model.vehicle.state(t_s));
     let truth = EulerParts::of(&n_from_b);
     let (gimbal_rad, rate_rad_per_s) = model.scheme.state(t_s - model.scheme_t0_s);
+    let encoder_rad = encoder_readings_of(model, t_s, &gimbal_rad);
+    let corrected = state.correct(&model.compensation, t_s, &encoder_rad);
+    let key = (model.id, [gimbal_rad, rate_rad_per_s, encoder_rad, corrected]);
+    let table = match state.table {
+        Some(t) if t.key == key => t,
+        _ => *state.table.insert(table_step(model, key)),
+    };
 
     // Truth: the IMU attitude through the exact chain (an ideal INS reports it without error).
-    let true_shafts = model.chain.shaft_rotations(&gimbal_rad);
-    let n_from_s = n_from_b * model.chain.b_from_s_with(&model.truth_rot, &true_shafts);
-
-    let encoder_rad = encoder_readings(model, t_s);
-    // Shaft rotations of other angles; reuses the true ones when the angles are identical.
-    let shafts_of =
-        |angles: &AxisValues| if *angles == gimbal_rad { true_shafts } else { model.chain.shaft_rotations(angles) };
-
+    let n_from_s = n_from_b * table.true_b_from_s;
     // 1. Uncompensated: the nominal table with the raw encoder angles.
-    let uncompensated = demodulated(n_from_s, model.chain.b_from_s_nominal_with(&shafts_of(&encoder_rad)));
-
+    let uncompensated = demodulated(n_from_s, table.nominal_b_from_s);
     // 2. Compensated: the exact chain with the assumed errors and corrected encoder angles.
-    let corrected = state.correct(&model.compensation, t_s, &encoder_rad);
-    let compensated = demodulated(n_from_s, model.chain.b_from_s_with(&model.compensation_rot, &shafts_of(&corrected)));
-
+    let compensated = demodulated(n_from_s, table.compensated_b_from_s);
     // 3. Closed form: first-order error model (docs/closed-form.md).
-    let phi_b =
-        model.chain.first_order_phi_b_with(&model.truth, &model.truth_rot, &gimbal_rad, &rate_rad_per_s, &true_shafts);
-    let closed_form = AttitudeError::first_order(&n_from_b, n_from_b.apply(phi_b));
+    let closed_form = AttitudeError::first_order(&n_from_b, n_from_b.apply(table.phi_b));
 
     StepOutput {
         t_s,
@@ -396,6 +435,40 @@ mod tests {
         for v in 0..3 {
             assert!(peak_arcsec(&stats, v) < 1e-6, "variant {v}: {}", peak_arcsec(&stats, v));
         }
+    }
+
+    #[test]
+    fn a_step_in_a_dwell_is_the_step_of_a_fresh_state_and_a_new_model_is_not_taken_for_the_old() {
+        // The table's part of a step is kept while the angles repeat (a dwell): every step of a
+        // 16-position period with one state must equal a step with no memory (a fresh state fed
+        // the previous instant, as the delay correction needs); a new model at the same angles (a
+        // live reload of the table's errors) must not reuse the old one's.
+        let (scheme, truth) = (sixteen_position(), all_errors());
+        let model = table_model(dual_axis_chain(), moving_vehicle(), scheme.clone(), truth.clone(), truth.scaled(0.5));
+        let mut kept = DemodState::default();
+        for i in 0..3400 {
+            let t = f64::from(i) * 0.1;
+            let out = step(&model, &mut kept, t);
+            let mut fresh = DemodState::default();
+            if i > 0 {
+                fresh.observe(&model, t - 0.1);
+            }
+            let want = step(&model, &mut fresh, t);
+            assert_eq!(out.errors, want.errors, "at {t} s");
+        }
+        // In the first dwell (the angles at rest): the old model's step, then the new one's, whose
+        // outer swing cone is twice as wide (the encoders read the same).
+        let mut wider = truth.clone();
+        wider.axes[0].swing_half_angle_rad *= 2.0;
+        let other = table_model(dual_axis_chain(), moving_vehicle(), scheme, wider, truth.scaled(0.5));
+        let mut reloaded = DemodState::default();
+        let _ = step(&model, &mut reloaded, 5.0);
+        let after = step(&other, &mut reloaded, 5.1);
+        let mut fresh = DemodState::default();
+        fresh.observe(&other, 5.0);
+        assert_eq!(after.errors, step(&other, &mut fresh, 5.1).errors);
+        let old_model = step(&model, &mut DemodState::default(), 5.1);
+        assert!(after.errors[0] != old_model.errors[0], "the wider cone shows");
     }
 
     #[test]
