@@ -63,14 +63,6 @@ impl<'a> IntoIterator for &'a AlgorithmErrors {
     }
 }
 
-impl FromIterator<AttitudeError> for AlgorithmErrors {
-    fn from_iter<I: IntoIterator<Item = AttitudeError>>(iter: I) -> Self {
-        let mut out = Self::default();
-        iter.into_iter().for_each(|e| out.push(e));
-        out
-    }
-}
-
 /// The INS's view of the body at one output instant.
 #[derive(Debug, Clone)]
 pub struct InsView {
