@@ -28,13 +28,14 @@ pub(crate) struct InsScene {
     filtered: Vec<f64>,
     /// Per buffered scene frame, the true IMU attitude (the trace's moving frame).
     trace_imu: Vec<rerun::Quaternion>,
-    /// The computed axes relative to the true ones (error ×N, in the IMU frame): the frames where
-    /// the drawing moved by more than [`TRACE_DEAD_BAND_RAD`] since the last sent, and when.
-    trace_error: Vec<rerun::Quaternion>,
-    trace_error_t: Vec<f64>,
-    /// The last relative rotation sent (or buffered) and the newest computed, not yet sent.
-    trace_error_last: Option<UnitQuaternion<f64>>,
-    trace_error_pending: Option<(f64, UnitQuaternion<f64>)>,
+    /// The computed axes' attitude (the error ×N turning the true attitude): the frames where the
+    /// true attitude moved or the error's drawing moved by more than [`TRACE_DEAD_BAND_RAD`] since
+    /// the last buffered, and when.
+    trace_computed: Vec<rerun::Quaternion>,
+    trace_computed_t: Vec<f64>,
+    /// The last true attitude and drawn error buffered, and the newest computed axes not buffered.
+    trace_last: Option<(rerun::Quaternion, UnitQuaternion<f64>)>,
+    trace_computed_pending: Option<(f64, UnitQuaternion<f64>)>,
     /// The last true attitude sent (a table that stands still sends nothing).
     trace_imu_last: Option<rerun::Quaternion>,
     pub(crate) exaggeration: f64,
@@ -78,10 +79,10 @@ impl InsScene {
             raw: Vec::new(),
             filtered: Vec::new(),
             trace_imu: Vec::new(),
-            trace_error: Vec::new(),
-            trace_error_t: Vec::new(),
-            trace_error_last: None,
-            trace_error_pending: None,
+            trace_computed: Vec::new(),
+            trace_computed_t: Vec::new(),
+            trace_last: None,
+            trace_computed_pending: None,
             trace_imu_last: None,
             // The dial turns by the errors: none without them.
             dial_on: plots.algorithms.len() >= 2 && plots.errors,
@@ -109,20 +110,24 @@ impl InsScene {
                 .and_then(|v| Some((*v.imu_true?.quaternion(), *v.imu_ins.quaternion())))
                 .unwrap_or((UnitQuaternion::identity(), UnitQuaternion::identity()));
             let err = rotvec::log(&(c * t.inverse())) * self.exaggeration;
-            // The computed axes are exp(err)·t: the exaggerated error in the navigation frame,
-            // which moves slowly (sent only when the drawing moved by more than the eye sees, and
-            // its newest frame at a flush), turning the true attitude (every frame; the true axes
-            // are the same frame, outside the error's).
-            self.trace_imu.push(super::to_rerun_quaternion(&t));
-            let relative = rotvec::exp(&err);
-            let moved = self.trace_error_last.is_none_or(|last| last.angle_to(&relative) > TRACE_DEAD_BAND_RAD);
+            // The computed axes are exp(err)·t: the exaggerated error in the navigation frame
+            // turning the true attitude, one entity (a viewer's stream carries a chunk per moving
+            // entity). The error moves slowly: a table standing still sends its computed axes only
+            // when their drawing moved by more than the eye sees (and the newest at a full flush).
+            let true_q = super::to_rerun_quaternion(&t);
+            self.trace_imu.push(true_q);
+            let drawn = rotvec::exp(&err);
+            let computed = drawn * t;
+            let moved = self.trace_last.is_none_or(|(last_t, last_drawn)| {
+                last_t != true_q || last_drawn.angle_to(&drawn) > TRACE_DEAD_BAND_RAD
+            });
             if moved {
-                self.trace_error_t.push(t_s);
-                self.trace_error.push(super::to_rerun_quaternion(&relative));
-                self.trace_error_last = Some(relative);
-                self.trace_error_pending = None;
+                self.trace_computed_t.push(t_s);
+                self.trace_computed.push(super::to_rerun_quaternion(&computed));
+                self.trace_last = Some((true_q, drawn));
+                self.trace_computed_pending = None;
             } else {
-                self.trace_error_pending = Some((t_s, relative));
+                self.trace_computed_pending = Some((t_s, computed));
             }
         }
         // The needles turn clockwise by the size of each algorithm's attitude error (whichever
@@ -152,27 +157,25 @@ impl InsScene {
         let mut sent = 0;
         if !imu.iter().all(|q| Some(*q) == self.trace_imu_last) {
             self.trace_imu_last = imu.last().copied();
-            for path in [TRACE_IMU_PATH, TRACE_COMPUTED_IMU_PATH] {
-                stream.rec().send_columns(
-                    path,
-                    stream.time_columns(times),
-                    rerun::Transform3D::update_fields().with_many_quaternion(imu.clone()).columns_of_unit_batches()?,
-                )?;
-                sent += 1;
-            }
-        }
-        // The error as drawn at the newest frame, if it moved less than the dead band since.
-        if let Some((t, q)) = self.trace_error_pending.take_if(|_| newest) {
-            self.trace_error_t.push(t);
-            self.trace_error.push(super::to_rerun_quaternion(&q));
-        }
-        let error_t = std::mem::take(&mut self.trace_error_t);
-        if !error_t.is_empty() {
             stream.rec().send_columns(
-                TRACE_ERROR_PATH,
-                stream.time_columns(&error_t),
+                TRACE_IMU_PATH,
+                stream.time_columns(times),
+                rerun::Transform3D::update_fields().with_many_quaternion(imu).columns_of_unit_batches()?,
+            )?;
+            sent += 1;
+        }
+        // The computed axes at the newest frame, if their error moved less than the dead band since.
+        if let Some((t, q)) = self.trace_computed_pending.take_if(|_| newest) {
+            self.trace_computed_t.push(t);
+            self.trace_computed.push(super::to_rerun_quaternion(&q));
+        }
+        let computed_t = std::mem::take(&mut self.trace_computed_t);
+        if !computed_t.is_empty() {
+            stream.rec().send_columns(
+                TRACE_COMPUTED_PATH,
+                stream.time_columns(&computed_t),
                 rerun::Transform3D::update_fields()
-                    .with_many_quaternion(std::mem::take(&mut self.trace_error))
+                    .with_many_quaternion(std::mem::take(&mut self.trace_computed))
                     .columns_of_unit_batches()?,
             )?;
             sent += 1;
@@ -225,10 +228,9 @@ pub(crate) fn needle(angle_rad: f64) -> [f32; 3] {
 
 /// The INS trace's true axes: the true IMU attitude (its arrows).
 pub(crate) const TRACE_IMU_PATH: &str = "world/ins_trace/imu";
-/// The computed axes: the INS's attitude error ×N (a rotation in the navigation frame) ...
-pub(crate) const TRACE_ERROR_PATH: &str = "world/ins_trace/error";
-/// ... turning the true IMU attitude (the computed axes are its arrows).
-pub(crate) const TRACE_COMPUTED_IMU_PATH: &str = "world/ins_trace/error/imu";
+/// The computed axes: the INS's attitude error ×N (a rotation in the navigation frame) turning the
+/// true IMU attitude.
+pub(crate) const TRACE_COMPUTED_PATH: &str = "world/ins_trace/computed";
 /// The drawn computed axes are sent again when they moved by more than this, rad (0.2°: under
 /// what the eye tells apart on an axis 0.6 long; the newest frame goes out at every flush).
 const TRACE_DEAD_BAND_RAD: f64 = 0.2 * crate::math::units::RAD_PER_DEG;
@@ -391,7 +393,7 @@ impl InsScene {
             &rerun::Arrows3D::from_vectors(axes).with_colors([rgb([170, 170, 170])]).with_radii([0.012]),
         )?;
         rec.log_static(
-            format!("{TRACE_COMPUTED_IMU_PATH}/axes"),
+            format!("{TRACE_COMPUTED_PATH}/axes"),
             &rerun::Arrows3D::from_vectors(axes).with_colors(colors::SENSOR.map(rgb)).with_radii([0.012]),
         )?;
         let ins_label = format!("INS IMU axes (error ×{})", layout.exaggeration);

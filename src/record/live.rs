@@ -44,15 +44,27 @@ impl Recorder {
         self.live.is_some()
     }
 
-    /// Live mode: new parameters apply from simulated time `t_s` on (buffered rows go out first).
+    /// Live mode: new parameters apply from simulated time `t_s` on (buffered rows go out first,
+    /// but to a viewer's stream with the first new ones).
     pub fn reconfigure(&mut self, t_s: f64, params: &Params) -> RecordingStreamResult<()> {
-        self.flush_now()?;
+        // A viewer's stream sends its buffered rows with the first rows of the new parameters (the
+        // reload's flush, `app::live::RELOAD_FLUSH` later): a chunk per entity, not two — the
+        // buffered rows are values already, and a viewer ingests a few dozen chunks a second.
+        if self.live != Some(LiveOutput::Viewer) {
+            self.flush_now()?;
+        }
         // The 3D view's title names each class's drawing factor: the layout follows a change of it.
         let refactored =
             self.table.as_mut().is_some_and(|t| t.set_truth(&params.table.truth, params.recording.exaggeration));
         let retitle = refactored
             || self.live_params.as_ref().is_some_and(|p| p.recording.exaggeration != params.recording.exaggeration);
         let old = self.live_params.replace(Box::new(params.clone()));
+        // The table's drawn errors depend on its truth and the drawing factor alone: a reload that
+        // changes neither (a cone, a speed, an algorithm shown) leaves them be — a viewer's stream
+        // carries a chunk per entity sent, and a reload's burst is what a slow viewer waits through.
+        let redraw_table = old.as_ref().is_none_or(|p| {
+            p.table.truth != params.table.truth || p.recording.exaggeration != params.recording.exaggeration
+        });
         // Pure coning: the drawn cone and its label follow a new cone.
         let alpha = |p: &Params| p.table.vehicle.pure_coning().map_or(0.0, |c| c.half_angle_rad);
         if let Some(gizmo) = self.cone.as_mut()
@@ -81,7 +93,12 @@ impl Recorder {
                 )?;
             }
         }
-        self.log_errors(params, self.geometry_at(t_s))
+        let at = self.geometry_at(t_s);
+        super::documents::log_documents(&self.stream, params, self.replay, at)?;
+        match &self.table {
+            Some(table) if redraw_table => table.log_errors(&self.stream, params, at),
+            _ => Ok(()),
+        }
     }
 
     /// Sends the buffered time-series rows to viewers watching live: a series whose rows all

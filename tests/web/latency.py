@@ -18,8 +18,9 @@ steady-state lag (after the viewer first shows data plus WARMUP) has a median ov
 ten samples a median over MAX_LAG (it did not recover), or any sample exceeds MAX_LAG_PEAK; or when a
 change was not seen, the median change took longer than MAX_MOVE_MEDIAN or one longer than MAX_MOVE.
 A viewer that falls behind (the defect this guards against: 52 s after two minutes) fails all of them.
-One that keeps up but paints at 1.6-2.5 fps in software rendering lags by its frame period on top of
-the stream's flush (0.25-0.5 s): 0.5-0.9 s here. The tighter TARGET_LAG_PEAK and TARGET_MOVE (what a
+One that keeps up but paints at 1.3-2.5 fps in software rendering lags by its frame period on top of
+the stream's flush (0.25-0.5 s): 0.5-1.2 s here; MAX_LAG and MAX_MOVE_MEDIAN hold at 2 fps, and a
+slower viewer's measured frame period beyond 0.5 s is added to them (once, and twice). The tighter TARGET_LAG_PEAK and TARGET_MOVE (what a
 class should see: 1.5 s) are measured and reported, not asserted: these machines are shared, and a
 neighbour's burst stalls the software renderer for seconds (a CI run saw 2.5 s for about 5 s, then
 0.6 s again) — timing targets belong to benchmarks, the test to what a stall cannot explain.
@@ -173,6 +174,17 @@ finally:
     b.close()
 
 steady = [s["lag_s"] for s in samples if s["lag_s"] is not None and first_data is not None and s["wall_s"] >= first_data + a.warmup]
+# The bounds are the stream's flush plus the viewer's own frames: MAX_LAG is the stream's flush
+# (0.5 s) and one frame at 2 fps, MAX_MOVE_MEDIAN that lag and one more frame. A viewer painting
+# slower than 2 fps (software rendering on a slow hour: 1.3-1.6 fps) shows the newest data a frame
+# period after it ingests it, which no stream can shorten: its measured frame period beyond 0.5 s
+# is added, once to the lag and twice to a change. At 2 fps or faster the bounds are MAX_LAG and
+# MAX_MOVE_MEDIAN as given. A viewer that falls behind still fails them: its lag grows, its frame
+# period does not.
+steady_fps = [s["fps"] for s in samples if s["fps"] and first_data is not None and s["wall_s"] >= first_data + a.warmup]
+slow_frame_s = max(0.0, 1.0 / statistics.median(steady_fps) - 0.5) if steady_fps else 0.0
+max_lag = a.max_lag + slow_frame_s if a.max_lag is not None else None
+max_move_median = a.max_move_median + 2 * slow_frame_s if a.max_move_median is not None else None
 summary = {"samples": len(samples), "steady_samples": len(steady), "first_data_wall_s": first_data}
 if steady:
     q = sorted(steady)
@@ -184,21 +196,25 @@ seen = []
 if moves:
     seen = [m["seen_after_s"] for m in moves if m["seen_after_s"] is not None]
     summary.update({"moves": len(moves), "moves_seen": len(seen), "move_seen_median_s": round(statistics.median(seen), 2) if seen else None, "move_seen_max_s": max(seen) if seen else None})
+if slow_frame_s > 0:
+    summary["slow_frame_s"] = round(slow_frame_s, 3)
+    summary["max_lag_s"] = None if max_lag is None else round(max_lag, 3)
+    summary["max_move_median_s"] = None if max_move_median is None else round(max_move_median, 3)
 print("summary:", json.dumps(summary), flush=True)
 if a.json:
     with open(a.json, "w") as f:
         json.dump({"samples": samples, "moves": moves, "summary": summary}, f, indent=1)
 failed = []
-if a.max_lag is not None and (not steady or summary["lag_median_s"] > a.max_lag):
-    failed.append(f"the viewer's median lag was {summary.get('lag_median_s')} s (at most {a.max_lag} s)")
-if a.max_lag is not None and steady and statistics.median(steady[-10:]) > a.max_lag:
-    failed.append(f"the viewer did not recover: its last ten samples' median lag was {statistics.median(steady[-10:]):.2f} s (at most {a.max_lag} s)")
+if max_lag is not None and (not steady or summary["lag_median_s"] > max_lag):
+    failed.append(f"the viewer's median lag was {summary.get('lag_median_s')} s (at most {max_lag:.2f} s)")
+if max_lag is not None and steady and statistics.median(steady[-10:]) > max_lag:
+    failed.append(f"the viewer did not recover: its last ten samples' median lag was {statistics.median(steady[-10:]):.2f} s (at most {max_lag:.2f} s)")
 if a.max_lag_peak is not None and (not steady or max(steady) > a.max_lag_peak):
     failed.append(f"the viewer's lag reached {max(steady) if steady else 'no data'} s (at most {a.max_lag_peak} s)")
 if moves and len(seen) < len(moves):
     failed.append(f"{len(moves) - len(seen)} of {len(moves)} changes never showed")
-if a.max_move_median is not None and seen and statistics.median(seen) > a.max_move_median:
-    failed.append(f"a change showed after {statistics.median(seen):.2f} s in the median (at most {a.max_move_median} s)")
+if max_move_median is not None and seen and statistics.median(seen) > max_move_median:
+    failed.append(f"a change showed after {statistics.median(seen):.2f} s in the median (at most {max_move_median:.2f} s)")
 if a.max_move is not None and seen and max(seen) > a.max_move:
     failed.append(f"a change showed after {max(seen)} s (at most {a.max_move} s)")
 missed = []

@@ -248,23 +248,26 @@ pub const SCENE_FLUSH: Duration = Duration::from_millis(250);
 /// Same for the plots.
 pub const SERIES_FLUSH: Duration = Duration::from_millis(500);
 /// The chunks a second the viewers' stream carries for the scene and for the plots, at most:
-/// every flush is a chunk per moving entity, and a web viewer drawing without a GPU (2 frames a
-/// second, Rerun 0.36 in headless Chromium on 2 cores: `tests/web/latency.py`) ingests a few
-/// dozen a second. Pure coning at the fixed rates above sent 37 a second (five moving entities
-/// at 4 Hz, six plots at 2 Hz): after the viewer's first-load stall it was 20 s behind, catching
-/// up at 1.8× the session's pace; at about 20 a second it had no backlog. A scene of many moving
-/// parts (or many plots) is flushed less often instead ([`Cadence`]).
-pub const SCENE_CHUNKS_PER_S: f64 = 12.0;
-/// Same for the plots.
-pub const SERIES_CHUNKS_PER_S: f64 = 6.0;
+/// every flush is a chunk per moving entity, and a web viewer drawing without a GPU ingests what
+/// arrives for 10 ms of each frame (Rerun 0.36's `receive_messages`), some 14 chunks a frame: at
+/// 1.4 frames a second (headless Chromium on 2 cores, `tests/web/latency.py`, a slow hour) about
+/// 20 chunks a second. Pure coning at 12 + 6 a second sent 23 a second (five moving entities
+/// every 0.42 s, its plots every 1.2 s): that viewer fell behind by 2-4 s at each reload and
+/// never caught up (14 s behind after a minute). Now its four moving entities go out every
+/// 0.44 s and its six moving plots every 3 s, about 13 chunks a second.
+/// A scene of many moving parts (or many plots) is flushed less often instead ([`Cadence`]).
+pub const SCENE_CHUNKS_PER_S: f64 = 9.0;
+/// Same for the plots, which a user reads rather than watches move.
+pub const SERIES_CHUNKS_PER_S: f64 = 2.0;
 /// The longest the scene and the plots wait between two flushes.
 const SCENE_FLUSH_MAX: Duration = Duration::from_secs(1);
-const SERIES_FLUSH_MAX: Duration = Duration::from_secs(2);
+const SERIES_FLUSH_MAX: Duration = Duration::from_secs(3);
 /// How long after a reload the viewers get what the new parameters did (a few steps of it).
 const RELOAD_FLUSH: Duration = Duration::from_millis(60);
 /// A plot whose rows repeat its last one (a zero error, a vehicle at rest) sends its newest row
-/// to viewers this often, not at every flush ([`Recorder::flush_series_held`]).
-pub const SERIES_HOLD: Duration = Duration::from_secs(4);
+/// to viewers this often, not at every flush ([`Recorder::flush_series_held`]): twice the plots'
+/// longest wait.
+pub const SERIES_HOLD: Duration = Duration::from_secs(6);
 
 /// A request for the session so far as one recording (the class page's `/history.rrd`), answered
 /// by the recorder thread with the `.rrd` bytes or why not.

@@ -456,10 +456,10 @@ fn a_reload_keeps_the_sessions_imu_compensation() {
 
 #[test]
 fn the_viewers_cadence_keeps_each_flush_within_its_chunk_rate() {
-    // Pure coning's scene: five moving entities a flush at 12 chunks a second are 5/12 s apart.
+    // Pure coning's scene: four moving entities a flush at 9 chunks a second are 4/9 s apart.
     let mut c = Cadence::new(SCENE_FLUSH, SCENE_FLUSH_MAX, SCENE_CHUNKS_PER_S);
-    c.flushed(5);
-    assert!((c.wait.as_secs_f64() - 5.0 / 12.0).abs() < 1e-9, "{:?}", c.wait);
+    c.flushed(4);
+    assert!((c.wait.as_secs_f64() - 4.0 / 9.0).abs() < 1e-9, "{:?}", c.wait);
     assert!(!c.due());
     // One entity: no sooner than the fastest cadence; fifty: no later than the slowest.
     c.flushed(1);
