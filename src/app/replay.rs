@@ -401,7 +401,7 @@ pub fn replay(
                 let truth = truth.unwrap_or(body);
                 let out = StepOutput {
                     t_s: s.t_s,
-                    attitude: truth,
+                    euler: Some(truth),
                     n_from_b: truth.n_from_b(),
                     gimbal_rad: corrected,
                     encoder_rad: encoder,

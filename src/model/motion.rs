@@ -371,6 +371,19 @@ impl VehicleMotion {
         }
     }
 
+    /// C_b^n at `t_s`, with the Euler angles where the motion gives them (None for a coned body,
+    /// whose angles are read from C_b^n: [`Attitude::from_n_from_b`], by whoever needs them).
+    #[must_use]
+    pub fn n_from_b_and_euler(&self, t_s: f64) -> (Rot<N, B>, Option<Attitude>) {
+        match self.coning {
+            None => {
+                let a = self.euler(t_s);
+                (a.n_from_b(), Some(a))
+            }
+            Some(_) => (self.n_from_b(t_s), None),
+        }
+    }
+
     /// C_b^n at `t_s`.
     #[must_use]
     pub fn n_from_b(&self, t_s: f64) -> Rot<N, B> {

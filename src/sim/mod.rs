@@ -204,8 +204,10 @@ impl DemodState {
 pub struct StepOutput {
     /// Simulated time, s.
     pub t_s: f64,
-    /// True vehicle attitude.
-    pub attitude: Attitude,
+    /// True vehicle attitude as the motion gives it (Euler angles), or None where it is read from
+    /// `n_from_b` ([`StepOutput::attitude`]): a coned body's, computed by whoever plots it (the
+    /// recorder's thread) rather than at every step.
+    pub euler: Option<Attitude>,
     /// True C_b^n.
     pub n_from_b: Rot<N, B>,
     /// True gimbal angles, rad.
@@ -214,6 +216,14 @@ pub struct StepOutput {
     pub encoder_rad: AxisValues,
     /// Attitude errors per demodulation (see [`DEMODULATIONS`]).
     pub errors: [AttitudeError; 3],
+}
+
+impl StepOutput {
+    /// True vehicle attitude (Euler angles).
+    #[must_use]
+    pub fn attitude(&self) -> Attitude {
+        self.euler.unwrap_or_else(|| Attitude::from_n_from_b(&self.n_from_b))
+    }
 }
 
 /// The body attitude a RINS computes from the IMU attitude and a model of the table.
@@ -249,7 +259,10 @@ fn table_step(model: &Model, key: (u64, [AxisValues; 4])) -> TableStep {
 /// Advances the simulation to `t_s` (steps must come in increasing time).
 #[must_use]
 pub fn step(model: &Model, state: &mut DemodState, t_s: f64) -> StepOutput {
-    let (attitude, n_from_b) = model.fixed_attitude.unwrap_or_else(|| model.vehicle.state(t_s));
+    let (n_from_b, euler) = match model.fixed_attitude {
+        Some((a, r)) => (r, Some(a)),
+        None => model.vehicle.n_from_b_and_euler(t_s),
+    };
     let truth = EulerParts::of(&n_from_b);
     let (gimbal_rad, rate_rad_per_s) = model.scheme.state(t_s - model.scheme_t0_s);
     let encoder_rad = encoder_readings_of(model, t_s, &gimbal_rad);
@@ -271,7 +284,7 @@ pub fn step(model: &Model, state: &mut DemodState, t_s: f64) -> StepOutput {
 
     StepOutput {
         t_s,
-        attitude,
+        euler,
         n_from_b,
         gimbal_rad,
         encoder_rad,

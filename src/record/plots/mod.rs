@@ -130,9 +130,10 @@ impl Plots {
                     v.extend((0..3).map(|a| (closed[a] - exact[a]) * ARCSEC_PER_RAD));
                 }
                 Quantity::GimbalAngles => v.extend(out.gimbal_rad[..width].iter().map(|x| x * DEG_PER_RAD)),
-                Quantity::VehicleAttitude => v.extend(
-                    [out.attitude.pitch_rad, out.attitude.roll_rad, out.attitude.heading_rad].map(|x| x * DEG_PER_RAD),
-                ),
+                Quantity::VehicleAttitude => {
+                    let a = out.attitude();
+                    v.extend([a.pitch_rad, a.roll_rad, a.heading_rad].map(|x| x * DEG_PER_RAD));
+                }
                 Quantity::Swing(k) => {
                     let g = &chain.axes()[k];
                     let sw = chain.swing_vector(k, &truth.axes[k], out.gimbal_rad[k]);
