@@ -359,16 +359,8 @@ impl VehicleMotion {
     /// Euler angles and C_b^n at `t_s` (one evaluation for both).
     #[must_use]
     pub fn state(&self, t_s: f64) -> (Attitude, Rot<N, B>) {
-        match self.coning {
-            None => {
-                let a = self.euler(t_s);
-                (a, a.n_from_b())
-            }
-            Some(_) => {
-                let r = self.n_from_b(t_s);
-                (Attitude::from_n_from_b(&r), r)
-            }
-        }
+        let (r, euler) = self.n_from_b_and_euler(t_s);
+        (euler.unwrap_or_else(|| Attitude::from_n_from_b(&r)), r)
     }
 
     /// C_b^n at `t_s`, with the Euler angles where the motion gives them (None for a coned body,

@@ -56,15 +56,13 @@ impl Recorder {
         // The 3D view's title names each class's drawing factor: the layout follows a change of it.
         let refactored =
             self.table.as_mut().is_some_and(|t| t.set_truth(&params.table.truth, params.recording.exaggeration));
-        let retitle = refactored
-            || self.live_params.as_ref().is_some_and(|p| p.recording.exaggeration != params.recording.exaggeration);
         let old = self.live_params.replace(Box::new(params.clone()));
+        let new_factor = old.as_ref().is_some_and(|p| p.recording.exaggeration != params.recording.exaggeration);
+        let retitle = refactored || new_factor;
         // The table's drawn errors depend on its truth and the drawing factor alone: a reload that
         // changes neither (a cone, a speed, an algorithm shown) leaves them be — a viewer's stream
         // carries a chunk per entity sent, and a reload's burst is what a slow viewer waits through.
-        let redraw_table = old.as_ref().is_none_or(|p| {
-            p.table.truth != params.table.truth || p.recording.exaggeration != params.recording.exaggeration
-        });
+        let redraw_table = new_factor || old.as_ref().is_none_or(|p| p.table.truth != params.table.truth);
         // Pure coning: the drawn cone and its label follow a new cone.
         let alpha = |p: &Params| p.table.vehicle.pure_coning().map_or(0.0, |c| c.half_angle_rad);
         if let Some(gizmo) = self.cone.as_mut()
