@@ -80,8 +80,22 @@ fn a_one_sample_glitch_survives_in_the_recording_and_the_summary_counts_every_sa
     std::fs::write(&path, edited.join("\n") + "\n").expect("write");
 
     let (summary, plots, tables) = recorded(&dir, &["replay".as_ref(), log.as_os_str()]);
-    let set = rinscope::scenario::logset::load(&log).expect("log set");
-    let bucket_s = 1.0 / set.table.recording.series_hz;
+    // The buckets a run of the log's length gets: 3000 over the log (`Bandwidth::series_hz`), the
+    // length read from the export's time column (not from rinscope's estimate of it).
+    let (_, clock) = csv_table(&error_table(&tables, "pitch").0);
+    let length_s = clock.last().expect("rows")[0] - clock[0][0];
+    let bucket_s = length_s / 3000.0;
+    // Four rows a bucket at most (first, extremes, last) on every plot, whatever the log's length:
+    // a recording sized for the viewer (a replay made 50 buckets a second before it knew its length).
+    for line in plots.iter().flat_map(|p| p.series.iter()) {
+        assert!(
+            line.t.len() <= 4 * 3000 + 8,
+            "{} ({}): {} rows over {length_s} s",
+            line.entity,
+            line.name,
+            line.t.len()
+        );
+    }
 
     let mut spikes = 0;
     for axis in ["pitch", "roll", "heading"] {

@@ -144,6 +144,10 @@ fn every_log_format_replays_to_the_same_result() {
     let mut summaries = Vec::new();
     for format in ["csv", "npy", "parquet"] {
         let log = export(&dir, "li2014-coning", format);
+        // The series rate left to rinscope (the export writes the scenario's 5 Hz): a log's default.
+        let table = std::fs::read_to_string(log.join("table.toml")).expect("table.toml");
+        let table: Vec<&str> = table.lines().filter(|l| !l.starts_with("series_hz")).collect();
+        std::fs::write(log.join("table.toml"), table.join("\n") + "\n").expect("table.toml");
         let out = dir.join(format!("{format}.json"));
         ok(&rinscope()
             .arg("replay")
@@ -155,6 +159,14 @@ fn every_log_format_replays_to_the_same_result() {
             .output()
             .expect("replay"));
         summaries.push(json(&out)["ins_attitude_error_arcsec"].clone());
+        // Each format tells its length before the replay (.npy's shape, Parquet's metadata, the CSV's
+        // size): the plots get 3000 buckets over the log, four rows a bucket at most, as a run's do.
+        // (50 buckets a second before: 30 000 over this 600-s coning log, its attitude lines varying.)
+        let plots = rinscope::record::read::plots(&dir.join(format!("{format}.rrd"))).expect("recording");
+        let rows: Vec<(String, usize)> =
+            plots.iter().flat_map(|p| &p.series).map(|s| (format!("{} {}", s.entity, s.name), s.t.len())).collect();
+        assert!(rows.iter().all(|(_, n)| *n <= 4 * 3000 + 8), "{format}: rows per line {rows:?}");
+        assert!(rows.iter().any(|(_, n)| *n > 3000), "{format}: some line varies in every bucket {rows:?}");
     }
     assert!(summaries[0].as_object().is_some_and(|m| m.len() == 5), "five algorithms compared: {}", summaries[0]);
     assert_eq!(summaries[0], summaries[1], "csv vs npy");

@@ -260,6 +260,11 @@ pub fn replay(
     let rerun = |e: crate::record::RecordError| PlaybackError::Record(e.to_string());
     if let Some(r) = recorder.as_deref_mut() {
         r.set_file_clock(pb.file_time_s(0.0)).map_err(rerun)?;
+        // The plots' envelopes get 3000 buckets over the log, as a run's over its duration (the
+        // default series rate; a `[recording] series_hz` stays as written).
+        if let Some(p) = pb.length_hint_s().and_then(|d| log.recording_params(d).ok()) {
+            r.set_run_length(&p);
+        }
     }
     let chain = &log.table.chain;
     let nominal = TableErrors::zero(chain.axes().len());

@@ -447,7 +447,13 @@ impl Recorder {
         self.live.map(|_| t_s)
     }
 
-    /// Sends the layout again for `params` (a replay knows its length only at the end).
+    /// A replay's length known from its file before its first row: the plots' buckets sized for
+    /// it (`params`' series rate), as a run's are for its duration.
+    pub fn set_run_length(&mut self, params: &Params) {
+        self.plots.set_series_hz(params.recording.series_hz);
+    }
+
+    /// Sends the layout again for `params` (a replay knows its exact length only at the end).
     pub fn resend_layout(&self, params: &Params) -> RecordingStreamResult<()> {
         self.send_blueprint(params, self.custom.clone())
     }

@@ -410,6 +410,13 @@ impl Playback {
         Ok(log.table.chain.b_from_s(&log.table.chain.error_rotations(compensation), &corrected))
     }
 
+    /// How long the replay will be, s after its origin, as the file states or suggests its length
+    /// (the span asked for taken into account); None where the format does not tell.
+    #[must_use]
+    pub fn length_hint_s(&self) -> Option<f64> {
+        self.imu.duration_hint_s().map(|d| (d.min(self.until_s) - self.origin_s).max(0.0))
+    }
+
     /// An instant (seconds after the replay's origin) on the IMU file's own clock, s.
     #[must_use]
     pub fn file_time_s(&self, t_s: f64) -> f64 {
@@ -584,6 +591,8 @@ impl EncoderReadings {
 /// increments in the RFU sensor frame (rates held over their interval), gaps reported, not bridged.
 pub struct ImuSamples {
     imu: ImuStream,
+    /// The log's length as its file states or suggests it, s ([`ImuReader::duration_hint_s`]).
+    duration_hint_s: Option<f64>,
 }
 
 impl ImuSamples {
@@ -637,7 +646,15 @@ impl ImuSamples {
             pending_gap: false,
             compensation: log.imu_compensation,
         };
-        Ok((Self { imu: ImuStream::spawn(imu, increments)? }, start))
+        let duration_hint_s = imu.duration_hint_s();
+        Ok((Self { imu: ImuStream::spawn(imu, increments)?, duration_hint_s }, start))
+    }
+
+    /// The log's length, s, as its file states it (.npy, Parquet) or suggests it (text: its size);
+    /// None where unknown (MCAP).
+    #[must_use]
+    pub fn duration_hint_s(&self) -> Option<f64> {
+        self.duration_hint_s
     }
 
     /// The next sample or gap; None at the end of the file.

@@ -383,6 +383,10 @@ impl Source for NpySource {
     fn location(&self) -> Location {
         Location { row: self.row, line: None }
     }
+
+    fn rows_hint(&self) -> Option<u64> {
+        Some(self.header.rows)
+    }
 }
 
 /// Streams rows of f64 into a `.npy` (v1.0, `<f8`, C order) whose row count is patched at the end.

@@ -295,6 +295,10 @@ impl Source for ParquetSource {
     fn location(&self) -> Location {
         Location { row: self.row, line: None }
     }
+
+    fn rows_hint(&self) -> Option<u64> {
+        u64::try_from(self.metadata.metadata().file_metadata().num_rows()).ok()
+    }
 }
 
 /// Streams rows of f64 into a Parquet file, one row group per [`ROW_GROUP_ROWS`] rows.

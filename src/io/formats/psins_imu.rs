@@ -410,6 +410,9 @@ impl Source for PsinsSource {
             return Ok(false);
         };
         self.row += 1;
+        if self.row == 1 {
+            self.lines.mark_first_row();
+        }
         self.line = line.number;
         split(&line.bytes, Delimiter::Whitespace, &mut self.spans);
         let found = self.spans.len();
@@ -456,6 +459,10 @@ impl Source for PsinsSource {
 
     fn location(&self) -> Location {
         Location { row: self.row, line: Some(self.line) }
+    }
+
+    fn rows_hint(&self) -> Option<u64> {
+        self.lines.rows_estimate(self.row)
     }
 
     fn selected_width(&self) -> usize {

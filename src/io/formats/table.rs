@@ -95,6 +95,11 @@ pub(crate) trait Source {
     fn psins_header(&self) -> Option<&PsinsHeader> {
         None
     }
+    /// The data rows the whole file holds: exact where the format states it (.npy's shape,
+    /// Parquet's metadata), estimated from the bytes read so far for text; None where unknown.
+    fn rows_hint(&self) -> Option<u64> {
+        None
+    }
 }
 
 /// Reads selected columns of a table as f64 rows, streaming: memory does not grow with the file.
@@ -310,6 +315,13 @@ impl ColumnReader {
             });
         }
         Ok(n)
+    }
+
+    /// The data rows the whole file holds: exact for .npy and Parquet, estimated from what was
+    /// read so far for text (a recording's plots size their buckets by it); None where unknown.
+    #[must_use]
+    pub fn rows_hint(&self) -> Option<u64> {
+        self.source.rows_hint()
     }
 
     /// The header of a PSINS SIMU file ([`Format::PsinsImu`]); `None` for other formats.

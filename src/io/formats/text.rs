@@ -44,16 +44,49 @@ pub(crate) struct LineReader {
     reader: BufReader<File>,
     line_number: u64,
     first_line: bool,
+    /// Bytes read so far, the last line's, where the data rows start (after a header), and the
+    /// file's length (0: not known, a pipe).
+    bytes_read: u64,
+    last_line_bytes: u64,
+    data_from: Option<u64>,
+    file_len: u64,
+    /// The mean length of the lines in the file's last 64 KiB (a large file's), bytes.
+    tail_line_bytes: Option<f64>,
+}
+
+/// The mean length of the whole lines in the last `TAIL` bytes of a file of `len` bytes, read
+/// once at opening (a line's length changes along a log: its time stamp gains digits).
+fn tail_line_bytes(path: &Path, len: u64) -> Option<f64> {
+    use std::io::{Seek, SeekFrom};
+    const TAIL: u64 = 1 << 16;
+    if len < 4 * TAIL {
+        return None;
+    }
+    let mut file = crate::io::files::open_input(path).ok()?;
+    file.seek(SeekFrom::Start(len - TAIL)).ok()?;
+    let mut tail = Vec::with_capacity(TAIL as usize);
+    file.take(TAIL).read_to_end(&mut tail).ok()?;
+    let first = tail.iter().position(|&b| b == b'\n')? + 1;
+    let last = tail.iter().rposition(|&b| b == b'\n')? + 1;
+    let lines = tail[first..last].iter().filter(|&&b| b == b'\n').count();
+    (lines > 0).then(|| (last - first) as f64 / lines as f64)
 }
 
 impl LineReader {
     pub(crate) fn open(path: &Path) -> Result<Self> {
         let file = crate::io::files::open_input(path).map_err(|e| LogError::io(path, "cannot open", e))?;
+        let file_len = file.metadata().map_or(0, |m| if m.is_file() { m.len() } else { 0 });
+        let tail_line_bytes = tail_line_bytes(path, file_len);
         Ok(Self {
             path: path.to_path_buf(),
             reader: BufReader::with_capacity(1 << 16, file),
             line_number: 0,
             first_line: true,
+            bytes_read: 0,
+            last_line_bytes: 0,
+            data_from: None,
+            file_len,
+            tail_line_bytes,
         })
     }
 
@@ -69,6 +102,8 @@ impl LineReader {
             return Ok(None);
         }
         self.line_number += 1;
+        self.bytes_read += n as u64;
+        self.last_line_bytes = n as u64;
         let terminated = bytes.last() == Some(&b'\n');
         if !terminated && n as u64 == MAX_LINE_BYTES {
             return Err(LogError::corrupt(
@@ -94,6 +129,25 @@ impl LineReader {
     /// The number of the last line read (0 before the first).
     pub(crate) fn line_number(&self) -> u64 {
         self.line_number
+    }
+
+    /// Marks the last line read as the first data row (what precedes it is a header).
+    pub(crate) fn mark_first_row(&mut self) {
+        self.data_from.get_or_insert(self.bytes_read - self.last_line_bytes);
+    }
+
+    /// The rows the whole file holds, estimated from the `rows` read so far: the data's bytes after
+    /// the header over a row's mean length, the mean of the rows read and of the file's last lines
+    /// (exact for lines growing at a steady rate); None before a row, or for a pipe.
+    pub(crate) fn rows_estimate(&self, rows: u64) -> Option<u64> {
+        let from = self.data_from?;
+        let read = self.bytes_read.saturating_sub(from);
+        if rows == 0 || read == 0 || self.file_len <= from {
+            return None;
+        }
+        let head = read as f64 / rows as f64;
+        let mean = self.tail_line_bytes.map_or(head, |tail| 0.5 * (head + tail));
+        Some(((self.file_len - from) as f64 / mean).round() as u64)
     }
 }
 
@@ -298,6 +352,9 @@ impl Source for TextSource {
         };
         self.current = line;
         self.row += 1;
+        if self.row == 1 {
+            self.lines.mark_first_row();
+        }
         split(&self.current.bytes, self.delimiter, &mut self.spans);
         if self.spans.len() != self.field_count {
             return Err(LogError::FieldCount {
@@ -337,6 +394,10 @@ impl Source for TextSource {
 
     fn location(&self) -> Location {
         Location { row: self.row, line: Some(self.current.number) }
+    }
+
+    fn rows_hint(&self) -> Option<u64> {
+        self.lines.rows_estimate(self.row)
     }
 }
 

@@ -459,6 +459,15 @@ impl ImuReader {
         ))
     }
 
+    /// The log's length, s: the rows the file holds ([`ColumnReader::rows_hint`]: exact for .npy and
+    /// Parquet, estimated for text) times the sampling interval; None where the format does not
+    /// tell (MCAP). What a recording sizes its plots' buckets by before the log is read.
+    #[must_use]
+    pub fn duration_hint_s(&self) -> Option<f64> {
+        let dt = self.nominal_dt_s.or(self.measured_dt_s)?;
+        self.reader.rows_hint().map(|rows| rows as f64 * dt)
+    }
+
     /// The first time stamp as written in the file (known once a row has been read).
     #[must_use]
     pub fn start_time(&self) -> Option<StartTime> {

@@ -62,12 +62,29 @@ impl Plots {
         let unit = params.recording.error_unit;
         let mut series = series::table_series(&chain, replay, unit);
         let ins = series::ins_series(params, replay, &mut series);
-        let bucket_s = 1.0 / params.recording.series_hz;
-        for s in &mut series {
-            s.envelope = envelope::Envelope::new(s.width(), bucket_s);
-        }
         let truth = params.table.truth.clone();
-        Self { series, t: Vec::new(), newest: None, chain, truth, unit, ins, extents: Extents::default(), exporting }
+        let mut me = Self {
+            series,
+            t: Vec::new(),
+            newest: None,
+            chain,
+            truth,
+            unit,
+            ins,
+            extents: Extents::default(),
+            exporting,
+        };
+        me.set_series_hz(params.recording.series_hz);
+        me
+    }
+
+    /// Buckets of `1 / series_hz` for every plot's envelope, before its first sample (a replay
+    /// learns its length from its file after the recording has started).
+    pub(crate) fn set_series_hz(&mut self, series_hz: f64) {
+        debug_assert!(self.newest.is_none() && self.series.iter().all(|s| s.envelope.t.is_empty()));
+        for s in &mut self.series {
+            s.envelope = envelope::Envelope::new(s.width(), 1.0 / series_hz);
+        }
     }
 
     /// The unit of the table's error plots.
