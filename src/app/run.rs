@@ -10,7 +10,8 @@ use serde::Serialize;
 use crate::app::failure::Failure;
 use crate::app::feed::{self, Outbox, OutputRow};
 use crate::app::outputs::{RecordingName, RecordingRequest, check_output, finish, write_json};
-use crate::ins::pipeline::{InsRun, InsView};
+use crate::ins::core::SampleOut;
+use crate::ins::pipeline::{InsOutputs, InsRun, InsView, InsViewer};
 use crate::math::stats::RunningStat;
 use crate::math::timeline::{Timeline, decimation};
 use crate::math::units::ARCSEC_PER_RAD;
@@ -394,66 +395,131 @@ impl Producer<'_> {
             return self.run_ideal(timeline);
         };
         let mut ins = InsRun::new(ins_params, self.params.site, self.params.meta.seed, self.model.clone());
-        let mut state = DemodState::default();
-        let mut stats = ErrorStats::default();
-        let mut ins_stats = InsStats {
+        let ins_stats = InsStats {
             algorithms: ins.algorithms().iter().map(|a| a.name().to_owned()).collect(),
             ..InsStats::default()
         };
-        let mut out = Outbox::new(self.tx);
+        // The INS's errors, the table's demodulations and the statistics on a thread of their own:
+        // the simulation (truth, sensors, the computer) hands each update's outputs on, as the
+        // recorder's thread takes the rows (a third of the simulation's time was the errors').
+        let viewer = ins.viewer();
+        let (tx, rx) = crossbeam_channel::bounded::<Vec<Update>>(4);
+        std::thread::scope(|scope| {
+            let views = scope.spawn(move || self.view_updates(viewer, ins_stats, &rx));
+            let (done, interrupted) = self.simulate(&mut ins, timeline, &tx);
+            drop(tx);
+            let (stats, ins_stats) = views.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
+            (stats, ins_stats, done, interrupted)
+        })
+    }
+
+    /// The simulation's side of [`Self::run_ins`]: one IMU sample per step; the outputs of every
+    /// attitude update to `tx`, marked for the statistics and the scene at the updates closest to
+    /// their rates; the gyro signal's first samples. Returns (instants done, interrupted).
+    fn simulate(
+        &self,
+        ins: &mut InsRun,
+        timeline: &Timeline,
+        tx: &crossbeam_channel::Sender<Vec<Update>>,
+    ) -> (u64, bool) {
+        const UPDATES_PER_BATCH: usize = 512;
         let window = ins.config().signal_window_s;
         let (mut done, mut interrupted) = (1, false);
         let (mut next_scene, mut next_stats) = (0u64, 0u64);
-        // The latest attitude update: its instant and whether its step was computed.
-        let mut last_update: Option<(f64, bool)> = None;
+        let mut batch = Vec::with_capacity(UPDATES_PER_BATCH);
         for i in 1..=timeline.intervals() {
             if i % 65_536 == 0 && self.check(i) {
                 interrupted = true;
                 break;
             }
             let s = ins.step();
-            if s.t_s <= window && !out.signal(s) {
-                break;
+            if s.t_s <= window {
+                batch.push(Update::Signal(s));
             }
             done = i + 1;
-            if !s.updated {
-                continue;
-            }
-            // Statistics not at the recorded rows (a peak between two rows, or in the last rows of
-            // a growing drift, is not missed): the INS's errors at every update (their bandwidth
-            // is the algorithms', not the motion's), the table's at the statistics rate
-            // (Bandwidth::statistics_hz). The true IMU attitude only for the scene.
-            let want_scene = i >= next_scene;
-            let view = if want_scene { ins.view(s.t_s) } else { ins.errors_view(s.t_s) };
-            ins_stats.add(&view);
-            let want_stats = i >= next_stats || i.saturating_add(self.stats_every) > timeline.intervals();
-            let wanted = want_stats || want_scene;
-            // The previous update's instant, for the delay correction when it was not computed.
-            let previous_update = last_update.replace((s.t_s, wanted));
-            if !wanted {
-                continue;
-            }
-            if let Some((t_prev, false)) = previous_update {
-                state.observe(self.model, t_prev);
-            }
-            let core = step(self.model, &mut state, s.t_s);
-            if want_stats {
-                next_stats = i.saturating_add(self.stats_every);
-                stats.add(&core);
-                if !out.series(OutputRow { core, ins: Some(view.clone()), solution: None }) {
-                    break;
+            if s.updated {
+                // Statistics not at the recorded rows (a peak between two rows, or in the last rows
+                // of a growing drift, is not missed): the INS's errors at every update (their
+                // bandwidth is the algorithms', not the motion's), the table's at the statistics
+                // rate (Bandwidth::statistics_hz). The true IMU attitude only for the scene.
+                let want_scene = i >= next_scene;
+                let want_stats = i >= next_stats || i.saturating_add(self.stats_every) > timeline.intervals();
+                if want_scene {
+                    next_scene = i.saturating_add(self.scene_every);
                 }
+                if want_stats {
+                    next_stats = i.saturating_add(self.stats_every);
+                }
+                batch.push(Update::Output { outputs: ins.outputs(s.t_s, want_scene), want_stats, want_scene });
             }
-            if want_scene {
-                next_scene = i.saturating_add(self.scene_every);
-                if !out.scene(OutputRow { core, ins: Some(view), solution: None }) {
-                    break;
+            if batch.len() >= UPDATES_PER_BATCH
+                && tx.send(std::mem::replace(&mut batch, Vec::with_capacity(UPDATES_PER_BATCH))).is_err()
+            {
+                // The statistics' thread stopped: the recorder failed (it reports why).
+                return (done, interrupted);
+            }
+        }
+        let _ = tx.send(batch);
+        (done, interrupted)
+    }
+
+    /// The statistics' side of [`Self::run_ins`]: each update's INS errors (`viewer`) into
+    /// `ins_stats`; at the marked ones the table's step into the run's statistics, and the rows to
+    /// the recorder. Returns (the table's statistics, the INS's).
+    fn view_updates(
+        &self,
+        mut viewer: InsViewer,
+        mut ins_stats: InsStats,
+        rx: &crossbeam_channel::Receiver<Vec<Update>>,
+    ) -> (ErrorStats, InsStats) {
+        let mut state = DemodState::default();
+        let mut stats = ErrorStats::default();
+        let mut out = Outbox::new(self.tx);
+        // The latest attitude update: its instant and whether its step was computed.
+        let mut last_update: Option<(f64, bool)> = None;
+        'batches: for batch in rx {
+            for update in batch {
+                let (outputs, want_stats, want_scene) = match update {
+                    Update::Signal(s) if out.signal(s) => continue,
+                    Update::Signal(_) => break 'batches,
+                    Update::Output { outputs, want_stats, want_scene } => (outputs, want_stats, want_scene),
+                };
+                let view = viewer.view(&outputs);
+                ins_stats.add(&view);
+                let wanted = want_stats || want_scene;
+                // The previous update's instant, for the delay correction when it was not computed.
+                let previous_update = last_update.replace((outputs.t_s(), wanted));
+                if !wanted {
+                    continue;
+                }
+                if let Some((t_prev, false)) = previous_update {
+                    state.observe(self.model, t_prev);
+                }
+                let core = step(self.model, &mut state, outputs.t_s());
+                if want_stats {
+                    stats.add(&core);
+                    if !out.series(OutputRow { core, ins: Some(view.clone()), solution: None }) {
+                        break 'batches;
+                    }
+                }
+                if want_scene && !out.scene(OutputRow { core, ins: Some(view), solution: None }) {
+                    break 'batches;
                 }
             }
         }
         out.close();
-        (stats, ins_stats, done, interrupted)
+        (stats, ins_stats)
     }
+}
+
+/// What the simulation hands the statistics' thread, in order ([`Producer::run_ins`]).
+// The large variant is the one of every update; boxing it would allocate per update.
+#[allow(clippy::large_enum_variant)]
+enum Update {
+    /// A sample of the gyro signal's first seconds.
+    Signal(SampleOut),
+    /// An attitude update's outputs, and whether the statistics and the scene take its instant.
+    Output { outputs: InsOutputs, want_stats: bool, want_scene: bool },
 }
 
 /// `rinscope run` (and Python's `run`): the scenario and where its outputs go.

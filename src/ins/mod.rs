@@ -19,6 +19,7 @@ pub mod sensor;
 pub mod strapdown;
 pub mod trace;
 pub mod truth;
+pub mod view;
 
 use nalgebra::Vector3;
 

@@ -6,91 +6,16 @@ use nalgebra::Vector3;
 
 use super::InsParams;
 use super::coning::Algorithm;
-use super::core::{InsCore, NavError, SampleOut};
+use super::core::{InsCore, SampleOut};
 use super::nav::NavState;
 use super::sensor::Sensors;
 use super::truth::TruthImu;
-use crate::math::attitude::{Attitude, AttitudeError, EulerParts};
+pub use super::view::{AlgorithmErrors, InsOutputs, InsView, InsViewer};
+use crate::math::attitude::Attitude;
 use crate::math::frames::{B, N, Rot, S};
 use crate::math::rotvec;
 use crate::model::earth::{Earth, Site};
-use crate::model::gimbal::ChainMemo;
-use crate::model::scheme::AxisValues;
-use crate::sim::{DemodState, Model, demodulated, encoder_readings};
-
-/// One attitude error per algorithm run, in integrator order: a fixed array (at most the five
-/// algorithms), so a view at every update allocates nothing and copies as a value.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct AlgorithmErrors {
-    len: usize,
-    values: [AttitudeError; Algorithm::ALL.len()],
-}
-
-impl AlgorithmErrors {
-    /// Appends the next algorithm's error.
-    ///
-    /// # Panics
-    /// Past the five algorithms (an INS runs each at most once).
-    pub fn push(&mut self, e: AttitudeError) {
-        self.values[self.len] = e;
-        self.len += 1;
-    }
-
-    /// Empties it (for the next update).
-    pub fn clear(&mut self) {
-        self.len = 0;
-    }
-}
-
-impl std::ops::Deref for AlgorithmErrors {
-    type Target = [AttitudeError];
-    fn deref(&self) -> &[AttitudeError] {
-        &self.values[..self.len]
-    }
-}
-
-impl std::ops::DerefMut for AlgorithmErrors {
-    fn deref_mut(&mut self) -> &mut [AttitudeError] {
-        &mut self.values[..self.len]
-    }
-}
-
-impl<'a> IntoIterator for &'a AlgorithmErrors {
-    type Item = &'a AttitudeError;
-    type IntoIter = std::slice::Iter<'a, AttitudeError>;
-    fn into_iter(self) -> Self::IntoIter {
-        self.iter()
-    }
-}
-
-/// The INS's view of the body at one output instant.
-#[derive(Debug, Clone)]
-pub struct InsView {
-    /// Output time, s.
-    pub t_s: f64,
-    /// Truth reference time (output time minus the compensation Δt), s.
-    pub t_ref_s: f64,
-    /// Body attitude error of each algorithm (computed minus true), in integrator order.
-    pub errors: AlgorithmErrors,
-    /// True C_s^n at the instant the INS output represents (None from [`InsRun::errors_view`]:
-    /// what only the scene draws is not computed at every update).
-    pub imu_true: Option<Rot<N, S>>,
-    /// The primary algorithm's C_s^n.
-    pub imu_ins: Rot<N, S>,
-    /// Navigation errors, when navigating.
-    pub nav: Option<NavError>,
-}
-
-/// An algorithm's latest error and the (instant, attitude) it was computed for.
-type LastError = (f64, Rot<N, S>, AttitudeError);
-
-/// What [`InsRun::view`] computes once per output instant for the algorithms that share it.
-#[derive(Clone)]
-struct Shared {
-    t_repr_s: f64,
-    encoder_rad: AxisValues,
-    truth: EulerParts,
-}
+use crate::sim::Model;
 
 /// The INS in the loop (cloned to fork one IMU stream into two navigation strategies).
 #[derive(Clone)]
@@ -100,18 +25,12 @@ pub struct InsRun {
     core: InsCore,
     h: f64,
     index: u64,
-    demod: Vec<DemodState>,
     /// The measured (end time, Δθ, Δv) before t = 0 that pre-rolled the computer.
     pre_roll: Vec<(f64, Vector3<f64>, Vector3<f64>)>,
     /// The computer's initial C_s^n (at −d, with the alignment error).
     start: Rot<N, S>,
-    /// Each algorithm's latest error and the (instant, attitude) it was computed for: an algorithm
-    /// that has not updated since (more samples per update than the primary) is not recomputed.
-    last_error: Vec<Option<LastError>>,
-    /// The view's per-instant scratch, kept between views (no allocation per view).
-    shared: Vec<Shared>,
-    /// The compensated chain at the latest corrected angles, one per algorithm at most.
-    chains: ChainMemo,
+    /// The errors against the truth (the table's demodulation state).
+    viewer: InsViewer,
     /// IMU errors the computer removes from every sample before using it (a self-calibration's
     /// estimates), if any.
     compensation: Option<super::imu_errors::ImuErrors>,
@@ -166,21 +85,16 @@ impl InsRun {
         };
         let samples: Vec<(Vector3<f64>, Vector3<f64>)> = pre_roll.iter().map(|(_, g, a)| (*g, *a)).collect();
         let core = InsCore::compensated(cfg, site, start, &samples, cfg.imu_compensation);
-        let demod = vec![DemodState::default(); core.algorithms().len()];
-        let demod_len = demod.len();
-        let last_error = vec![None; demod_len];
+        let viewer = InsViewer::new(truth.model().clone(), h, core.algorithms().len());
         Self {
             truth,
             sensors,
             core,
             h,
             index: 0,
-            demod,
             pre_roll,
             start,
-            last_error,
-            shared: Vec::new(),
-            chains: ChainMemo::new(demod_len),
+            viewer,
             // The computer (the core) removes `cfg.imu_compensation` itself: the samples stay raw.
             compensation: None,
             t0_s,
@@ -264,9 +178,8 @@ impl InsRun {
     /// A live session's reload: the table (its errors, compensation, motion) is `model` from the
     /// next sample on; the sensors and the computer go on as they were.
     pub fn replace_model(&mut self, model: Model) {
+        self.viewer.replace_model(model.clone());
         self.truth.replace_model(model);
-        self.last_error.iter_mut().for_each(|e| *e = None);
-        self.chains = ChainMemo::new(self.demod.len());
     }
 
     /// The model (truth).
@@ -349,47 +262,22 @@ impl InsRun {
     }
 
     fn view_with(&mut self, t_s: f64, with_truth: bool) -> InsView {
-        let model = self.truth.model();
-        let mut errors = AlgorithmErrors::default();
-        // Algorithms that stand for the same instant share its encoder readings (a pure function of
-        // the instant) and its true attitude; the same corrected angles, the compensated chain.
-        let mut shared = std::mem::take(&mut self.shared);
-        shared.clear();
-        for k in 0..self.demod.len() {
-            let (t_repr, n_from_s) = self.core.output_attitude(k);
-            if let Some((t, q, e)) = self.last_error[k] {
-                // The same output as last time: the same error (the demodulation's state is that of
-                // having read this instant already).
-                if t == t_repr && q.quaternion() == n_from_s.quaternion() {
-                    errors.push(e);
-                    continue;
-                }
-            }
-            let known = shared.iter().position(|e| e.t_repr_s == t_repr);
-            let (encoder, truth_att) = match known {
-                Some(i) => (shared[i].encoder_rad, shared[i].truth),
-                None => {
-                    let t_ref = self.core.reference_instant(t_repr);
-                    // The encoders are read for the instant the IMU data represent (matched synchronisation).
-                    let truth = model.fixed_state().map_or_else(|| model.vehicle.n_from_b(t_ref), |(_, r)| r);
-                    (encoder_readings(model, t_repr), EulerParts::of(&truth))
-                }
-            };
-            self.demod[k].observe_if_first(model, t_repr - self.h);
-            let corrected = self.demod[k].correct(&model.compensation, t_repr, &encoder);
-            let b_from_s_comp = self.chains.get(&model.chain, model.compensation_rotations(), &corrected);
-            if known.is_none() {
-                shared.push(Shared { t_repr_s: t_repr, encoder_rad: encoder, truth: truth_att });
-            }
-            let error = AttitudeError::between(&demodulated(n_from_s, b_from_s_comp), &truth_att);
-            self.last_error[k] = Some((t_repr, n_from_s, error));
-            errors.push(error);
-        }
-        let (t_repr, imu_ins) = self.core.output_attitude(0);
-        let imu_true = with_truth.then(|| self.truth.n_from_s(t_repr));
-        let nav: Option<NavError> = self.core.nav_error();
-        self.shared = shared;
-        InsView { t_s, t_ref_s: t_s - self.core.config().output_compensation_s, errors, imu_true, imu_ins, nav }
+        let o = self.outputs(t_s, with_truth);
+        self.viewer.view(&o)
+    }
+
+    /// The computer's outputs after a primary update at `t_s` (what [`Self::view`] shows), with
+    /// the true C_s^n if `with_truth`: a value for an [`InsViewer`] elsewhere ([`Self::viewer`]).
+    pub fn outputs(&mut self, t_s: f64, with_truth: bool) -> InsOutputs {
+        let imu_true = with_truth.then(|| self.truth.n_from_s(self.core.output_attitude(0).0));
+        InsOutputs::of(&self.core, t_s, imu_true)
+    }
+
+    /// A viewer of this INS's outputs in its present state (a run's statistics' thread views the
+    /// outputs [`Self::outputs`] sends it; this INS's own views are then not to be taken).
+    #[must_use]
+    pub fn viewer(&self) -> InsViewer {
+        self.viewer.clone()
     }
 
     /// The body attitude the primary INS outputs (for tests and resets).
