@@ -56,21 +56,25 @@ impl Envelope {
         }
     }
 
-    /// The bucket of time `t_s` on the grid.
-    fn bucket_of(&self, t_s: f64) -> i64 {
-        if self.bucket_s > 0.0 { (t_s / self.bucket_s + 1e-9).floor() as i64 } else { i64::MIN }
+    /// The bucket of time `t_s` on a grid of `bucket_s` (0: every sample its own).
+    pub(crate) fn bucket_of(bucket_s: f64, t_s: f64) -> i64 {
+        if bucket_s > 0.0 { (t_s / bucket_s + 1e-9).floor() as i64 } else { i64::MIN }
     }
 
     /// Takes one sample `row` (`width` values) at `t_s` (not before the previous sample's).
+    #[cfg(test)]
     pub(crate) fn push(&mut self, t_s: f64, row: &[f64]) {
+        self.push_in(Self::bucket_of(self.bucket_s, t_s), t_s, row);
+    }
+
+    /// [`Self::push`] of a sample in the grid's bucket `bucket` ([`Self::bucket_of`] of `t_s`:
+    /// the plots of a row share it, computed once for all of them).
+    pub(crate) fn push_in(&mut self, bucket: i64, t_s: f64, row: &[f64]) {
         debug_assert_eq!(row.len(), self.width);
-        // Still in the open bucket: `bucket_of`'s floor without calling it (a libm call per line
-        // and sample was a tenth of the recorder's time).
-        let x = t_s / self.bucket_s + 1e-9;
-        let open = self.bucket_s > 0.0 && self.bucket.is_some_and(|b| x >= b as f64 && x < (b + 1) as f64);
-        if !open {
+        debug_assert_eq!(bucket, Self::bucket_of(self.bucket_s, t_s));
+        if self.bucket_s <= 0.0 || self.bucket != Some(bucket) {
             self.close();
-            self.bucket = Some(self.bucket_of(t_s));
+            self.bucket = Some(bucket);
         }
         if self.n == 0 {
             self.t_first = t_s;

@@ -43,6 +43,8 @@ pub(crate) struct Plots {
     extents: Extents,
     /// Whether every sample's row is kept for the export tables (`--export`).
     exporting: bool,
+    /// The envelopes' bucket, s (every plot's).
+    bucket_s: f64,
 }
 
 /// What a row without a navigation view shows.
@@ -73,6 +75,7 @@ impl Plots {
             ins,
             extents: Extents::default(),
             exporting,
+            bucket_s: 0.0,
         };
         me.set_series_hz(params.recording.series_hz);
         me
@@ -82,8 +85,9 @@ impl Plots {
     /// learns its length from its file after the recording has started).
     pub(crate) fn set_series_hz(&mut self, series_hz: f64) {
         debug_assert!(self.newest.is_none() && self.series.iter().all(|s| s.envelope.t.is_empty()));
+        self.bucket_s = 1.0 / series_hz;
         for s in &mut self.series {
-            s.envelope = envelope::Envelope::new(s.width(), 1.0 / series_hz);
+            s.envelope = envelope::Envelope::new(s.width(), self.bucket_s);
         }
     }
 
@@ -127,7 +131,7 @@ impl Plots {
     /// Buffers one row of every series from the table's step `out`, the INS's view `ins` (errors,
     /// navigation) and, in a replay, its own `solution`.
     pub(crate) fn push(&mut self, out: &StepOutput, ins: Option<&InsView>, solution: Option<&Solution>) {
-        let Self { series, chain, truth, unit, ins: layout, t, exporting, .. } = self;
+        let Self { series, chain, truth, unit, ins: layout, t, exporting, bucket_s, .. } = self;
         if *exporting {
             t.push(out.t_s);
         }
@@ -136,6 +140,9 @@ impl Plots {
         let lines = layout.as_ref().and_then(|l| l.coning.as_ref());
         let nav = ins.and_then(|v| v.nav).unwrap_or(NO_NAV);
         let state = solution.and_then(|s| s.nav);
+        // One bucket for the row's every plot (a division per plot and sample: 5 % of a pure
+        // coning run's CPU).
+        let bucket = envelope::Envelope::bucket_of(*bucket_s, out.t_s);
         for s in series.iter_mut() {
             let width = s.width();
             let start = s.values.len();
@@ -189,7 +196,7 @@ impl Plots {
                 ),
                 Quantity::Height => v.push(state.map_or(f64::NAN, |n| n.height_m)),
             }
-            s.envelope.push(out.t_s, &s.values[start..]);
+            s.envelope.push_in(bucket, out.t_s, &s.values[start..]);
             if !*exporting {
                 s.values.truncate(start);
             }
