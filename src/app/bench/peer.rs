@@ -129,6 +129,11 @@ pub struct StreamReport {
     pub rinscope_run: Vec<Timing>,
     /// pyins kernel region / `rinscope run` whole process, per round.
     pub ratio_run_kernel: Spread,
+    /// On the coning stream: `rinscope run --scenario pure-coning` for as many samples at its
+    /// 100 Hz (five algorithms, each one's exact error at every sample), whole process, per round.
+    pub rinscope_pure_coning: Vec<Timing>,
+    /// pyins kernel region / that process, per round (None on the static stream).
+    pub ratio_pure_coning_kernel: Option<Spread>,
     /// rinscope's INS pipeline on the same motion, timed in this process (the exact IMU truth,
     /// sensor model, strapdown, navigation and the error views at 100 Hz, as `rinscope bench`'s
     /// "INS pipeline" line; no statistics at every update, no recording), one per round.
@@ -226,6 +231,7 @@ fn compare_stream(
     let pipeline_params =
         crate::scenario::parse(&std::fs::read_to_string(&scenario)?, "bench").map_err(|e| anyhow!("{e}"))?;
     let mut rounds: Vec<[Timing; 5]> = Vec::new();
+    let mut pure = Vec::new();
     let (mut ours, mut theirs) = (None, None);
     let args_pyins = |mode: &str| -> Vec<String> {
         let mut a = vec![
@@ -247,6 +253,9 @@ fn compare_stream(
         let (p, _) = run_pyins(&opts.python, &args_pyins("pipeline"))?;
         let s = run_simulated(&scenario)?;
         let q = time_pipeline(&pipeline_params, opts.samples)?;
+        if kind == "coning" {
+            pure.push(run_pure_coning(dir, opts.samples)?);
+        }
         ours = Some(state);
         theirs = Some(kstate);
         rounds.push([r, k, p, s, q]);
@@ -260,6 +269,9 @@ fn compare_stream(
         ratio_pipeline: ratio(&|r| r[2].region_s / r[0].process_s),
         ratio_pipeline_process: ratio(&|r| r[2].process_s / r[0].process_s),
         ratio_run_kernel: ratio(&|r| r[1].region_s / r[3].process_s),
+        ratio_pure_coning_kernel: (!pure.is_empty())
+            .then(|| Spread::of(rounds.iter().zip(&pure).map(|(r, p)| r[1].region_s / p.process_s).collect())),
+        rinscope_pure_coning: pure,
         rinscope_run: rounds.iter().map(|r| r[3].clone()).collect(),
         ratio_pipeline_kernel: ratio(&|r| r[1].region_s / r[4].region_s),
         rinscope_pipeline: rounds.iter().map(|r| r[4].clone()).collect(),
@@ -370,6 +382,14 @@ fn timing(process_s: f64, s: &Value) -> anyhow::Result<Timing> {
     Ok(Timing { process_s, region_s: num("wall_time_s")?, peak_rss_mb: num("peak_rss_mb")? })
 }
 
+/// `rinscope run --scenario pure-coning` for `samples` samples at its 100 Hz, whole process.
+fn run_pure_coning(dir: &Path, samples: u64) -> anyhow::Result<Timing> {
+    let duration = format!("{}", samples as f64 / 100.0);
+    let args = ["--scenario".as_ref(), "pure-coning".as_ref(), "--duration-s".as_ref(), duration.as_ref()];
+    let (process_s, s) = run_self("run", &args, &dir.join("pure-coning"))?;
+    timing(process_s, &s)
+}
+
 /// `rinscope run` of a scenario, whole process.
 fn run_simulated(scenario: &Path) -> anyhow::Result<Timing> {
     let (process_s, s) = run_self("run", &["--config".as_ref(), scenario.as_os_str()], scenario)?;
@@ -434,6 +454,9 @@ pub fn text(reports: &[StreamReport]) -> String {
         s.push_str(&line("pyins kernel", &r.pyins_kernel, "kernel      "));
         s.push_str(&line("pyins pipeline", &r.pyins_pipeline, "pipeline    "));
         s.push_str(&line("rinscope run", &r.rinscope_run, "run loop    "));
+        if !r.rinscope_pure_coning.is_empty() {
+            s.push_str(&line("rinscope coning5", &r.rinscope_pure_coning, "run loop    "));
+        }
         let q = spread(r.rinscope_pipeline.iter().map(|x| x.region_s).collect());
         s.push_str(&format!(
             "  {:<16} in this process                 pipeline     {:.2} s [{:.2}, {:.2}]\n",
@@ -451,6 +474,13 @@ pub fn text(reports: &[StreamReport]) -> String {
             ratio(r.ratio_pipeline_kernel),
             ratio(r.ratio_run_kernel)
         ));
+        if let Some(x) = r.ratio_pure_coning_kernel {
+            s.push_str(&format!(
+                "  speed: pyins kernel / rinscope run --scenario pure-coning process ({} samples at 100 Hz, five algorithms, each one's exact error at every sample: `rinscope coning5`) {} (issue 33: >= 1.5x)\n",
+                r.samples,
+                ratio(x)
+            ));
+        }
         let diff = |d: &Difference| {
             format!(
                 "roll {:+.2e}″ pitch {:+.2e}″ heading {:+.2e}″, horizontal {:.2e} m, height {:+.2e} m, velocity ENU [{:+.1e}, {:+.1e}, {:+.1e}] m/s",
