@@ -125,6 +125,9 @@ fn mcap_ros2_imu_matches() {
         write_mcap(&path, &[other.clone(), imu.clone()], summary);
         let reader = ImuReader::open(&path, &ImuOptions::new(Layout::Ros2)).unwrap();
         assert_eq!(reader.start_time(), Some(StartTime::Nanoseconds(T0_NS)));
+        // Its length: the summary's message count of the IMU topic (not /tf's) at 100 Hz; none without.
+        let hint = reader.duration_hint_s();
+        assert_eq!(hint.map(|d| (d * 100.0).round()), summary.then_some(N as f64), "{hint:?}");
         // FLU → RFU is a permutation with a sign: exact.
         assert_same(&samples(reader), &truth, 0.0);
     }
@@ -218,7 +221,8 @@ fn each_format_tells_the_log_length_before_it_is_read() {
     // before reading the log: .npy's shape and Parquet's metadata state the rows; a text file's
     // are its data bytes over a row's mean length, of the first rows and of the file's last 64 KiB
     // (f64 `Display` of varying width here, a header and comments before the data: 1.7 % long,
-    // accepted within 2 %, i.e. 3000 ± 60 buckets); a pipe or MCAP says nothing.
+    // accepted within 2 %, i.e. 3000 ± 60 buckets); MCAP's summary counts its messages
+    // (`mcap_ros2_imu_matches`); a pipe says nothing.
     const ROWS: usize = 20_000;
     let dir = scratch("length_hint");
     let inc = truth_increments(ROWS);

@@ -650,8 +650,8 @@ impl ImuSamples {
         Ok((Self { imu: ImuStream::spawn(imu, increments)?, duration_hint_s }, start))
     }
 
-    /// The log's length, s, as its file states it (.npy, Parquet) or suggests it (text: its size);
-    /// None where unknown (MCAP).
+    /// The log's length, s, as its file states it (.npy, Parquet, a summarised MCAP) or suggests
+    /// it (text: its size); None where unknown.
     #[must_use]
     pub fn duration_hint_s(&self) -> Option<f64> {
         self.duration_hint_s

@@ -48,6 +48,8 @@ struct ChannelInfo {
     topic: String,
     schema: String,
     encoding: String,
+    /// Its messages, as the summary's statistics count them (None without them).
+    messages: Option<u64>,
 }
 
 impl ChannelInfo {
@@ -203,13 +205,15 @@ fn summary_channels(path: &Path, file: &mut File) -> Result<Option<BTreeMap<u16,
     if summary.channels.is_empty() {
         return Ok(None);
     }
+    let counts = summary.stats.as_ref().map(|s| &s.channel_message_counts);
     Ok(Some(
         summary
             .channels
             .iter()
             .map(|(&id, c)| {
                 let schema = c.schema.as_ref().map(|s| s.name.clone()).unwrap_or_default();
-                (id, ChannelInfo { topic: c.topic.clone(), schema, encoding: c.message_encoding.clone() })
+                let messages = counts.map(|m| m.get(&id).copied().unwrap_or(0));
+                (id, ChannelInfo { topic: c.topic.clone(), schema, encoding: c.message_encoding.clone(), messages })
             })
             .collect(),
     ))
@@ -251,7 +255,7 @@ fn scan_channels(path: &Path, file: &File) -> Result<BTreeMap<u16, ChannelInfo>>
         .into_iter()
         .map(|(id, (schema_id, topic, encoding))| {
             let schema = schemas.get(&schema_id).cloned().unwrap_or_default();
-            (id, ChannelInfo { topic, schema, encoding })
+            (id, ChannelInfo { topic, schema, encoding, messages: None })
         })
         .collect())
 }
@@ -264,6 +268,8 @@ pub(crate) struct McapImuSource {
     names: Vec<String>,
     selected: Vec<usize>,
     row: u64,
+    /// The IMU topic's messages, from the summary's statistics.
+    rows_hint: Option<u64>,
 }
 
 impl McapImuSource {
@@ -308,6 +314,8 @@ impl McapImuSource {
             }
         };
         let channel_ids = channels.iter().filter(|(_, c)| c.topic == chosen).map(|(&id, _)| id).collect();
+        // The rows: the topic's messages, if the summary counts every one of its channels'.
+        let rows_hint = channels.values().filter(|c| c.topic == chosen).map(|c| c.messages).sum();
         file.rewind().map_err(|e| LogError::io(path, "cannot seek", e))?;
         Ok(Self {
             path: path.to_path_buf(),
@@ -317,6 +325,7 @@ impl McapImuSource {
             names: MCAP_IMU_COLUMNS.iter().map(|s| (*s).to_owned()).collect(),
             selected: Vec::new(),
             row: 0,
+            rows_hint,
         })
     }
 }
@@ -388,5 +397,9 @@ impl Source for McapImuSource {
 
     fn location(&self) -> Location {
         Location { row: self.row, line: None }
+    }
+
+    fn rows_hint(&self) -> Option<u64> {
+        self.rows_hint
     }
 }

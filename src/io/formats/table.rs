@@ -96,7 +96,8 @@ pub(crate) trait Source {
         None
     }
     /// The data rows the whole file holds: exact where the format states it (.npy's shape,
-    /// Parquet's metadata), estimated from the bytes read so far for text; None where unknown.
+    /// Parquet's metadata, an MCAP summary's message count), estimated from the bytes read so far
+    /// for text; None where unknown (an MCAP file without a summary).
     fn rows_hint(&self) -> Option<u64> {
         None
     }
@@ -317,8 +318,8 @@ impl ColumnReader {
         Ok(n)
     }
 
-    /// The data rows the whole file holds: exact for .npy and Parquet, estimated from what was
-    /// read so far for text (a recording's plots size their buckets by it); None where unknown.
+    /// The data rows the whole file holds: exact for .npy, Parquet and an MCAP file with a summary,
+    /// estimated for text (a recording's plots size their buckets by it); None where unknown.
     #[must_use]
     pub fn rows_hint(&self) -> Option<u64> {
         self.source.rows_hint()

@@ -459,9 +459,10 @@ impl ImuReader {
         ))
     }
 
-    /// The log's length, s: the rows the file holds ([`ColumnReader::rows_hint`]: exact for .npy and
-    /// Parquet, estimated for text) times the sampling interval; None where the format does not
-    /// tell (MCAP). What a recording sizes its plots' buckets by before the log is read.
+    /// The log's length, s: the rows the file holds ([`ColumnReader::rows_hint`]: exact for .npy,
+    /// Parquet and a summarised MCAP, estimated for text) times the sampling interval; None where
+    /// the file does not tell (an MCAP without a summary). What a recording sizes its plots'
+    /// buckets by before the log is read.
     #[must_use]
     pub fn duration_hint_s(&self) -> Option<f64> {
         let dt = self.nominal_dt_s.or(self.measured_dt_s)?;
