@@ -187,6 +187,12 @@ impl InsCore {
         self.integrators.iter().map(|i| i.algorithm).collect()
     }
 
+    /// How many algorithms run ([`Self::algorithms`] without its list: no allocation per update).
+    #[must_use]
+    pub fn algorithm_count(&self) -> usize {
+        self.integrators.len()
+    }
+
     /// Navigation solution, if navigating.
     #[must_use]
     pub fn nav_state(&self) -> Option<&NavState> {

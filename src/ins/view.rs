@@ -102,7 +102,7 @@ impl InsOutputs {
     /// `core`'s outputs after a primary update at `t_s`, with the true C_s^n `imu_true` if drawn.
     #[must_use]
     pub fn of(core: &InsCore, t_s: f64, imu_true: Option<Rot<N, S>>) -> Self {
-        let len = core.algorithms().len();
+        let len = core.algorithm_count();
         let mut attitudes = [(0.0, 0.0, Rot::identity()); Algorithm::ALL.len()];
         for (k, a) in attitudes.iter_mut().enumerate().take(len) {
             let (t_repr, n_from_s) = core.output_attitude(k);
