@@ -91,12 +91,7 @@ impl Recorder {
                 )?;
             }
         }
-        let at = self.geometry_at(t_s);
-        super::documents::log_documents(&self.stream, params, self.replay, at)?;
-        match &self.table {
-            Some(table) if redraw_table => table.log_errors(&self.stream, params, at),
-            _ => Ok(()),
-        }
+        self.log_errors(params, self.geometry_at(t_s), redraw_table)
     }
 
     /// Sends the buffered time-series rows to viewers watching live: a series whose rows all

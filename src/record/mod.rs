@@ -371,7 +371,7 @@ impl Recorder {
         if let Some(c) = params.table.vehicle.pure_coning().filter(|c| c.half_angle_rad > 0.0) {
             me.cone = Some(ConeGizmo::new(me.stream.rec(), c.half_angle_rad, at)?);
         }
-        me.log_errors(params, at)?;
+        me.log_errors(params, at, true)?;
         me.send_blueprint(params, custom)?;
         let started = if live.is_some() {
             // A live session has no length of its own: it runs until it is stopped.
@@ -426,12 +426,12 @@ impl Recorder {
     }
 
     /// Everything that depends on the error values (in live mode at `at` on the timeline): the
-    /// documents and the table's error geometry.
-    fn log_errors(&self, p: &Params, at: Option<f64>) -> RecordingStreamResult<()> {
+    /// documents and, with `table`, the table's error geometry.
+    fn log_errors(&self, p: &Params, at: Option<f64>, table: bool) -> RecordingStreamResult<()> {
         documents::log_documents(&self.stream, p, self.replay, at)?;
         match &self.table {
-            Some(table) => table.log_errors(&self.stream, p, at),
-            None => Ok(()),
+            Some(scene) if table => scene.log_errors(&self.stream, p, at),
+            _ => Ok(()),
         }
     }
 

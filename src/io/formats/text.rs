@@ -50,12 +50,10 @@ pub(crate) struct LineReader {
     last_line_bytes: u64,
     data_from: Option<u64>,
     file_len: u64,
-    /// The mean length of the lines in the file's last 64 KiB (a large file's), bytes.
-    tail_line_bytes: Option<f64>,
 }
 
-/// The mean length of the whole lines in the last `TAIL` bytes of a file of `len` bytes, read
-/// once at opening (a line's length changes along a log: its time stamp gains digits).
+/// The mean length of the whole lines in the last `TAIL` bytes of a file of `len` bytes (a line's
+/// length changes along a log: its time stamp gains digits); None for a file under 4 × `TAIL`.
 fn tail_line_bytes(path: &Path, len: u64) -> Option<f64> {
     use std::io::{Seek, SeekFrom};
     const TAIL: u64 = 1 << 16;
@@ -76,7 +74,6 @@ impl LineReader {
     pub(crate) fn open(path: &Path) -> Result<Self> {
         let file = crate::io::files::open_input(path).map_err(|e| LogError::io(path, "cannot open", e))?;
         let file_len = file.metadata().map_or(0, |m| if m.is_file() { m.len() } else { 0 });
-        let tail_line_bytes = tail_line_bytes(path, file_len);
         Ok(Self {
             path: path.to_path_buf(),
             reader: BufReader::with_capacity(1 << 16, file),
@@ -86,7 +83,6 @@ impl LineReader {
             last_line_bytes: 0,
             data_from: None,
             file_len,
-            tail_line_bytes,
         })
     }
 
@@ -138,7 +134,8 @@ impl LineReader {
 
     /// The rows the whole file holds, estimated from the `rows` read so far: the data's bytes after
     /// the header over a row's mean length, the mean of the rows read and of the file's last lines
-    /// (exact for lines growing at a steady rate); None before a row, or for a pipe.
+    /// (exact for lines growing at a steady rate; the tail is read here, by the one caller that
+    /// asks, not at every opening); None before a row, or for a pipe.
     pub(crate) fn rows_estimate(&self, rows: u64) -> Option<u64> {
         let from = self.data_from?;
         let read = self.bytes_read.saturating_sub(from);
@@ -146,7 +143,7 @@ impl LineReader {
             return None;
         }
         let head = read as f64 / rows as f64;
-        let mean = self.tail_line_bytes.map_or(head, |tail| 0.5 * (head + tail));
+        let mean = tail_line_bytes(&self.path, self.file_len).map_or(head, |tail| 0.5 * (head + tail));
         Some(((self.file_len - from) as f64 / mean).round() as u64)
     }
 }
