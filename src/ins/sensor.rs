@@ -244,6 +244,8 @@ struct Triad {
     /// `gain` is the identity (no scale factor or misalignment): the product is skipped (it would
     /// give the same numbers).
     unit_gain: bool,
+    /// Nothing is added or drawn (unit gain, no bias, no noise): the triad measures the truth.
+    exact: bool,
 }
 
 impl Triad {
@@ -270,16 +272,22 @@ impl Triad {
             // Start in the stationary distribution.
             gm = Spec::Sigma(spec.instability).draw(rng);
         }
+        let white_per_sample = spec.white_per_sqrt_s * h.sqrt();
+        let gm_gain = gain(on.markov);
+        let unit_gain = gain_matrix == Matrix3::identity();
+        let exact =
+            unit_gain && white_per_sample <= 0.0 && gm_drive <= 0.0 && (bias + gm * gm_gain).iter().all(|x| *x == 0.0);
         Self {
             bias,
             gain: gain_matrix,
-            white_per_sample: spec.white_per_sqrt_s * h.sqrt(),
+            white_per_sample,
             white_gain: gain(on.white),
             gm,
             gm_decay,
             gm_drive,
-            gm_gain: gain(on.markov),
-            unit_gain: gain_matrix == Matrix3::identity(),
+            gm_gain,
+            unit_gain,
+            exact,
         }
     }
 
@@ -316,6 +324,9 @@ pub struct Sensors {
     readout: (bool, bool),
     /// The constant biases drawn (gyro rad/s, accel m/s²), for reports.
     pub drawn_bias: (Vector3<f64>, Vector3<f64>),
+    /// Nothing acts (exact triads, no g-sensitivity, noise generators, dither or readout): each
+    /// sample is the truth, returned as it is (a run on exact increments: the peer's workload).
+    exact: bool,
 }
 
 impl Sensors {
@@ -349,7 +360,14 @@ impl Sensors {
         if !on.dither {
             dither.amplitudes_rad = [0.0; 3];
         }
+        let exact = gyro.exact
+            && accel.exact
+            && spec.g_sensitivity * gain(on.g_sensitivity) == 0.0
+            && gyro_ieee.is_none()
+            && accel_ieee.is_none()
+            && dither.amplitudes_rad.iter().all(|x| *x == 0.0);
         let mut me = Self {
+            exact,
             gyro,
             accel,
             gyro_ieee,
@@ -381,6 +399,10 @@ impl Sensors {
     /// Measured (Δθ, Δv) for the true increments of the sample ending at `t1`.
     #[inline]
     pub fn measure(&mut self, dtheta: &Vector3<f64>, dv: &Vector3<f64>, t1: f64) -> (Vector3<f64>, Vector3<f64>) {
+        if self.exact {
+            // What the triads would give: x + 0·h, the same numbers (but for the sign of a zero).
+            return (*dtheta, *dv);
+        }
         let f = dv / self.h;
         let mut g = self.gyro.apply(dtheta, f * self.g_sensitivity, self.h, &mut self.rng);
         let mut a = self.accel.apply(dv, Vector3::zeros(), self.h, &mut self.rng);
