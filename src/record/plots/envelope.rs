@@ -33,6 +33,10 @@ pub(crate) struct Envelope {
     previous: Vec<f64>,
     /// The time of the newest row held back because it repeats `previous`.
     repeat_s: Option<f64>,
+    /// The next sample's row, written in place by the caller ([`Self::row`]) and taken by
+    /// [`Self::commit`], which swaps it with `last`: no copy of the row per sample (those copies
+    /// were a sixth of a pure coning run's recorder).
+    row: Vec<f64>,
 }
 
 impl Envelope {
@@ -53,6 +57,7 @@ impl Envelope {
             values: Vec::new(),
             previous: Vec::new(),
             repeat_s: None,
+            row: Vec::with_capacity(width),
         }
     }
 
@@ -64,13 +69,21 @@ impl Envelope {
     /// Takes one sample `row` (`width` values) at `t_s` (not before the previous sample's).
     #[cfg(test)]
     pub(crate) fn push(&mut self, t_s: f64, row: &[f64]) {
-        self.push_in(Self::bucket_of(self.bucket_s, t_s), t_s, row);
+        self.row().extend_from_slice(row);
+        self.commit(Self::bucket_of(self.bucket_s, t_s), t_s);
     }
 
-    /// [`Self::push`] of a sample in the grid's bucket `bucket` ([`Self::bucket_of`] of `t_s`:
-    /// the plots of a row share it, computed once for all of them).
-    pub(crate) fn push_in(&mut self, bucket: i64, t_s: f64, row: &[f64]) {
-        debug_assert_eq!(row.len(), self.width);
+    /// The next sample's row, empty, for the caller to write its `width` values into; then
+    /// [`Self::commit`].
+    pub(crate) fn row(&mut self) -> &mut Vec<f64> {
+        self.row.clear();
+        &mut self.row
+    }
+
+    /// Takes the row written into [`Self::row`] as the sample at `t_s`, in the grid's bucket
+    /// `bucket` ([`Self::bucket_of`] of `t_s`: the plots of a row share it, computed once).
+    pub(crate) fn commit(&mut self, bucket: i64, t_s: f64) {
+        debug_assert_eq!(self.row.len(), self.width);
         debug_assert_eq!(bucket, Self::bucket_of(self.bucket_s, t_s));
         if self.bucket_s <= 0.0 || self.bucket != Some(bucket) {
             self.close();
@@ -78,12 +91,11 @@ impl Envelope {
         }
         if self.n == 0 {
             self.t_first = t_s;
-            self.first.copy_from_slice(row);
+            self.first.copy_from_slice(&self.row);
         }
         self.n += 1;
         self.t_last = t_s;
-        self.last.copy_from_slice(row);
-        for (j, &v) in row.iter().enumerate() {
+        for (j, &v) in self.row.iter().enumerate() {
             if v < self.lo[j].0 {
                 self.lo[j] = (v, t_s);
             }
@@ -91,6 +103,12 @@ impl Envelope {
                 self.hi[j] = (v, t_s);
             }
         }
+        std::mem::swap(&mut self.row, &mut self.last);
+    }
+
+    /// The row of the latest sample committed.
+    pub(crate) fn last_row(&self) -> &[f64] {
+        &self.last
     }
 
     /// Emits the open bucket's rows (the end of the data, or a sample in another bucket).

@@ -145,8 +145,7 @@ impl Plots {
         let bucket = envelope::Envelope::bucket_of(*bucket_s, out.t_s);
         for s in series.iter_mut() {
             let width = s.width();
-            let start = s.values.len();
-            let v = &mut s.values;
+            let v = s.envelope.row();
             match s.what {
                 Quantity::TableError(a) => v.extend(out.errors[..width].iter().map(|e| e.as_array()[a] * per_rad)),
                 Quantity::ClosedForm => {
@@ -196,9 +195,9 @@ impl Plots {
                 ),
                 Quantity::Height => v.push(state.map_or(f64::NAN, |n| n.height_m)),
             }
-            s.envelope.push_in(bucket, out.t_s, &s.values[start..]);
-            if !*exporting {
-                s.values.truncate(start);
+            s.envelope.commit(bucket, out.t_s);
+            if *exporting {
+                s.values.extend_from_slice(s.envelope.last_row());
             }
         }
     }
