@@ -18,7 +18,7 @@ use crate::math::units::ARCSEC_PER_RAD;
 use crate::record::Recorder;
 use crate::record::sink::OpenSinks;
 use crate::scenario::Params;
-use crate::sim::{DEMODULATIONS, DemodState, ERROR_AXES, ErrorStats, Model, step};
+use crate::sim::{DEMODULATIONS, DemodState, ERROR_AXES, ErrorStats, Model, step, step_with};
 
 /// Summary row of the closed form minus the exact (uncompensated) error.
 pub const CLOSED_FORM_DEVIATION: &str = "closed_form_minus_exact";
@@ -495,7 +495,8 @@ impl Producer<'_> {
                 if let Some((t_prev, false)) = previous_update {
                     state.observe(self.model, t_prev);
                 }
-                let core = step(self.model, &mut state, outputs.t_s());
+                let truth = viewer.truth_at(self.model, outputs.t_s());
+                let core = step_with(self.model, &mut state, outputs.t_s(), truth);
                 if want_stats {
                     stats.add(&core);
                     if !out.series(OutputRow { core, ins: Some(view.clone()), solution: None }) {

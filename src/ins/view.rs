@@ -6,7 +6,7 @@
 use super::coning::Algorithm;
 use super::core::{InsCore, NavError};
 use crate::math::attitude::{AttitudeError, EulerParts};
-use crate::math::frames::{N, Rot, S};
+use crate::math::frames::{B, N, Rot, S};
 use crate::model::gimbal::ChainMemo;
 use crate::model::scheme::AxisValues;
 use crate::sim::{DemodState, Model, demodulated, encoder_readings};
@@ -82,6 +82,9 @@ type LastError = (f64, Rot<N, S>, AttitudeError);
 struct Shared {
     t_repr_s: f64,
     encoder_rad: AxisValues,
+    /// The truth's instant, the true C_b^n there and its parts.
+    t_ref_s: f64,
+    n_from_b: Rot<N, B>,
     truth: EulerParts,
 }
 
@@ -158,6 +161,17 @@ impl InsViewer {
         self.chains = ChainMemo::new(self.demod.len());
     }
 
+    /// The true C_b^n of `model` at `t_s` and its parts, if the latest view computed them (an
+    /// algorithm's truth instant is `t_s` and the model is this viewer's): what the table's step at
+    /// the same instant takes instead of computing them again (`sim::step_with`).
+    #[must_use]
+    pub fn truth_at(&self, model: &Model, t_s: f64) -> Option<(Rot<N, B>, EulerParts)> {
+        if model.id() != self.model.id() {
+            return None;
+        }
+        self.shared.iter().find(|e| e.t_ref_s == t_s).map(|e| (e.n_from_b, e.truth))
+    }
+
     /// The INS body attitude errors of the outputs `o`. Each algorithm is compared at the instant
     /// its own latest output stands for (algorithms with more samples per update update less
     /// often), against the truth `output_compensation` earlier.
@@ -178,19 +192,25 @@ impl InsViewer {
                 }
             }
             let known = shared.iter().position(|e| e.t_repr_s == t_repr);
-            let (encoder, truth_att) = match known {
-                Some(i) => (shared[i].encoder_rad, shared[i].truth),
+            let (encoder, n_from_b, truth_att) = match known {
+                Some(i) => (shared[i].encoder_rad, shared[i].n_from_b, shared[i].truth),
                 None => {
                     // The encoders are read for the instant the IMU data represent (matched synchronisation).
                     let truth = model.fixed_state().map_or_else(|| model.vehicle.n_from_b(t_ref), |(_, r)| r);
-                    (encoder_readings(model, t_repr), EulerParts::of(&truth))
+                    (encoder_readings(model, t_repr), truth, EulerParts::of(&truth))
                 }
             };
             self.demod[k].observe_if_first(model, t_repr - self.h);
             let corrected = self.demod[k].correct(&model.compensation, t_repr, &encoder);
             let b_from_s_comp = self.chains.get(&model.chain, model.compensation_rotations(), &corrected);
             if known.is_none() {
-                shared.push(Shared { t_repr_s: t_repr, encoder_rad: encoder, truth: truth_att });
+                shared.push(Shared {
+                    t_repr_s: t_repr,
+                    encoder_rad: encoder,
+                    t_ref_s: t_ref,
+                    n_from_b,
+                    truth: truth_att,
+                });
             }
             let error = AttitudeError::between(&demodulated(n_from_s, b_from_s_comp), &truth_att);
             self.last_error[k] = Some((t_repr, n_from_s, error));

@@ -252,6 +252,13 @@ impl VehicleMotion {
         self.coning.filter(|_| self.euler_fixed.is_some())
     }
 
+    /// Whether the body is coned (its attitude is C_b^n, without Euler angles of its own:
+    /// [`Self::n_from_b_and_euler`] gives None for them).
+    #[must_use]
+    pub fn is_coned(&self) -> bool {
+        self.coning.is_some()
+    }
+
     /// Adds pure coning on top of the Euler-angle motion.
     #[must_use]
     pub fn with_coning(mut self, coning: Coning) -> Self {

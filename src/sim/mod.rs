@@ -85,6 +85,12 @@ impl Model {
         }
     }
 
+    /// Which [`Model::new`] made it: clones share it, a reload's model has another.
+    #[must_use]
+    pub fn id(&self) -> u64 {
+        self.id
+    }
+
     /// Number of gimbal axes.
     #[must_use]
     pub fn n_axes(&self) -> usize {
@@ -259,11 +265,27 @@ fn table_step(model: &Model, key: (u64, [AxisValues; 4])) -> TableStep {
 /// Advances the simulation to `t_s` (steps must come in increasing time).
 #[must_use]
 pub fn step(model: &Model, state: &mut DemodState, t_s: f64) -> StepOutput {
-    let (n_from_b, euler) = match model.fixed_attitude {
-        Some((a, r)) => (r, Some(a)),
-        None => model.vehicle.n_from_b_and_euler(t_s),
+    step_with(model, state, t_s, None)
+}
+
+/// [`step`], given a coned body's true attitude at `t_s` when it is already known (`truth`:
+/// C_b^n and its [`EulerParts`], as `model.vehicle.n_from_b(t_s)` gives them — an INS view at the
+/// same instant computed it: `ins::view::InsViewer::truth_at`); otherwise computed.
+pub fn step_with(
+    model: &Model,
+    state: &mut DemodState,
+    t_s: f64,
+    truth: Option<(Rot<N, B>, EulerParts)>,
+) -> StepOutput {
+    let (n_from_b, euler, truth) = match (model.fixed_attitude, truth) {
+        (Some((a, r)), _) => (r, Some(a), EulerParts::of(&r)),
+        // A coned body has no Euler angles of its own (the recorder reads them from C_b^n).
+        (None, Some((r, parts))) if model.vehicle.is_coned() => (r, None, parts),
+        (None, _) => {
+            let (r, euler) = model.vehicle.n_from_b_and_euler(t_s);
+            (r, euler, EulerParts::of(&r))
+        }
     };
-    let truth = EulerParts::of(&n_from_b);
     let (gimbal_rad, rate_rad_per_s) = model.scheme.state(t_s - model.scheme_t0_s);
     let encoder_rad = encoder_readings_of(model, t_s, &gimbal_rad);
     let corrected = state.correct(&model.compensation, t_s, &encoder_rad);
