@@ -478,13 +478,14 @@ impl Producer<'_> {
         // The latest attitude update: its instant and whether its step was computed.
         let mut last_update: Option<(f64, bool)> = None;
         'batches: for batch in rx {
-            for update in batch {
+            // By reference: moving each update out of the batch copied its outputs (2 % of the CPU).
+            for update in &batch {
                 let (outputs, want_stats, want_scene) = match update {
-                    Update::Signal(s) if out.signal(s) => continue,
+                    Update::Signal(s) if out.signal(*s) => continue,
                     Update::Signal(_) => break 'batches,
-                    Update::Output { outputs, want_stats, want_scene } => (outputs, want_stats, want_scene),
+                    Update::Output { outputs, want_stats, want_scene } => (outputs, *want_stats, *want_scene),
                 };
-                let view = viewer.view(&outputs);
+                let view = viewer.view(outputs);
                 ins_stats.add(&view);
                 let wanted = want_stats || want_scene;
                 // The previous update's instant, for the delay correction when it was not computed.

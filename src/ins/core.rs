@@ -329,6 +329,7 @@ impl InsCore {
     /// Integrator `k`'s C_s^n as output after its latest update, and the instant it represents:
     /// with the zero-order hold, the value h/2 earlier, interpolated between the two latest updates.
     #[must_use]
+    #[inline]
     pub fn output_attitude(&self, k: usize) -> (f64, Rot<N, S>) {
         output_attitude(&self.history[k], self.zoh_delay_s)
     }
@@ -343,12 +344,14 @@ impl InsCore {
     /// The instant the truth is taken at for an output representing `t_repr`: the output left the
     /// computer d + zoh after the instant it represents, and is compared `output_compensation` earlier.
     #[must_use]
+    #[inline]
     pub fn reference_instant(&self, t_repr: f64) -> f64 {
         t_repr + self.fir_delay_s + self.zoh_delay_s - self.cfg.output_compensation_s
     }
 
     /// The navigation errors relative to the start site (the vehicle rests there), if navigating.
     #[must_use]
+    #[inline]
     pub fn nav_error(&self) -> Option<NavError> {
         self.nav.as_ref().map(|n| {
             let s = &n.state;

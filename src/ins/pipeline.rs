@@ -244,6 +244,7 @@ impl InsRun {
 
     /// Integrator `k`'s C_s^n as output after its latest update, and the instant it represents.
     #[must_use]
+    #[inline]
     pub fn output_attitude(&self, k: usize) -> (f64, Rot<N, S>) {
         self.core.output_attitude(k)
     }

@@ -42,6 +42,7 @@ impl Attitude {
 
     /// Component-wise difference `self - truth`, with roll and heading wrapped into (-pi, pi].
     #[must_use]
+    #[inline]
     pub fn error_from(&self, truth: &Self) -> AttitudeError {
         AttitudeError {
             pitch_rad: self.pitch_rad - truth.pitch_rad,
@@ -91,6 +92,7 @@ pub struct EulerParts {
 impl EulerParts {
     /// The parts of `n_from_b` (five DCM elements, straight from the quaternion).
     #[must_use]
+    #[inline]
     pub fn of(n_from_b: &Rot<N, B>) -> Self {
         let Cosines { c01, c11, c20, c21, c22 } = Cosines::of(n_from_b);
         // sin θ = C21 and cos θ = √(C20² + C22²) ≥ 0 (the third column is a unit vector): pitch
@@ -142,6 +144,7 @@ impl AttitudeError {
     /// [−π, π]), read from the two attitudes' [`EulerParts`]: the difference's sine and cosine per
     /// angle, no arctangent of either attitude.
     #[must_use]
+    #[inline]
     pub fn between(computed: &EulerParts, truth: &EulerParts) -> Self {
         Self {
             pitch_rad: angle_between(computed.pitch, truth.pitch),
@@ -152,6 +155,7 @@ impl AttitudeError {
 
     /// The three components as an array ordered pitch, roll, heading.
     #[must_use]
+    #[inline]
     pub fn as_array(&self) -> [f64; 3] {
         [self.pitch_rad, self.roll_rad, self.heading_rad]
     }
@@ -164,6 +168,7 @@ impl AttitudeError {
     /// The sines and cosines come from the DCM itself (C01 = sin ψ cos θ, C11 = cos ψ cos θ,
     /// C21 = sin θ), so the hot path needs no trigonometry.
     #[must_use]
+    #[inline]
     pub fn first_order(n_from_b: &Rot<N, B>, phi_n: V3<N>) -> Self {
         let Cosines { c01, c11, c21, .. } = Cosines::of(n_from_b);
         let cos_pitch = c01.hypot(c11);

@@ -10,6 +10,7 @@ pub struct RunningStat {
 
 impl RunningStat {
     /// Adds one sample.
+    #[inline]
     pub fn add(&mut self, x: f64) {
         self.sum_sq += x * x;
         self.peak_abs = self.peak_abs.max(x.abs());

@@ -315,6 +315,7 @@ impl VehicleMotion {
     }
 
     /// The cone's (half-angle, its rate, phase, angular frequency) at `t_s`.
+    #[inline]
     fn cone_state_full(&self, t_s: f64) -> (f64, f64, f64, f64) {
         match (self.coning, self.cone_continuation) {
             (None, _) => (0.0, 0.0, 0.0, 0.0),
@@ -324,6 +325,7 @@ impl VehicleMotion {
     }
 
     /// The cone's rotation K at `t_s` (body side of the Euler frame).
+    #[inline]
     fn cone_rotation(&self, c: &Coning, t_s: f64) -> UnitQuaternion<f64> {
         let (alpha, _, phase, _) = self.cone_state_full(t_s);
         let k = if alpha == c.half_angle_rad { self.cone_constants } else { Coning::constants_of(alpha) };
@@ -385,6 +387,7 @@ impl VehicleMotion {
 
     /// C_b^n at `t_s`.
     #[must_use]
+    #[inline]
     pub fn n_from_b(&self, t_s: f64) -> Rot<N, B> {
         let e = self.euler_fixed.unwrap_or_else(|| self.euler(t_s).n_from_b());
         match self.coning {

@@ -306,6 +306,7 @@ impl Scheme {
 
     /// True gimbal angles and rates at `t_s`.
     #[must_use]
+    #[inline]
     pub fn state(&self, t_s: f64) -> (AxisValues, AxisValues) {
         let mut angle = self.initial;
         let mut rate = [0.0; MAX_AXES];

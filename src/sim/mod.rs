@@ -143,11 +143,13 @@ struct TableStep {
 /// `delay` earlier, then offset and scale applied, plus white noise (docs/model.md, "Encoder").
 /// The noise is a pure function of (seed, axis, `t_s`): asking twice gives the same reading.
 #[must_use]
+#[inline]
 pub fn encoder_readings(model: &Model, t_s: f64) -> AxisValues {
     encoder_readings_of(model, t_s, &model.scheme.state(t_s - model.scheme_t0_s).0)
 }
 
 /// [`encoder_readings`] when the true angles at `t_s`, `now`, are known.
+#[inline]
 fn encoder_readings_of(model: &Model, t_s: f64, now: &AxisValues) -> AxisValues {
     let t_scheme = t_s - model.scheme_t0_s;
     let mut encoder_rad = [0.0; MAX_AXES];
@@ -165,6 +167,7 @@ fn encoder_readings_of(model: &Model, t_s: f64, now: &AxisValues) -> AxisValues 
 impl DemodState {
     /// Encoder angles corrected with the assumed parameters `assumed`: offset and scale removed,
     /// then extrapolated over the assumed delay with the rate seen in successive corrected readings.
+    #[inline]
     pub fn correct(&mut self, assumed: &TableErrors, t_s: f64, encoder_rad: &AxisValues) -> AxisValues {
         let n = assumed.axes.len();
         let mut corrected = [0.0; MAX_AXES];
@@ -234,6 +237,7 @@ impl StepOutput {
 
 /// The body attitude a RINS computes from the IMU attitude and a model of the table.
 #[must_use]
+#[inline]
 pub fn demodulate(n_from_s: Rot<N, S>, b_from_s: Rot<B, S>) -> Attitude {
     Attitude::from_n_from_b(&(n_from_s * b_from_s.inverse()))
 }
@@ -241,6 +245,7 @@ pub fn demodulate(n_from_s: Rot<N, S>, b_from_s: Rot<B, S>) -> Attitude {
 /// [`demodulate`]'s attitude as the parts an error is read from ([`AttitudeError::between`]): no
 /// trigonometry, what the errors at every update take.
 #[must_use]
+#[inline]
 pub fn demodulated(n_from_s: Rot<N, S>, b_from_s: Rot<B, S>) -> EulerParts {
     EulerParts::of(&(n_from_s * b_from_s.inverse()))
 }

@@ -108,6 +108,7 @@ impl ImuStream {
         Ok(Self { rx, items: Vec::new().into_iter() })
     }
 
+    #[inline]
     fn next(&mut self) -> Option<Result<ImuItem, LogError>> {
         loop {
             if let Some(item) = self.items.next() {
@@ -424,6 +425,7 @@ impl Playback {
     }
 
     /// The next IMU sample through the computer; None at the end of the log.
+    #[inline]
     pub fn step(&mut self) -> Result<Option<SampleOut>, PlaybackError> {
         let Some(s) = self.read()? else { return Ok(None) };
         self.samples += 1;
@@ -515,6 +517,7 @@ impl Playback {
     }
 
     /// One sample as increments in the RFU sensor frame, or None at the end (gaps recorded).
+    #[inline]
     fn read(&mut self) -> Result<Option<Sample>, PlaybackError> {
         if let Some(s) = self.pending.pop_front() {
             return Ok(Some(s));
@@ -658,6 +661,7 @@ impl ImuSamples {
     }
 
     /// The next sample or gap; None at the end of the file.
+    #[inline]
     pub fn next_item(&mut self) -> Result<Option<ImuItem>, PlaybackError> {
         Ok(self.imu.next().transpose()?)
     }

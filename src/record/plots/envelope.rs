@@ -62,6 +62,7 @@ impl Envelope {
     }
 
     /// The bucket of time `t_s` on a grid of `bucket_s` (0: every sample its own).
+    #[inline]
     pub(crate) fn bucket_of(bucket_s: f64, t_s: f64) -> i64 {
         if bucket_s > 0.0 { (t_s / bucket_s + 1e-9).floor() as i64 } else { i64::MIN }
     }
@@ -82,6 +83,7 @@ impl Envelope {
 
     /// Takes the row written into [`Self::row`] as the sample at `t_s`, in the grid's bucket
     /// `bucket` ([`Self::bucket_of`] of `t_s`: the plots of a row share it, computed once).
+    #[inline]
     pub(crate) fn commit(&mut self, bucket: i64, t_s: f64) {
         debug_assert_eq!(self.row.len(), self.width);
         debug_assert_eq!(bucket, Self::bucket_of(self.bucket_s, t_s));
