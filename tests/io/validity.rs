@@ -4,7 +4,10 @@
 //! the column and the value in a short form.
 
 use crate::common::*;
-use rinscope::io::{Col, ColumnReader, Frame, ImuOptions, ImuReader, Layout, LogError, ReadOptions, TimeUnit};
+use rinscope::io::{
+    BlockEnd, Col, ColumnReader, Frame, GapPolicy, ImuEvent, ImuOptions, ImuReader, Layout, LogError, ReadOptions,
+    TimeUnit,
+};
 use std::path::Path;
 
 /// A rinscope csv of increments at 100 Hz: `rows` rows of plausible numbers, each cell as text.
@@ -224,4 +227,91 @@ fn bytes_after_a_files_end_are_refused() {
     std::fs::write(&joined, [bytes.clone(), bytes].concat()).unwrap();
     let e = read(&joined, Layout::Rinscope).unwrap_err();
     message_of(&e, &joined, &["nothing refers to them", "two Parquet files joined"]);
+}
+
+/// What a reader yields to its end: the samples, the gaps (as `(t_before_s, t_after_s)`) and the
+/// first error's message, through `next_samples` (blocks: a block format's rows go through the
+/// fast path) or through the iterator (one `step` per row, every check on every row).
+type Yield = (Vec<rinscope::io::ImuSample>, Vec<(f64, f64)>, Option<String>);
+
+fn read_all_ways(path: &Path, policy: GapPolicy) -> (Yield, Yield) {
+    let mut options = ImuOptions::new(Layout::Npy7 { time: TimeUnit::Seconds });
+    options.frame = Some(Frame::Named("frd".into()));
+    options.gap_policy = policy;
+    let gap_of = |e: ImuEvent| match e {
+        ImuEvent::Gap { t_before_s, t_after_s, .. } => (t_before_s, t_after_s),
+        ImuEvent::Sample(_) => unreachable!("a sample is not a gap"),
+    };
+    let mut blocks: Yield = (Vec::new(), Vec::new(), None);
+    let mut r = ImuReader::open(path, &options).unwrap();
+    loop {
+        match r.next_samples(&mut blocks.0, 1000) {
+            Ok(BlockEnd::Full) => {}
+            Ok(BlockEnd::Gap(g)) => blocks.1.push(gap_of(g)),
+            Ok(BlockEnd::End) => break,
+            Err(e) => {
+                blocks.2 = Some(e.to_string());
+                break;
+            }
+        }
+    }
+    let mut rows: Yield = (Vec::new(), Vec::new(), None);
+    for e in ImuReader::open(path, &options).unwrap() {
+        match e {
+            Ok(ImuEvent::Sample(s)) => rows.0.push(s),
+            Ok(g) => rows.1.push(gap_of(g)),
+            Err(e) => rows.2 = Some(e.to_string()),
+        }
+    }
+    (blocks, rows)
+}
+
+/// Deep inside a block format (.npy, encoded here from the format's spec; read thousands of rows at
+/// a time, where the reader checks a block's rows as plain comparisons), every defect is found at
+/// the same row with the same message, every sample is the same number and every gap the same, as
+/// when each row goes through the reader's full per-row checks: a NaN, a value beyond any
+/// instrument, a stamp that goes back, a repeated stamp, a stamp off the clock, a gap (refused,
+/// and split), and a clean file; in a frame that is not rinscope's (the axes turned).
+#[test]
+fn a_block_formats_rows_are_checked_as_row_by_row() {
+    let dir = scratch("block_rows");
+    let n = 9000;
+    let clean: Vec<Vec<f64>> = (0..n)
+        .map(|k| {
+            let t = k as f64 * DT;
+            vec![t, 1.5e-7 * (1.0 + t.sin()), -2.5e-7, 3.0e-7, 0.0316, -0.0021 * t.cos(), 0.098]
+        })
+        .collect();
+    type Defect = fn(&mut [Vec<f64>]);
+    let defects: [(&str, Defect, &str); 7] = [
+        ("clean", |_| {}, ""),
+        ("nan", |r| r[5000][2] = f64::NAN, "data row 5001"),
+        ("beyond", |r| r[6100][5] = 1e6, "data row 6101"),
+        ("backwards", |r| r[7000][0] = r[6990][0], "data row 7001"),
+        ("repeated", |r| r[7000][0] = r[6999][0], "data row 7001"),
+        ("off the clock", |r| r[8000][0] += 2e9, "data row 8001"),
+        ("gap", |r| r[4500..].iter_mut().for_each(|row| row[0] += 1.0), "data row 4501"),
+    ];
+    for (name, defect, row) in defects {
+        let mut rows = clean.clone();
+        defect(&mut rows);
+        let path = dir.join(format!("{}.npy", name.replace(' ', "_")));
+        write_npy(&path, &rows, "<f8");
+        for policy in [GapPolicy::Refuse, GapPolicy::Split] {
+            let (blocks, by_row) = read_all_ways(&path, policy);
+            assert_eq!(blocks, by_row, "{name}, {policy:?}");
+            let split_gap = name == "gap" && policy == GapPolicy::Split;
+            match &blocks.2 {
+                Some(msg) => assert!(!split_gap && msg.contains(row), "{name}, {policy:?}: {msg}"),
+                None => assert!(name == "clean" || split_gap, "{name}, {policy:?}: no error"),
+            }
+            // The samples before a defect: all of them, or (a NaN, which the file's reader refuses as
+            // it decodes a block) those of the blocks before — the same both ways.
+            let before = row.trim_start_matches("data row ").parse::<usize>().map_or(n, |r| r - 1);
+            let kept = blocks.0.len();
+            let whole = if blocks.2.is_some() { kept <= before && kept >= before - before % 4096 } else { kept == n };
+            assert!(whole, "{name}, {policy:?}: {kept} samples before the defect");
+            assert_eq!(blocks.1.len(), usize::from(split_gap), "{name}, {policy:?}: gaps");
+        }
+    }
 }

@@ -574,6 +574,67 @@ impl ImuReader {
     }
 }
 
+impl ImuReader {
+    /// [`Self::step`] over the current block's rows while every check passes — a block format's
+    /// samples, none at a gap or out of bounds: the same conversion of the stamp and the values and
+    /// the same checks, as comparisons, without a row's error context (its location, its cells)
+    /// built and moved per sample (they were most of the reading thread's time). The first row a
+    /// check refuses is left in the block for [`Self::step`], which reports it, or returns its gap,
+    /// as it always does. Appends at most `max` samples to `out`; returns how many.
+    fn clean_block_rows(&mut self, out: &mut Vec<ImuSample>, max: usize) -> usize {
+        // After the first row (the clock's origin and `prev` set), nothing held or looked ahead,
+        // and a stamp that converts without state (not GPS seconds of week, not exact integers).
+        let (Some(first), None, Some((mut t_prev, mut raw_prev))) = (self.clock.first, self.clock.first_ns, self.prev)
+        else {
+            return 0;
+        };
+        if self.held.is_some()
+            || !self.lookahead.is_empty()
+            || self.read_error.is_some()
+            || !self.reader.reads_in_blocks()
+            || self.clock.unit == TimeUnit::GpsSecondsOfWeek
+        {
+            return 0;
+        }
+        use crate::io::validity::{MAX_LOG_SPAN_S, MAX_RATE_RAD_PER_S, MAX_SPECIFIC_FORCE_MPS2};
+        let to_s = self.clock.unit.to_s();
+        let gap_s = self.nominal_dt_s.map_or(f64::INFINITY, |n| self.gap_factor * n);
+        let increments = self.kind == SampleKind::Increments;
+        let s = self.scale;
+        let rows = self.block.len() / 7;
+        let mut n = 0;
+        while n < max && self.block_pos < rows {
+            let row = &self.block[self.block_pos * 7..self.block_pos * 7 + 7];
+            let t = (row[0] - first) * to_s;
+            let dt = t - t_prev;
+            // `dt > 0` also refuses a NaN stamp; `step` says which check failed.
+            if !(t.abs() <= MAX_LOG_SPAN_S && dt > 0.0 && dt <= gap_s) {
+                break;
+            }
+            let per = if increments { dt } else { 1.0 };
+            let within = |k: usize, bound: f64| {
+                let si = row[k + 1] * s[k];
+                !(si.is_nan() || si.abs() > bound * per)
+            };
+            if !((0..3).all(|k| within(k, MAX_RATE_RAD_PER_S)) && (3..6).all(|k| within(k, MAX_SPECIFIC_FORCE_MPS2))) {
+                break;
+            }
+            let mut gyro = Vector3::new(row[1] * s[0], row[2] * s[1], row[3] * s[2]);
+            let mut accel = Vector3::new(row[4] * s[3], row[5] * s[4], row[6] * s[5]);
+            if !self.c_identity {
+                gyro = self.c * gyro;
+                accel = self.c * accel;
+            }
+            out.push(ImuSample { t_s: t, gyro, accel });
+            (t_prev, raw_prev.value) = (t, row[0]);
+            self.block_pos += 1;
+            n += 1;
+        }
+        self.prev = Some((t_prev, raw_prev));
+        n
+    }
+}
+
 /// What [`ImuReader::next_samples`] stopped at.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum BlockEnd {
@@ -595,7 +656,13 @@ impl ImuReader {
         if self.done {
             return Ok(BlockEnd::End);
         }
-        for _ in 0..max {
+        let mut taken = 0;
+        while taken < max {
+            taken += self.clean_block_rows(out, max - taken);
+            if taken == max {
+                break;
+            }
+            taken += 1;
             match self.step() {
                 Ok(Some(ImuEvent::Sample(s))) => out.push(s),
                 Ok(Some(gap)) => return Ok(BlockEnd::Gap(gap)),
