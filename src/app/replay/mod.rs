@@ -10,22 +10,24 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+mod views;
+use views::{AlgorithmOutput, Batch, Item, Tallies, Update, Views};
+
 use super::failure::Failure;
-use super::feed::{self, Outbox, OutputRow};
+use super::feed::{self, Outbox};
 use super::outputs::{RecordingName, RecordingRequest, check_output, finish, write_json};
 use super::playback::{AlignmentReport, Gap, Playback, PlaybackError};
 use super::run::{NavSummary, RmsPeak};
-use crate::ins::pipeline::{AlgorithmErrors, InsView};
-use crate::math::attitude::{Attitude, AttitudeError};
+use crate::math::attitude::Attitude;
 use crate::math::frames::Rot;
 use crate::math::stats::RunningStat;
 use crate::math::timeline::decimation;
 use crate::math::units::ARCSEC_PER_RAD;
 use crate::model::gimbal::ChainMemo;
 use crate::model::gimbal::TableErrors;
-use crate::record::{Recorder, Solution};
+use crate::record::Recorder;
 use crate::scenario::logset::{LogSet, Reference};
-use crate::sim::{DemodState, ERROR_AXES, StepOutput, demodulate};
+use crate::sim::{DemodState, ERROR_AXES};
 
 /// The result of a replay, as printed and as written by `--summary-json`.
 #[derive(Debug, Clone, Serialize)]
@@ -268,37 +270,41 @@ pub fn replay(
     }
     let chain = &log.table.chain;
     let nominal = TableErrors::zero(chain.axes().len());
-    let (nominal_rot, comp_rot) = (chain.error_rotations(&nominal), chain.error_rotations(compensation));
     let algorithms: Vec<String> = pb.core.algorithms().iter().map(|a| a.name().to_owned()).collect();
     let rate = log.table.ins.rate_hz;
     // The plots' envelopes and the export take every update at the statistics rate.
     let series_every = decimation(rate, log.table.recording.bandwidth.statistics_hz().min(rate));
     let scene_every = decimation(rate, log.table.recording.scene_hz);
     let window = log.table.ins.signal_window_s;
-    let mut demod = vec![DemodState::default(); algorithms.len()];
-    let mut demod_nominal = DemodState::default();
-    // A table that stands (a dwell, a static test, no encoder file) costs one chain evaluation.
-    let mut comp_cache = ChainMemo::new(algorithms.len());
-    let mut nominal_cache = ChainMemo::new(1);
-    let mut stats = [[RunningStat::default(); 3]; 2];
-    let mut ins_stats = vec![[RunningStat::default(); 3]; algorithms.len()];
-    let mut nav: Option<NavSummary> = None;
+    let has_reference = !matches!(log.reference, Reference::None);
+    let views = Views {
+        chain,
+        compensation,
+        nominal_rot: chain.error_rotations(&nominal),
+        comp_rot: chain.error_rotations(compensation),
+        nominal,
+        has_reference,
+        demod: vec![DemodState::default(); algorithms.len()],
+        demod_nominal: DemodState::default(),
+        comp_cache: ChainMemo::new(algorithms.len()),
+        nominal_cache: ChainMemo::new(1),
+    };
     let (mut next_series, mut next_scene) = (0u64, 0u64);
     let mut interrupted = false;
     let mut t_end = 0.0;
     let mut i = 0u64;
-    let nan = AttitudeError { pitch_rad: f64::NAN, roll_rad: f64::NAN, heading_rad: f64::NAN };
-    // Each update's errors, one per algorithm (a fixed array: an allocation per update was a tenth
-    // of a replay's time); a recorded row takes a copy.
-    let mut errors = AlgorithmErrors::default();
-    let has_reference = !matches!(log.reference, Reference::None);
-    let mut compared = 0u64;
     let recording = recorder.is_some();
-    // The recorder on its own thread (`feed`): the loop never waits for the encoding.
-    std::thread::scope(|scope| -> Result<(), PlaybackError> {
+    // Three threads besides the file's reader: this loop (the log through the navigation
+    // computer), the errors, demodulations and statistics (`views`: a third of this loop's time
+    // was theirs), and the recorder (`feed`): neither waits for the encoding.
+    let tallies = std::thread::scope(|scope| -> Result<Tallies, PlaybackError> {
         let (tx, rx) = feed::channel();
         let consumer = recorder.as_deref_mut().map(|r| scope.spawn(move || feed::consume(r, rx)));
-        let mut outbox = Outbox::new(&tx);
+        let (to_views, from_loop) = crossbeam_channel::bounded::<Batch>(4);
+        // The views' thread holds the recorder's channel: the recorder stops when it does.
+        let viewer = scope.spawn(move || views.consume(&from_loop, Outbox::new(&tx)));
+        const UPDATES_PER_BATCH: usize = 512;
+        let mut batch = Batch::default();
         let looped = (|| -> Result<(), PlaybackError> {
             while let Some(s) = pb.step()? {
                 i += 1;
@@ -316,143 +322,64 @@ pub fn replay(
                         ));
                     }
                 }
-                if s.t_s <= window && recording && !outbox.signal(s) {
+                if s.t_s <= window && recording {
+                    batch.items.push(Item::Signal(s));
+                }
+                if s.updated {
+                    // Every update is demodulated and counted in the statistics (as a run does); the
+                    // plots take the updates at the statistics rate (their envelopes), the scene its own.
+                    let (want_series, want_scene) = (i >= next_series, i >= next_scene);
+                    if want_series {
+                        next_series = i.saturating_add(series_every);
+                    }
+                    if want_scene {
+                        next_scene = i.saturating_add(scene_every);
+                    }
+                    // Each algorithm at the instant its own output stands for, with the encoder
+                    // readings there and the reference at its truth instant (the files are read here).
+                    let mut t_ref_s = 0.0;
+                    for k in 0..algorithms.len() {
+                        let (t_repr_s, n_from_s) = pb.core.output_attitude(k);
+                        let t_ref = pb.core.reference_instant(t_repr_s);
+                        if k == 0 {
+                            t_ref_s = t_ref;
+                        }
+                        let encoder_rad = pb.encoders_at(t_repr_s)?;
+                        let reference = pb.reference_at(t_ref)?;
+                        batch.algorithms.push(AlgorithmOutput { t_repr_s, n_from_s, encoder_rad, reference });
+                    }
+                    let series_row = recording && want_series;
+                    batch.items.push(Item::Update(Update {
+                        t_s: s.t_s,
+                        t_ref_s,
+                        algorithms: algorithms.len(),
+                        nav_error: pb.core.nav_error(),
+                        nav_state: if series_row { pb.core.nav_state().copied() } else { None },
+                        series_row,
+                        scene_row: recording && want_scene,
+                    }));
+                }
+                // The views' thread stopped: the recorder failed (it reports why).
+                if batch.items.len() >= UPDATES_PER_BATCH && to_views.send(std::mem::take(&mut batch)).is_err() {
                     break;
-                }
-                if !s.updated {
-                    continue;
-                }
-                // Every update is demodulated and counted in the statistics (as a run does); the plots
-                // take the updates at the statistics rate (their envelopes), the scene its own rate.
-                let (want_series, want_scene) = (i >= next_series, i >= next_scene);
-                let row = recording && (want_series || want_scene);
-                // Each algorithm at the instant its own output stands for, as the simulation compares them.
-                // The Euler angles are taken only where they are compared or drawn: without a reference
-                // the compensated demodulation is its own reference, an error of zero by definition.
-                errors.clear();
-                let mut primary = None;
-                for (k, state) in demod.iter_mut().enumerate() {
-                    let (t_repr, n_from_s) = pb.core.output_attitude(k);
-                    let t_ref = pb.core.reference_instant(t_repr);
-                    let encoder = pb.encoders_at(t_repr)?;
-                    let corrected = state.correct(compensation, t_repr, &encoder);
-                    let comp_b_from_s = comp_cache.get(chain, &comp_rot, &corrected);
-                    let reference = pb.reference_at(t_ref)?;
-                    let body = (reference.is_some() || (k == 0 && row)).then(|| demodulate(n_from_s, comp_b_from_s));
-                    errors.push(match (body, reference) {
-                        (Some(b), Some(r)) => b.error_from(&r),
-                        _ => AttitudeError::default(),
-                    });
-                    if k == 0 {
-                        let raw = demod_nominal.correct(&nominal, t_repr, &encoder);
-                        let nominal_b_from_s = nominal_cache.get(chain, &nominal_rot, &raw);
-                        // Nothing compensated (no table errors known): the same chain, the same attitude.
-                        let nominal = (nominal_b_from_s.quaternion() != comp_b_from_s.quaternion())
-                            .then(|| demodulate(n_from_s, nominal_b_from_s));
-                        let body = body.or_else(|| nominal.map(|_| demodulate(n_from_s, comp_b_from_s)));
-                        primary =
-                            Some((t_repr, encoder, corrected, (n_from_s, comp_b_from_s), body, nominal, reference));
-                    }
-                }
-                let Some((t_repr, encoder, corrected, compensated_chain, body, nominal, reference)) = primary else {
-                    continue;
-                };
-                // Outside the reference's span (it starts late or ends early) nothing is compared (the
-                // errors recorded there are NaN); the INS's own solution is recorded all along.
-                let compare = !(has_reference && reference.is_none());
-                let truth = reference.or(body);
-                let table_errors = if compare {
-                    // The compensated body against the reference (or itself); the nominal one against it.
-                    let compensated = errors[0];
-                    match (nominal, truth) {
-                        (Some(n), Some(truth)) => [n.error_from(&truth), compensated],
-                        _ => [compensated; 2],
-                    }
-                } else {
-                    [nan; 2]
-                };
-                let nav_error = pb.core.nav_error();
-                if compare {
-                    compared += 1;
-                    for (v, e) in table_errors.iter().enumerate() {
-                        for (a, x) in e.as_array().into_iter().enumerate() {
-                            stats[v][a].add(x);
-                        }
-                    }
-                    for (k, e) in errors.iter().enumerate() {
-                        for (a, x) in e.as_array().into_iter().enumerate() {
-                            ins_stats[k][a].add(x);
-                        }
-                    }
-                    if let Some(e) = nav_error {
-                        let peak = nav.map_or(0.0, |n| n.peak_radial_m).max(e.radial_m);
-                        nav = Some(NavSummary {
-                            peak_radial_m: peak,
-                            final_radial_m: e.radial_m,
-                            final_east_m: e.east_m,
-                            final_north_m: e.north_m,
-                        });
-                    }
-                } else {
-                    errors.iter_mut().for_each(|e| *e = nan);
-                }
-                if !(want_series || want_scene) || !recording {
-                    next_series = if want_series { i.saturating_add(series_every) } else { next_series };
-                    next_scene = if want_scene { i.saturating_add(scene_every) } else { next_scene };
-                    continue;
-                }
-                // A recorded row: the rest of what the scene and plots show (the body was demodulated).
-                let body = body.unwrap_or_else(|| demodulate(compensated_chain.0, compensated_chain.1));
-                let truth = truth.unwrap_or(body);
-                let out = StepOutput {
-                    t_s: s.t_s,
-                    euler: Some(truth),
-                    n_from_b: truth.n_from_b(),
-                    gimbal_rad: corrected,
-                    encoder_rad: encoder,
-                    errors: [table_errors[0], table_errors[1], nan],
-                };
-                let (_, imu_ins) = pb.core.output_attitude(0);
-                // The best estimate of the true IMU attitude: the reference through the compensated table.
-                let imu_true = Some(match reference {
-                    Some(r) => r.n_from_b() * chain.b_from_s(&comp_rot, &corrected),
-                    None => imu_ins,
-                });
-                let view = InsView {
-                    t_s: s.t_s,
-                    t_ref_s: pb.core.reference_instant(t_repr),
-                    errors,
-                    imu_true,
-                    imu_ins,
-                    nav: nav_error,
-                };
-                if want_series {
-                    next_series = i.saturating_add(series_every);
-                    let solution = Some(Solution { body, nav: pb.core.nav_state().copied() });
-                    if !outbox.series(OutputRow { core: out, ins: Some(view.clone()), solution }) {
-                        break;
-                    }
-                }
-                if want_scene {
-                    next_scene = i.saturating_add(scene_every);
-                    if !outbox.scene(OutputRow { core: out, ins: Some(view), solution: None }) {
-                        break;
-                    }
                 }
             }
             Ok(())
         })();
-        outbox.close();
-        drop(tx);
+        let _ = to_views.send(batch);
+        drop(to_views);
+        let tallies = viewer.join();
         // A data error first (the recording then holds what came before it); else the recorder's.
         let recorded = consumer.map(|h| h.join());
         looped?;
+        let tallies = tallies.map_err(|_| PlaybackError::Record("the statistics' thread panicked".into()))?;
         match recorded {
             Some(Ok(Err(e))) => Err(rerun(e)),
             Some(Err(_)) => Err(PlaybackError::Record("the recorder's thread panicked".into())),
-            _ => Ok(()),
+            _ => Ok(tallies),
         }
     })?;
+    let Tallies { stats, ins_stats, nav, compared } = tallies;
     if !interrupted {
         pb.finish()?;
     }
