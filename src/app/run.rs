@@ -45,13 +45,7 @@ impl InsStats {
             }
         }
         if let Some(e) = v.nav {
-            let peak = self.nav.map_or(0.0, |n| n.peak_radial_m).max(e.radial_m);
-            self.nav = Some(NavSummary {
-                peak_radial_m: peak,
-                final_radial_m: e.radial_m,
-                final_east_m: e.east_m,
-                final_north_m: e.north_m,
-            });
+            self.nav = Some(NavSummary::after(self.nav, &e));
         }
     }
 }
@@ -117,6 +111,18 @@ pub struct NavSummary {
     pub final_east_m: f64,
     /// North position error at the end, m.
     pub final_north_m: f64,
+}
+
+impl NavSummary {
+    /// The summary `previous` (None: none yet) with the navigation errors `e` of the next update.
+    pub(crate) fn after(previous: Option<Self>, e: &crate::ins::core::NavError) -> Self {
+        Self {
+            peak_radial_m: previous.map_or(0.0, |n| n.peak_radial_m).max(e.radial_m),
+            final_radial_m: e.radial_m,
+            final_east_m: e.east_m,
+            final_north_m: e.north_m,
+        }
+    }
 }
 
 impl RunSummary {

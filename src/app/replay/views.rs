@@ -174,13 +174,7 @@ impl Views<'_> {
                 }
             }
             if let Some(e) = u.nav_error {
-                let peak = tallies.nav.map_or(0.0, |n| n.peak_radial_m).max(e.radial_m);
-                tallies.nav = Some(NavSummary {
-                    peak_radial_m: peak,
-                    final_radial_m: e.radial_m,
-                    final_east_m: e.east_m,
-                    final_north_m: e.north_m,
-                });
+                tallies.nav = Some(NavSummary::after(tallies.nav, &e));
             }
         } else {
             errors.iter_mut().for_each(|e| *e = nan);
