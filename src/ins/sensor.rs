@@ -360,9 +360,10 @@ impl Sensors {
         if !on.dither {
             dither.amplitudes_rad = [0.0; 3];
         }
+        let g_sensitivity = spec.g_sensitivity * gain(on.g_sensitivity);
         let exact = gyro.exact
             && accel.exact
-            && spec.g_sensitivity * gain(on.g_sensitivity) == 0.0
+            && g_sensitivity == 0.0
             && gyro_ieee.is_none()
             && accel_ieee.is_none()
             && dither.amplitudes_rad.iter().all(|x| *x == 0.0);
@@ -372,7 +373,7 @@ impl Sensors {
             accel,
             gyro_ieee,
             accel_ieee,
-            g_sensitivity: spec.g_sensitivity * gain(on.g_sensitivity),
+            g_sensitivity,
             dither,
             dither_phase,
             dither_last: [0.0; 3],

@@ -109,12 +109,20 @@ pub fn check_angle(file: &Path, at: Location, column: &str, cell: f64, si: f64) 
     ))
 }
 
+/// Whether a time `t_s` after the first stamp lies within a log's span ([`MAX_LOG_SPAN_S`]; a NaN
+/// does not): [`check_span`]'s rule, as a comparison.
+#[inline]
+#[must_use]
+pub fn within_span(t_s: f64) -> bool {
+    t_s.abs() <= MAX_LOG_SPAN_S
+}
+
 /// Checks a time stamp `t_s` (s after the log's first) read as `cell` from `column` at `at`.
 ///
 /// # Errors
 /// [`LogError::BadValue`] naming the value and the bound.
 pub fn check_span(file: &Path, at: Location, column: &str, cell: f64, t_s: f64) -> Result<(), LogError> {
-    if t_s.abs() <= MAX_LOG_SPAN_S {
+    if within_span(t_s) {
         return Ok(());
     }
     Err(bad_value(

@@ -352,7 +352,6 @@ pub fn replay(
                     batch.items.push(Item::Update(Update {
                         t_s: s.t_s,
                         t_ref_s,
-                        algorithms: algorithms.len(),
                         nav_error: pb.core.nav_error(),
                         nav_state: if series_row { pb.core.nav_state().copied() } else { None },
                         series_row,

@@ -29,13 +29,12 @@ pub(super) struct AlgorithmOutput {
 }
 
 /// An attitude update: its sample's time, the primary algorithm's truth instant, the navigation
-/// errors (and state, for a recorded row), whether the plots and the scene take it; its algorithms'
-/// outputs follow in the batch's `algorithms`.
+/// errors (and state, for a recorded row), whether the plots and the scene take it; its outputs,
+/// one per algorithm, follow in the batch's `algorithms`.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Update {
     pub(super) t_s: f64,
     pub(super) t_ref_s: f64,
-    pub(super) algorithms: usize,
     pub(super) nav_error: Option<NavError>,
     pub(super) nav_state: Option<NavState>,
     pub(super) series_row: bool,
@@ -97,7 +96,7 @@ impl Views<'_> {
                 let go_on = match item {
                     Item::Signal(s) => outbox.signal(*s),
                     Item::Update(u) => {
-                        let (these, rest) = algorithms.split_at(u.algorithms);
+                        let (these, rest) = algorithms.split_at(self.demod.len());
                         algorithms = rest;
                         self.update(u, these, &mut tallies, &mut outbox)
                     }

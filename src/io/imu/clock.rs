@@ -104,7 +104,19 @@ impl Clock {
             self.prev_sow = value;
             return (value + self.week_offset_s - first, raw);
         }
-        ((value - first) * self.unit.to_s(), raw)
+        (self.since(first, value), raw)
+    }
+
+    /// A stamp `value` in seconds after the first stamp `first` (decimal units: no state).
+    #[inline]
+    pub(crate) fn since(&self, first: f64, value: f64) -> f64 {
+        (value - first) * self.unit.to_s()
+    }
+
+    /// The first stamp, once known, if every later stamp converts without state ([`Self::since`]):
+    /// neither GPS seconds of week (rollovers) nor exact integers.
+    pub(crate) fn stateless_origin(&self) -> Option<f64> {
+        self.first.filter(|_| self.first_ns.is_none() && self.unit != TimeUnit::GpsSecondsOfWeek)
     }
 
     pub(crate) fn start(&self) -> Option<StartTime> {

@@ -391,15 +391,22 @@ impl ImuReader {
             (self.reader.exact_integer(0), self.reader.location())
         };
         let (t_s, raw_t) = self.clock.convert(row[0], exact);
+        let cells = [row[1], row[2], row[3], row[4], row[5], row[6]];
+        Ok(Some(Pending { sample: self.sample_of(t_s, &cells), at, raw_t, cells }))
+    }
+
+    /// The sample at `t_s` of a row's six sensor `cells` (file units and axes): scaled to SI
+    /// units, turned into RFU.
+    #[inline]
+    fn sample_of(&self, t_s: f64, cells: &[f64]) -> ImuSample {
         let s = &self.scale;
-        let mut gyro = Vector3::new(row[1] * s[0], row[2] * s[1], row[3] * s[2]);
-        let mut accel = Vector3::new(row[4] * s[3], row[5] * s[4], row[6] * s[5]);
+        let mut gyro = Vector3::new(cells[0] * s[0], cells[1] * s[1], cells[2] * s[2]);
+        let mut accel = Vector3::new(cells[3] * s[3], cells[4] * s[4], cells[5] * s[5]);
         if !self.c_identity {
             gyro = self.c * gyro;
             accel = self.c * accel;
         }
-        let cells = [row[1], row[2], row[3], row[4], row[5], row[6]];
-        Ok(Some(Pending { sample: ImuSample { t_s, gyro, accel }, at, raw_t, cells }))
+        ImuSample { t_s, gyro, accel }
     }
 
     /// Increments or rates.
@@ -559,19 +566,25 @@ impl ImuReader {
         let increments = (self.kind == SampleKind::Increments).then_some(interval_s);
         for (k, cell) in p.cells.iter().enumerate() {
             let si = cell * self.scale[k];
-            let (sensor, bound) = if k < 3 {
-                (Sensor::Gyro, crate::io::validity::MAX_RATE_RAD_PER_S)
-            } else {
-                (Sensor::Accel, crate::io::validity::MAX_SPECIFIC_FORCE_MPS2)
-            };
             // The hot path: one comparison per value; the message only when it fails.
-            if si.is_nan() || si.abs() > bound * increments.unwrap_or(1.0) {
+            if beyond_bounds(k, si, increments.unwrap_or(1.0)) {
                 let column = self.reader.columns().get(k + 1).map_or("", String::as_str);
+                let sensor = if k < 3 { Sensor::Gyro } else { Sensor::Accel };
                 check_imu_value(&self.path, p.at, column, *cell, si, sensor, increments)?;
             }
         }
         Ok(())
     }
+}
+
+/// Whether sensor value `k` (0-2 gyros, 3-5 accelerometers), `si` in SI units, is NaN or beyond
+/// what any instrument measures ([`crate::io::validity`]) over `per` seconds (an increment's
+/// interval; 1 for a rate).
+#[inline]
+fn beyond_bounds(k: usize, si: f64, per: f64) -> bool {
+    use crate::io::validity::{MAX_RATE_RAD_PER_S, MAX_SPECIFIC_FORCE_MPS2};
+    let bound = if k < 3 { MAX_RATE_RAD_PER_S } else { MAX_SPECIFIC_FORCE_MPS2 };
+    si.is_nan() || si.abs() > bound * per
 }
 
 impl ImuReader {
@@ -580,52 +593,35 @@ impl ImuReader {
     /// the same checks, as comparisons, without a row's error context (its location, its cells)
     /// built and moved per sample (they were most of the reading thread's time). The first row a
     /// check refuses is left in the block for [`Self::step`], which reports it, or returns its gap,
-    /// as it always does. Appends at most `max` samples to `out`; returns how many.
+    /// as it always does. For a reader that [`ColumnReader::reads_in_blocks`]; appends at most
+    /// `max` samples to `out`; returns how many.
     fn clean_block_rows(&mut self, out: &mut Vec<ImuSample>, max: usize) -> usize {
         // After the first row (the clock's origin and `prev` set), nothing held or looked ahead,
         // and a stamp that converts without state (not GPS seconds of week, not exact integers).
-        let (Some(first), None, Some((mut t_prev, mut raw_prev))) = (self.clock.first, self.clock.first_ns, self.prev)
-        else {
+        let (Some(first), Some((mut t_prev, mut raw_prev))) = (self.clock.stateless_origin(), self.prev) else {
             return 0;
         };
-        if self.held.is_some()
-            || !self.lookahead.is_empty()
-            || self.read_error.is_some()
-            || !self.reader.reads_in_blocks()
-            || self.clock.unit == TimeUnit::GpsSecondsOfWeek
-        {
+        if self.held.is_some() || !self.lookahead.is_empty() || self.read_error.is_some() {
             return 0;
         }
-        use crate::io::validity::{MAX_LOG_SPAN_S, MAX_RATE_RAD_PER_S, MAX_SPECIFIC_FORCE_MPS2};
-        let to_s = self.clock.unit.to_s();
         let gap_s = self.nominal_dt_s.map_or(f64::INFINITY, |n| self.gap_factor * n);
         let increments = self.kind == SampleKind::Increments;
-        let s = self.scale;
         let rows = self.block.len() / 7;
         let mut n = 0;
         while n < max && self.block_pos < rows {
             let row = &self.block[self.block_pos * 7..self.block_pos * 7 + 7];
-            let t = (row[0] - first) * to_s;
+            let t = self.clock.since(first, row[0]);
             let dt = t - t_prev;
             // `dt > 0` also refuses a NaN stamp; `step` says which check failed.
-            if !(t.abs() <= MAX_LOG_SPAN_S && dt > 0.0 && dt <= gap_s) {
+            if !(crate::io::validity::within_span(t) && dt > 0.0 && dt <= gap_s) {
                 break;
             }
             let per = if increments { dt } else { 1.0 };
-            let within = |k: usize, bound: f64| {
-                let si = row[k + 1] * s[k];
-                !(si.is_nan() || si.abs() > bound * per)
-            };
-            if !((0..3).all(|k| within(k, MAX_RATE_RAD_PER_S)) && (3..6).all(|k| within(k, MAX_SPECIFIC_FORCE_MPS2))) {
+            let cells = &row[1..];
+            if (0..6).any(|k| beyond_bounds(k, cells[k] * self.scale[k], per)) {
                 break;
             }
-            let mut gyro = Vector3::new(row[1] * s[0], row[2] * s[1], row[3] * s[2]);
-            let mut accel = Vector3::new(row[4] * s[3], row[5] * s[4], row[6] * s[5]);
-            if !self.c_identity {
-                gyro = self.c * gyro;
-                accel = self.c * accel;
-            }
-            out.push(ImuSample { t_s: t, gyro, accel });
+            out.push(self.sample_of(t, cells));
             (t_prev, raw_prev.value) = (t, row[0]);
             self.block_pos += 1;
             n += 1;
@@ -656,9 +652,13 @@ impl ImuReader {
         if self.done {
             return Ok(BlockEnd::End);
         }
+        // Text formats read row by row: every row through `step`.
+        let blocks = self.reader.reads_in_blocks();
         let mut taken = 0;
         while taken < max {
-            taken += self.clean_block_rows(out, max - taken);
+            if blocks {
+                taken += self.clean_block_rows(out, max - taken);
+            }
             if taken == max {
                 break;
             }
