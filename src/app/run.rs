@@ -11,7 +11,7 @@ use crate::app::failure::Failure;
 use crate::app::feed::{self, Outbox, OutputRow};
 use crate::app::outputs::{RecordingName, RecordingRequest, check_output, finish, write_json};
 use crate::ins::core::SampleOut;
-use crate::ins::pipeline::{InsOutputs, InsRun, InsView, InsViewer};
+use crate::ins::pipeline::{AlgorithmOutput, InsOutputs, InsRun, InsView, InsViewer};
 use crate::math::stats::RunningStat;
 use crate::math::timeline::{Timeline, decimation};
 use crate::math::units::ARCSEC_PER_RAD;
@@ -409,7 +409,7 @@ impl Producer<'_> {
         // the simulation (truth, sensors, the computer) hands each update's outputs on, as the
         // recorder's thread takes the rows (a third of the simulation's time was the errors').
         let viewer = ins.viewer();
-        let (tx, rx) = crossbeam_channel::bounded::<Vec<Update>>(4);
+        let (tx, rx) = crossbeam_channel::bounded::<Batch>(4);
         std::thread::scope(|scope| {
             let views = scope.spawn(move || self.view_updates(viewer, ins_stats, &rx));
             let (done, interrupted) = self.simulate(&mut ins, timeline, &tx);
@@ -422,17 +422,17 @@ impl Producer<'_> {
     /// The simulation's side of [`Self::run_ins`]: one IMU sample per step; the outputs of every
     /// attitude update to `tx`, marked for the statistics and the scene at the updates closest to
     /// their rates; the gyro signal's first samples. Returns (instants done, interrupted).
-    fn simulate(
-        &self,
-        ins: &mut InsRun,
-        timeline: &Timeline,
-        tx: &crossbeam_channel::Sender<Vec<Update>>,
-    ) -> (u64, bool) {
+    fn simulate(&self, ins: &mut InsRun, timeline: &Timeline, tx: &crossbeam_channel::Sender<Batch>) -> (u64, bool) {
         const UPDATES_PER_BATCH: usize = 512;
+        let algorithms = ins.algorithms().len();
+        let new_batch = || Batch {
+            updates: Vec::with_capacity(UPDATES_PER_BATCH),
+            attitudes: Vec::with_capacity(UPDATES_PER_BATCH * algorithms),
+        };
         let window = ins.config().signal_window_s;
         let (mut done, mut interrupted) = (1, false);
         let (mut next_scene, mut next_stats) = (0u64, 0u64);
-        let mut batch = Vec::with_capacity(UPDATES_PER_BATCH);
+        let mut batch = new_batch();
         for i in 1..=timeline.intervals() {
             if i % 65_536 == 0 && self.check(i) {
                 interrupted = true;
@@ -440,7 +440,7 @@ impl Producer<'_> {
             }
             let s = ins.step();
             if s.t_s <= window {
-                batch.push(Update::Signal(s));
+                batch.updates.push(Update::Signal(s));
             }
             done = i + 1;
             if s.updated {
@@ -456,10 +456,10 @@ impl Producer<'_> {
                 if want_stats {
                     next_stats = i.saturating_add(self.stats_every);
                 }
-                batch.push(Update::Output { outputs: ins.outputs(s.t_s, want_scene), want_stats, want_scene });
+                let outputs = ins.outputs(s.t_s, want_scene, &mut batch.attitudes);
+                batch.updates.push(Update::Output { outputs, want_stats, want_scene });
             }
-            if batch.len() >= UPDATES_PER_BATCH
-                && tx.send(std::mem::replace(&mut batch, Vec::with_capacity(UPDATES_PER_BATCH))).is_err()
+            if batch.updates.len() >= UPDATES_PER_BATCH && tx.send(std::mem::replace(&mut batch, new_batch())).is_err()
             {
                 // The statistics' thread stopped: the recorder failed (it reports why).
                 return (done, interrupted);
@@ -476,7 +476,7 @@ impl Producer<'_> {
         &self,
         mut viewer: InsViewer,
         mut ins_stats: InsStats,
-        rx: &crossbeam_channel::Receiver<Vec<Update>>,
+        rx: &crossbeam_channel::Receiver<Batch>,
     ) -> (ErrorStats, InsStats) {
         let mut state = DemodState::default();
         let mut stats = ErrorStats::default();
@@ -485,13 +485,16 @@ impl Producer<'_> {
         let mut last_update: Option<(f64, bool)> = None;
         'batches: for batch in rx {
             // By reference: moving each update out of the batch copied its outputs (2 % of the CPU).
-            for update in &batch {
+            let mut attitudes = batch.attitudes.as_slice();
+            for update in &batch.updates {
                 let (outputs, want_stats, want_scene) = match update {
                     Update::Signal(s) if out.signal(*s) => continue,
                     Update::Signal(_) => break 'batches,
                     Update::Output { outputs, want_stats, want_scene } => (outputs, *want_stats, *want_scene),
                 };
-                let view = viewer.view(outputs);
+                let (these, rest) = attitudes.split_at(outputs.algorithms());
+                attitudes = rest;
+                let view = viewer.view(outputs, these);
                 ins_stats.add(&view);
                 let wanted = want_stats || want_scene;
                 // The previous update's instant, for the delay correction when it was not computed.
@@ -518,6 +521,13 @@ impl Producer<'_> {
         out.close();
         (stats, ins_stats)
     }
+}
+
+/// What the simulation hands the statistics' thread: updates in order, their algorithms' outputs
+/// one after the other ([`Producer::run_ins`]).
+struct Batch {
+    updates: Vec<Update>,
+    attitudes: Vec<AlgorithmOutput>,
 }
 
 /// What the simulation hands the statistics' thread, in order ([`Producer::run_ins`]).

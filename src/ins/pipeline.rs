@@ -10,7 +10,7 @@ use super::core::{InsCore, SampleOut};
 use super::nav::NavState;
 use super::sensor::Sensors;
 use super::truth::TruthImu;
-pub use super::view::{AlgorithmErrors, InsOutputs, InsView, InsViewer};
+pub use super::view::{AlgorithmErrors, AlgorithmOutput, InsOutputs, InsView, InsViewer};
 use crate::math::attitude::Attitude;
 use crate::math::frames::{B, N, Rot, S};
 use crate::math::rotvec;
@@ -31,6 +31,8 @@ pub struct InsRun {
     start: Rot<N, S>,
     /// The errors against the truth (the table's demodulation state).
     viewer: InsViewer,
+    /// The algorithms' outputs of the latest view (kept: no allocation per view).
+    attitudes: Vec<AlgorithmOutput>,
     /// IMU errors the computer removes from every sample before using it (a self-calibration's
     /// estimates), if any.
     compensation: Option<super::imu_errors::ImuErrors>,
@@ -95,6 +97,7 @@ impl InsRun {
             pre_roll,
             start,
             viewer,
+            attitudes: Vec::new(),
             // The computer (the core) removes `cfg.imu_compensation` itself: the samples stay raw.
             compensation: None,
             t0_s,
@@ -263,15 +266,20 @@ impl InsRun {
     }
 
     fn view_with(&mut self, t_s: f64, with_truth: bool) -> InsView {
-        let o = self.outputs(t_s, with_truth);
-        self.viewer.view(&o)
+        let mut attitudes = std::mem::take(&mut self.attitudes);
+        attitudes.clear();
+        let o = self.outputs(t_s, with_truth, &mut attitudes);
+        let view = self.viewer.view(&o, &attitudes);
+        self.attitudes = attitudes;
+        view
     }
 
     /// The computer's outputs after a primary update at `t_s` (what [`Self::view`] shows), with
-    /// the true C_s^n if `with_truth`: a value for an [`InsViewer`] elsewhere ([`Self::viewer`]).
-    pub fn outputs(&mut self, t_s: f64, with_truth: bool) -> InsOutputs {
+    /// the true C_s^n if `with_truth`, its algorithms' appended to `attitudes`: for an
+    /// [`InsViewer`] elsewhere ([`Self::viewer`]).
+    pub fn outputs(&mut self, t_s: f64, with_truth: bool, attitudes: &mut Vec<AlgorithmOutput>) -> InsOutputs {
         let imu_true = with_truth.then(|| self.truth.n_from_s(self.core.output_attitude(0).0));
-        InsOutputs::of(&self.core, t_s, imu_true)
+        InsOutputs::of(&self.core, t_s, imu_true, attitudes)
     }
 
     /// A viewer of this INS's outputs in its present state (a run's statistics' thread views the

@@ -88,31 +88,44 @@ struct Shared {
     truth: EulerParts,
 }
 
-/// What the computer outputs at an update, all a view needs: each algorithm's C_s^n, the instant
-/// it stands for and the truth instant it is compared at; the navigation errors; the true C_s^n
-/// when the scene draws it. A value (a run sends it to its statistics' thread).
+/// One algorithm's output at an update: the instant it stands for, the truth instant it is
+/// compared at, its C_s^n.
+pub type AlgorithmOutput = (f64, f64, Rot<N, S>);
+
+/// What the computer outputs at an update, all a view needs: the navigation errors, the true C_s^n
+/// when the scene draws it; and each algorithm's [`AlgorithmOutput`], which [`Self::of`] appends to
+/// a list the caller keeps. A value (a run sends it to its statistics' thread, the algorithms'
+/// outputs of a batch of updates in one list: an update's share is as long as the algorithms run,
+/// not the five there could be — a fixed array of five made each update 370 bytes, written and
+/// read across threads, where one algorithm's is 130).
 #[derive(Debug, Clone, Copy)]
 pub struct InsOutputs {
     t_s: f64,
     t_ref_s: f64,
-    attitudes: [(f64, f64, Rot<N, S>); Algorithm::ALL.len()],
+    /// The algorithms' outputs in the caller's list.
     len: usize,
     imu_true: Option<Rot<N, S>>,
     nav: Option<NavError>,
 }
 
 impl InsOutputs {
-    /// `core`'s outputs after a primary update at `t_s`, with the true C_s^n `imu_true` if drawn.
+    /// `core`'s outputs after a primary update at `t_s`, with the true C_s^n `imu_true` if drawn;
+    /// each algorithm's appended to `attitudes`, in integrator order.
     #[must_use]
-    pub fn of(core: &InsCore, t_s: f64, imu_true: Option<Rot<N, S>>) -> Self {
+    pub fn of(core: &InsCore, t_s: f64, imu_true: Option<Rot<N, S>>, attitudes: &mut Vec<AlgorithmOutput>) -> Self {
         let len = core.algorithm_count();
-        let mut attitudes = [(0.0, 0.0, Rot::identity()); Algorithm::ALL.len()];
-        for (k, a) in attitudes.iter_mut().enumerate().take(len) {
+        for k in 0..len {
             let (t_repr, n_from_s) = core.output_attitude(k);
-            *a = (t_repr, core.reference_instant(t_repr), n_from_s);
+            attitudes.push((t_repr, core.reference_instant(t_repr), n_from_s));
         }
         let t_ref_s = t_s - core.config().output_compensation_s;
-        Self { t_s, t_ref_s, attitudes, len, imu_true, nav: core.nav_error() }
+        Self { t_s, t_ref_s, len, imu_true, nav: core.nav_error() }
+    }
+
+    /// The number of algorithms' outputs [`Self::of`] appended.
+    #[must_use]
+    pub fn algorithms(&self) -> usize {
+        self.len
     }
 
     /// The output time, s.
@@ -172,17 +185,18 @@ impl InsViewer {
         self.shared.iter().find(|e| e.t_ref_s == t_s).map(|e| (e.n_from_b, e.truth))
     }
 
-    /// The INS body attitude errors of the outputs `o`. Each algorithm is compared at the instant
-    /// its own latest output stands for (algorithms with more samples per update update less
-    /// often), against the truth `output_compensation` earlier.
-    pub fn view(&mut self, o: &InsOutputs) -> InsView {
+    /// The INS body attitude errors of the outputs `o` (its algorithms' `attitudes`). Each algorithm
+    /// is compared at the instant its own latest output stands for (algorithms with more samples per
+    /// update update less often), against the truth `output_compensation` earlier.
+    pub fn view(&mut self, o: &InsOutputs, attitudes: &[AlgorithmOutput]) -> InsView {
+        debug_assert_eq!(attitudes.len(), o.len);
         let model = &self.model;
         let mut errors = AlgorithmErrors::default();
         // Algorithms that stand for the same instant share its encoder readings (a pure function of
         // the instant) and its true attitude; the same corrected angles, the compensated chain.
         let mut shared = std::mem::take(&mut self.shared);
         shared.clear();
-        for (k, &(t_repr, t_ref, n_from_s)) in o.attitudes[..o.len].iter().enumerate() {
+        for (k, &(t_repr, t_ref, n_from_s)) in attitudes.iter().enumerate() {
             if let Some((t, q, e)) = self.last_error[k] {
                 // The same output as last time: the same error (the demodulation's state is that of
                 // having read this instant already).
@@ -217,7 +231,7 @@ impl InsViewer {
             errors.push(error);
         }
         self.shared = shared;
-        let imu_ins = o.attitudes[0].2;
+        let imu_ins = attitudes[0].2;
         InsView { t_s: o.t_s, t_ref_s: o.t_ref_s, errors, imu_true: o.imu_true, imu_ins, nav: o.nav }
     }
 }
