@@ -304,7 +304,10 @@ pub fn replay(
         // The views' thread holds the recorder's channel: the recorder stops when it does.
         let viewer = scope.spawn(move || views.consume(&from_loop, Outbox::new(&tx)));
         const UPDATES_PER_BATCH: usize = 512;
-        let mut batch = Batch::default();
+        // Each batch at its full size from the start (grown item by item from empty, every item
+        // was copied about twice more).
+        let new_batch = || Batch::with_capacity(UPDATES_PER_BATCH, algorithms.len());
+        let mut batch = new_batch();
         let looped = (|| -> Result<(), PlaybackError> {
             while let Some(s) = pb.step()? {
                 i += 1;
@@ -349,17 +352,21 @@ pub fn replay(
                         batch.algorithms.push(AlgorithmOutput { t_repr_s, n_from_s, encoder_rad, reference });
                     }
                     let series_row = recording && want_series;
+                    if let Some(state) = pb.core.nav_state().filter(|_| series_row) {
+                        batch.nav_states.push(*state);
+                    }
                     batch.items.push(Item::Update(Update {
                         t_s: s.t_s,
                         t_ref_s,
                         nav_error: pb.core.nav_error(),
-                        nav_state: if series_row { pb.core.nav_state().copied() } else { None },
                         series_row,
                         scene_row: recording && want_scene,
                     }));
                 }
                 // The views' thread stopped: the recorder failed (it reports why).
-                if batch.items.len() >= UPDATES_PER_BATCH && to_views.send(std::mem::take(&mut batch)).is_err() {
+                if batch.items.len() >= UPDATES_PER_BATCH
+                    && to_views.send(std::mem::replace(&mut batch, new_batch())).is_err()
+                {
                     break;
                 }
             }

@@ -29,14 +29,13 @@ pub(super) struct AlgorithmOutput {
 }
 
 /// An attitude update: its sample's time, the primary algorithm's truth instant, the navigation
-/// errors (and state, for a recorded row), whether the plots and the scene take it; its outputs,
-/// one per algorithm, follow in the batch's `algorithms`.
+/// errors, whether the plots and the scene take it; its outputs, one per algorithm, follow in the
+/// batch's `algorithms`, and a plotted row's navigation state in its `nav_states` (when navigating).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Update {
     pub(super) t_s: f64,
     pub(super) t_ref_s: f64,
     pub(super) nav_error: Option<NavError>,
-    pub(super) nav_state: Option<NavState>,
     pub(super) series_row: bool,
     pub(super) scene_row: bool,
 }
@@ -49,11 +48,24 @@ pub(super) enum Item {
     Update(Update),
 }
 
-/// A batch of items, the updates' algorithm outputs one after the other.
-#[derive(Default)]
+/// A batch of items, the updates' algorithm outputs one after the other, and the navigation states
+/// of the updates the plots take (a state in every update was 56 of its 136 bytes, written by the
+/// loop and read by the views' thread, for the few rows plotted).
 pub(super) struct Batch {
     pub(super) items: Vec<Item>,
     pub(super) algorithms: Vec<AlgorithmOutput>,
+    pub(super) nav_states: Vec<NavState>,
+}
+
+impl Batch {
+    /// An empty batch with room for `updates` updates of `algorithms` algorithms each.
+    pub(super) fn with_capacity(updates: usize, algorithms: usize) -> Self {
+        Self {
+            items: Vec::with_capacity(updates),
+            algorithms: Vec::with_capacity(updates * algorithms),
+            nav_states: Vec::new(),
+        }
+    }
 }
 
 /// The statistics a replay reports: the table's (nominal, compensated), each algorithm's, the
@@ -92,13 +104,15 @@ impl Views<'_> {
         };
         'batches: for batch in rx {
             let mut algorithms = batch.algorithms.as_slice();
+            let mut nav_states = batch.nav_states.iter();
             for item in &batch.items {
                 let go_on = match item {
                     Item::Signal(s) => outbox.signal(*s),
                     Item::Update(u) => {
                         let (these, rest) = algorithms.split_at(self.demod.len());
                         algorithms = rest;
-                        self.update(u, these, &mut tallies, &mut outbox)
+                        let nav_state = if u.series_row { nav_states.next().copied() } else { None };
+                        self.update(u, these, nav_state, &mut tallies, &mut outbox)
                     }
                 };
                 if !go_on {
@@ -118,6 +132,7 @@ impl Views<'_> {
         &mut self,
         u: &Update,
         outputs: &[AlgorithmOutput],
+        nav_state: Option<NavState>,
         tallies: &mut Tallies,
         outbox: &mut Outbox<'_>,
     ) -> bool {
@@ -199,7 +214,7 @@ impl Views<'_> {
         });
         let view = InsView { t_s: u.t_s, t_ref_s: u.t_ref_s, errors, imu_true, imu_ins: a.n_from_s, nav: u.nav_error };
         if u.series_row {
-            let solution = Some(Solution { body, nav: u.nav_state });
+            let solution = Some(Solution { body, nav: nav_state });
             if !outbox.series(OutputRow { core: out, ins: Some(view.clone()), solution }) {
                 return false;
             }
