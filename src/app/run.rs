@@ -531,8 +531,6 @@ struct Batch {
 }
 
 /// What the simulation hands the statistics' thread, in order ([`Producer::run_ins`]).
-// The large variant is the one of every update; boxing it would allocate per update.
-#[allow(clippy::large_enum_variant)]
 enum Update {
     /// A sample of the gyro signal's first seconds.
     Signal(SampleOut),
