@@ -11,7 +11,7 @@ use crate::app::failure::Failure;
 use crate::app::feed::{self, Outbox, OutputRow};
 use crate::app::outputs::{RecordingName, RecordingRequest, check_output, finish, write_json};
 use crate::ins::core::SampleOut;
-use crate::ins::pipeline::{AlgorithmOutput, InsOutputs, InsRun, InsView, InsViewer};
+use crate::ins::pipeline::{AttitudeOutput, InsOutputs, InsRun, InsView, InsViewer};
 use crate::math::stats::RunningStat;
 use crate::math::timeline::{Timeline, decimation};
 use crate::math::units::ARCSEC_PER_RAD;
@@ -492,7 +492,7 @@ impl Producer<'_> {
                     Update::Signal(_) => break 'batches,
                     Update::Output { outputs, want_stats, want_scene } => (outputs, *want_stats, *want_scene),
                 };
-                let (these, rest) = attitudes.split_at(outputs.algorithms());
+                let (these, rest) = attitudes.split_at(viewer.algorithms());
                 attitudes = rest;
                 let view = viewer.view(outputs, these);
                 ins_stats.add(&view);
@@ -527,7 +527,7 @@ impl Producer<'_> {
 /// one after the other ([`Producer::run_ins`]).
 struct Batch {
     updates: Vec<Update>,
-    attitudes: Vec<AlgorithmOutput>,
+    attitudes: Vec<AttitudeOutput>,
 }
 
 /// What the simulation hands the statistics' thread, in order ([`Producer::run_ins`]).

@@ -10,7 +10,7 @@ use super::core::{InsCore, SampleOut};
 use super::nav::NavState;
 use super::sensor::Sensors;
 use super::truth::TruthImu;
-pub use super::view::{AlgorithmErrors, AlgorithmOutput, InsOutputs, InsView, InsViewer};
+pub use super::view::{AlgorithmErrors, AttitudeOutput, InsOutputs, InsView, InsViewer};
 use crate::math::attitude::Attitude;
 use crate::math::frames::{B, N, Rot, S};
 use crate::math::rotvec;
@@ -32,7 +32,7 @@ pub struct InsRun {
     /// The errors against the truth (the table's demodulation state).
     viewer: InsViewer,
     /// The algorithms' outputs of the latest view (kept: no allocation per view).
-    attitudes: Vec<AlgorithmOutput>,
+    attitudes: Vec<AttitudeOutput>,
     /// IMU errors the computer removes from every sample before using it (a self-calibration's
     /// estimates), if any.
     compensation: Option<super::imu_errors::ImuErrors>,
@@ -277,7 +277,7 @@ impl InsRun {
     /// The computer's outputs after a primary update at `t_s` (what [`Self::view`] shows), with
     /// the true C_s^n if `with_truth`, its algorithms' appended to `attitudes`: for an
     /// [`InsViewer`] elsewhere ([`Self::viewer`]).
-    pub fn outputs(&mut self, t_s: f64, with_truth: bool, attitudes: &mut Vec<AlgorithmOutput>) -> InsOutputs {
+    pub fn outputs(&mut self, t_s: f64, with_truth: bool, attitudes: &mut Vec<AttitudeOutput>) -> InsOutputs {
         let imu_true = with_truth.then(|| self.truth.n_from_s(self.core.output_attitude(0).0));
         InsOutputs::of(&self.core, t_s, imu_true, attitudes)
     }

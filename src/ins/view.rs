@@ -88,12 +88,12 @@ struct Shared {
     truth: EulerParts,
 }
 
-/// One algorithm's output at an update: the instant it stands for, the truth instant it is
-/// compared at, its C_s^n.
-pub type AlgorithmOutput = (f64, f64, Rot<N, S>);
+/// One algorithm's attitude output at an update: the instant it stands for, the truth instant it
+/// is compared at, its C_s^n.
+pub type AttitudeOutput = (f64, f64, Rot<N, S>);
 
 /// What the computer outputs at an update, all a view needs: the navigation errors, the true C_s^n
-/// when the scene draws it; and each algorithm's [`AlgorithmOutput`], which [`Self::of`] appends to
+/// when the scene draws it; and each algorithm's [`AttitudeOutput`], which [`Self::of`] appends to
 /// a list the caller keeps. A value (a run sends it to its statistics' thread, the algorithms'
 /// outputs of a batch of updates in one list: an update's share is as long as the algorithms run,
 /// not the five there could be — a fixed array of five made each update 370 bytes, written and
@@ -102,8 +102,6 @@ pub type AlgorithmOutput = (f64, f64, Rot<N, S>);
 pub struct InsOutputs {
     t_s: f64,
     t_ref_s: f64,
-    /// The algorithms' outputs in the caller's list.
-    len: usize,
     imu_true: Option<Rot<N, S>>,
     nav: Option<NavError>,
 }
@@ -112,20 +110,13 @@ impl InsOutputs {
     /// `core`'s outputs after a primary update at `t_s`, with the true C_s^n `imu_true` if drawn;
     /// each algorithm's appended to `attitudes`, in integrator order.
     #[must_use]
-    pub fn of(core: &InsCore, t_s: f64, imu_true: Option<Rot<N, S>>, attitudes: &mut Vec<AlgorithmOutput>) -> Self {
-        let len = core.algorithm_count();
-        for k in 0..len {
+    pub fn of(core: &InsCore, t_s: f64, imu_true: Option<Rot<N, S>>, attitudes: &mut Vec<AttitudeOutput>) -> Self {
+        for k in 0..core.algorithm_count() {
             let (t_repr, n_from_s) = core.output_attitude(k);
             attitudes.push((t_repr, core.reference_instant(t_repr), n_from_s));
         }
         let t_ref_s = t_s - core.config().output_compensation_s;
-        Self { t_s, t_ref_s, len, imu_true, nav: core.nav_error() }
-    }
-
-    /// The number of algorithms' outputs [`Self::of`] appended.
-    #[must_use]
-    pub fn algorithms(&self) -> usize {
-        self.len
+        Self { t_s, t_ref_s, imu_true, nav: core.nav_error() }
     }
 
     /// The output time, s.
@@ -185,11 +176,18 @@ impl InsViewer {
         self.shared.iter().find(|e| e.t_ref_s == t_s).map(|e| (e.n_from_b, e.truth))
     }
 
-    /// The INS body attitude errors of the outputs `o` (its algorithms' `attitudes`). Each algorithm
-    /// is compared at the instant its own latest output stands for (algorithms with more samples per
-    /// update update less often), against the truth `output_compensation` earlier.
-    pub fn view(&mut self, o: &InsOutputs, attitudes: &[AlgorithmOutput]) -> InsView {
-        debug_assert_eq!(attitudes.len(), o.len);
+    /// The number of algorithms viewed: the attitude outputs each update has.
+    #[must_use]
+    pub fn algorithms(&self) -> usize {
+        self.demod.len()
+    }
+
+    /// The INS body attitude errors of the outputs `o` (its algorithms' `attitudes`, one per
+    /// [`Self::algorithms`]). Each algorithm is compared at the instant its own latest output stands
+    /// for (algorithms with more samples per update update less often), against the truth
+    /// `output_compensation` earlier.
+    pub fn view(&mut self, o: &InsOutputs, attitudes: &[AttitudeOutput]) -> InsView {
+        debug_assert_eq!(attitudes.len(), self.demod.len());
         let model = &self.model;
         let mut errors = AlgorithmErrors::default();
         // Algorithms that stand for the same instant share its encoder readings (a pure function of
