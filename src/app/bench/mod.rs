@@ -73,6 +73,20 @@ pub fn peak_rss_bytes() -> u64 {
         .map_or(0, |kb| kb * 1024)
 }
 
+/// CPU time (user + system) of this process's children that have ended and been waited for, s:
+/// `cutime` + `cstime` of `/proc/self/stat` (proc(5)), in the kernel's user-visible clock ticks,
+/// 100 per second on Linux; 0 where there is no such file. The difference across a child's
+/// `Command::output` is that child's CPU time, every thread of it, to 10 ms.
+pub(crate) fn children_cpu_s() -> f64 {
+    const TICKS_PER_S: f64 = 100.0;
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else { return 0.0 };
+    // The command name (field 2) is in parentheses and may hold spaces: fields from the 3rd on
+    // follow its last ')'. cutime and cstime are fields 16 and 17.
+    let fields: Vec<&str> = stat.rsplit_once(')').map_or(Vec::new(), |(_, rest)| rest.split_whitespace().collect());
+    let ticks = |field: usize| fields.get(field - 3).and_then(|f| f.parse::<u64>().ok()).unwrap_or(0);
+    (ticks(16) + ticks(17)) as f64 / TICKS_PER_S
+}
+
 /// An error once `stop` is set (a signal): the benchmarks end between two measurements (each at
 /// most a few seconds), as every command does.
 fn check(stop: &AtomicBool) -> anyhow::Result<()> {
@@ -586,5 +600,28 @@ mod tests {
         let stop = super::AtomicBool::new(false);
         super::strapdown_speed(&mut figs, &stop)?;
         super::pipeline_speed(&mut figs, &stop)
+    }
+
+    /// A child's CPU time as the bench reads it (`children_cpu_s` before and after) against the
+    /// child's own account: a shell that spins, then prints its user and system time with the
+    /// POSIX `times` builtin (the shell's times(2), on its side of the process boundary). Both
+    /// count in 10 ms ticks: they agree to two ticks.
+    #[test]
+    fn a_childs_cpu_time_is_what_the_child_itself_reports() {
+        let before = super::children_cpu_s();
+        let out = std::process::Command::new("sh")
+            .args(["-c", "i=0; while [ $i -lt 300000 ]; do i=$((i+1)); done; times"])
+            .output()
+            .expect("sh runs");
+        let measured = super::children_cpu_s() - before;
+        let text = String::from_utf8_lossy(&out.stdout);
+        // "0m0.41s 0m0.00s" (dash) or "0m0.410000s 0m0.001000s" (bash): minutes and seconds.
+        let seconds = |f: &str| -> f64 {
+            let (m, s) = f.trim_end_matches('s').split_once('m').expect("XmY.Ys");
+            m.parse::<f64>().expect("minutes") * 60.0 + s.parse::<f64>().expect("seconds")
+        };
+        let own: f64 = text.lines().next().expect("times' first line").split_whitespace().take(2).map(seconds).sum();
+        assert!(own > 0.05, "the loop spun {own} s of CPU: too little to compare ({text:?})");
+        assert!((measured - own).abs() <= 0.025, "children_cpu_s read {measured} s; the shell reported {own} s");
     }
 }

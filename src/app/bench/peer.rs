@@ -47,6 +47,10 @@ pub struct Timing {
     pub region_s: f64,
     /// Peak resident memory, MB.
     pub peak_rss_mb: f64,
+    /// CPU time of the whole process (user + system, all its threads), s; 0 for a region timed in
+    /// this process. Over `process_s`, the cores it kept busy: a process that saturates the machine
+    /// gets faster only with less CPU.
+    pub cpu_s: f64,
 }
 
 /// Median and range over the rounds.
@@ -355,13 +359,19 @@ fn time_pipeline(p: &crate::scenario::Params, samples: u64) -> anyhow::Result<Ti
         }
     }
     let region_s = started.elapsed().as_secs_f64();
-    Ok(Timing { process_s: region_s, region_s, peak_rss_mb: crate::app::bench::peak_rss_bytes() as f64 / 1e6 })
+    Ok(Timing {
+        process_s: region_s,
+        region_s,
+        peak_rss_mb: crate::app::bench::peak_rss_bytes() as f64 / 1e6,
+        cpu_s: 0.0,
+    })
 }
 
 /// This rinscope as a whole process: `command` on `input`, saving beside `stem`, its summary JSON
 /// read back. Returns the wall time of the process and the summary.
-fn run_self(command: &str, input: &[&std::ffi::OsStr], stem: &Path) -> anyhow::Result<(f64, Value)> {
+fn run_self(command: &str, input: &[&std::ffi::OsStr], stem: &Path) -> anyhow::Result<(f64, f64, Value)> {
     let json = stem.with_extension("json");
+    let cpu_before = super::children_cpu_s();
     let started = Instant::now();
     let out = Command::new(std::env::current_exe()?)
         .arg(command)
@@ -372,33 +382,32 @@ fn run_self(command: &str, input: &[&std::ffi::OsStr], stem: &Path) -> anyhow::R
         .arg(&json)
         .output()?;
     let process_s = started.elapsed().as_secs_f64();
+    let cpu_s = super::children_cpu_s() - cpu_before;
     ensure!(out.status.success(), "rinscope {command} failed: {}", String::from_utf8_lossy(&out.stderr));
-    Ok((process_s, serde_json::from_str(&std::fs::read_to_string(&json)?)?))
+    Ok((process_s, cpu_s, serde_json::from_str(&std::fs::read_to_string(&json)?)?))
 }
 
 /// The timing fields of a summary.
-fn timing(process_s: f64, s: &Value) -> anyhow::Result<Timing> {
+fn timing((process_s, cpu_s, s): &(f64, f64, Value)) -> anyhow::Result<Timing> {
     let num = |k: &str| s[k].as_f64().ok_or_else(|| anyhow!("the summary lacks {k}"));
-    Ok(Timing { process_s, region_s: num("wall_time_s")?, peak_rss_mb: num("peak_rss_mb")? })
+    Ok(Timing { process_s: *process_s, region_s: num("wall_time_s")?, peak_rss_mb: num("peak_rss_mb")?, cpu_s: *cpu_s })
 }
 
 /// `rinscope run --scenario pure-coning` for `samples` samples at its 100 Hz, whole process.
 fn run_pure_coning(dir: &Path, samples: u64) -> anyhow::Result<Timing> {
     let duration = format!("{}", samples as f64 / 100.0);
     let args = ["--scenario".as_ref(), "pure-coning".as_ref(), "--duration-s".as_ref(), duration.as_ref()];
-    let (process_s, s) = run_self("run", &args, &dir.join("pure-coning"))?;
-    timing(process_s, &s)
+    timing(&run_self("run", &args, &dir.join("pure-coning"))?)
 }
 
 /// `rinscope run` of a scenario, whole process.
 fn run_simulated(scenario: &Path) -> anyhow::Result<Timing> {
-    let (process_s, s) = run_self("run", &["--config".as_ref(), scenario.as_os_str()], scenario)?;
-    timing(process_s, &s)
+    timing(&run_self("run", &["--config".as_ref(), scenario.as_os_str()], scenario)?)
 }
 
 fn run_rinscope(logs: &Path) -> anyhow::Result<(Timing, State)> {
-    let (process_s, s) = run_self("replay", &[logs.as_os_str()], &logs.join("replay"))?;
-    let f = &s["final_state"];
+    let done = run_self("replay", &[logs.as_os_str()], &logs.join("replay"))?;
+    let f = &done.2["final_state"];
     let num =
         |v: &Value| v.as_f64().ok_or_else(|| anyhow!("replay summary lacks a final state (is the navigation on?)"));
     let state = State {
@@ -410,13 +419,15 @@ fn run_rinscope(logs: &Path) -> anyhow::Result<(Timing, State)> {
             num(&f["velocity_enu_mps"][2])?,
         ],
     };
-    Ok((timing(process_s, &s)?, state))
+    Ok((timing(&done)?, state))
 }
 
 fn run_pyins(python: &Path, args: &[String]) -> anyhow::Result<(Timing, State)> {
+    let cpu_before = super::children_cpu_s();
     let started = Instant::now();
     let out = Command::new(python).args(args).output()?;
     let process_s = started.elapsed().as_secs_f64();
+    let cpu_s = super::children_cpu_s() - cpu_before;
     ensure!(out.status.success(), "pyins_bench.py {} failed: {}", args[1], String::from_utf8_lossy(&out.stderr));
     let line = String::from_utf8_lossy(&out.stdout);
     let v: Value = serde_json::from_str(line.lines().last().unwrap_or_default()).context("pyins_bench.py's output")?;
@@ -426,7 +437,7 @@ fn run_pyins(python: &Path, args: &[String]) -> anyhow::Result<(Timing, State)> 
         lla: [num("lat_deg")?, num("lon_deg")?, num("height_m")?],
         vel_enu_mps: [num("vel_east")?, num("vel_north")?, num("vel_up")?],
     };
-    Ok((Timing { process_s, region_s: num("seconds")?, peak_rss_mb: num("peak_rss_mb")? }, state))
+    Ok((Timing { process_s, region_s: num("seconds")?, peak_rss_mb: num("peak_rss_mb")?, cpu_s }, state))
 }
 
 /// The comparison as text.
@@ -439,9 +450,11 @@ pub fn text(reports: &[StreamReport]) -> String {
             let p = spread(t.iter().map(|x| x.process_s).collect());
             let g = spread(t.iter().map(|x| x.region_s).collect());
             let m = spread(t.iter().map(|x| x.peak_rss_mb).collect());
+            let c = spread(t.iter().map(|x| x.cpu_s).collect());
+            let cores = spread(t.iter().map(|x| x.cpu_s / x.process_s.max(1e-9)).collect());
             format!(
-                "  {name:<16} whole process {:.2} s [{:.2}, {:.2}]   {region} {:.2} s [{:.2}, {:.2}]   peak RSS {:.0} MB\n",
-                p.median, p.min, p.max, g.median, g.min, g.max, m.max
+                "  {name:<16} whole process {:.2} s [{:.2}, {:.2}]   {region} {:.2} s [{:.2}, {:.2}]   peak RSS {:.0} MB   CPU {:.2} s ({:.1} cores busy)\n",
+                p.median, p.min, p.max, g.median, g.min, g.max, m.max, c.median, cores.median
             )
         };
         s.push_str(&format!(
