@@ -409,7 +409,7 @@ impl Producer<'_> {
         // the simulation (truth, sensors, the computer) hands each update's outputs on, as the
         // recorder's thread takes the rows (a third of the simulation's time was the errors').
         let viewer = ins.viewer();
-        let (tx, rx) = crossbeam_channel::bounded::<Batch>(4);
+        let (tx, rx) = crossbeam_channel::bounded::<Batch>(feed::STAGE_BATCHES);
         std::thread::scope(|scope| {
             let views = scope.spawn(move || self.view_updates(viewer, ins_stats, &rx));
             let (done, interrupted) = self.simulate(&mut ins, timeline, &tx);
