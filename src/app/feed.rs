@@ -31,7 +31,7 @@ pub(crate) enum Batch {
 }
 
 /// Batches of updates a stage's channel holds between two compute threads (a run's simulation and
-/// its statistics, a replay's loop and its views). Four to six threads share two cores: the
+/// its statistics). Four to six threads share two cores: the
 /// scheduler leaves a runnable thread waiting for up to its period (~12-24 ms here), and a producer
 /// whose channel holds less than that stops when its consumer is descheduled, with a core idle.
 /// Four batches of 512 updates were ~6 ms of a 2 kHz run: in a `run` of pyins' coning stream the
