@@ -300,8 +300,8 @@ pub fn replay(
     let tallies = std::thread::scope(|scope| -> Result<Tallies, PlaybackError> {
         let (tx, rx) = feed::channel();
         let consumer = recorder.as_deref_mut().map(|r| scope.spawn(move || feed::consume(r, rx)));
-        // Four batches, not a run's `feed::STAGE_BATCHES`: with 64 the loop read a log to its end
-        // ~32 k updates before the views did, and a SIGTERM in that time found nothing left to
+        // Four batches, not a run's `STAGE_BATCHES` (app/run.rs): with 64 the loop read a log to its
+        // end ~32 k updates before the views did, and a SIGTERM in that time found nothing left to
         // interrupt (tests/trust.rs expects 143 from a replay stopped while it records).
         let (to_views, from_loop) = crossbeam_channel::bounded::<Batch>(4);
         // The views' thread holds the recorder's channel: the recorder stops when it does.
