@@ -669,10 +669,12 @@ fn a_closed_or_broken_stderr_does_not_silence_the_signals() {
             }
             let mut child = cmd.spawn().expect("runs");
             wait_for_file(&dir.join("r.rrd.partial"));
-            std::thread::sleep(Duration::from_millis(300));
+            // Well before the replay's end (~0.5 s after the partial file appears on this machine;
+            // at 300 ms the signal came ~80 ms before it, a margin a faster replay would take away).
+            std::thread::sleep(Duration::from_millis(100));
             signal(&child, "-TERM");
             if twice {
-                std::thread::sleep(Duration::from_millis(150));
+                std::thread::sleep(Duration::from_millis(50));
                 if child.try_wait().expect("wait").is_none() {
                     signal(&child, "-TERM");
                 }

@@ -330,16 +330,6 @@ pub fn record_run(
     Ok(summary)
 }
 
-/// Batches of updates the channel from a run's simulation to its statistics' thread holds. Four to
-/// six threads share two cores: the scheduler leaves a runnable thread waiting for up to its period
-/// (~12-24 ms here), and a producer whose channel holds less than that stops when its consumer is
-/// descheduled, with a core idle.
-/// Four batches of 512 updates were ~6 ms of a 2 kHz run: in a `run` of pyins' coning stream the
-/// simulation (0.33-0.36 s of CPU) waited 0.12-0.15 s on a full channel; its static stream's `run`
-/// kept 1.1 of the 2 cores busy. 64 hold ~100 ms, and it waits 0.00-0.02 s (a bound in updates,
-/// not in time: memory stays flat, ≤ 12 MB at five algorithms).
-const STAGE_BATCHES: usize = 64;
-
 /// The simulation thread's side of a recorded run.
 struct Producer<'a> {
     model: &'a Model,
@@ -419,13 +409,18 @@ impl Producer<'_> {
         // the simulation (truth, sensors, the computer) hands each update's outputs on, as the
         // recorder's thread takes the rows (a third of the simulation's time was the errors').
         let viewer = ins.viewer();
-        let (tx, rx) = crossbeam_channel::bounded::<Batch>(STAGE_BATCHES);
+        let (tx, rx) = crossbeam_channel::bounded::<Batch>(feed::STAGE_BATCHES);
         std::thread::scope(|scope| {
             let views = scope.spawn(move || self.view_updates(viewer, ins_stats, &rx));
             let (done, interrupted) = self.simulate(&mut ins, timeline, &tx);
             drop(tx);
-            let (stats, ins_stats) = views.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
-            (stats, ins_stats, done, interrupted)
+            let (stats, ins_stats, stopped_at) = views.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
+            // A signal the statistics' thread saw ends the run where it did, which may be behind
+            // the simulation.
+            match stopped_at {
+                Some(done) => (stats, ins_stats, done, true),
+                None => (stats, ins_stats, done, interrupted),
+            }
         })
     }
 
@@ -438,6 +433,7 @@ impl Producer<'_> {
         let new_batch = || Batch {
             updates: Vec::with_capacity(UPDATES_PER_BATCH),
             attitudes: Vec::with_capacity(UPDATES_PER_BATCH * algorithms),
+            done: 0,
         };
         let window = ins.config().signal_window_s;
         let (mut done, mut interrupted) = (1, false);
@@ -469,31 +465,41 @@ impl Producer<'_> {
                 let outputs = ins.outputs(s.t_s, want_scene, &mut batch.attitudes);
                 batch.updates.push(Update::Output { outputs, want_stats, want_scene });
             }
-            if batch.updates.len() >= UPDATES_PER_BATCH && tx.send(std::mem::replace(&mut batch, new_batch())).is_err()
-            {
-                // The statistics' thread stopped: the recorder failed (it reports why).
-                return (done, interrupted);
+            if batch.updates.len() >= UPDATES_PER_BATCH {
+                batch.done = done;
+                if tx.send(std::mem::replace(&mut batch, new_batch())).is_err() {
+                    // The statistics' thread stopped: a signal, or the recorder failed (it reports why).
+                    return (done, interrupted);
+                }
             }
         }
+        batch.done = done;
         let _ = tx.send(batch);
         (done, interrupted)
     }
 
     /// The statistics' side of [`Self::run_ins`]: each update's INS errors (`viewer`) into
     /// `ins_stats`; at the marked ones the table's step into the run's statistics, and the rows to
-    /// the recorder. Returns (the table's statistics, the INS's).
+    /// the recorder. A signal (`stop`) ends it at its next batch, the batches still queued left.
+    /// Returns (the table's statistics, the INS's, the instants done when a signal stopped it).
     fn view_updates(
         &self,
         mut viewer: InsViewer,
         mut ins_stats: InsStats,
         rx: &crossbeam_channel::Receiver<Batch>,
-    ) -> (ErrorStats, InsStats) {
+    ) -> (ErrorStats, InsStats, Option<u64>) {
         let mut state = DemodState::default();
         let mut stats = ErrorStats::default();
         let mut out = Outbox::new(self.tx);
         // The latest attitude update: its instant and whether its step was computed.
         let mut last_update: Option<(f64, bool)> = None;
+        let (mut done, mut stopped_at) = (1, None);
         'batches: for batch in rx {
+            if self.stop.load(Ordering::Relaxed) {
+                stopped_at = Some(done);
+                break;
+            }
+            done = batch.done;
             // By reference: moving each update out of the batch copied its outputs (2 % of the CPU).
             let mut attitudes = batch.attitudes.as_slice();
             for update in &batch.updates {
@@ -529,7 +535,7 @@ impl Producer<'_> {
             }
         }
         out.close();
-        (stats, ins_stats)
+        (stats, ins_stats, stopped_at)
     }
 }
 
@@ -538,6 +544,8 @@ impl Producer<'_> {
 struct Batch {
     updates: Vec<Update>,
     attitudes: Vec<AttitudeOutput>,
+    /// The instants done when it was sent: where a run that stops after it ended.
+    done: u64,
 }
 
 /// What the simulation hands the statistics' thread, in order ([`Producer::run_ins`]).

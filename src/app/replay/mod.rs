@@ -11,7 +11,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 mod views;
-use views::{AlgorithmOutput, Batch, Item, Tallies, Update, Views};
+use views::{AlgorithmOutput, Batch, Item, Reached, Tallies, Update, Views};
 
 use super::failure::Failure;
 use super::feed::{self, Outbox};
@@ -300,12 +300,11 @@ pub fn replay(
     let tallies = std::thread::scope(|scope| -> Result<Tallies, PlaybackError> {
         let (tx, rx) = feed::channel();
         let consumer = recorder.as_deref_mut().map(|r| scope.spawn(move || feed::consume(r, rx)));
-        // Four batches, not a run's `STAGE_BATCHES` (app/run.rs): with 64 the loop read a log to its
-        // end ~32 k updates before the views did, and a SIGTERM in that time found nothing left to
-        // interrupt (tests/trust.rs expects 143 from a replay stopped while it records).
-        let (to_views, from_loop) = crossbeam_channel::bounded::<Batch>(4);
+        // The loop may read the log to its end ~32 k updates before the views; a signal in that
+        // time stops the views, which then decide where the replay ended.
+        let (to_views, from_loop) = crossbeam_channel::bounded::<Batch>(feed::STAGE_BATCHES);
         // The views' thread holds the recorder's channel: the recorder stops when it does.
-        let viewer = scope.spawn(move || views.consume(&from_loop, Outbox::new(&tx)));
+        let viewer = scope.spawn(move || views.consume(&from_loop, stop, Outbox::new(&tx)));
         const UPDATES_PER_BATCH: usize = 512;
         // Each batch at its full size from the start (grown item by item from empty, every item
         // was copied about twice more).
@@ -366,15 +365,17 @@ pub fn replay(
                         scene_row: recording && want_scene,
                     }));
                 }
-                // The views' thread stopped: the recorder failed (it reports why).
-                if batch.items.len() >= UPDATES_PER_BATCH
-                    && to_views.send(std::mem::replace(&mut batch, new_batch())).is_err()
-                {
-                    break;
+                // The views' thread stopped: a signal, or the recorder failed (it reports why).
+                if batch.items.len() >= UPDATES_PER_BATCH {
+                    batch.reached = Reached { samples: pb.samples, t_s: t_end };
+                    if to_views.send(std::mem::replace(&mut batch, new_batch())).is_err() {
+                        break;
+                    }
                 }
             }
             Ok(())
         })();
+        batch.reached = Reached { samples: pb.samples, t_s: t_end };
         let _ = to_views.send(batch);
         drop(to_views);
         let tallies = viewer.join();
@@ -388,7 +389,12 @@ pub fn replay(
             _ => Ok(tallies),
         }
     })?;
-    let Tallies { stats, ins_stats, nav, compared } = tallies;
+    let Tallies { stats, ins_stats, nav, compared, stopped_at } = tallies;
+    // A signal the views saw ends the replay where they did, which may be behind the loop.
+    let mut samples = pb.samples;
+    if let Some(r) = stopped_at {
+        (interrupted, samples, t_end) = (true, r.samples, r.t_s);
+    }
     if !interrupted {
         pb.finish()?;
     }
@@ -421,10 +427,10 @@ pub fn replay(
             .map(|a| alignment_compensation(a, log.imu_compensation.as_ref())),
         notes: pb.notes.clone(),
         compared_updates: compared,
-        samples: pb.samples,
+        samples,
         duration_s: t_end,
         wall_time_s: wall,
-        samples_per_second: pb.samples as f64 / wall.max(1e-9),
+        samples_per_second: samples as f64 / wall.max(1e-9),
         interrupted,
         attitude_error_arcsec: if strapdown {
             BTreeMap::new()

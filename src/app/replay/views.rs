@@ -4,6 +4,8 @@
 //! readings and reference there), as a run's simulation hands them to its statistics' thread; the
 //! rows for the recorder go on from here.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use super::super::feed::{Outbox, OutputRow};
 use crate::ins::core::{NavError, SampleOut};
 use crate::ins::nav::NavState;
@@ -55,6 +57,15 @@ pub(super) struct Batch {
     pub(super) items: Vec<Item>,
     pub(super) algorithms: Vec<AlgorithmOutput>,
     pub(super) nav_states: Vec<NavState>,
+    /// Where the loop was when it sent the batch: what a replay that stops after it reached.
+    pub(super) reached: Reached,
+}
+
+/// How far a replay got: the IMU samples replayed and the last one's time.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(super) struct Reached {
+    pub(super) samples: u64,
+    pub(super) t_s: f64,
 }
 
 impl Batch {
@@ -64,6 +75,7 @@ impl Batch {
             items: Vec::with_capacity(updates),
             algorithms: Vec::with_capacity(updates * algorithms),
             nav_states: Vec::new(),
+            reached: Reached::default(),
         }
     }
 }
@@ -75,6 +87,8 @@ pub(super) struct Tallies {
     pub(super) ins_stats: Vec<[RunningStat; 3]>,
     pub(super) nav: Option<NavSummary>,
     pub(super) compared: u64,
+    /// Where the replay stopped when a signal stopped it here (the loop may have read further).
+    pub(super) stopped_at: Option<Reached>,
 }
 
 /// The table's demodulations and the INS's errors at each update, with their state.
@@ -93,16 +107,29 @@ pub(super) struct Views<'a> {
 }
 
 impl Views<'_> {
-    /// Every batch from `rx` until the loop closes it (or the recorder goes away): the statistics,
-    /// and the rows to `outbox`.
-    pub(super) fn consume(mut self, rx: &crossbeam_channel::Receiver<Batch>, mut outbox: Outbox<'_>) -> Tallies {
+    /// Every batch from `rx` until the loop closes it, the recorder goes away or `stop` is raised
+    /// (a signal: the batches still queued are left, and the replay ends where the last one handled
+    /// did): the statistics, and the rows to `outbox`.
+    pub(super) fn consume(
+        mut self,
+        rx: &crossbeam_channel::Receiver<Batch>,
+        stop: &AtomicBool,
+        mut outbox: Outbox<'_>,
+    ) -> Tallies {
         let mut tallies = Tallies {
             stats: [[RunningStat::default(); 3]; 2],
             ins_stats: vec![[RunningStat::default(); 3]; self.demod.len()],
             nav: None,
             compared: 0,
+            stopped_at: None,
         };
+        let mut reached = Reached::default();
         'batches: for batch in rx {
+            if stop.load(Ordering::Relaxed) {
+                tallies.stopped_at = Some(reached);
+                break;
+            }
+            reached = batch.reached;
             let mut algorithms = batch.algorithms.as_slice();
             let mut nav_states = batch.nav_states.iter();
             for item in &batch.items {
