@@ -304,7 +304,7 @@ impl ColumnReader {
         let n = n?;
         let width = self.names.len().max(1);
         if !self.allow_non_finite
-            && let Some(i) = out[start..].iter().position(|v| !v.is_finite())
+            && let Some(i) = first_non_finite(&out[start..])
         {
             let row_in_batch = i / width;
             let end = self.source.location();
@@ -335,5 +335,44 @@ impl ColumnReader {
     #[must_use]
     pub fn reads_in_blocks(&self) -> bool {
         self.source.never_exact()
+    }
+}
+
+/// The index of the first value that is not finite. Blocks of 16 values are checked without an
+/// early exit first (the compiler vectorises that; an element-wise search with one was ~10
+/// instructions per value, a tenth of a replay's log reader), then the block that has one is searched.
+fn first_non_finite(values: &[f64]) -> Option<usize> {
+    const BLOCK: usize = 16;
+    let blocks = values.chunks(BLOCK);
+    for (b, block) in blocks.enumerate() {
+        if !block.iter().fold(true, |all, v| all & v.is_finite()) {
+            return block.iter().position(|v| !v.is_finite()).map(|i| b * BLOCK + i);
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::first_non_finite;
+
+    #[test]
+    fn the_first_non_finite_value_is_found_in_every_block_and_position() {
+        // Against the element-wise search, for lengths around the block's 16 and every position of
+        // a NaN, an infinity or two of them.
+        for len in 0..50 {
+            let clean: Vec<f64> = (0..len).map(|i| i as f64 * 0.5 - 3.0).collect();
+            assert_eq!(first_non_finite(&clean), None, "len {len}");
+            for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                for at in 0..len {
+                    let mut v = clean.clone();
+                    v[at] = bad;
+                    if at + 17 < len {
+                        v[at + 17] = f64::NAN;
+                    }
+                    assert_eq!(first_non_finite(&v), Some(at), "len {len}, {bad} at {at}");
+                }
+            }
+        }
     }
 }
