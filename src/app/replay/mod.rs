@@ -77,7 +77,9 @@ pub struct ReplaySummary {
     pub navigation: Option<NavSummary>,
     /// Gaps in the IMU data the replay carried the attitude across.
     pub gaps: Vec<Gap>,
-    /// The navigation computer's state after the last sample (to compare with another INS).
+    /// The navigation computer's state after the last sample (to compare with another INS). In a
+    /// replay a signal stopped, after the last sample the computer took: its `t_s` may be a little
+    /// later than `duration_s`, where the statistics and the recording end.
     pub final_state: FinalState,
     /// Peak resident memory of the process at the end of the replay, MB.
     pub peak_rss_mb: f64,
