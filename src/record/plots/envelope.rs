@@ -9,11 +9,16 @@
 //! last samples (a drift), gives only its samples; a stretch of repeated rows (a zero error, a
 //! vehicle at rest) gives its first and last row: the same line, drawn flat.
 
+use std::ops::Range;
+
 use super::series::same_row;
 
-/// An envelope of `width` lines over buckets of `bucket_s` seconds on a grid from t = 0.
-pub(crate) struct Envelope {
-    width: usize,
+/// The open bucket of every line of the plots sampled together (all of a recording's plots take
+/// every row, on one grid): the bucket, its samples' count and times, and per line its first and
+/// last sample and its extremes. One wide bucket, not one per plot: per plot and row, the
+/// bookkeeping of a few lines cost more than the lines (a fifth of a pure coning run's recorder).
+/// Each plot's [`Rows`] takes its lines when the bucket closes.
+pub(crate) struct Bucket {
     bucket_s: f64,
     /// The open bucket's index on the grid (None before the first sample).
     bucket: Option<i64>,
@@ -26,24 +31,27 @@ pub(crate) struct Envelope {
     /// Per line, the smallest and the largest finite sample so far and their times.
     lo: Vec<(f64, f64)>,
     hi: Vec<(f64, f64)>,
-    /// The rows ready to send: their times and values (row-major).
-    pub(crate) t: Vec<f64>,
-    pub(crate) values: Vec<f64>,
-    /// The last row emitted (compared with the next).
-    previous: Vec<f64>,
-    /// The time of the newest row held back because it repeats `previous`.
-    repeat_s: Option<f64>,
     /// The next sample's row, written in place by the caller ([`Self::row`]) and taken by
     /// [`Self::commit`], which swaps it with `last`: no copy of the row per sample (those copies
     /// were a sixth of a pure coning run's recorder).
     row: Vec<f64>,
 }
 
-impl Envelope {
-    /// An envelope of `width` lines over buckets of `bucket_s` s (0: every sample is a bucket).
+/// A closed bucket's lines `first..last` of a [`Bucket`], for one plot's [`Rows::close`].
+pub(crate) struct Lines<'a> {
+    n: usize,
+    t_first: f64,
+    t_last: f64,
+    first: &'a [f64],
+    last: &'a [f64],
+    lo: &'a [(f64, f64)],
+    hi: &'a [(f64, f64)],
+}
+
+impl Bucket {
+    /// A bucket of `width` lines over buckets of `bucket_s` s (0: every sample is a bucket).
     pub(crate) fn new(width: usize, bucket_s: f64) -> Self {
         Self {
-            width,
             bucket_s,
             bucket: None,
             n: 0,
@@ -53,12 +61,13 @@ impl Envelope {
             last: vec![f64::NAN; width],
             lo: vec![(f64::INFINITY, 0.0); width],
             hi: vec![(f64::NEG_INFINITY, 0.0); width],
-            t: Vec::new(),
-            values: Vec::new(),
-            previous: Vec::new(),
-            repeat_s: None,
             row: Vec::with_capacity(width),
         }
+    }
+
+    /// The buckets' width, s.
+    pub(crate) fn bucket_s(&self) -> f64 {
+        self.bucket_s
     }
 
     /// The bucket of time `t_s` on a grid of `bucket_s` (0: every sample its own).
@@ -67,14 +76,15 @@ impl Envelope {
         if bucket_s > 0.0 { (t_s / bucket_s + 1e-9).floor() as i64 } else { i64::MIN }
     }
 
-    /// Takes one sample `row` (`width` values) at `t_s` (not before the previous sample's).
-    #[cfg(test)]
-    pub(crate) fn push(&mut self, t_s: f64, row: &[f64]) {
-        self.row().extend_from_slice(row);
-        self.commit(Self::bucket_of(self.bucket_s, t_s), t_s);
+    /// Whether a sample in the grid's bucket `bucket` closes the open bucket first (every sample
+    /// does with buckets of 0 s): then each plot takes its lines ([`Self::lines`]) and
+    /// [`Self::clear`] empties it, before [`Self::commit`].
+    #[inline]
+    pub(crate) fn leaves(&self, bucket: i64) -> bool {
+        self.n > 0 && (self.bucket_s <= 0.0 || self.bucket != Some(bucket))
     }
 
-    /// The next sample's row, empty, for the caller to write its `width` values into; then
+    /// The next sample's row, empty, for the caller to write every line's value into; then
     /// [`Self::commit`].
     pub(crate) fn row(&mut self) -> &mut Vec<f64> {
         self.row.clear();
@@ -82,15 +92,13 @@ impl Envelope {
     }
 
     /// Takes the row written into [`Self::row`] as the sample at `t_s`, in the grid's bucket
-    /// `bucket` ([`Self::bucket_of`] of `t_s`: the plots of a row share it, computed once).
+    /// `bucket` ([`Self::bucket_of`] of `t_s`), the open one unless [`Self::leaves`] closed it.
     #[inline]
     pub(crate) fn commit(&mut self, bucket: i64, t_s: f64) {
-        debug_assert_eq!(self.row.len(), self.width);
+        debug_assert_eq!(self.row.len(), self.lo.len());
         debug_assert_eq!(bucket, Self::bucket_of(self.bucket_s, t_s));
-        if self.bucket_s <= 0.0 || self.bucket != Some(bucket) {
-            self.close();
-            self.bucket = Some(bucket);
-        }
+        debug_assert!(!self.leaves(bucket));
+        self.bucket = Some(bucket);
         if self.n == 0 {
             self.t_first = t_s;
             self.first.copy_from_slice(&self.row);
@@ -115,14 +123,54 @@ impl Envelope {
         &self.last
     }
 
-    /// Emits the open bucket's rows (the end of the data, or a sample in another bucket).
-    pub(crate) fn close(&mut self) {
-        let n = std::mem::take(&mut self.n);
+    /// The open bucket's `lines`, as a plot's [`Rows::close`] takes them.
+    pub(crate) fn lines(&self, lines: Range<usize>) -> Lines<'_> {
+        Lines {
+            n: self.n,
+            t_first: self.t_first,
+            t_last: self.t_last,
+            first: &self.first[lines.clone()],
+            last: &self.last[lines.clone()],
+            lo: &self.lo[lines.clone()],
+            hi: &self.hi[lines],
+        }
+    }
+
+    /// Empties the open bucket (every plot took its lines).
+    pub(crate) fn clear(&mut self) {
+        self.n = 0;
+        self.lo.fill((f64::INFINITY, 0.0));
+        self.hi.fill((f64::NEG_INFINITY, 0.0));
+    }
+}
+
+/// One plot's rows: what its lines' closed buckets gave, ready to send.
+pub(crate) struct Rows {
+    width: usize,
+    /// The rows ready to send: their times and values (row-major).
+    pub(crate) t: Vec<f64>,
+    pub(crate) values: Vec<f64>,
+    /// The last row emitted (compared with the next).
+    previous: Vec<f64>,
+    /// The time of the newest row held back because it repeats `previous`.
+    repeat_s: Option<f64>,
+}
+
+impl Rows {
+    /// The rows of a plot of `width` lines.
+    pub(crate) fn new(width: usize) -> Self {
+        Self { width, t: Vec::new(), values: Vec::new(), previous: Vec::new(), repeat_s: None }
+    }
+
+    /// Emits the rows of a closed bucket's lines `b` (this plot's).
+    pub(crate) fn close(&mut self, b: &Lines<'_>) {
+        debug_assert_eq!(b.first.len(), self.width);
+        let n = b.n;
         if n == 0 {
             return;
         }
-        let (first, last) = (std::mem::take(&mut self.first), std::mem::take(&mut self.last));
-        self.emit(self.t_first, &first);
+        let (first, last) = (b.first, b.last);
+        self.emit(b.t_first, first);
         if n >= 3 {
             // Per line, its extremes in the order they happened; the bucket adds rows only when
             // some line's extremes are not its first and last samples.
@@ -130,7 +178,7 @@ impl Envelope {
             let (mut early, mut late) = (vec![f64::NAN; self.width], vec![f64::NAN; self.width]);
             let (mut t_early, mut t_late, mut timed) = (0.0, 0.0, 0usize);
             for j in 0..self.width {
-                let ((lo, t_lo), (hi, t_hi)) = (self.lo[j], self.hi[j]);
+                let ((lo, t_lo), (hi, t_hi)) = (b.lo[j], b.hi[j]);
                 if !lo.is_finite() && !hi.is_finite() {
                     continue;
                 }
@@ -145,18 +193,15 @@ impl Envelope {
             }
             if inner && timed > 0 {
                 let k = timed as f64;
-                let t1 = (t_early / k).clamp(self.t_first, self.t_last);
-                let t2 = (t_late / k).clamp(t1, self.t_last);
+                let t1 = (t_early / k).clamp(b.t_first, b.t_last);
+                let t2 = (t_late / k).clamp(t1, b.t_last);
                 self.emit(t1, &early);
                 self.emit(t2, &late);
             }
         }
         if n >= 2 {
-            self.emit(self.t_last, &last);
+            self.emit(b.t_last, last);
         }
-        (self.first, self.last) = (first, last);
-        self.lo.fill((f64::INFINITY, 0.0));
-        self.hi.fill((f64::NEG_INFINITY, 0.0));
     }
 
     /// Appends a row to the output, holding back one that repeats the last.
@@ -184,6 +229,42 @@ impl Envelope {
     pub(crate) fn take(&mut self) -> (Vec<f64>, Vec<f64>) {
         self.release();
         (std::mem::take(&mut self.t), std::mem::take(&mut self.values))
+    }
+}
+
+/// One plot's envelope on its own: a bucket of its lines and its rows.
+#[cfg(test)]
+pub(crate) struct Envelope {
+    bucket: Bucket,
+    rows: Rows,
+}
+
+#[cfg(test)]
+impl Envelope {
+    /// An envelope of `width` lines over buckets of `bucket_s` s (0: every sample is a bucket).
+    pub(crate) fn new(width: usize, bucket_s: f64) -> Self {
+        Self { bucket: Bucket::new(width, bucket_s), rows: Rows::new(width) }
+    }
+
+    /// Takes one sample `row` (`width` values) at `t_s` (not before the previous sample's).
+    pub(crate) fn push(&mut self, t_s: f64, row: &[f64]) {
+        let bucket = Bucket::bucket_of(self.bucket.bucket_s(), t_s);
+        if self.bucket.leaves(bucket) {
+            self.close();
+        }
+        self.bucket.row().extend_from_slice(row);
+        self.bucket.commit(bucket, t_s);
+    }
+
+    /// Emits the open bucket's rows (the end of the data).
+    pub(crate) fn close(&mut self) {
+        self.rows.close(&self.bucket.lines(0..self.rows.width));
+        self.bucket.clear();
+    }
+
+    /// The rows ready to send, taken.
+    pub(crate) fn take(&mut self) -> (Vec<f64>, Vec<f64>) {
+        self.rows.take()
     }
 }
 

@@ -43,8 +43,8 @@ pub(crate) struct Plots {
     extents: Extents,
     /// Whether every sample's row is kept for the export tables (`--export`).
     exporting: bool,
-    /// The envelopes' bucket, s (every plot's).
-    bucket_s: f64,
+    /// Every plot's open envelope bucket: their lines side by side, in the series' order.
+    bucket: envelope::Bucket,
 }
 
 /// What a row without a navigation view shows.
@@ -75,7 +75,7 @@ impl Plots {
             ins,
             extents: Extents::default(),
             exporting,
-            bucket_s: 0.0,
+            bucket: envelope::Bucket::new(0, 0.0),
         };
         me.set_series_hz(params.recording.series_hz);
         me
@@ -84,11 +84,14 @@ impl Plots {
     /// Buckets of `1 / series_hz` for every plot's envelope, before its first sample (a replay
     /// learns its length from its file after the recording has started).
     pub(crate) fn set_series_hz(&mut self, series_hz: f64) {
-        debug_assert!(self.newest.is_none() && self.series.iter().all(|s| s.envelope.t.is_empty()));
-        self.bucket_s = 1.0 / series_hz;
+        debug_assert!(self.newest.is_none() && self.series.iter().all(|s| s.rows.t.is_empty()));
+        let mut width = 0;
         for s in &mut self.series {
-            s.envelope = envelope::Envelope::new(s.width(), self.bucket_s);
+            s.rows = envelope::Rows::new(s.width());
+            s.lines = width..width + s.width();
+            width += s.width();
         }
+        self.bucket = envelope::Bucket::new(width, 1.0 / series_hz);
     }
 
     /// The unit of the table's error plots.
@@ -115,7 +118,7 @@ impl Plots {
     /// (a chunk is sent per 8192 of them: a chunk per few thousand samples made tens of thousands
     /// of tiny chunks over a long run, and the file sink's index of them grew with the run).
     pub(crate) fn buffered(&self) -> usize {
-        if self.exporting { self.t.len() } else { self.series.iter().map(|s| s.envelope.t.len()).max().unwrap_or(0) }
+        if self.exporting { self.t.len() } else { self.series.iter().map(|s| s.rows.t.len()).max().unwrap_or(0) }
     }
 
     /// The newest sample's time since the last flush, s.
@@ -131,7 +134,13 @@ impl Plots {
     /// Buffers one row of every series from the table's step `out`, the INS's view `ins` (errors,
     /// navigation) and, in a replay, its own `solution`.
     pub(crate) fn push(&mut self, out: &StepOutput, ins: Option<&InsView>, solution: Option<&Solution>) {
-        let Self { series, chain, truth, unit, ins: layout, t, exporting, bucket_s, .. } = self;
+        // One bucket for the row's every plot (a division per plot and sample: 5 % of a pure
+        // coning run's CPU).
+        let bucket = envelope::Bucket::bucket_of(self.bucket.bucket_s(), out.t_s);
+        if self.bucket.leaves(bucket) {
+            self.close_buckets();
+        }
+        let Self { series, chain, truth, unit, ins: layout, t, exporting, bucket: open, .. } = self;
         if *exporting {
             t.push(out.t_s);
         }
@@ -140,12 +149,9 @@ impl Plots {
         let lines = layout.as_ref().and_then(|l| l.coning.as_ref());
         let nav = ins.and_then(|v| v.nav).unwrap_or(NO_NAV);
         let state = solution.and_then(|s| s.nav);
-        // One bucket for the row's every plot (a division per plot and sample: 5 % of a pure
-        // coning run's CPU).
-        let bucket = envelope::Envelope::bucket_of(*bucket_s, out.t_s);
-        for s in series.iter_mut() {
+        let v = open.row();
+        for s in series.iter() {
             let width = s.width();
-            let v = s.envelope.row();
             match s.what {
                 Quantity::TableError(a) => v.extend(out.errors[..width].iter().map(|e| e.as_array()[a] * per_rad)),
                 Quantity::ClosedForm => {
@@ -195,9 +201,12 @@ impl Plots {
                 ),
                 Quantity::Height => v.push(state.map_or(f64::NAN, |n| n.height_m)),
             }
-            s.envelope.commit(bucket, out.t_s);
-            if *exporting {
-                s.values.extend_from_slice(s.envelope.last_row());
+            debug_assert_eq!(v.len(), s.lines.end, "{}", s.path);
+        }
+        open.commit(bucket, out.t_s);
+        if *exporting {
+            for s in series.iter_mut() {
+                s.values.extend_from_slice(&open.last_row()[s.lines.clone()]);
             }
         }
     }
@@ -205,8 +214,9 @@ impl Plots {
     /// Closes every plot's open bucket (the end of the data): the next flush sends it.
     pub(crate) fn close_buckets(&mut self) {
         for s in &mut self.series {
-            s.envelope.close();
+            s.rows.close(&self.bucket.lines(s.lines.clone()));
         }
+        self.bucket.clear();
     }
 
     /// Sends every finished bucket's rows to the plots, and every sample's rows to the export
@@ -230,7 +240,7 @@ impl Plots {
                 }
                 stream.export_series(&s.path, &s.names, &samples, &raw);
             }
-            let (times, mut values) = s.envelope.take();
+            let (times, mut values) = s.rows.take();
             if logarithmic {
                 log10_of_positive(&mut values);
             }

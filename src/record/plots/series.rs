@@ -5,7 +5,7 @@
 use nalgebra::Vector3;
 
 use super::coning::{self, ConingLines};
-use super::envelope::Envelope;
+use super::envelope::Rows;
 use crate::ins::nav::{NavState, Vertical};
 use crate::math::attitude::Attitude;
 use crate::math::units::AngleUnit;
@@ -65,8 +65,10 @@ pub(crate) struct Series {
     pub(crate) names: Vec<String>,
     /// Every sample's row since the last flush (exported at full rate, then dropped).
     pub(crate) values: Vec<f64>,
-    /// What the plot draws of them: the per-bucket envelope.
-    pub(crate) envelope: Envelope,
+    /// What the plot draws of them: the per-bucket envelope's rows (of its `lines` of the plots'
+    /// shared [`super::envelope::Bucket`]).
+    pub(crate) rows: Rows,
+    pub(crate) lines: std::ops::Range<usize>,
     pub(crate) what: Quantity,
     /// The last row sent and when (a live viewer's stream holds rows that repeat it).
     pub(crate) last_sent: Option<(Vec<f64>, std::time::Instant)>,
@@ -85,8 +87,17 @@ pub(crate) fn same_row(a: &[f64], b: &[f64]) -> bool {
 
 impl Series {
     pub(crate) fn new(path: impl Into<String>, names: Vec<String>, what: Quantity) -> Self {
-        let envelope = Envelope::new(names.len(), 0.0);
-        Self { path: path.into(), names, values: Vec::new(), envelope, what, last_sent: None, held_until_s: None }
+        let rows = Rows::new(names.len());
+        Self {
+            path: path.into(),
+            names,
+            values: Vec::new(),
+            rows,
+            lines: 0..0,
+            what,
+            last_sent: None,
+            held_until_s: None,
+        }
     }
 
     pub(crate) fn width(&self) -> usize {
