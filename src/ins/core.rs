@@ -389,7 +389,7 @@ impl InsCore {
     pub fn is_finite(&self) -> bool {
         // Without early exits (`&`, not `&&` or `all`): a replay asks after every update, and the
         // short-circuits were a branch per number (59 instructions a call, 4 % of the replay's loop).
-        let all_finite = |values: &[f64]| values.iter().fold(true, |all, x| all & x.is_finite());
+        use crate::math::stats::all_finite;
         let attitudes =
             self.history.iter().fold(true, |all, h| all & all_finite(h[1].1.quaternion().coords.as_slice()));
         let nav = self.nav.as_ref().is_none_or(|n| {
