@@ -145,8 +145,8 @@ impl Bucket {
 }
 
 /// One plot's rows: what its lines' closed buckets gave, ready to send.
+#[derive(Default)]
 pub(crate) struct Rows {
-    width: usize,
     /// The rows ready to send: their times and values (row-major).
     pub(crate) t: Vec<f64>,
     pub(crate) values: Vec<f64>,
@@ -157,14 +157,9 @@ pub(crate) struct Rows {
 }
 
 impl Rows {
-    /// The rows of a plot of `width` lines.
-    pub(crate) fn new(width: usize) -> Self {
-        Self { width, t: Vec::new(), values: Vec::new(), previous: Vec::new(), repeat_s: None }
-    }
-
-    /// Emits the rows of a closed bucket's lines `b` (this plot's).
+    /// Emits the rows of a closed bucket's lines `b` (this plot's, always the same lines).
     pub(crate) fn close(&mut self, b: &Lines<'_>) {
-        debug_assert_eq!(b.first.len(), self.width);
+        let width = b.first.len();
         let n = b.n;
         if n == 0 {
             return;
@@ -175,9 +170,9 @@ impl Rows {
             // Per line, its extremes in the order they happened; the bucket adds rows only when
             // some line's extremes are not its first and last samples.
             let mut inner = false;
-            let (mut early, mut late) = (vec![f64::NAN; self.width], vec![f64::NAN; self.width]);
+            let (mut early, mut late) = (vec![f64::NAN; width], vec![f64::NAN; width]);
             let (mut t_early, mut t_late, mut timed) = (0.0, 0.0, 0usize);
-            for j in 0..self.width {
+            for j in 0..width {
                 let ((lo, t_lo), (hi, t_hi)) = (b.lo[j], b.hi[j]);
                 if !lo.is_finite() && !hi.is_finite() {
                     continue;
@@ -243,7 +238,7 @@ pub(crate) struct Envelope {
 impl Envelope {
     /// An envelope of `width` lines over buckets of `bucket_s` s (0: every sample is a bucket).
     pub(crate) fn new(width: usize, bucket_s: f64) -> Self {
-        Self { bucket: Bucket::new(width, bucket_s), rows: Rows::new(width) }
+        Self { bucket: Bucket::new(width, bucket_s), rows: Rows::default() }
     }
 
     /// Takes one sample `row` (`width` values) at `t_s` (not before the previous sample's).
@@ -258,7 +253,7 @@ impl Envelope {
 
     /// Emits the open bucket's rows (the end of the data).
     pub(crate) fn close(&mut self) {
-        self.rows.close(&self.bucket.lines(0..self.rows.width));
+        self.rows.close(&self.bucket.lines(0..self.bucket.first.len()));
         self.bucket.clear();
     }
 

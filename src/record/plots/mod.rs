@@ -87,7 +87,7 @@ impl Plots {
         debug_assert!(self.newest.is_none() && self.series.iter().all(|s| s.rows.t.is_empty()));
         let mut width = 0;
         for s in &mut self.series {
-            s.rows = envelope::Rows::new(s.width());
+            s.rows = envelope::Rows::default();
             s.lines = width..width + s.width();
             width += s.width();
         }

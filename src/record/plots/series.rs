@@ -65,8 +65,8 @@ pub(crate) struct Series {
     pub(crate) names: Vec<String>,
     /// Every sample's row since the last flush (exported at full rate, then dropped).
     pub(crate) values: Vec<f64>,
-    /// What the plot draws of them: the per-bucket envelope's rows (of its `lines` of the plots'
-    /// shared [`super::envelope::Bucket`]).
+    /// What the plot draws of them: the per-bucket envelope's rows, from its `lines` of the plots'
+    /// shared [`super::envelope::Bucket`] (where `Plots::set_series_hz` places them).
     pub(crate) rows: Rows,
     pub(crate) lines: std::ops::Range<usize>,
     pub(crate) what: Quantity,
@@ -87,12 +87,11 @@ pub(crate) fn same_row(a: &[f64], b: &[f64]) -> bool {
 
 impl Series {
     pub(crate) fn new(path: impl Into<String>, names: Vec<String>, what: Quantity) -> Self {
-        let rows = Rows::new(names.len());
         Self {
             path: path.into(),
             names,
             values: Vec::new(),
-            rows,
+            rows: Rows::default(),
             lines: 0..0,
             what,
             last_sent: None,
