@@ -187,3 +187,54 @@ fn tpr_refuses_a_scenario_without_fixes_and_leaves_no_file() {
     assert!(!out_file.exists() && !dir.join("tpr.rrd.partial").exists(), "no file for a refused run");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn events_refuse_a_damaged_recording_by_what_is_wrong_and_read_one_cut_short_with_a_note() {
+    let dir = scratch("damaged-rrd");
+    let rrd = dir.join("whole.rrd");
+    let o = rinscope()
+        .args(["run", "--scenario", "jiang2017-dual-axis", "--duration-s", "20", "--save"])
+        .arg(&rrd)
+        .output()
+        .expect("run");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let events = |path: &Path| rinscope().arg("events").arg(path).output().expect("events");
+    let whole = events(&rrd);
+    assert!(whole.status.success(), "{}", stderr(&whole));
+    let listed = String::from_utf8_lossy(&whole.stdout).to_string();
+    assert!(listed.contains("run started") && stderr(&whole).is_empty(), "{listed}\n{}", stderr(&whole));
+    let bytes = std::fs::read(&rrd).expect("recording");
+    let n = bytes.len();
+    // Rerun's frames (re_log_encoding 0.36): a 12-byte stream header ("RRF2", version, options),
+    // 16-byte message headers, and at the end a 32-byte stream footer: the footer payload's start
+    // and length (u64 each), its CRC (u32), "RRF2", "FOOT" and the number of entries (u32).
+    let variant = |name: &str, data: &[u8]| {
+        let p = dir.join(name);
+        std::fs::write(&p, data).expect("write variant");
+        p
+    };
+    let flipped = |at: usize| {
+        let mut b = bytes.clone();
+        b[at] ^= 0x5a;
+        b
+    };
+    for (name, data, expected) in [
+        ("count.rrd", flipped(n - 1), "entries, not 1"),
+        ("crc.rrd", flipped(n - 16), "checksum"),
+        ("message.rrd", flipped(12), "stop being readable at byte"),
+        ("empty.rrd", Vec::new(), "0 bytes"),
+        ("header.rrd", flipped(0), "FourCC"),
+    ] {
+        let path = variant(name, &data);
+        let o = events(&path);
+        // Exit 2, not an abort (the footer's entry count made Rerun's decoder allocate ~36 GB).
+        assert_eq!(o.status.code(), Some(2), "{name}: {}", stderr(&o));
+        assert!(stderr(&o).contains(expected) && stderr(&o).contains(name), "{name}: {}", stderr(&o));
+        assert!(o.stdout.is_empty(), "{name}: nothing listed");
+    }
+    // Cut short (a copy that stopped): its events, and a note that it is not a finished file.
+    let cut = events(&variant("cut.rrd", &bytes[..n - 5]));
+    assert!(cut.status.success(), "{}", stderr(&cut));
+    assert_eq!(String::from_utf8_lossy(&cut.stdout), listed, "the messages before the footer are all there");
+    assert!(stderr(&cut).contains("cut short"), "{}", stderr(&cut));
+}

@@ -7,12 +7,14 @@ use crate::app::failure::Failure;
 use crate::record::read::Event;
 use crate::scenario::{self, Params, presets};
 
-/// `rinscope events`: the text log of the recording at `file`, in time order.
+/// `rinscope events`: the text log of the recording at `file`, in time order, and a note when the
+/// file is not a finished recording (cut short: the events are those it holds).
 ///
 /// # Errors
-/// A file that is not a readable recording.
-pub fn events(file: &Path) -> Result<Vec<Event>, Failure> {
-    crate::record::read::events(file).map_err(|e| Failure::input(format!("{e:#}")))
+/// A file that is not a readable recording (damaged, or not an `.rrd`).
+pub fn events(file: &Path) -> Result<(Vec<Event>, Option<String>), Failure> {
+    let events = crate::record::read::events(file).map_err(|e| Failure::input(format!("{e:#}")))?;
+    Ok((events, crate::record::read::incomplete(file)))
 }
 
 /// `rinscope check-config`: the scenario `file`, validated as a run would load it.

@@ -271,7 +271,11 @@ pub(super) fn sweep(args: &SweepArgs) -> Result<(), Failure> {
 
 /// `rinscope events`.
 pub(super) fn events(file: &Path) -> Result<(), Failure> {
-    for e in crate::app::inspect::events(file)? {
+    let (events, incomplete) = crate::app::inspect::events(file)?;
+    if let Some(note) = incomplete {
+        errln!("rinscope: note: {note}");
+    }
+    for e in events {
         match e.t_s {
             Some(t) => outln!("{t:>10.3} s  {:<5} {}", e.level, e.text),
             None => outln!("{:>12}  {:<5} {}", "static", e.level, e.text),

@@ -25,13 +25,38 @@ pub struct Event {
 }
 
 /// The data chunks of the recording at `path`, each with its store's kind and its entity path
-/// (without the leading `/`); an unreadable file named in the error.
+/// (without the leading `/`); an unreadable file named in the error. A file whose footer is
+/// damaged is refused before it is decoded (`sink::ending`), and one whose messages stop being
+/// readable before its footer ends with an error that says where: Rerun's decoder stops there
+/// without one. A file without a footer (cut short) gives what it holds ([`incomplete`] says so).
 fn chunks(path: &Path) -> anyhow::Result<impl Iterator<Item = anyhow::Result<(StoreId, String, Chunk)>> + '_> {
-    let file = crate::io::files::open_input(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    let decoder = DecoderApp::decode_eager(BufReader::new(file))
-        .map_err(|e| anyhow::anyhow!("{}: not a readable .rrd: {e}", path.display()))?;
-    Ok(decoder.filter_map(move |m| match m {
-        Err(e) => Some(Err(anyhow::anyhow!("{}: {e}", path.display()))),
+    let damaged = |e: &dyn std::fmt::Display| anyhow::anyhow!("{}: not a readable .rrd: {e}", path.display());
+    let mut file = crate::io::files::open_input(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let ending = super::sink::ending(&mut file).map_err(|e| damaged(&e))?;
+    std::io::Seek::rewind(&mut file).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let mut decoder = DecoderApp::decode_eager(BufReader::new(file)).map_err(|e| damaged(&e))?;
+    let mut ended = false;
+    let messages = std::iter::from_fn(move || {
+        if ended {
+            return None;
+        }
+        let next = decoder.next();
+        if next.is_none() {
+            ended = true;
+            let read = decoder.num_bytes_processed();
+            if let super::sink::Ending::Footer { payload_start } = ending
+                && read < payload_start
+            {
+                return Some(Err(anyhow::anyhow!(
+                    "{}: damaged: its messages stop being readable at byte {read}, before its footer at byte {payload_start}",
+                    path.display()
+                )));
+            }
+        }
+        next.map(|m| m.map_err(|e| anyhow::anyhow!("{}: {e}", path.display())))
+    });
+    Ok(messages.filter_map(|m| match m {
+        Err(e) => Some(Err(e)),
         Ok(LogMsg::ArrowMsg(store_id, arrow_msg)) => {
             Some(Chunk::from_arrow_msg(&arrow_msg).map_err(anyhow::Error::from).map(|chunk| {
                 let entity = chunk.entity_path().to_string().trim_start_matches('/').to_owned();
@@ -40,6 +65,21 @@ fn chunks(path: &Path) -> anyhow::Result<impl Iterator<Item = anyhow::Result<(St
         }
         Ok(_) => None,
     }))
+}
+
+/// Why the recording at `path` is not a finished one, if it is not: it ends without the footer a
+/// finished `.rrd` has (a writer that stopped, a copy cut short). Its messages before that read.
+#[must_use]
+pub fn incomplete(path: &Path) -> Option<String> {
+    let mut file = crate::io::files::open_input(path).ok()?;
+    match super::sink::ending(&mut file) {
+        Ok(super::sink::Ending::None) => Some(format!(
+            "{} ends without the footer a finished recording has ({} bytes): it was cut short, and what follows is what it holds",
+            path.display(),
+            std::fs::metadata(path).map_or(0, |m| m.len())
+        )),
+        _ => None,
+    }
 }
 
 /// The `events` entries of the recording at `path`, in time order.

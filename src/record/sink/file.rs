@@ -249,42 +249,75 @@ impl RrdFile {
     }
 }
 
-/// Reads the footer of a finished `.rrd` back: the stream header's FourCC and version, the stream
-/// footer at the end, and the checksum of the footer payload it points to, with Rerun's own frame
-/// types and checksum — the steps of Rerun's `read_rrd_footer` before it converts the manifest to
-/// Arrow. That conversion re-reads what Rerun's encoder wrote in this process, and took ~36 M
-/// instructions (~6 ms) at the end of every command with a recording; a file cut short, or with
-/// a byte of its footer changed, fails here as it does there (tests).
+/// Reads the footer of a finished `.rrd` back ([`ending`]): a file written here has one.
 pub(super) fn verify(partial: &Path, written: u64) -> Result<(), String> {
-    use rerun::external::re_log_encoding::{Decodable as _, StreamFooter, StreamHeader};
-    use std::io::{Read as _, Seek as _, SeekFrom};
-    let mut file = std::fs::File::open(partial).map_err(|e| e.to_string())?;
-    let len = file.metadata().map_err(|e| e.to_string())?.len();
+    let len = std::fs::metadata(partial).map_err(|e| e.to_string())?.len();
     if len != written {
         return Err(format!("{len} bytes on disk, {written} written"));
     }
+    let mut file = std::fs::File::open(partial).map_err(|e| e.to_string())?;
+    match ending(&mut file)? {
+        Ending::Footer { .. } => Ok(()),
+        Ending::None => Err(format!("{len} bytes and no footer at the end")),
+    }
+}
+
+/// How an `.rrd` ends ([`ending`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Ending {
+    /// With a stream footer whose payload, from byte `payload_start`, has the checksum it states:
+    /// the file was finished. The messages lie before it.
+    Footer {
+        /// Where the footer's payload starts, bytes from the file's start.
+        payload_start: u64,
+    },
+    /// Without one: cut short (a writer that did not finish), or written without a footer.
+    None,
+}
+
+/// Checks the frames of the `.rrd` open as `file` without decoding its messages: the stream header's FourCC and
+/// version, and how it ends. A stream footer at the end (its FourCC and identifier) must count
+/// one entry, point within the file and match the checksum of the payload it points to — the
+/// steps of Rerun's `read_rrd_footer` before it converts the manifest to Arrow, with Rerun's own
+/// frame types and checksum. That conversion re-read what Rerun's encoder had written in the same
+/// process: ~36 M instructions, ~6 ms at the end of every command with a recording.
+///
+/// # Errors
+/// Not an `.rrd` (too short, another FourCC, a version this Rerun cannot read), or a footer that
+/// is damaged: Rerun's decoder reserves as many entries as the footer's last 4 bytes count before
+/// it reads them, so a changed byte there aborted the process that decoded the file.
+pub fn ending(file: &mut std::fs::File) -> Result<Ending, String> {
+    use rerun::external::re_log_encoding::{Decodable as _, RRD_FOURCC, StreamFooter, StreamHeader};
+    use std::io::{Read as _, Seek as _, SeekFrom};
+    let len = file.metadata().map_err(|e| e.to_string())?.len();
     let (head, foot) = (StreamHeader::ENCODED_SIZE_BYTES, StreamFooter::ENCODED_SIZE_BYTES);
-    if len < (head + foot) as u64 {
-        return Err(format!("{len} bytes: too short for an .rrd's header and footer"));
+    if len < head as u64 {
+        return Err(format!("{len} bytes: too short for an .rrd's header ({head} bytes)"));
     }
     let mut read_at = |at: u64, n: usize| -> Result<Vec<u8>, String> {
         let mut bytes = vec![0; n];
         file.seek(SeekFrom::Start(at)).and_then(|_| file.read_exact(&mut bytes)).map_err(|e| e.to_string())?;
         Ok(bytes)
     };
-    StreamHeader::from_rrd_bytes(&read_at(0, head)?).map_err(|e| e.to_string())?;
+    let header = StreamHeader::from_rrd_bytes(&read_at(0, head)?).map_err(|e| e.to_string())?;
+    header.to_version_and_options().map_err(|e| e.to_string())?;
+    if len < (head + foot) as u64 {
+        return Ok(Ending::None);
+    }
     let tail = read_at(len - foot as u64, foot)?;
-    // The footer's last 4 bytes count its entries, and Rerun's decoder allocates that many before
-    // it reads them (a changed byte there aborted the process); its writer writes one.
+    if tail[foot - 12..foot - 8] != RRD_FOURCC || tail[foot - 8..foot - 4] != StreamFooter::RRD_IDENTIFIER {
+        return Ok(Ending::None);
+    }
     let count = tail[foot - 4..].iter().rev().fold(0u32, |n, &b| n << 8 | u32::from(b));
     if count != 1 {
-        return Err(format!("no footer (the stream footer counts {count} entries, not 1)"));
+        return Err(format!("the stream footer counts {count} entries, not 1"));
     }
-    let footer = StreamFooter::from_rrd_bytes(&tail).map_err(|e| format!("no footer ({e})"))?;
-    let entry = footer.entries.first().ok_or("a footer without an entry")?;
+    let footer = StreamFooter::from_rrd_bytes(&tail).map_err(|e| e.to_string())?;
+    let entry = footer.entries.first().ok_or("a stream footer without an entry")?;
     let span = &entry.rrd_footer_byte_span_from_start_excluding_header;
-    let end = span.start.checked_add(span.len).filter(|&end| end <= len);
-    let n = usize::try_from(span.len).ok().filter(|_| end.is_some()).ok_or_else(|| {
+    let within =
+        span.start >= head as u64 && span.start.checked_add(span.len).is_some_and(|end| end <= len - foot as u64);
+    let n = usize::try_from(span.len).ok().filter(|_| within).ok_or_else(|| {
         format!("the footer's payload ({} bytes at {}) is not within the file's {len} bytes", span.len, span.start)
     })?;
     let crc = StreamFooter::compute_crc(&read_at(span.start, n)?);
@@ -294,7 +327,7 @@ pub(super) fn verify(partial: &Path, written: u64) -> Result<(), String> {
             entry.crc_excluding_header
         ));
     }
-    Ok(())
+    Ok(Ending::Footer { payload_start: span.start })
 }
 
 #[cfg(test)]

@@ -24,6 +24,8 @@ use std::sync::{Arc, Mutex};
 
 pub mod address;
 mod file;
+
+pub(crate) use file::{Ending, ending};
 pub mod viewer;
 
 /// The viewer version that matches the SDK this binary is built with.
