@@ -30,7 +30,6 @@ mod common;
 use common::rinscope;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs::File;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -212,49 +211,9 @@ fn store_table(path: &Path, t: &Table) {
     w.finish().expect("finish");
 }
 
-/// A CDR (little-endian) `sensor_msgs/msg/Imu`, fields in order, each aligned to its size.
-fn cdr_imu(ns: i64, w: [f64; 3], a: [f64; 3]) -> Vec<u8> {
-    let (sec, nanosec) = (ns.div_euclid(1_000_000_000) as i32, ns.rem_euclid(1_000_000_000) as u32);
-    let mut b = vec![0u8, 1, 0, 0];
-    b.extend(sec.to_le_bytes());
-    b.extend(nanosec.to_le_bytes());
-    b.extend(4u32.to_le_bytes());
-    b.extend(b"imu\0");
-    let mut f64s = |values: &[f64]| {
-        for v in values {
-            while !(b.len() - 4).is_multiple_of(8) {
-                b.push(0);
-            }
-            b.extend(v.to_le_bytes());
-        }
-    };
-    f64s(&[0.0, 0.0, 0.0, 1.0]);
-    f64s(&[0.0; 9]);
-    f64s(&w);
-    f64s(&[0.0; 9]);
-    f64s(&a);
-    f64s(&[0.0; 9]);
-    b
-}
-
 /// Writes rows of [t_ns, ω x y z, f x y z] as an MCAP of `sensor_msgs/msg/Imu` on `/imu`.
 fn store_mcap(path: &Path, t: &Table) {
-    let file = std::io::BufWriter::new(File::create(path).expect("mcap"));
-    let mut w = mcap::WriteOptions::new().create(file).expect("mcap writer");
-    let schema = w.add_schema("sensor_msgs/msg/Imu", "ros2msg", b"std_msgs/Header header\n").expect("schema");
-    let channel = w.add_channel(schema, "/imu", "cdr", &BTreeMap::new()).expect("channel");
-    for (k, r) in t.rows.iter().enumerate() {
-        let ns = r[0] as i64;
-        let header = mcap::records::MessageHeader {
-            channel_id: channel,
-            sequence: k as u32,
-            log_time: ns.max(0) as u64,
-            publish_time: ns.max(0) as u64,
-        };
-        w.write_to_known_channel(&header, &cdr_imu(ns, [r[1], r[2], r[3]], [r[4], r[5], r[6]])).expect("message");
-    }
-    w.finish().expect("finish");
-    w.into_inner().flush().expect("flush");
+    common::write_imu_mcap(path, &t.rows, None);
 }
 
 /// The JSON fields that are `Option`s (null when absent: a combination of one state determines no

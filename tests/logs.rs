@@ -452,3 +452,65 @@ fn data_from_another_latitude_than_the_site_s_are_warned_about() {
     assert!(stdout(&o).contains("WARNING"), "{}", stdout(&o));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The offsets of the records of `opcode` in an MCAP file: after the 8-byte magic, each record is
+/// an opcode byte, a u64 little-endian length and that many bytes (the MCAP specification).
+fn mcap_records(bytes: &[u8], opcode: u8) -> Vec<usize> {
+    let (mut at, mut found) = (8, Vec::new());
+    while at + 9 <= bytes.len() {
+        if bytes[at] == opcode {
+            found.push(at);
+        }
+        let len = u64::from_le_bytes(bytes[at + 1..at + 9].try_into().expect("8 bytes")) as usize;
+        at += 9 + len;
+    }
+    found
+}
+
+#[test]
+fn an_mcap_chunk_that_does_not_read_as_one_is_damage_not_a_shorter_log() {
+    use rinscope::io::{Col, ColumnReader, ReadOptions};
+    let dir = scratch("mcap-chunk");
+    // 20 s of a still IMU at 200 Hz, in chunks of ~16 kB (about 10 of them), with the summary's
+    // statistics counting the messages, written by the `mcap` crate.
+    let rows: Vec<Vec<f64>> = (0..4000).map(|k| vec![1e9 + k as f64 * 5e6, 1e-5, 0.0, 0.0, 0.0, 0.0, 9.8]).collect();
+    let whole = dir.join("whole.mcap");
+    common::write_imu_mcap(&whole, &rows, Some(16_384));
+    let bytes = std::fs::read(&whole).expect("mcap");
+    let chunks = mcap_records(&bytes, 0x06);
+    assert!(chunks.len() >= 5, "{} chunks", chunks.len());
+    let read_all = |path: &Path| -> Result<usize, String> {
+        let cols: Vec<Col> = (0..7).map(Col::Index).collect();
+        let mut r = ColumnReader::open(path, &cols, &ReadOptions::default()).map_err(|e| e.to_string())?;
+        let (mut row, mut n) = (vec![0.0; 7], 0);
+        while r.next_row(&mut row).map_err(|e| e.to_string())? {
+            n += 1;
+        }
+        Ok(n)
+    };
+    assert_eq!(read_all(&whole), Ok(4000));
+    // A chunk's opcode changed: a reader skips a record it does not know (the rule for newer
+    // opcodes), and the log read on as if it started later, ended earlier or had a hole.
+    for (which, at) in [("first", chunks[0]), ("middle", chunks[chunks.len() / 2]), ("last", chunks[chunks.len() - 1])]
+    {
+        let mut damaged = bytes.clone();
+        damaged[at] ^= 0x5a;
+        let path = dir.join(format!("{which}.mcap"));
+        std::fs::write(&path, &damaged).expect("write");
+        let e = read_all(&path).expect_err(which);
+        assert!(
+            e.contains("summary counts 4000 messages on /imu") && e.contains(&format!("{which}.mcap")),
+            "{which}: {e}"
+        );
+        // And through `replay`, a replay of what is left would have said nothing.
+        let o = rinscope()
+            .args(["replay", "--imu"])
+            .arg(&path)
+            .args(["--position", "40", "116", "50", "--save"])
+            .arg(dir.join("x.rrd"))
+            .output()
+            .expect("replay");
+        assert_eq!(o.status.code(), Some(2), "{which}: {}", stderr(&o));
+        assert!(!dir.join("x.rrd").exists(), "{which}: no recording of a damaged log");
+    }
+}

@@ -38,3 +38,54 @@ pub fn csv_table(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
     let rows = lines.map(|l| l.split(',').map(|v| v.parse::<f64>().expect("number")).collect()).collect();
     (header, rows)
 }
+
+/// A CDR (little-endian) `sensor_msgs/msg/Imu`, fields in order, each aligned to its size.
+fn cdr_imu(ns: i64, w: [f64; 3], a: [f64; 3]) -> Vec<u8> {
+    let (sec, nanosec) = (ns.div_euclid(1_000_000_000) as i32, ns.rem_euclid(1_000_000_000) as u32);
+    let mut b = vec![0u8, 1, 0, 0];
+    b.extend(sec.to_le_bytes());
+    b.extend(nanosec.to_le_bytes());
+    b.extend(4u32.to_le_bytes());
+    b.extend(b"imu\0");
+    let mut f64s = |values: &[f64]| {
+        for v in values {
+            while !(b.len() - 4).is_multiple_of(8) {
+                b.push(0);
+            }
+            b.extend(v.to_le_bytes());
+        }
+    };
+    f64s(&[0.0, 0.0, 0.0, 1.0]);
+    f64s(&[0.0; 9]);
+    f64s(&w);
+    f64s(&[0.0; 9]);
+    f64s(&a);
+    f64s(&[0.0; 9]);
+    b
+}
+
+/// Writes rows of [t_ns, ω x y z, f x y z] as an MCAP of `sensor_msgs/msg/Imu` on `/imu` with the
+/// `mcap` crate's writer (chunks of `chunk_bytes`, or its default; a summary with statistics).
+pub fn write_imu_mcap(path: &Path, rows: &[Vec<f64>], chunk_bytes: Option<u64>) {
+    use std::io::Write as _;
+    let file = std::io::BufWriter::new(std::fs::File::create(path).expect("mcap"));
+    let mut options = mcap::WriteOptions::new();
+    if let Some(n) = chunk_bytes {
+        options = options.chunk_size(Some(n));
+    }
+    let mut w = options.create(file).expect("mcap writer");
+    let schema = w.add_schema("sensor_msgs/msg/Imu", "ros2msg", b"std_msgs/Header header\n").expect("schema");
+    let channel = w.add_channel(schema, "/imu", "cdr", &std::collections::BTreeMap::new()).expect("channel");
+    for (k, r) in rows.iter().enumerate() {
+        let ns = r[0] as i64;
+        let header = mcap::records::MessageHeader {
+            channel_id: channel,
+            sequence: k as u32,
+            log_time: ns.max(0) as u64,
+            publish_time: ns.max(0) as u64,
+        };
+        w.write_to_known_channel(&header, &cdr_imu(ns, [r[1], r[2], r[3]], [r[4], r[5], r[6]])).expect("message");
+    }
+    w.finish().expect("finish");
+    w.into_inner().flush().expect("flush");
+}

@@ -379,6 +379,17 @@ impl Source for McapImuSource {
             Ok(true)
         })?;
         if !found {
+            // A record a reader does not know is skipped (the format's rule for newer opcodes), so
+            // a chunk whose opcode byte is damaged vanished with its messages, and the log read on
+            // as if it started or ended later. The summary's statistics count every message.
+            if let Some(counted) = self.rows_hint.filter(|&n| n != self.row) {
+                return Err(LogError::corrupt(
+                    path,
+                    format!(
+                        "its summary counts {counted} messages on {topic}, {row} were read: records of the file are damaged (a chunk or a message that does not read as one)"
+                    ),
+                ));
+            }
             return Ok(false);
         }
         self.row += 1;
