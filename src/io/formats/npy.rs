@@ -186,7 +186,8 @@ fn parse_header(path: &Path, file: &mut impl Read, file_len: u64) -> Result<Head
         return Err(corrupt("no \\x93NUMPY magic".into()));
     }
     let (major, minor) = (pre[6], pre[7]);
-    let header_len = match major {
+    // NumPy reads versions 1.0, 2.0 and 3.0 only (`numpy.lib.format`), and so do we.
+    let header_len = match if minor == 0 { major } else { 0 } {
         1 => {
             let mut b = [0u8; 2];
             file.read_exact(&mut b).map_err(|_| corrupt("truncated in the header length".into()))?;
@@ -210,6 +211,21 @@ fn parse_header(path: &Path, file: &mut impl Read, file_len: u64) -> Result<Head
     let Py::Dict(items) = parser.value(0).map_err(corrupt)? else {
         return Err(corrupt("the header is not a dict".into()));
     };
+    // Exactly NumPy's three keys, each once: NumPy refuses another key, and of a key given twice
+    // it would take the last (a `shape` given twice could describe the data two ways).
+    let mut seen: Vec<&str> = Vec::new();
+    for (key, _) in &items {
+        let Py::Str(key) = key else { return Err(corrupt(format!("a header key that is not a string: {key:?}"))) };
+        if !["descr", "fortran_order", "shape"].contains(&key.as_str()) {
+            return Err(corrupt(format!(
+                "the header has a key '{key}' (NumPy's format has exactly 'descr', 'fortran_order' and 'shape')"
+            )));
+        }
+        if seen.contains(&key.as_str()) {
+            return Err(corrupt(format!("the header gives '{key}' twice")));
+        }
+        seen.push(key);
+    }
     let get = |key: &str| items.iter().find(|(k, _)| *k == Py::Str(key.into())).map(|(_, v)| v);
     let descr = match get("descr") {
         Some(Py::Str(s)) => s.clone(),
@@ -448,6 +464,49 @@ impl NpyWriter {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A version 1.x/2.x file as NumPy's format document lays it out: magic, version, the header
+    /// length, the dict padded with spaces to a multiple of 64 bytes and ended by '\n', then zeros.
+    fn by_hand(major: u8, minor: u8, dict: &str, data_bytes: usize) -> Vec<u8> {
+        let len_bytes = if major == 1 { 2 } else { 4 };
+        let mut header = dict.to_owned();
+        while !(6 + 2 + len_bytes + header.len() + 1).is_multiple_of(64) {
+            header.push(' ');
+        }
+        header.push('\n');
+        let mut b = b"\x93NUMPY".to_vec();
+        b.extend([major, minor]);
+        if major == 1 {
+            b.extend((header.len() as u16).to_le_bytes());
+        } else {
+            b.extend((header.len() as u32).to_le_bytes());
+        }
+        b.extend(header.bytes());
+        b.extend(std::iter::repeat_n(0u8, data_bytes));
+        b
+    }
+
+    #[test]
+    fn a_header_numpy_would_refuse_or_read_otherwise_is_refused() {
+        let parse =
+            |b: Vec<u8>| parse_header(Path::new("x.npy"), &mut &b[..], b.len() as u64).map_err(|e| e.to_string());
+        let good = "{'descr': '<f8', 'fortran_order': False, 'shape': (4, 7), }";
+        for (major, minor) in [(1, 0), (2, 0), (3, 0)] {
+            let h = parse(by_hand(major, minor, good, 4 * 7 * 8)).expect("NumPy's own versions");
+            assert_eq!((h.rows, h.cols), (4, 7));
+        }
+        // NumPy 2.x: "we only support format version (1,0), (2,0), and (3,0), not (1, 90)".
+        for (major, minor) in [(1, 90), (2, 1), (4, 0)] {
+            let e = parse(by_hand(major, minor, good, 4 * 7 * 8)).expect_err("another version");
+            assert!(e.contains(&format!("format version {major}.{minor}")), "{e}");
+        }
+        // A key given twice (NumPy would take the last: 9 rows of which the file has 4) or a key
+        // NumPy's format does not have ("Header does not contain the correct keys").
+        let twice = "{'descr': '<f8', 'fortran_order': False, 'shape': (4, 7), 'shape': (9, 7), }";
+        assert!(parse(by_hand(1, 0, twice, 4 * 7 * 8)).expect_err("twice").contains("gives 'shape' twice"));
+        let extra = "{'descr': '<f8', 'fortran_order': False, 'shape': (4, 7), 'units': 'rad', }";
+        assert!(parse(by_hand(1, 0, extra, 4 * 7 * 8)).expect_err("extra key").contains("a key 'units'"));
+    }
 
     #[test]
     fn header_is_aligned_and_parses() {
