@@ -13,8 +13,7 @@ use crate::scenario::{self, Params, presets};
 /// # Errors
 /// A file that is not a readable recording (damaged, or not an `.rrd`).
 pub fn events(file: &Path) -> Result<(Vec<Event>, Option<String>), Failure> {
-    let events = crate::record::read::events(file).map_err(|e| Failure::input(format!("{e:#}")))?;
-    Ok((events, crate::record::read::incomplete(file)))
+    crate::record::read::event_log(file).map_err(|e| Failure::input(format!("{e:#}")))
 }
 
 /// `rinscope check-config`: the scenario `file`, validated as a run would load it.

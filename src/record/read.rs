@@ -24,12 +24,20 @@ pub struct Event {
     pub text: String,
 }
 
-/// The data chunks of the recording at `path`, each with its store's kind and its entity path
-/// (without the leading `/`); an unreadable file named in the error. A file whose footer is
+/// A data chunk with its store's id and its entity path (without the leading `/`).
+type Tagged = (StoreId, String, Chunk);
+
+/// The data chunks of the recording at `path` ([`opened`]).
+fn chunks(path: &Path) -> anyhow::Result<impl Iterator<Item = anyhow::Result<Tagged>> + '_> {
+    Ok(opened(path)?.1)
+}
+
+/// How the recording at `path` ends, and its data chunks, each with its store's kind and its entity
+/// path (without the leading `/`); an unreadable file named in the error. A file whose footer is
 /// damaged is refused before it is decoded (`sink::ending`), and one whose messages stop being
 /// readable before its footer ends with an error that says where: Rerun's decoder stops there
-/// without one. A file without a footer (cut short) gives what it holds ([`incomplete`] says so).
-fn chunks(path: &Path) -> anyhow::Result<impl Iterator<Item = anyhow::Result<(StoreId, String, Chunk)>> + '_> {
+/// without one. A file without a footer (cut short) gives what it holds.
+fn opened(path: &Path) -> anyhow::Result<(super::sink::Ending, impl Iterator<Item = anyhow::Result<Tagged>> + '_)> {
     let damaged = |e: &dyn std::fmt::Display| anyhow::anyhow!("{}: not a readable .rrd: {e}", path.display());
     let mut file = crate::io::files::open_input(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let ending = super::sink::ending(&mut file).map_err(|e| damaged(&e))?;
@@ -55,39 +63,35 @@ fn chunks(path: &Path) -> anyhow::Result<impl Iterator<Item = anyhow::Result<(St
         }
         next.map(|m| m.map_err(|e| anyhow::anyhow!("{}: {e}", path.display())))
     });
-    Ok(messages.filter_map(|m| match m {
-        Err(e) => Some(Err(e)),
-        Ok(LogMsg::ArrowMsg(store_id, arrow_msg)) => {
-            Some(Chunk::from_arrow_msg(&arrow_msg).map_err(anyhow::Error::from).map(|chunk| {
-                let entity = chunk.entity_path().to_string().trim_start_matches('/').to_owned();
-                (store_id, entity, chunk)
-            }))
-        }
-        Ok(_) => None,
-    }))
-}
-
-/// Why the recording at `path` is not a finished one, if it is not: it ends without the footer a
-/// finished `.rrd` has (a writer that stopped, a copy cut short). Its messages before that read.
-#[must_use]
-pub fn incomplete(path: &Path) -> Option<String> {
-    let mut file = crate::io::files::open_input(path).ok()?;
-    match super::sink::ending(&mut file) {
-        Ok(super::sink::Ending::None) => Some(format!(
-            "{} ends without the footer a finished recording has ({} bytes): it was cut short, and what follows is what it holds",
-            path.display(),
-            std::fs::metadata(path).map_or(0, |m| m.len())
-        )),
-        _ => None,
-    }
+    Ok((
+        ending,
+        messages.filter_map(|m| match m {
+            Err(e) => Some(Err(e)),
+            Ok(LogMsg::ArrowMsg(store_id, arrow_msg)) => {
+                Some(Chunk::from_arrow_msg(&arrow_msg).map_err(anyhow::Error::from).map(|chunk| {
+                    let entity = chunk.entity_path().to_string().trim_start_matches('/').to_owned();
+                    (store_id, entity, chunk)
+                }))
+            }
+            Ok(_) => None,
+        }),
+    ))
 }
 
 /// The `events` entries of the recording at `path`, in time order.
 pub fn events(path: &Path) -> anyhow::Result<Vec<Event>> {
+    Ok(event_log(path)?.0)
+}
+
+/// The `events` entries of the recording at `path`, in time order, and why the file is not a
+/// finished recording if it is not: it ends without the footer a finished `.rrd` has (a writer
+/// that stopped, a copy cut short), and the entries are those its messages before that hold.
+pub fn event_log(path: &Path) -> anyhow::Result<(Vec<Event>, Option<String>)> {
     let text_component = rerun::TextLog::descriptor_text().component;
     let level_component = rerun::TextLog::descriptor_level().component;
     let mut out = Vec::new();
-    for item in chunks(path)? {
+    let (ending, items) = opened(path)?;
+    for item in items {
         let (store_id, entity, chunk) = item?;
         if store_id.kind() != StoreKind::Recording || entity != "events" {
             continue;
@@ -113,7 +117,14 @@ pub fn events(path: &Path) -> anyhow::Result<Vec<Event>> {
         }
     }
     out.sort_by(|a, b| a.t_s.unwrap_or(-1.0).total_cmp(&b.t_s.unwrap_or(-1.0)));
-    Ok(out)
+    let incomplete = match ending {
+        super::sink::Ending::None { bytes } => Some(format!(
+            "{} ends without the footer a finished recording has ({bytes} bytes): it was cut short, and what follows is what it holds",
+            path.display()
+        )),
+        super::sink::Ending::Footer { .. } => None,
+    };
+    Ok((out, incomplete))
 }
 
 /// The labels of the 3D points at `entity` (without the leading `/`) in the recording at `path`,

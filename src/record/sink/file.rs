@@ -251,14 +251,14 @@ impl RrdFile {
 
 /// Reads the footer of a finished `.rrd` back ([`ending`]): a file written here has one.
 pub(super) fn verify(partial: &Path, written: u64) -> Result<(), String> {
-    let len = std::fs::metadata(partial).map_err(|e| e.to_string())?.len();
+    let mut file = std::fs::File::open(partial).map_err(|e| e.to_string())?;
+    let len = file.metadata().map_err(|e| e.to_string())?.len();
     if len != written {
         return Err(format!("{len} bytes on disk, {written} written"));
     }
-    let mut file = std::fs::File::open(partial).map_err(|e| e.to_string())?;
     match ending(&mut file)? {
         Ending::Footer { .. } => Ok(()),
-        Ending::None => Err(format!("{len} bytes and no footer at the end")),
+        Ending::None { bytes } => Err(format!("{bytes} bytes and no footer at the end")),
     }
 }
 
@@ -272,12 +272,15 @@ pub enum Ending {
         payload_start: u64,
     },
     /// Without one: cut short (a writer that did not finish), or written without a footer.
-    None,
+    None {
+        /// The file's length.
+        bytes: u64,
+    },
 }
 
-/// Checks the frames of the `.rrd` open as `file` without decoding its messages: the stream header's FourCC and
-/// version, and how it ends. A stream footer at the end (its FourCC and identifier) must count
-/// one entry, point within the file and match the checksum of the payload it points to — the
+/// Checks the frames of the `.rrd` open as `file` without decoding its messages: the stream
+/// header's FourCC and version, and how it ends. A stream footer at the end (its FourCC and
+/// identifier) must count one entry, point within the file and match the checksum of the payload it points to — the
 /// steps of Rerun's `read_rrd_footer` before it converts the manifest to Arrow, with Rerun's own
 /// frame types and checksum. That conversion re-read what Rerun's encoder had written in the same
 /// process: ~36 M instructions, ~6 ms at the end of every command with a recording.
@@ -302,13 +305,13 @@ pub fn ending(file: &mut std::fs::File) -> Result<Ending, String> {
     let header = StreamHeader::from_rrd_bytes(&read_at(0, head)?).map_err(|e| e.to_string())?;
     header.to_version_and_options().map_err(|e| e.to_string())?;
     if len < (head + foot) as u64 {
-        return Ok(Ending::None);
+        return Ok(Ending::None { bytes: len });
     }
     let tail = read_at(len - foot as u64, foot)?;
     if tail[foot - 12..foot - 8] != RRD_FOURCC || tail[foot - 8..foot - 4] != StreamFooter::RRD_IDENTIFIER {
-        return Ok(Ending::None);
+        return Ok(Ending::None { bytes: len });
     }
-    let count = tail[foot - 4..].iter().rev().fold(0u32, |n, &b| n << 8 | u32::from(b));
+    let count = u32::from_le_bytes([tail[foot - 4], tail[foot - 3], tail[foot - 2], tail[foot - 1]]);
     if count != 1 {
         return Err(format!("the stream footer counts {count} entries, not 1"));
     }
