@@ -226,19 +226,18 @@ impl Views<'_> {
         // A recorded row: the rest of what the scene and plots show (the body was demodulated).
         let body = body.unwrap_or_else(|| demodulate(a.n_from_s, comp_b_from_s));
         let truth = truth.unwrap_or(body);
+        let n_from_b = truth.n_from_b();
         let out = StepOutput {
             t_s: u.t_s,
             euler: Some(truth),
-            n_from_b: truth.n_from_b(),
+            n_from_b,
             gimbal_rad: corrected,
             encoder_rad: a.encoder_rad,
             errors: [table_errors[0], table_errors[1], nan],
         };
-        // The best estimate of the true IMU attitude: the reference through the compensated table.
-        let imu_true = Some(match a.reference {
-            Some(r) => r.n_from_b() * self.chain.b_from_s(&self.comp_rot, &corrected),
-            None => a.n_from_s,
-        });
+        // The best estimate of the true IMU attitude: the reference (the truth here) through the
+        // compensated table, both at hand (not built a second time: three sines and the chain).
+        let imu_true = Some(if a.reference.is_some() { n_from_b * comp_b_from_s } else { a.n_from_s });
         let view = InsView { t_s: u.t_s, t_ref_s: u.t_ref_s, errors, imu_true, imu_ins: a.n_from_s, nav: u.nav_error };
         if u.series_row {
             let solution = Some(Solution { body, nav: nav_state });
