@@ -224,6 +224,10 @@ fn events_refuse_a_damaged_recording_by_what_is_wrong_and_read_one_cut_short_wit
         ("message.rrd", flipped(12), "stop being readable at byte"),
         ("empty.rrd", Vec::new(), "0 bytes"),
         ("header.rrd", flipped(0), "FourCC"),
+        // Two recordings one after the other (`cat a.rrd b.rrd`): named as such, also when the
+        // first one's footer is damaged (Rerun's decoder would reach it and abort).
+        ("twice.rrd", [bytes.as_slice(), &bytes].concat(), "more than one recording"),
+        ("twice-damaged.rrd", [flipped(n - 1).as_slice(), &bytes].concat(), "the last starts at byte"),
     ] {
         let path = variant(name, &data);
         let o = events(&path);

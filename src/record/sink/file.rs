@@ -323,6 +323,20 @@ pub fn ending(file: &mut std::fs::File) -> Result<Ending, String> {
     let n = usize::try_from(span.len).ok().filter(|_| within).ok_or_else(|| {
         format!("the footer's payload ({} bytes at {}) is not within the file's {len} bytes", span.len, span.start)
     })?;
+    // The footer's payload ends where the stream footer starts, at offsets from its own stream's
+    // start: when that stream starts after byte 0 (with a stream header and the payload the checksum
+    // says there), the file is several recordings one after another (`cat a.rrd b.rrd`), which
+    // Rerun's decoder reads as one (the same file twice listed every event twice) or aborts on (a
+    // damaged footer inside).
+    let later = (len - foot as u64) - (span.start + span.len);
+    if later > 0
+        && read_at(later, head).is_ok_and(|h| StreamHeader::from_rrd_bytes(&h).is_ok())
+        && StreamFooter::compute_crc(&read_at(later + span.start, n)?) == entry.crc_excluding_header
+    {
+        return Err(format!(
+            "it holds more than one recording, one after another (the last starts at byte {later}, as `cat a.rrd b.rrd` makes them); rinscope reads one recording a file: open each on its own, or join them into one with `rerun rrd merge FILE > joined.rrd`"
+        ));
+    }
     let crc = StreamFooter::compute_crc(&read_at(span.start, n)?);
     if crc != entry.crc_excluding_header {
         return Err(format!(
