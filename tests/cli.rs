@@ -241,4 +241,15 @@ fn events_refuse_a_damaged_recording_by_what_is_wrong_and_read_one_cut_short_wit
     assert!(cut.status.success(), "{}", stderr(&cut));
     assert_eq!(String::from_utf8_lossy(&cut.stdout), listed, "the messages before the footer are all there");
     assert!(stderr(&cut).contains("cut short"), "{}", stderr(&cut));
+    // The same bytes while another process holds the file's lock (a run writing its `.partial`):
+    // not "cut short" but still being written.
+    let partial = variant("live.rrd.partial", &bytes[..n - 5]);
+    let writer = std::fs::OpenOptions::new().append(true).open(&partial).expect("open the partial");
+    writer.lock().expect("lock it as a writing run does");
+    let live = events(&partial);
+    assert!(live.status.success(), "{}", stderr(&live));
+    assert_eq!(String::from_utf8_lossy(&live.stdout), listed);
+    assert!(stderr(&live).contains("still being written") && !stderr(&live).contains("cut short"), "{}", stderr(&live));
+    writer.unlock().expect("unlock");
+    assert!(stderr(&events(&partial)).contains("cut short"), "its writer gone, the same file was cut short");
 }

@@ -29,17 +29,29 @@ type Tagged = (StoreId, String, Chunk);
 
 /// The data chunks of the recording at `path` ([`opened`]).
 fn chunks(path: &Path) -> anyhow::Result<impl Iterator<Item = anyhow::Result<Tagged>> + '_> {
-    Ok(opened(path)?.1)
+    Ok(opened(path)?.2)
 }
 
 /// How the recording at `path` ends, and its data chunks, each with its store's kind and its entity
 /// path (without the leading `/`); an unreadable file named in the error. A file whose footer is
 /// damaged is refused before it is decoded (`sink::ending`), and one whose messages stop being
 /// readable before its footer ends with an error that says where: Rerun's decoder stops there
-/// without one. A file without a footer (cut short) gives what it holds.
-fn opened(path: &Path) -> anyhow::Result<(super::sink::Ending, impl Iterator<Item = anyhow::Result<Tagged>> + '_)> {
+/// without one. A file without a footer (cut short) gives what it holds. The flag: another process
+/// holds the file's lock — a run writing it right now (its `PATH.partial`, `io::files`).
+fn opened(
+    path: &Path,
+) -> anyhow::Result<(super::sink::Ending, bool, impl Iterator<Item = anyhow::Result<Tagged>> + '_)> {
     let damaged = |e: &dyn std::fmt::Display| anyhow::anyhow!("{}: not a readable .rrd: {e}", path.display());
     let mut file = crate::io::files::open_input(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let being_written = match file.try_lock_shared() {
+        // Not held: let go at once (held while reading, it would stop a run from starting to write it).
+        Ok(()) => {
+            let _ = file.unlock();
+            false
+        }
+        Err(std::fs::TryLockError::WouldBlock) => true,
+        Err(std::fs::TryLockError::Error(_)) => false,
+    };
     let ending = super::sink::ending(&mut file).map_err(|e| damaged(&e))?;
     std::io::Seek::rewind(&mut file).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let mut decoder = DecoderApp::decode_eager(BufReader::new(file)).map_err(|e| damaged(&e))?;
@@ -65,6 +77,7 @@ fn opened(path: &Path) -> anyhow::Result<(super::sink::Ending, impl Iterator<Ite
     });
     Ok((
         ending,
+        being_written,
         messages.filter_map(|m| match m {
             Err(e) => Some(Err(e)),
             Ok(LogMsg::ArrowMsg(store_id, arrow_msg)) => {
@@ -85,12 +98,13 @@ pub fn events(path: &Path) -> anyhow::Result<Vec<Event>> {
 
 /// The `events` entries of the recording at `path`, in time order, and why the file is not a
 /// finished recording if it is not: it ends without the footer a finished `.rrd` has (a writer
-/// that stopped, a copy cut short), and the entries are those its messages before that hold.
+/// that stopped, a copy cut short, or a run still writing it: its lock is held), and the entries
+/// are those its messages before that hold.
 pub fn event_log(path: &Path) -> anyhow::Result<(Vec<Event>, Option<String>)> {
     let text_component = rerun::TextLog::descriptor_text().component;
     let level_component = rerun::TextLog::descriptor_level().component;
     let mut out = Vec::new();
-    let (ending, items) = opened(path)?;
+    let (ending, being_written, items) = opened(path)?;
     for item in items {
         let (store_id, entity, chunk) = item?;
         if store_id.kind() != StoreKind::Recording || entity != "events" {
@@ -118,6 +132,10 @@ pub fn event_log(path: &Path) -> anyhow::Result<(Vec<Event>, Option<String>)> {
     }
     out.sort_by(|a, b| a.t_s.unwrap_or(-1.0).total_cmp(&b.t_s.unwrap_or(-1.0)));
     let incomplete = match ending {
+        super::sink::Ending::None { bytes } if being_written => Some(format!(
+            "{} is still being written (another process holds its lock: a run saving it right now; {bytes} bytes so far): what follows is what it holds so far",
+            path.display()
+        )),
         super::sink::Ending::None { bytes } => Some(format!(
             "{} ends without the footer a finished recording has ({bytes} bytes): it was cut short, and what follows is what it holds",
             path.display()
