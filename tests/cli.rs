@@ -252,4 +252,15 @@ fn events_refuse_a_damaged_recording_by_what_is_wrong_and_read_one_cut_short_wit
     assert!(stderr(&live).contains("still being written") && !stderr(&live).contains("cut short"), "{}", stderr(&live));
     writer.unlock().expect("unlock");
     assert!(stderr(&events(&partial)).contains("cut short"), "its writer gone, the same file was cut short");
+    // A live session's first seconds: its writer has put nothing out yet.
+    let empty = variant("new.rrd.partial", &[]);
+    let writer = std::fs::OpenOptions::new().append(true).open(&empty).expect("open the partial");
+    writer.lock().expect("lock it as a writing run does");
+    let early = events(&empty);
+    assert!(early.status.success() && early.stdout.is_empty(), "{}", stderr(&early));
+    assert!(
+        stderr(&early).contains("still being written") && stderr(&early).contains("0 bytes so far"),
+        "{}",
+        stderr(&early)
+    );
 }

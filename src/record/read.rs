@@ -52,14 +52,20 @@ fn opened(
         Err(std::fs::TryLockError::WouldBlock) => true,
         Err(std::fs::TryLockError::Error(_)) => false,
     };
-    let ending = super::sink::ending(&mut file).map_err(|e| damaged(&e))?;
-    std::io::Seek::rewind(&mut file).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    let mut decoder = DecoderApp::decode_eager(BufReader::new(file)).map_err(|e| damaged(&e))?;
+    let bytes = file.metadata().map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?.len();
+    let header = rerun::external::re_log_encoding::StreamHeader::ENCODED_SIZE_BYTES as u64;
+    // A run writing it that has not put out its stream header yet (a live session's first
+    // seconds): nothing so far, no decoder.
+    let (ending, mut decoder) = if being_written && bytes < header {
+        (super::sink::Ending::None { bytes }, None)
+    } else {
+        let ending = super::sink::ending(&mut file).map_err(|e| damaged(&e))?;
+        std::io::Seek::rewind(&mut file).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        (ending, Some(DecoderApp::decode_eager(BufReader::new(file)).map_err(|e| damaged(&e))?))
+    };
     let mut ended = false;
     let messages = std::iter::from_fn(move || {
-        if ended {
-            return None;
-        }
+        let decoder = decoder.as_mut().filter(|_| !ended)?;
         let next = decoder.next();
         if next.is_none() {
             ended = true;
