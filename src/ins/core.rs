@@ -22,7 +22,7 @@ use crate::model::earth::{Earth, Site};
 /// What one IMU sample produced. `repr(C)` keeps the flag beside the time: in Rust's own layout it
 /// came last, and the replay's loop moved it and the bytes after it in overlapping 4-byte copies
 /// that its next loads could not take from the stores in flight (a stall on every sample; the
-/// replay of pyins' coning stream is 1.09× as fast with it, docs/benchmarks.md).
+/// replay of pyins' coning stream is 1.08× as fast with it, docs/benchmarks.md).
 #[derive(Debug, Clone, Copy)]
 #[repr(C)]
 pub struct SampleOut {
